@@ -1,0 +1,65 @@
+// The magnetic equivalent circuit as a netlist (eq. 23 is one instance of it).
+//
+// A branch b runs from node `from` to node `to`; its flux phi_b counts positive from
+// `from` to `to`. It has a reluctance R_b [1/H] and an MMF source F_b [A-turns] that
+// drives flux from `from` to `to`:
+//     phi_b = (psi_from - psi_to + F_b) / R_b
+// where psi are magnetic scalar potentials [A-turns], zero at the reference node.
+// Flux conservation at every non-reference node gives the nodal (graph-Laplacian) system
+//     sum_b A_nb phi_b = 0   =>   (A R^-1 A^T) psi = -A R^-1 F
+// solved by Cholesky every step. Node index -1 is the reference node.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace gmasim {
+
+struct CircuitBranch {
+  std::string name;
+  int from = -1;              // node index, -1 = reference
+  int to = -1;                // node index, -1 = reference
+  double fixed_reluctance_per_H = 0.0;  // used when rod < 0
+  int rod = -1;               // index of the rod whose reluctance (eq. 2) this branch is
+  double coil_turns = 0.0;    // MMF contribution N * I [A-turns per A]
+  double pm_mmf_At = 0.0;     // permanent-magnet MMF F_pm at T0 [A-turns], scaled by eq. (1)
+};
+
+struct Circuit {
+  std::vector<std::string> node_names;   // non-reference nodes, index = position
+  std::string reference_node;
+  std::vector<CircuitBranch> branches;
+  std::vector<int> rod_branch;           // rod index -> branch index
+  Eigen::MatrixXd fixed_laplacian;       // contribution of the fixed-reluctance branches
+
+  int node_count() const { return static_cast<int>(node_names.size()); }
+  int branch_count() const { return static_cast<int>(branches.size()); }
+};
+
+// Builds the index structure, checks it (unknown nodes, floating nodes, rod branches)
+// and precomputes the fixed part of the Laplacian. Throws InputError with `where` in
+// the message.
+void finalize_circuit(Circuit& c, int rod_count, const std::string& where);
+
+// Buffers of the nodal solve, sized once.
+struct CircuitWorkspace {
+  Eigen::MatrixXd G;
+  Eigen::VectorXd rhs;
+  Eigen::LLT<Eigen::MatrixXd> llt;
+  std::vector<double> reluctance;  // per branch, this step [1/H]
+  std::vector<double> mmf;         // per branch, this step [A-turns]
+  std::vector<double> phi;         // per branch, solved flux [Wb]
+
+  void resize(const Circuit& c);
+};
+
+// Solves the circuit for the given rod reluctances, coil current and PM MMF (already
+// temperature-scaled by eq. 1). Fills ws.phi. Allocation-free once ws is sized.
+// Returns false if the nodal matrix is not positive definite.
+bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_H,
+                   double current_A, double pm_scale, CircuitWorkspace& ws);
+
+}  // namespace gmasim

@@ -1,0 +1,51 @@
+// Input and output: TOML model files, waveform CSV, atomic output files.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "gmasim/model.hpp"
+#include "gmasim/simulate.hpp"
+
+namespace gmasim {
+
+// The built-in model (models/mdma.toml compiled into the library).
+extern const char* const kBuiltinModelToml;
+extern const char* const kBuiltinModelName;
+
+// Parses and validates a model file against the schema (docs/model.md, "Model file"):
+// malformed TOML, unknown keys, missing keys, wrong types, NaN/Inf, non-positive
+// lengths/areas/masses/stiffnesses/reluctances, bad option values. Every problem is an
+// InputError "file:line: message naming the value and the rule". `load_model_spec`
+// collects all problems of a file and reports them together (one per line).
+ModelSpec parse_model_spec(const std::string& toml_text, const std::string& source_name);
+ModelSpec load_model_spec(const std::string& path);
+ModelSpec builtin_model_spec();
+
+// Convenience: load (path empty -> built-in) and compile.
+Model load_model(const std::string& path);
+
+// One row per parameter: dotted name, value, unit, provenance; and the options.
+struct ParamRow {
+  std::string name, value, unit, provenance;
+  long line;
+};
+std::vector<ParamRow> describe_model(const ModelSpec& spec);
+
+// Waveform CSV: header "t_s,current_A", then numeric rows, strictly increasing time.
+// Throws InputError with file:line for an empty file, a bad header, non-numeric cells,
+// NaN/Inf, or time that does not increase.
+Waveform load_waveform_csv(const std::string& path);
+
+// Writes `content` to `path` atomically: a temporary file in the same directory, flushed,
+// then renamed over the target. Throws InputError if the directory cannot be written.
+void write_file_atomic(const std::string& path, const std::string& content);
+
+// Creates the directory (and parents) if needed and checks it is writable.
+void ensure_output_dir(const std::string& dir);
+
+std::string timeseries_csv(const TimeSeries& ts);
+// metrics.json: settings, metrics, status; `extra` holds more "key": value lines.
+std::string metrics_json(const Result& r, const SimulationSettings& s, const Model& m);
+
+}  // namespace gmasim

@@ -1,0 +1,221 @@
+// ModelSpec (plain data read from TOML) -> Model (immutable, compiled) -> Conditions
+// (every temperature-dependent constant at one temperature) -> State + step().
+#pragma once
+
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "gmasim/circuit.hpp"
+#include "gmasim/physics/jiles_atherton.hpp"
+#include "gmasim/physics/magnetostriction.hpp"
+
+namespace gmasim {
+
+// ---------------------------------------------------------------------------------------
+// ModelSpec: what the TOML file says, validated field by field, with provenance.
+// ---------------------------------------------------------------------------------------
+struct ParamValue {
+  double value = 0.0;
+  std::string unit;        // from the schema, e.g. "A/m"
+  std::string provenance;  // the trailing comment of the TOML line ("Table 4", ...)
+  long line = 0;           // source line in the model file
+};
+
+struct SpecBranch {
+  std::string name, from, to;
+  std::vector<std::string> series;  // names in [circuit.reluctances], summed
+  std::string rod;                  // or the rod whose eq. (2) reluctance this is
+  long line = 0;
+};
+
+struct ModelSpec {
+  std::string source;  // file path, or "models/mdma.toml (built-in)"
+  // Every numeric parameter by its dotted TOML name ("rod1.ja.k0_A_per_m").
+  std::map<std::string, ParamValue> params;
+  // Every string/boolean option by dotted name ("options.eq10_temperature_scale").
+  std::map<std::string, std::string> options;
+  std::map<std::string, long> option_lines;
+  std::vector<std::string> rods;  // stack.rods, in order
+  std::string reference_node;
+  std::vector<std::string> nodes;  // circuit.nodes: the non-reference nodes
+  long nodes_line = 0;
+  std::vector<SpecBranch> branches;
+  std::vector<std::string> flux_sensor_branches;  // sensor.flux_branches
+  std::vector<std::string> element_names;         // mechanics.elements.*
+  std::vector<std::string> sleeve_names;          // mechanics.sleeves.*
+  std::map<std::string, std::vector<std::string>> chains;  // rod -> load chain (eq. 18/27/28)
+
+  double get(const std::string& dotted) const;        // throws InputError if unknown
+  void set(const std::string& dotted, double value);  // throws InputError if unknown
+  long line_of(const std::string& dotted) const;
+};
+
+// ---------------------------------------------------------------------------------------
+// Options: the readings READING-NOTES leaves open (docs/model.md).
+// ---------------------------------------------------------------------------------------
+enum class StressSign { CompressionNegative, CompressionPositive };
+enum class Eq10Scale { RoomReferenced, Kelvin, Celsius };
+enum class ShapeLaw { Printed, MeanField };
+
+struct Options {
+  StressSign stress_sign = StressSign::CompressionNegative;
+  Eq10Scale eq10_scale = Eq10Scale::RoomReferenced;
+  ShapeLaw shape_law = ShapeLaw::Printed;
+  bool thermal_expansion_in_output = false;
+  bool geometry_thermal_expansion = true;
+};
+
+// One switch per temperature law: a frozen law is evaluated at the reference
+// temperature T_r (20 degC) whatever the operating temperature. Used by ablation.
+struct Freeze {
+  bool pm_mmf = false;         // eq. (1)
+  bool permeability = false;   // eq. (3)-(4) inside mu_G (and the eddy tau through mu_G)
+  bool resistivity = false;    // eq. (8)
+  bool magnetisation = false;  // eq. (10) JA coefficients, M_s^T of eq. (9) and (11)
+  bool modulus = false;        // eq. (13) E_G (its M_s^T and beta dT terms)
+  bool sleeve_modulus = false; // eq. (19) E_t^T
+  bool geometry = false;       // thermal expansion of lengths and areas
+};
+
+// ---------------------------------------------------------------------------------------
+// Model: compiled, immutable.
+// ---------------------------------------------------------------------------------------
+struct JaReference {
+  double a0_A_per_m, alpha0, c0, k0_A_per_m, beta1, beta2, beta3;
+};
+
+struct RodModel {
+  std::string name;
+  double length_m, r_outer_m, r_inner_m, mass_kg;
+  double k_f, k_j;                 // eq. (7) flux-leakage and eddy-current factors
+  double damping_N_s_per_m;        // c_i of eq. (25)
+  JaReference ja;
+};
+
+struct Material {  // Terfenol-D, shared by the rods
+  double Ms_A_per_m, lambda_s, sigma_lambda_Pa, Es_Pa, Tc_C, rho0_ohm_m, drho_dT_ohm_m_per_K;
+  double beta_per_K, chi_m, x_exponent, alpha_thermal_per_K;
+};
+
+struct ChainElementModel {   // a magnetizer, output rod or disk spring: constant m, k, c
+  std::string name;
+  double mass_kg, stiffness_N_per_m, damping_N_s_per_m;
+};
+
+struct SleeveModel {         // eq. (19)
+  std::string name;
+  double mass_kg, damping_N_s_per_m;
+  std::array<double, 3> lengths_m, areas_m2;
+  double alpha_thermal_per_K;
+};
+
+struct ChainLink {  // one member of a rod's load chain
+  enum Kind { Element, Sleeve, Rod } kind;
+  int index;
+};
+
+struct Model {
+  ModelSpec spec;  // kept for `model show` and identification
+  Options options;
+  Material material;
+  std::vector<RodModel> rods;
+  Circuit circuit;
+  std::vector<int> flux_sensor_branches;
+  double flux_sensor_area_m2 = 0.0;
+  double T_ref_C = 20.0;              // T_0 of eq. (1), (8); T_r of eq. (4)
+  double preload_N = 0.0;             // disk-spring preload through the rod stack
+  double alpha_pm1_per_K = 0.0, alpha_pm2_per_K2 = 0.0;
+  double Et_Pa = 0.0, dEt_dT_Pa_per_C = 0.0;  // eq. (19) law
+  std::vector<ChainElementModel> elements;
+  std::vector<SleeveModel> sleeves;
+  std::vector<std::vector<ChainLink>> chains;  // per rod
+  // eq. (21) alpha*l products of the stack [m/K]
+  double xT_rod_m_per_K = 0, xT_magnetizer_m_per_K = 0, xT_output_rod_m_per_K = 0,
+         xT_sleeve_m_per_K = 0;
+
+  int rod_count() const { return static_cast<int>(rods.size()); }
+};
+
+// Validates cross-field rules and builds the typed model. Throws InputError.
+Model compile(const ModelSpec& spec);
+
+// ---------------------------------------------------------------------------------------
+// Conditions: every temperature-dependent constant at one operating temperature.
+// ---------------------------------------------------------------------------------------
+struct RodConditions {
+  double length_m, area_m2, r_outer_m, r_inner_m;
+  double MsT_mu, MsT_ja, MsT_E;     // M_s^T of eq. (4) as seen by eq. (3), (9)/(11), (13)
+  double S_mu_J_per_m3;             // stress term of eq. (3)
+  physics::DeltaETerms dE;          // eq. (13) constants
+  physics::JaCoefficients ja;       // eq. (10) at T
+  double rho_ohm_m;                 // eq. (8)
+  double eddy_geometry_s_m_per_H;   // tau = mu * this  (eq. 7)
+  double sigma_Pa;                  // signed prestress used in eq. (3), (6), (13)
+  double sigma_p_Pa;                // compressive prestress magnitude of eq. (11)
+  double k_f, k_j;
+  double mass_osc_kg;               // eq. (24) + (27)
+  double damping_osc_N_s_per_m;     // eq. (25) + (28)
+  double fixed_compliance_m_per_N;  // sum of 1/k of the chain's non-rod members (eq. 18)
+  std::array<int, 8> chain_rods;    // rods inside this rod's load chain (eq. 18)
+  int chain_rod_count;
+};
+
+struct Conditions {
+  double temperature_C;
+  Freeze freeze;
+  double pm_scale;            // F_pm^T / F_pm, eq. (1)
+  double Et_Pa;               // eq. (19) modulus
+  std::vector<double> sleeve_stiffness_N_per_m;
+  std::vector<RodConditions> rods;
+  double thermal_expansion_m; // eq. (21)
+};
+
+// Throws InputError if the temperature is at/above T_c or below absolute zero.
+Conditions make_conditions(const Model& m, double temperature_C, const Freeze& freeze = {});
+
+// ---------------------------------------------------------------------------------------
+// State and step.
+// ---------------------------------------------------------------------------------------
+struct RodState {
+  // integrated state
+  double H_A_per_m = 0;     // eddy-filtered field (eq. 7)
+  double Mirr_A_per_m = 0;  // irreversible magnetisation (eq. 9)
+  double x_m = 0, v_m_per_s = 0;
+  // kept for the next step (hold values, warm starts)
+  double Hc_A_per_m = 0;    // static field of eq. (7) at the end of the last step
+  double M_A_per_m = 0;     // total magnetisation consistent with (H, M_irr)
+  double M_prev_A_per_m = 0;
+  double F_N = 0;           // force at the end of the last step
+  // reported
+  double mu_r = 1, E_Pa = 0, lambda = 0, tau_s = 0, phi_Wb = 0, k_rod_N_per_m = 0,
+         k_load_N_per_m = 0;
+};
+
+struct State {
+  double t_s = 0;
+  double current_A = 0;
+  double y_m = 0;     // total output x1 + x2 + x3 (+ x_T if the option says so)
+  double B_T = 0;     // flux density seen by the induction coil
+  std::vector<RodState> rods;
+  CircuitWorkspace circuit;
+  std::vector<double> rod_reluctance;
+};
+
+// Sizes every buffer, and places the actuator at rest in its quasi-static equilibrium
+// under current_A, demagnetised (M_irr = 0) before the field is applied.
+State make_state(const Model& m, const Conditions& c, double current_A);
+
+struct StepInput {
+  double current_A;  // coil current at the end of the step
+  double dt_s;       // step length
+};
+
+// Advances the state by one step. Allocation-free. Throws DivergenceError.
+void step(const Model& m, const Conditions& c, State& s, const StepInput& in);
+
+// Static stiffness of rod i's oscillator (eq. 16-18) at the state's magnetisation.
+double oscillator_stiffness(const Conditions& c, const State& s, int rod);
+
+}  // namespace gmasim

@@ -1,0 +1,108 @@
+// The paper's magnetic laws (section 3.1 and 3.2): eq. 1-8.
+// Pure functions of scalars, SI units throughout (A/m, T, Pa, H/m, ohm*m, kelvin
+// differences); each cites its equation in ../shared/paper/mctd-paper.txt.
+#pragma once
+
+#include <cmath>
+
+namespace gmasim::physics {
+
+inline constexpr double kMu0 = 1.25663706212e-6;  // vacuum permeability [H/m]
+inline constexpr double kPi = 3.14159265358979323846;
+inline constexpr double kZeroCelsiusInK = 273.15;
+
+// Eq. (1): temperature-dependent bias MMF of the permanent magnets [A-turns].
+//   F_pm^T = F_pm (1 + a1 (T - T0) + a2 (T - T0)^2)
+inline double pm_mmf(double F_pm_At, double alpha_pm1_per_K, double alpha_pm2_per_K2,
+                     double dT_K) {
+  return F_pm_At * (1.0 + alpha_pm1_per_K * dT_K + alpha_pm2_per_K2 * dT_K * dT_K);
+}
+
+// Eq. (2): reluctance of a magnetostrictive rod [1/H].  R = l / (mu A).
+inline double rod_reluctance(double length_m, double mu_H_per_m, double area_m2) {
+  return length_m / (mu_H_per_m * area_m2);
+}
+
+// Eq. (4): temperature-dependent saturation magnetisation [A/m].
+//   M_s^T = M_s (1 - dT/(T_c - T_r))^x
+inline double saturation_magnetisation(double Ms_A_per_m, double dT_K, double Tc_minus_Tr_K,
+                                       double x) {
+  return Ms_A_per_m * std::pow(1.0 - dT_K / Tc_minus_Tr_K, x);
+}
+
+// Eq. (5): relaxation factor k = (pi/2) chi_m / M_s^T  [m/A].
+inline double relaxation_factor(double chi_m, double MsT_A_per_m) {
+  return 0.5 * kPi * chi_m / MsT_A_per_m;
+}
+
+// Eq. (6): Lambda_0(sigma), the primitive of the domain-rotation strain lambda_0(sigma)
+// [Pa, i.e. J/m^3]. sigma0 = sigma_lambda * artanh(1/3). Compression is negative in this
+// form (Zheng/Zhou convention); see docs/model.md.
+inline double sigma0_of(double sigma_lambda_Pa) {
+  return sigma_lambda_Pa * std::atanh(1.0 / 3.0);
+}
+inline double Lambda0(double sigma_Pa, double lambda_s, double sigma_lambda_Pa) {
+  const double s = (sigma_Pa - sigma0_of(sigma_lambda_Pa)) / sigma_lambda_Pa;
+  // ln((2 sqrt2 / 3) cosh s) computed without overflow for large |s|:
+  // ln cosh s = |s| + log1p(exp(-2|s|)) - ln 2.
+  const double as = std::fabs(s);
+  const double ln_cosh = as + std::log1p(std::exp(-2.0 * as)) - std::log(2.0);
+  const double ln_term = std::log(2.0 * std::sqrt(2.0) / 3.0) + ln_cosh;
+  return 0.25 * lambda_s * sigma_Pa + 0.75 * lambda_s * sigma_lambda_Pa * ln_term;
+}
+
+// The stress part of the bracket of eq. (3) and of the denominator of eq. (13), in
+// units of J/m^3:  S = 2 (lambda_s sigma - Lambda_0(sigma)) + 2 beta dT sigma.
+// It does not depend on M, so Conditions precompute it.
+inline double stress_energy_term(double sigma_Pa, double lambda_s, double Lambda0_Pa,
+                                 double beta_per_K, double dT_K) {
+  return 2.0 * (lambda_s * sigma_Pa - Lambda0_Pa) + 2.0 * beta_per_K * dT_K * sigma_Pa;
+}
+
+// Eq. (3): inverse differential susceptibility (the bracket before the -1 power):
+//   1/chi = pi/(2 k M_s^T) sec^2(pi M / 2 M_s^T) - S / (mu0 (M_s^T)^2)
+// With eq. (5), pi/(2 k M_s^T) = 1/chi_m (READING-NOTES), so
+//   1/chi = sec^2(pi m / 2)/chi_m - S/(mu0 Ms^2),  m = M / M_s^T.
+// Returns 1/chi; it must stay > 0 for a physical permeability.
+inline double inverse_susceptibility(double m, double chi_m, double S_J_per_m3,
+                                     double MsT_A_per_m) {
+  const double c = std::cos(0.5 * kPi * m);
+  return 1.0 / (chi_m * c * c) - S_J_per_m3 / (kMu0 * MsT_A_per_m * MsT_A_per_m);
+}
+
+// Eq. (3): magneto-thermo-elastic permeability mu_G^{M,T,sigma} [H/m].
+//   mu = mu0 (1 + chi)
+inline double permeability(double inverse_chi) { return kMu0 * (1.0 + 1.0 / inverse_chi); }
+
+// Eq. (7), first line: the static (quasi-static) field in the rod from its flux [A/m].
+//   H_c = phi / (k_f mu A)
+inline double static_field(double phi_Wb, double k_f, double mu_H_per_m, double area_m2) {
+  return phi_Wb / (k_f * mu_H_per_m * area_m2);
+}
+
+// Eq. (7), second line: time constant of the first-order eddy-current lag [s].
+//   H(s) = H_c(s) / (1 + tau s),  tau = mu (r1^2 - r2^2) / (4 k_j rho)
+// (the second "k_f" of the printed eq. 7 is Table 4's k_j: READING-NOTES).
+inline double eddy_time_constant(double mu_H_per_m, double r_outer_m, double r_inner_m,
+                                 double k_j, double rho_ohm_m) {
+  return mu_H_per_m * (r_outer_m * r_outer_m - r_inner_m * r_inner_m) / (4.0 * k_j * rho_ohm_m);
+}
+
+// Eq. (8): temperature-dependent resistivity of Terfenol-D [ohm m].
+//   rho^T = rho0 + 2.5e-9 (T - T0)   (the slope is a model parameter, default 2.5e-9)
+inline double resistivity(double rho0_ohm_m, double drho_dT_ohm_m_per_K, double dT_K) {
+  return rho0_ohm_m + drho_dT_ohm_m_per_K * dT_K;
+}
+
+// Exact update of the first-order lag  tau dH/dt = u(t) - H  over one step h with u
+// linear from u0 to u1 (first-order hold). Exact for ramps; E = exp(-h/tau).
+inline double first_order_lag_step(double H0, double u0, double u1, double h_s, double tau_s) {
+  if (tau_s <= 0.0) return u1;
+  const double r = h_s / tau_s;
+  const double E = std::exp(-r);
+  // (1-E)/r computed stably for small r.
+  const double one_minus_E_over_r = r < 1e-8 ? 1.0 - 0.5 * r : -std::expm1(-r) / r;
+  return u1 + (H0 - u0) * E - (u1 - u0) * one_minus_E_over_r;
+}
+
+}  // namespace gmasim::physics

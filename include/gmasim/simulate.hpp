@@ -1,0 +1,106 @@
+// Excitations, the fixed-step run loop, recording and metrics.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "gmasim/model.hpp"
+
+namespace gmasim {
+
+// ---------------------------------------------------------------------------------------
+// Excitation current waveforms [A] driving the coil's N turns.
+// ---------------------------------------------------------------------------------------
+enum class WaveformKind { BiasedSine, DC, Step, Chirp, Table };
+
+struct Waveform {
+  WaveformKind kind = WaveformKind::BiasedSine;
+  // BiasedSine (Fig. 11): i(t) = min_A + pp_A/2 (1 - cos 2 pi f t); starts at its minimum.
+  double min_A = -3.0;
+  double pp_A = 8.0;
+  double frequency_Hz = 10.0;
+  // DC: level_A. Step: level_A before step_time_s, step_to_A after.
+  double level_A = 0.0;
+  double step_to_A = 0.0;
+  double step_time_s = 0.0;
+  // Chirp: offset_A + amplitude_A sin(phase), frequency swept linearly f0 -> f1 over
+  // duration_s (the run length).
+  double offset_A = 0.0, amplitude_A = 0.0, f0_Hz = 1.0, f1_Hz = 100.0, duration_s = 1.0;
+  // Table (CSV t_s,current_A): linear interpolation, held constant past the ends.
+  std::vector<double> table_t_s, table_current_A;
+  std::string table_source;
+
+  double current_at(double t_s) const;  // [A]
+  bool periodic() const { return kind == WaveformKind::BiasedSine; }
+  double period_s() const { return 1.0 / frequency_Hz; }
+};
+
+Waveform biased_sine(double pp_A, double frequency_Hz, double min_A = -3.0);
+
+// ---------------------------------------------------------------------------------------
+// Run settings and results.
+// ---------------------------------------------------------------------------------------
+struct SimulationSettings {
+  double temperature_C = 20.0;
+  Waveform waveform;
+  double periods = 3.0;        // run length for periodic waveforms
+  double duration_s = 0.0;     // run length for the others (Table: its last time if 0)
+  double dt_s = 0.0;           // 0: the automatic rule, auto_dt()
+  int record_every = 1;        // decimation of the recorded time series
+  Freeze freeze;
+};
+
+// The documented time-step rule (docs/model.md, "Time step"): a periodic run takes
+// kStepsPerPeriod steps per period, capped at kMaxDt_s; others use kMaxDt_s, or for
+// chirps 1/(kStepsPerPeriod f1) if smaller.
+inline constexpr double kStepsPerPeriod = 2000.0;
+inline constexpr double kMaxDt_s = 10e-6;
+double auto_dt(const Waveform& w);
+
+// A named set of equally long columns (SI values, names carry units: "y_um").
+struct TimeSeries {
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> columns;
+  const std::vector<double>& column(const std::string& name) const;  // throws
+  std::size_t rows() const { return columns.empty() ? 0 : columns[0].size(); }
+};
+
+struct Metrics {
+  double window_start_s = 0, window_end_s = 0;  // the last whole period
+  double stroke_um = 0;       // peak-to-peak of y
+  double hysteresis_um = 0;   // max |y_rising - y_falling| at equal current
+  double B_pp_T = 0;          // peak-to-peak of B
+  double y_mean_um = 0;
+};
+
+struct Result {
+  TimeSeries series;
+  Metrics metrics;
+  bool has_metrics = false;   // periodic runs only
+  double dt_s = 0;
+  long steps = 0;
+  double wall_time_s = 0;
+  bool diverged = false;
+  std::string error;          // DivergenceError message when diverged
+  double thermal_expansion_um = 0;
+};
+
+// Runs the model. Never throws on divergence: the partial result is returned with
+// diverged = true and error set. Throws InputError on bad settings.
+Result simulate(const Model& m, const SimulationSettings& s);
+
+// Metrics over [t0, t1] of a recorded run (uses columns t_s, current_A, y_um, B_T).
+Metrics compute_metrics(const TimeSeries& ts, double t0_s, double t1_s);
+
+// Largest gap between the rising-current and falling-current branches of y(I) at equal
+// current, over one period of samples [um]. Both branches are interpolated onto a
+// common grid of currents spanning their overlap.
+double hysteresis_width(const std::vector<double>& current_A, const std::vector<double>& y,
+                        std::size_t begin, std::size_t end);
+
+struct RmsPeak {
+  double rms = 0, peak = 0;   // RMS of the signal; peak of its absolute value
+};
+RmsPeak rms_and_peak(const std::vector<double>& v, std::size_t begin, std::size_t end);
+
+}  // namespace gmasim

@@ -1,0 +1,109 @@
+#include <fmt/format.h>
+
+#include <vector>
+
+#include "gmasim/circuit.hpp"
+#include "gmasim/errors.hpp"
+
+namespace gmasim {
+
+void finalize_circuit(Circuit& c, int rod_count, const std::string& where) {
+  const int n = c.node_count();
+  if (n == 0) throw InputError(located(where, 0, "circuit has no nodes besides the reference"));
+  c.rod_branch.assign(static_cast<std::size_t>(rod_count), -1);
+  // Union-find over nodes with the reference as index n: every node must connect to it.
+  std::vector<int> parent(static_cast<std::size_t>(n + 1));
+  for (int i = 0; i <= n; ++i) parent[static_cast<std::size_t>(i)] = i;
+  auto find = [&](int i) {
+    while (parent[static_cast<std::size_t>(i)] != i) {
+      parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+      i = parent[static_cast<std::size_t>(i)];
+    }
+    return i;
+  };
+  auto idx = [n](int node) { return node < 0 ? n : node; };
+  for (std::size_t b = 0; b < c.branches.size(); ++b) {
+    const auto& br = c.branches[b];
+    if (br.from == br.to)
+      throw InputError(located(where, 0, fmt::format("circuit branch '{}' starts and ends at the same node", br.name)));
+    if (br.rod >= 0) {
+      if (br.rod >= rod_count)
+        throw InputError(located(where, 0, fmt::format("circuit branch '{}' names rod index {} of {}", br.name, br.rod, rod_count)));
+      if (c.rod_branch[static_cast<std::size_t>(br.rod)] >= 0)
+        throw InputError(located(where, 0, fmt::format("rod index {} appears in two circuit branches", br.rod)));
+      c.rod_branch[static_cast<std::size_t>(br.rod)] = static_cast<int>(b);
+    } else if (!(br.fixed_reluctance_per_H > 0.0)) {
+      throw InputError(located(where, 0, fmt::format("circuit branch '{}' has reluctance {} 1/H; it must be > 0", br.name, br.fixed_reluctance_per_H)));
+    }
+    parent[static_cast<std::size_t>(find(idx(br.from)))] = find(idx(br.to));
+  }
+  for (int r = 0; r < rod_count; ++r)
+    if (c.rod_branch[static_cast<std::size_t>(r)] < 0)
+      throw InputError(located(where, 0, fmt::format("rod index {} is in no circuit branch", r)));
+  for (int i = 0; i < n; ++i)
+    if (find(i) != find(n))
+      throw InputError(located(where, 0, fmt::format("circuit node '{}' is floating: no path of branches joins it to the reference node '{}'", c.node_names[static_cast<std::size_t>(i)], c.reference_node)));
+
+  c.fixed_laplacian = Eigen::MatrixXd::Zero(n, n);
+  for (const auto& br : c.branches) {
+    if (br.rod >= 0) continue;
+    const double g = 1.0 / br.fixed_reluctance_per_H;
+    if (br.from >= 0) c.fixed_laplacian(br.from, br.from) += g;
+    if (br.to >= 0) c.fixed_laplacian(br.to, br.to) += g;
+    if (br.from >= 0 && br.to >= 0) {
+      c.fixed_laplacian(br.from, br.to) -= g;
+      c.fixed_laplacian(br.to, br.from) -= g;
+    }
+  }
+}
+
+void CircuitWorkspace::resize(const Circuit& c) {
+  const int n = c.node_count();
+  G = Eigen::MatrixXd::Zero(n, n);
+  rhs = Eigen::VectorXd::Zero(n);
+  llt = Eigen::LLT<Eigen::MatrixXd>(n);
+  reluctance.assign(c.branches.size(), 0.0);
+  mmf.assign(c.branches.size(), 0.0);
+  phi.assign(c.branches.size(), 0.0);
+}
+
+bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_H,
+                   double current_A, double pm_scale, CircuitWorkspace& ws) {
+  ws.G = c.fixed_laplacian;
+  ws.rhs.setZero();
+  const std::size_t nb = c.branches.size();
+  for (std::size_t b = 0; b < nb; ++b) {
+    const auto& br = c.branches[b];
+    const double R = br.rod >= 0 ? rod_reluctance_per_H[static_cast<std::size_t>(br.rod)]
+                                 : br.fixed_reluctance_per_H;
+    const double F = br.coil_turns * current_A + br.pm_mmf_At * pm_scale;
+    ws.reluctance[b] = R;
+    ws.mmf[b] = F;
+    const double g = 1.0 / R;
+    if (br.rod >= 0) {
+      if (br.from >= 0) ws.G(br.from, br.from) += g;
+      if (br.to >= 0) ws.G(br.to, br.to) += g;
+      if (br.from >= 0 && br.to >= 0) {
+        ws.G(br.from, br.to) -= g;
+        ws.G(br.to, br.from) -= g;
+      }
+    }
+    if (F != 0.0) {
+      // phi_b = (psi_from - psi_to + F)/R; KCL at `from` (outflow) and `to` (inflow).
+      if (br.from >= 0) ws.rhs(br.from) -= F * g;
+      if (br.to >= 0) ws.rhs(br.to) += F * g;
+    }
+  }
+  ws.llt.compute(ws.G);
+  if (ws.llt.info() != Eigen::Success) return false;
+  ws.llt.solveInPlace(ws.rhs);  // rhs now holds psi
+  for (std::size_t b = 0; b < nb; ++b) {
+    const auto& br = c.branches[b];
+    const double pf = br.from >= 0 ? ws.rhs(br.from) : 0.0;
+    const double pt = br.to >= 0 ? ws.rhs(br.to) : 0.0;
+    ws.phi[b] = (pf - pt + ws.mmf[b]) / ws.reluctance[b];
+  }
+  return true;
+}
+
+}  // namespace gmasim

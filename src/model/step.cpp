@@ -1,0 +1,179 @@
+// The coupled step: circuit (eq. 2-3, 23) -> eddy lag (eq. 7) -> JA (eq. 9) -> Delta-E,
+// strain and force (eq. 11-14) -> mechanics (eq. 15-18). See docs/model.md, "The step".
+#include <fmt/format.h>
+
+#include <array>
+#include <cmath>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/model.hpp"
+#include "gmasim/physics/jiles_atherton.hpp"
+#include "gmasim/physics/magnetic.hpp"
+#include "gmasim/physics/magnetostriction.hpp"
+#include "gmasim/physics/mechanics.hpp"
+
+namespace gmasim {
+namespace {
+
+using namespace physics;
+
+// Permeability of rod i at magnetisation M (eq. 3); throws on a non-physical value.
+double rod_permeability(const RodConditions& rc, double chi_m, double M, double t,
+                        const std::string& rod) {
+  const double inv_chi = inverse_susceptibility(M / rc.MsT_mu, chi_m, rc.S_mu_J_per_m3, rc.MsT_mu);
+  if (!(inv_chi > 0.0) || !std::isfinite(inv_chi))
+    throw DivergenceError(t, rod, "1/chi of eq. (3)", inv_chi, "permeability not positive");
+  return permeability(inv_chi);
+}
+
+// Load stiffness of rod i (eq. 18): its fixed members plus the rods in its chain.
+double load_stiffness(const RodConditions& rc, const State& s) {
+  double inv_k = rc.fixed_compliance_m_per_N;
+  for (int j = 0; j < rc.chain_rod_count; ++j)
+    inv_k += 1.0 / s.rods[static_cast<std::size_t>(rc.chain_rods[static_cast<std::size_t>(j)])].k_rod_N_per_m;
+  return 1.0 / inv_k;
+}
+
+// Magnetostriction, Delta-E modulus and force of rod i at its present M (eq. 11-14, 17).
+void update_rod_mechanics(const Material& mat, const RodConditions& rc, RodState& r) {
+  r.E_Pa = delta_e_modulus(r.M_A_per_m / rc.MsT_E, rc.dE);                       // eq. (13)
+  r.lambda = magnetostriction(r.M_A_per_m / rc.MsT_ja, mat.lambda_s, rc.sigma_p_Pa, r.E_Pa);  // eq. (11)-(12)
+  r.F_N = rod_force(r.lambda, r.E_Pa, rc.area_m2);                                 // eq. (14)
+  r.k_rod_N_per_m = axial_stiffness(r.E_Pa, rc.area_m2, rc.length_m);              // eq. (17)
+}
+
+void check(double value, double t, const std::string& rod, const char* quantity, double limit) {
+  if (!std::isfinite(value) || std::fabs(value) > limit)
+    throw DivergenceError(t, rod, quantity, value,
+                          std::isfinite(value) ? fmt::format("|value| exceeds {:g}", limit)
+                                               : std::string("not finite"));
+}
+
+void finish_outputs(const Model& m, const Conditions& c, State& s) {
+  double y = 0.0;
+  for (std::size_t i = 0; i < s.rods.size(); ++i) {
+    auto& r = s.rods[i];
+    r.k_load_N_per_m = load_stiffness(c.rods[i], s);
+    y += r.x_m;
+  }
+  if (m.options.thermal_expansion_in_output) y += c.thermal_expansion_m;
+  s.y_m = y;
+  double phi = 0.0, area = 0.0;
+  for (int b : m.flux_sensor_branches) {
+    const int rod = m.circuit.branches[static_cast<std::size_t>(b)].rod;
+    phi += s.circuit.phi[static_cast<std::size_t>(b)];
+    area += c.rods[static_cast<std::size_t>(rod)].area_m2;
+  }
+  s.B_T = phi / area;
+}
+
+}  // namespace
+
+double oscillator_stiffness(const Conditions& c, const State& s, int rod) {
+  const auto i = static_cast<std::size_t>(rod);
+  return s.rods[i].k_rod_N_per_m + load_stiffness(c.rods[i], s);  // eq. (16)
+}
+
+State make_state(const Model& m, const Conditions& c, double current_A) {
+  State s;
+  const std::size_t n = m.rods.size();
+  s.rods.assign(n, RodState{});
+  s.rod_reluctance.assign(n, 0.0);
+  s.circuit.resize(m.circuit);
+  s.current_A = current_A;
+  // Quasi-static ramp of the total MMF from zero (demagnetised rods, no field) to its
+  // value at t = 0, along the initial magnetisation curve; no eddy lag (at rest).
+  const int ramp_steps = 400;
+  for (int k = 1; k <= ramp_steps; ++k) {
+    const double f = static_cast<double>(k) / ramp_steps;
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& rc = c.rods[i];
+      const double mu = rod_permeability(rc, m.material.chi_m, s.rods[i].M_A_per_m, 0.0, m.rods[i].name);
+      s.rod_reluctance[i] = rod_reluctance(rc.length_m, mu, rc.area_m2);
+      s.rods[i].mu_r = mu / kMu0;
+    }
+    if (!solve_circuit(m.circuit, s.rod_reluctance, f * current_A, f * c.pm_scale, s.circuit))
+      throw DivergenceError(0.0, "", "nodal matrix of the circuit", 0.0, "not positive definite");
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& rc = c.rods[i];
+      auto& r = s.rods[i];
+      r.phi_Wb = s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
+      const double Hc = static_field(r.phi_Wb, rc.k_f, r.mu_r * kMu0, rc.area_m2);
+      ja_step(r.H_A_per_m, Hc, rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m);
+      r.H_A_per_m = Hc;
+      r.Hc_A_per_m = Hc;
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    auto& r = s.rods[i];
+    r.M_prev_A_per_m = r.M_A_per_m;
+    r.tau_s = r.mu_r * kMu0 * c.rods[i].eddy_geometry_s_m_per_H;
+    update_rod_mechanics(m.material, c.rods[i], r);
+  }
+  for (std::size_t i = 0; i < n; ++i) {  // static equilibrium x = F / K (eq. 15 at rest)
+    auto& r = s.rods[i];
+    r.x_m = r.F_N / oscillator_stiffness(c, s, static_cast<int>(i));
+    r.v_m_per_s = 0.0;
+  }
+  finish_outputs(m, c, s);
+  return s;
+}
+
+void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
+  const double h = in.dt_s;
+  const double t1 = s.t_s + h;
+  const std::size_t n = s.rods.size();
+  const double chi_m = m.material.chi_m;
+
+  // 1. Rod reluctances (eq. 2-3) at the magnetisation extrapolated to the end of the
+  //    step (M* = 2 M_n - M_{n-1}, second order), then the nodal solve (eq. 23).
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& rc = c.rods[i];
+    auto& r = s.rods[i];
+    double Mx = 2.0 * r.M_A_per_m - r.M_prev_A_per_m;
+    const double lim = 0.999 * rc.MsT_mu;
+    Mx = Mx > lim ? lim : (Mx < -lim ? -lim : Mx);
+    const double mu = rod_permeability(rc, chi_m, Mx, t1, m.rods[i].name);
+    r.mu_r = mu / kMu0;
+    s.rod_reluctance[i] = rod_reluctance(rc.length_m, mu, rc.area_m2);
+  }
+  if (!solve_circuit(m.circuit, s.rod_reluctance, in.current_A, c.pm_scale, s.circuit))
+    throw DivergenceError(t1, "", "nodal matrix of the circuit", 0.0, "not positive definite");
+
+  // 2. Per rod: static field (eq. 7), eddy lag (eq. 7), JA (eq. 9), force (eq. 11-14).
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& rc = c.rods[i];
+    auto& r = s.rods[i];
+    const double mu = r.mu_r * kMu0;
+    r.phi_Wb = s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
+    const double Hc1 = static_field(r.phi_Wb, rc.k_f, mu, rc.area_m2);
+    r.tau_s = mu * rc.eddy_geometry_s_m_per_H;
+    const double H1 = first_order_lag_step(r.H_A_per_m, r.Hc_A_per_m, Hc1, h, r.tau_s);
+    r.M_prev_A_per_m = r.M_A_per_m;
+    ja_step(r.H_A_per_m, H1, rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m);
+    r.H_A_per_m = H1;
+    r.Hc_A_per_m = Hc1;
+    check(H1, t1, m.rods[i].name, "H [A/m]", 1e9);
+    check(r.M_A_per_m, t1, m.rods[i].name, "M [A/m]", 1.5 * rc.MsT_ja);
+  }
+  // 3. Mechanics (eq. 15-18): each rod's oscillator, exact over the step with the force
+  //    linear from F_n to F_{n+1} and the stiffness at the end of the step (which needs
+  //    every rod's new modulus first: eq. 18 couples them).
+  std::array<double, 8> F0{};
+  for (std::size_t i = 0; i < n; ++i) {
+    F0[i] = s.rods[i].F_N;
+    update_rod_mechanics(m.material, c.rods[i], s.rods[i]);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& rc = c.rods[i];
+    auto& r = s.rods[i];
+    const double K = oscillator_stiffness(c, s, static_cast<int>(i));
+    oscillator_step(rc.mass_osc_kg, rc.damping_osc_N_s_per_m, K, F0[i], r.F_N, h, r.x_m, r.v_m_per_s);
+    check(r.x_m, t1, m.rods[i].name, "x [m]", 1.0);
+  }
+  s.t_s = t1;
+  s.current_A = in.current_A;
+  finish_outputs(m, c, s);
+}
+
+}  // namespace gmasim

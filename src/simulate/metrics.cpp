@@ -1,0 +1,122 @@
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/simulate.hpp"
+
+namespace gmasim {
+
+const std::vector<double>& TimeSeries::column(const std::string& name) const {
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i] == name) return columns[i];
+  std::string known;
+  for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+  throw InputError(fmt::format("unknown quantity '{}'; recorded quantities: {}", name, known));
+}
+
+RmsPeak rms_and_peak(const std::vector<double>& v, std::size_t begin, std::size_t end) {
+  RmsPeak r;
+  if (end <= begin) return r;
+  double ss = 0.0;
+  for (std::size_t i = begin; i < end; ++i) {
+    ss += v[i] * v[i];
+    r.peak = std::max(r.peak, std::fabs(v[i]));
+  }
+  r.rms = std::sqrt(ss / static_cast<double>(end - begin));
+  return r;
+}
+
+namespace {
+
+// Samples of one monotone branch of y(I), sorted by current, for interpolation.
+struct Branch {
+  std::vector<double> I, y;
+  double at(double i) const {
+    const auto it = std::lower_bound(I.begin(), I.end(), i);
+    if (it == I.begin()) return y.front();
+    if (it == I.end()) return y.back();
+    const auto j = static_cast<std::size_t>(it - I.begin());
+    const double f = (i - I[j - 1]) / (I[j] - I[j - 1]);
+    return y[j - 1] + f * (y[j] - y[j - 1]);
+  }
+};
+
+}  // namespace
+
+double hysteresis_width(const std::vector<double>& current_A, const std::vector<double>& y,
+                        std::size_t begin, std::size_t end) {
+  if (end <= begin + 2) return 0.0;
+  // Split the period at its current extremes into the rising and the falling branch.
+  std::size_t imin = begin, imax = begin;
+  for (std::size_t i = begin; i < end; ++i) {
+    if (current_A[i] < current_A[imin]) imin = i;
+    if (current_A[i] > current_A[imax]) imax = i;
+  }
+  Branch rise, fall;
+  auto collect = [&](Branch& b, std::size_t from, std::size_t to, bool rising) {
+    // walk cyclically from `from` to `to` within [begin, end)
+    const std::size_t n = end - begin;
+    std::size_t k = from;
+    for (std::size_t cnt = 0; cnt <= n; ++cnt) {
+      b.I.push_back(current_A[k]);
+      b.y.push_back(y[k]);
+      if (k == to) break;
+      k = (k + 1 - begin) % n + begin;
+    }
+    if (!rising) {
+      std::reverse(b.I.begin(), b.I.end());
+      std::reverse(b.y.begin(), b.y.end());
+    }
+    // Keep a strictly increasing current sequence for interpolation.
+    std::size_t w = 0;
+    for (std::size_t i = 0; i < b.I.size(); ++i) {
+      if (w > 0 && b.I[i] <= b.I[w - 1]) continue;
+      b.I[w] = b.I[i];
+      b.y[w] = b.y[i];
+      ++w;
+    }
+    b.I.resize(w);
+    b.y.resize(w);
+  };
+  collect(rise, imin, imax, true);
+  collect(fall, imax, imin, false);
+  if (rise.I.size() < 2 || fall.I.size() < 2) return 0.0;
+  const double lo = std::max(rise.I.front(), fall.I.front());
+  const double hi = std::min(rise.I.back(), fall.I.back());
+  if (!(hi > lo)) return 0.0;
+  const int grid = 2001;
+  double gap = 0.0;
+  for (int g = 0; g < grid; ++g) {
+    const double i = lo + (hi - lo) * g / (grid - 1);
+    gap = std::max(gap, std::fabs(rise.at(i) - fall.at(i)));
+  }
+  return gap;
+}
+
+Metrics compute_metrics(const TimeSeries& ts, double t0, double t1) {
+  const auto& t = ts.column("t_s");
+  const auto& I = ts.column("current_A");
+  const auto& y = ts.column("y_um");
+  const auto& B = ts.column("B_T");
+  // Samples with t0 <= t < t1 (one whole period when t1 - t0 is the period).
+  const double eps = 1e-9 * (t1 - t0);
+  const auto b = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), t0 - eps) - t.begin());
+  const auto e = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), t1 - eps) - t.begin());
+  Metrics m;
+  m.window_start_s = t0;
+  m.window_end_s = t1;
+  if (e <= b + 2) throw InputError(fmt::format("metrics window [{}, {}] s holds fewer than 3 samples", t0, t1));
+  const auto [ymin, ymax] = std::minmax_element(y.begin() + static_cast<long>(b), y.begin() + static_cast<long>(e));
+  const auto [Bmin, Bmax] = std::minmax_element(B.begin() + static_cast<long>(b), B.begin() + static_cast<long>(e));
+  m.stroke_um = *ymax - *ymin;
+  m.B_pp_T = *Bmax - *Bmin;
+  double s = 0.0;
+  for (std::size_t i = b; i < e; ++i) s += y[i];
+  m.y_mean_um = s / static_cast<double>(e - b);
+  m.hysteresis_um = hysteresis_width(I, y, b, e);
+  return m;
+}
+
+}  // namespace gmasim
