@@ -215,6 +215,14 @@ struct StepInput {
 // Advances the state by one step. Allocation-free. Throws DivergenceError.
 void step(const Model& m, const Conditions& c, State& s, const StepInput& in);
 
+// Reference integrator: one plain explicit RK4 step of the same equations, with the state
+// (H, M_irr, x, v) of every rod integrated as an ODE in time and the circuit solved at each
+// stage. Stable only for dt below ~20 us (the 7-20 kHz mechanical modes); used by tests
+// and benchmarks to validate step() and to measure what the exact updates save.
+// Allocation-free like step().
+void rk4_reference_step(const Model& m, const Conditions& c, State& s, double current0_A,
+                        double current_mid_A, double current1_A, double dt_s);
+
 // Static stiffness of rod i's oscillator (eq. 16-18) at the state's magnetisation.
 double oscillator_stiffness(const Conditions& c, const State& s, int rod);
 

@@ -73,8 +73,14 @@ struct Metrics {
   double y_mean_um = 0;
 };
 
+struct QuantityStats {
+  std::string name;     // a column of the series, e.g. "rod1_F_N"
+  double rms = 0, peak = 0, pp = 0, mean = 0;
+};
+
 struct Result {
   TimeSeries series;
+  std::vector<QuantityStats> quantities;  // filled by add_quantity_stats()
   Metrics metrics;
   bool has_metrics = false;   // periodic runs only
   double dt_s = 0;
@@ -102,5 +108,10 @@ struct RmsPeak {
   double rms = 0, peak = 0;   // RMS of the signal; peak of its absolute value
 };
 RmsPeak rms_and_peak(const std::vector<double>& v, std::size_t begin, std::size_t end);
+
+// RMS, peak |v|, peak-to-peak and mean of each named column over the metrics window
+// (the last whole period), or over the whole run when the run is not periodic.
+// Throws InputError naming the recorded columns when a name is unknown.
+void add_quantity_stats(Result& r, const std::vector<std::string>& names);
 
 }  // namespace gmasim

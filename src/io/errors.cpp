@@ -17,10 +17,10 @@ namespace {
 std::string divergence_message(double time_s, const std::string& rod, const std::string& quantity,
                                double value, const std::string& why) {
   if (rod.empty()) {
-    return fmt::format("diverged at t = {:.9g} s: {} = {:g} ({})", time_s, quantity, value, why);
+    return fmt::format("diverged at t = {:.9f} s: {} = {:g} ({})", time_s, quantity, value, why);
   }
-  return fmt::format("diverged at t = {:.9g} s in {}: {} = {:g} ({})", time_s, rod, quantity,
-                     value, why);
+  return fmt::format("diverged at t = {:.9f} s in {}: {} = {:g} ({})", time_s, rod, quantity, value,
+                     why);
 }
 
 }  // namespace

@@ -120,3 +120,33 @@ Metrics compute_metrics(const TimeSeries& ts, double t0, double t1) {
 }
 
 }  // namespace gmasim
+
+namespace gmasim {
+
+void add_quantity_stats(Result& r, const std::vector<std::string>& names) {
+  const auto& t = r.series.column("t_s");
+  std::size_t b = 0, e = t.size();
+  if (r.has_metrics) {
+    const double eps = 1e-9 * (r.metrics.window_end_s - r.metrics.window_start_s);
+    b = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), r.metrics.window_start_s - eps) - t.begin());
+    e = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), r.metrics.window_end_s - eps) - t.begin());
+  }
+  for (const auto& name : names) {
+    const auto& v = r.series.column(name);
+    QuantityStats q;
+    q.name = name;
+    const RmsPeak rp = rms_and_peak(v, b, e);
+    q.rms = rp.rms;
+    q.peak = rp.peak;
+    if (e > b) {
+      const auto [lo, hi] = std::minmax_element(v.begin() + static_cast<long>(b), v.begin() + static_cast<long>(e));
+      q.pp = *hi - *lo;
+      double s = 0.0;
+      for (std::size_t i = b; i < e; ++i) s += v[i];
+      q.mean = s / static_cast<double>(e - b);
+    }
+    r.quantities.push_back(q);
+  }
+}
+
+}  // namespace gmasim

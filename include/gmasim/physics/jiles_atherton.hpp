@@ -85,6 +85,23 @@ inline double ja_total_magnetisation(double H_A_per_m, double Mirr_A_per_m, doub
   return M;
 }
 
+// Eq. (9), second line, as a slope (for explicit integrators such as the RK4 reference):
+// dM_irr/dH_e = (M_an - M_irr)/(k delta), delta = sign of dH_e, and zero where
+// (M_an - M_irr) delta < 0 (Jiles 1992). With chi_e = (1-c) dMirr/dHe + c dMan/dHe and
+// dH_e = dH + alpha dM, the slope along the applied field is
+//   dM_irr/dH = (dM_irr/dH_e) / (1 - alpha chi_e).
+inline double ja_irreversible_slope(double H_A_per_m, double M_A_per_m, double Mirr_A_per_m,
+                                    double delta, double MsT_A_per_m, const JaCoefficients& p) {
+  const double He = H_A_per_m + p.alpha * M_A_per_m;
+  const double x = He / p.a_A_per_m;
+  const double Man = MsT_A_per_m * langevin(x);
+  const double diff = Man - Mirr_A_per_m;
+  const double dirr_dHe = diff * delta > 0.0 ? diff / (p.k_A_per_m * delta) : 0.0;
+  const double dMan = MsT_A_per_m / p.a_A_per_m * langevin_derivative(x);
+  const double chi_e = (1.0 - p.c) * dirr_dHe + p.c * dMan;
+  return dirr_dHe / (1.0 - p.alpha * chi_e);
+}
+
 // Eq. (9), second line, integrated over one step. dM_irr/dH_e = (M_an - M_irr)/(k delta)
 // with delta = sign(dH_e) is, along the path length s = |H_e - H_e0|, the first-order
 // relaxation  k dM_irr/ds = M_an - M_irr : a lag of M_irr behind M_an with "time

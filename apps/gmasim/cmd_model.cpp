@@ -1,0 +1,47 @@
+// gmasim model show / model check.
+#include <fmt/format.h>
+
+#include <memory>
+
+#include "commands.hpp"
+#include "gmasim/errors.hpp"
+#include "gmasim/io.hpp"
+
+namespace gmasim::cli {
+
+Runner add_model(CLI::App& app) {
+  auto* sub = app.add_subcommand("model", "Inspect and validate model files");
+  sub->require_subcommand(1);
+  auto show_path = std::make_shared<std::string>();
+  auto check_path = std::make_shared<std::string>();
+  auto* show = sub->add_subcommand("show", "List every parameter with its value, unit and provenance");
+  show->add_option("--model", *show_path, "Model file (TOML); default: the built-in MDMA model");
+  auto* check = sub->add_subcommand("check", "Validate a model file and explain each problem");
+  check->add_option("file", *check_path, "Model file (TOML)")->required();
+  return [=]() -> int {
+    if (show->parsed()) {
+      const ModelSpec spec = show_path->empty() ? builtin_model_spec() : load_model_spec(*show_path);
+      (void)compile(spec);  // show only valid models
+      fmt::print("# {}\n", spec.source);
+      fmt::print("{:<48} {:>14}  {:<10} {}\n", "parameter", "value", "unit", "provenance");
+      for (const auto& row : describe_model(spec))
+        fmt::print("{:<48} {:>14}  {:<10} {}\n", row.name, row.value, row.unit, row.provenance);
+      return 0;
+    }
+    if (check->parsed()) {
+      try {
+        const Model m = compile(load_model_spec(*check_path));
+        (void)make_conditions(m, m.T_ref_C);
+        fmt::print("{}: OK ({} parameters, {} rods, {} circuit nodes, {} branches)\n", *check_path,
+                   m.spec.params.size(), m.rods.size(), m.circuit.node_count(), m.circuit.branch_count());
+        return 0;
+      } catch (const InputError& e) {
+        fmt::print(stderr, "{}: INVALID\n{}\n", *check_path, e.what());
+        return 2;
+      }
+    }
+    return -1;
+  };
+}
+
+}  // namespace gmasim::cli

@@ -1,0 +1,115 @@
+// gmasim simulate: one time-domain run of the model.
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <memory>
+
+#include "commands.hpp"
+#include "gmasim/errors.hpp"
+#include "gmasim/io.hpp"
+#include "gmasim/simulate.hpp"
+
+namespace gmasim::cli {
+namespace {
+
+struct SimulateArgs {
+  std::string model, waveform_csv, kind = "sine", out = "out/simulate";
+  double temperature_C = 20.0, pp_A = 8.0, min_A = -3.0, frequency_Hz = 10.0, periods = 3.0;
+  double dt_s = 0.0, level_A = 0.0, step_to_A = 0.0, step_time_s = 0.0;
+  double f0_Hz = 1.0, f1_Hz = 1000.0, amplitude_A = 1.0, offset_A = 0.0, duration_s = 0.0;
+  int record_every = 1;
+  std::vector<std::string> quantities;
+};
+
+Waveform make_waveform(const SimulateArgs& a) {
+  if (!a.waveform_csv.empty()) return load_waveform_csv(a.waveform_csv);
+  Waveform w;
+  if (a.kind == "sine") {
+    w = biased_sine(a.pp_A, a.frequency_Hz, a.min_A);
+  } else if (a.kind == "dc") {
+    w.kind = WaveformKind::DC;
+    w.level_A = a.level_A;
+  } else if (a.kind == "step") {
+    w.kind = WaveformKind::Step;
+    w.level_A = a.level_A;
+    w.step_to_A = a.step_to_A;
+    w.step_time_s = a.step_time_s;
+  } else if (a.kind == "chirp") {
+    w.kind = WaveformKind::Chirp;
+    w.f0_Hz = a.f0_Hz;
+    w.f1_Hz = a.f1_Hz;
+    w.amplitude_A = a.amplitude_A;
+    w.offset_A = a.offset_A;
+    w.duration_s = a.duration_s;
+    if (!(a.duration_s > 0)) throw InputError("--duration: a chirp needs a duration > 0 s");
+    if (!(a.f0_Hz > 0 && a.f1_Hz > 0)) throw InputError("--f0/--f1: chirp frequencies must be > 0 Hz");
+  }
+  return w;
+}
+
+int run_simulate(const SimulateArgs& a) {
+  const Model model = load_model(a.model);
+  SimulationSettings s;
+  s.temperature_C = a.temperature_C;
+  s.waveform = make_waveform(a);
+  s.periods = a.periods;
+  s.duration_s = a.duration_s;
+  s.dt_s = a.dt_s;
+  s.record_every = a.record_every;
+  ensure_output_dir(a.out);  // fail before the run, not after it
+  Result r = simulate(model, s);
+  if (!r.diverged && !a.quantities.empty()) add_quantity_stats(r, a.quantities);
+  const std::filesystem::path dir(a.out);
+  write_file_atomic((dir / "timeseries.csv").string(), timeseries_csv(r.series));
+  write_file_atomic((dir / "metrics.json").string(), metrics_json(r, s, model));
+
+  fmt::print("gmasim simulate  model: {}\n", model_label(a.model));
+  fmt::print("  temperature {:.1f} degC, dt {:.4g} us, {} steps, wall time {:.3f} s\n",
+             s.temperature_C, r.dt_s * 1e6, r.steps, r.wall_time_s);
+  if (r.has_metrics) {
+    fmt::print("  stroke      {:9.3f} um   (peak-to-peak of y over the last period)\n", r.metrics.stroke_um);
+    fmt::print("  hysteresis  {:9.3f} um   (widest rising/falling gap at equal current)\n", r.metrics.hysteresis_um);
+    fmt::print("  B p-p       {:9.4f} T    (induction coil)\n", r.metrics.B_pp_T);
+  }
+  for (const auto& q : r.quantities)
+    fmt::print("  {:<22} rms {:.6g}  peak {:.6g}  p-p {:.6g}  mean {:.6g}\n", q.name, q.rms, q.peak, q.pp, q.mean);
+  fmt::print("  thermal expansion {:.3f} um ({} the output y)\n", r.thermal_expansion_um,
+             model.options.thermal_expansion_in_output ? "included in" : "not in");
+  fmt::print("  wrote {}/timeseries.csv and {}/metrics.json\n", a.out, a.out);
+  if (r.diverged) {
+    print_error(r.error + fmt::format(" (the {} steps before it are in {}/timeseries.csv)", r.steps, a.out));
+    return 3;
+  }
+  return 0;
+}
+
+}  // namespace
+
+Runner add_simulate(CLI::App& app) {
+  auto a = std::make_shared<SimulateArgs>();
+  auto* sub = app.add_subcommand("simulate", "Run the model in the time domain; writes timeseries.csv and metrics.json");
+  sub->add_option("--model", a->model, "Model file (TOML); default: the built-in MDMA model");
+  sub->add_option("--temperature", a->temperature_C, "Operating temperature [degC]")->capture_default_str();
+  sub->add_option("--waveform-kind", a->kind, "Current waveform: sine (biased, Fig. 11), dc, step, chirp")
+      ->check(CLI::IsMember({"sine", "dc", "step", "chirp"}))->capture_default_str();
+  sub->add_option("--current-pp", a->pp_A, "Biased sine: current peak-to-peak [A]")->capture_default_str();
+  sub->add_option("--current-min", a->min_A, "Biased sine: current minimum [A] (paper: -3 A)")->capture_default_str();
+  sub->add_option("--frequency", a->frequency_Hz, "Biased sine: frequency [Hz]")->capture_default_str();
+  sub->add_option("--periods", a->periods, "Biased sine: number of periods to run [-]; metrics use the last")->capture_default_str();
+  sub->add_option("--level", a->level_A, "DC level, or step initial level [A]")->capture_default_str();
+  sub->add_option("--step-to", a->step_to_A, "Step: level after the step [A]")->capture_default_str();
+  sub->add_option("--step-time", a->step_time_s, "Step: time of the step [s]")->capture_default_str();
+  sub->add_option("--f0", a->f0_Hz, "Chirp: start frequency [Hz]")->capture_default_str();
+  sub->add_option("--f1", a->f1_Hz, "Chirp: end frequency [Hz]")->capture_default_str();
+  sub->add_option("--amplitude", a->amplitude_A, "Chirp: current amplitude [A]")->capture_default_str();
+  sub->add_option("--offset", a->offset_A, "Chirp: current offset [A]")->capture_default_str();
+  sub->add_option("--duration", a->duration_s, "Run length for dc/step/chirp/CSV waveforms [s] (CSV: default its last time)")->capture_default_str();
+  sub->add_option("--waveform", a->waveform_csv, "Arbitrary current waveform, CSV with header t_s,current_A [s, A]");
+  sub->add_option("--dt", a->dt_s, "Time step [s]; 0 = automatic rule (T/2000, at most 10 us)")->capture_default_str();
+  sub->add_option("--record-every", a->record_every, "Record every N-th step [-]")->capture_default_str();
+  sub->add_option("--quantity", a->quantities, "Also report RMS, peak, p-p and mean of these columns (e.g. rod1_F_N) [column units]");
+  sub->add_option("--out", a->out, "Output directory")->capture_default_str();
+  return [a, sub]() -> int { return sub->parsed() ? run_simulate(*a) : -1; };
+}
+
+}  // namespace gmasim::cli

@@ -1,0 +1,276 @@
+// Output files: atomic writes, the output directory, timeseries.csv and metrics.json.
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iterator>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/io.hpp"
+
+namespace gmasim {
+
+// ---------------------------------------------------------------------------------------
+// Files
+// ---------------------------------------------------------------------------------------
+void write_file_atomic(const std::string& path, const std::string& content) {
+  const std::string tmp = fmt::format("{}.tmp.{}", path, static_cast<long>(::getpid()));
+  auto fail = [&](int err, std::FILE* f) {
+    if (f) std::fclose(f);
+    std::remove(tmp.c_str());
+    throw InputError(located(path, 0, fmt::format("cannot write output ({})", std::strerror(err))));
+  };
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) fail(errno, nullptr);
+  if (!content.empty() && std::fwrite(content.data(), 1, content.size(), f) != content.size())
+    fail(errno, f);
+  if (std::fflush(f) != 0) fail(errno, f);
+  if (::fsync(::fileno(f)) != 0) fail(errno, f);
+  if (std::fclose(f) != 0) fail(errno, nullptr);
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) fail(errno, nullptr);
+  // Make the rename itself durable; a failure here leaves a complete file, so it is not
+  // reported.
+  std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  if (dir.empty()) dir = ".";
+  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    (void)::fsync(dfd);
+    ::close(dfd);
+  }
+}
+
+void ensure_output_dir(const std::string& dir) {
+  namespace fs = std::filesystem;
+  const fs::path p = dir.empty() ? fs::path(".") : fs::path(dir);
+  auto fail = [&](const std::string& reason) {
+    throw InputError(located(dir, 0, fmt::format("output directory is not writable ({})", reason)));
+  };
+  std::error_code ec;
+  fs::create_directories(p, ec);
+  if (ec) fail(ec.message());
+  if (!fs::is_directory(p, ec)) fail(ec ? ec.message() : "not a directory");
+  const fs::path probe = p / fmt::format(".gmasim-write-test.{}", static_cast<long>(::getpid()));
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) fail(std::strerror(errno));
+  ::close(fd);
+  if (::unlink(probe.c_str()) != 0) fail(std::strerror(errno));
+}
+
+// ---------------------------------------------------------------------------------------
+// timeseries.csv
+// ---------------------------------------------------------------------------------------
+std::string timeseries_csv(const TimeSeries& ts) {
+  if (ts.columns.size() != ts.names.size())
+    throw std::invalid_argument("timeseries_csv: names and columns differ in number");
+  const std::size_t rows = ts.rows();
+  for (std::size_t c = 0; c < ts.columns.size(); ++c) {
+    if (ts.columns[c].size() != rows) {
+      throw std::invalid_argument(
+          fmt::format("timeseries_csv: column '{}' has {} rows, expected {}", ts.names[c],
+                      ts.columns[c].size(), rows));
+    }
+  }
+  fmt::memory_buffer out;
+  for (std::size_t c = 0; c < ts.names.size(); ++c) {
+    if (c > 0) out.push_back(',');
+    fmt::format_to(std::back_inserter(out), "{}", ts.names[c]);
+  }
+  out.push_back('\n');
+  for (std::size_t r = 0; r < rows; ++r) {
+    for (std::size_t c = 0; c < ts.columns.size(); ++c) {
+      if (c > 0) out.push_back(',');
+      fmt::format_to(std::back_inserter(out), "{:.10g}", ts.columns[c][r]);
+    }
+    out.push_back('\n');
+  }
+  return fmt::to_string(out);
+}
+
+// ---------------------------------------------------------------------------------------
+// metrics.json
+// ---------------------------------------------------------------------------------------
+namespace {
+
+std::string json_string(std::string_view s) {
+  std::string out = "\"";
+  for (const char ch : s) {
+    const auto c = static_cast<unsigned char>(ch);
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\b':
+        out += "\\b";
+        break;
+      case '\f':
+        out += "\\f";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (c < 0x20 || c == 0x7f) {
+          out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
+        } else {
+          out += ch;  // UTF-8 passes through unchanged
+        }
+    }
+  }
+  out += '"';
+  return out;
+}
+
+// JSON has no NaN or Inf: they are written as null.
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  return fmt::format("{:.10g}", v);
+}
+
+// Accumulates `"key": value` members of one object at one indentation.
+class JsonObject {
+ public:
+  explicit JsonObject(int indent) : indent_(indent) {}
+  void raw(std::string_view key, const std::string& value) {
+    members_.push_back(fmt::format("{:{}}{}: {}", "", indent_ + 2, json_string(key), value));
+  }
+  void number(std::string_view key, double v) { raw(key, json_number(v)); }
+  void integer(std::string_view key, long v) { raw(key, fmt::format("{}", v)); }
+  void string(std::string_view key, std::string_view v) { raw(key, json_string(v)); }
+  std::string str() const {
+    if (members_.empty()) return "{}";
+    std::string out = "{\n";
+    for (std::size_t i = 0; i < members_.size(); ++i) {
+      out += members_[i];
+      out += i + 1 < members_.size() ? ",\n" : "\n";
+    }
+    out += fmt::format("{:{}}}}", "", indent_);
+    return out;
+  }
+
+ private:
+  int indent_;
+  std::vector<std::string> members_;
+};
+
+std::string waveform_json(const Waveform& w, int indent) {
+  JsonObject o(indent);
+  switch (w.kind) {
+    case WaveformKind::BiasedSine:
+      o.string("kind", "biased_sine");
+      o.number("pp_A", w.pp_A);
+      o.number("min_A", w.min_A);
+      o.number("frequency_Hz", w.frequency_Hz);
+      break;
+    case WaveformKind::DC:
+      o.string("kind", "dc");
+      o.number("level_A", w.level_A);
+      break;
+    case WaveformKind::Step:
+      o.string("kind", "step");
+      o.number("level_A", w.level_A);
+      o.number("step_to_A", w.step_to_A);
+      o.number("step_time_s", w.step_time_s);
+      break;
+    case WaveformKind::Chirp:
+      o.string("kind", "chirp");
+      o.number("offset_A", w.offset_A);
+      o.number("amplitude_A", w.amplitude_A);
+      o.number("f0_Hz", w.f0_Hz);
+      o.number("f1_Hz", w.f1_Hz);
+      o.number("duration_s", w.duration_s);
+      break;
+    case WaveformKind::Table:
+      o.string("kind", "table");
+      o.string("source", w.table_source);
+      o.integer("points", static_cast<long>(w.table_t_s.size()));
+      break;
+  }
+  return o.str();
+}
+
+std::string frozen_json(const Freeze& f) {
+  const std::pair<const char*, bool> laws[] = {
+      {"pm_mmf", f.pm_mmf},           {"permeability", f.permeability},
+      {"resistivity", f.resistivity}, {"magnetisation", f.magnetisation},
+      {"modulus", f.modulus},         {"sleeve_modulus", f.sleeve_modulus},
+      {"geometry", f.geometry},
+  };
+  std::string out = "[";
+  bool first = true;
+  for (const auto& [name, frozen] : laws) {
+    if (!frozen) continue;
+    if (!first) out += ", ";
+    out += json_string(name);
+    first = false;
+  }
+  return out + "]";
+}
+
+}  // namespace
+
+std::string metrics_json(const Result& r, const SimulationSettings& s, const Model& m) {
+  JsonObject o(0);
+  o.string("status", r.diverged ? "diverged" : "ok");
+  o.raw("error", r.error.empty() ? std::string("null") : json_string(r.error));
+  o.string("model", m.spec.source);
+  if (const auto it = m.spec.options.find("meta.name"); it != m.spec.options.end())
+    o.string("model_name", it->second);
+  o.number("temperature_C", s.temperature_C);
+  o.raw("waveform", waveform_json(s.waveform, 2));
+  if (s.waveform.periodic()) {
+    o.number("periods", s.periods);
+  } else {
+    o.number("duration_s", s.duration_s);
+  }
+  o.number("dt_s", r.dt_s);
+  o.integer("record_every", s.record_every);
+  o.integer("steps", r.steps);
+  o.number("wall_time_s", r.wall_time_s);
+  o.raw("frozen", frozen_json(s.freeze));
+  if (r.has_metrics) {
+    JsonObject mo(2);
+    mo.number("stroke_um", r.metrics.stroke_um);
+    mo.number("hysteresis_um", r.metrics.hysteresis_um);
+    mo.number("B_pp_T", r.metrics.B_pp_T);
+    mo.number("y_mean_um", r.metrics.y_mean_um);
+    mo.number("window_start_s", r.metrics.window_start_s);
+    mo.number("window_end_s", r.metrics.window_end_s);
+    o.raw("metrics", mo.str());
+  }
+  if (!r.quantities.empty()) {
+    JsonObject qo(2);
+    for (const auto& q : r.quantities) {
+      JsonObject one(4);
+      one.number("rms", q.rms);
+      one.number("peak", q.peak);
+      one.number("pp", q.pp);
+      one.number("mean", q.mean);
+      qo.raw(q.name, one.str());
+    }
+    o.raw("quantities", qo.str());
+  }
+  o.number("thermal_expansion_um", r.thermal_expansion_um);
+  return o.str() + "\n";
+}
+
+}  // namespace gmasim
