@@ -196,7 +196,7 @@ TEST(ModelFile, DescribeListsOptionsAndStructure) {
   };
   const auto* opt = find("options.eq10_shape_law");
   ASSERT_NE(opt, nullptr);
-  EXPECT_EQ(opt->value, "printed");
+  EXPECT_EQ(opt->value, "mean_field");
   EXPECT_EQ(opt->unit, "option");
   EXPECT_THAT(opt->provenance, StartsWith("judgement"));
   const auto* rods = find("stack.rods");
@@ -391,7 +391,7 @@ TEST(ModelFileErrors, Inf) {
 }
 
 TEST(ModelFileErrors, BadOptionString) {
-  const std::string text = replace_once(builtin_text(), "eq10_shape_law = \"printed\"",
+  const std::string text = replace_once(builtin_text(), "eq10_shape_law = \"mean_field\"",
                                         "eq10_shape_law = \"parabolic\"");
   EXPECT_EQ(parse_error(text),
             at("bad.toml", line_of(text, "eq10_shape_law = ")) +

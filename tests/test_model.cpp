@@ -175,9 +175,11 @@ TEST(Conditions, FrozenLawsEqualTheReferenceTemperature) {
     EXPECT_DOUBLE_EQ(hot.rods[i].area_m2, ref.rods[i].area_m2);
   }
   EXPECT_DOUBLE_EQ(hot.Et_Pa, ref.Et_Pa);
-  // Room-referenced eq. (10): the table values hold at T_ref.
-  EXPECT_NEAR(ref.rods[0].ja.k_A_per_m, m.rods[0].ja.k0_A_per_m, 1e-9);
+  // The mean-field a^T law is referenced to T_ref: a(T_ref) = a0.
   EXPECT_NEAR(ref.rods[0].ja.a_A_per_m, m.rods[0].ja.a0_A_per_m, 1e-9);
+  // Eq. (10) in kelvin: k^T = k0 exp(-(T/T_c)/beta2) with T, T_c in K.
+  EXPECT_NEAR(ref.rods[0].ja.k_A_per_m,
+              m.rods[0].ja.k0_A_per_m * std::exp(-(293.15 / 653.15) / m.rods[0].ja.beta2), 1e-9);
 }
 
 // ---- analytic limits of the assembled model ---------------------------------------------

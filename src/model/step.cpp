@@ -149,8 +149,9 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
     const double Hc1 = static_field(r.phi_Wb, rc.k_f, mu, rc.area_m2);
     r.tau_s = mu * rc.eddy_geometry_s_m_per_H;
     const double H1 = first_order_lag_step(r.H_A_per_m, r.Hc_A_per_m, Hc1, h, r.tau_s);
+    const double M_guess = 2.0 * r.M_A_per_m - r.M_prev_A_per_m;  // linear extrapolation
     r.M_prev_A_per_m = r.M_A_per_m;
-    ja_step(r.H_A_per_m, H1, rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m);
+    ja_step(r.H_A_per_m, H1, rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m, M_guess);
     r.H_A_per_m = H1;
     r.Hc_A_per_m = Hc1;
     check(H1, t1, m.rods[i].name, "H [A/m]", 1e9);

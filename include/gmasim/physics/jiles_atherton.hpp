@@ -4,32 +4,32 @@
 
 #include <cmath>
 
+#include "gmasim/physics/magnetic.hpp"
+
 namespace gmasim::physics {
 
-// Langevin function L(x) = coth x - 1/x, accurate at small |x|.
-inline double langevin(double x) {
+// Langevin function L(x) = coth x - 1/x and its derivative L'(x) = 1/x^2 - 1/sinh^2 x,
+// from one exponential; Taylor series for |x| < 0.1 (truncation below 1e-16 relative).
+struct LangevinValue {
+  double L, dL;
+};
+inline LangevinValue langevin_pair(double x) {
   const double ax = std::fabs(x);
-  if (ax < 0.1) {  // Taylor series to x^9: truncation below 1e-16 relative
+  if (ax < 0.1) {
     const double x2 = x * x;
-    return x * (1.0 / 3.0 -
-                x2 * (1.0 / 45.0 - x2 * (2.0 / 945.0 - x2 * (1.0 / 4725.0 - x2 * (2.0 / 93555.0)))));
+    return {x * (1.0 / 3.0 - x2 * (1.0 / 45.0 - x2 * (2.0 / 945.0 - x2 * (1.0 / 4725.0 - x2 * (2.0 / 93555.0))))),
+            1.0 / 3.0 - x2 * (1.0 / 15.0 - x2 * (2.0 / 189.0 - x2 * (1.0 / 675.0 - x2 * (2.0 / 10395.0))))};
   }
-  if (ax > 20.0) return (x > 0 ? 1.0 : -1.0) - 1.0 / x;  // coth saturates to +-1
-  return 1.0 / std::tanh(x) - 1.0 / x;
+  const double inv_x = 1.0 / x;
+  if (ax > 40.0) return {(x > 0 ? 1.0 : -1.0) - inv_x, inv_x * inv_x};
+  const double e = std::exp(-2.0 * ax);          // coth|x| = (1+e)/(1-e)
+  const double one_minus_e = 1.0 - e;
+  const double coth_abs = (1.0 + e) / one_minus_e;
+  const double inv_sinh2 = 4.0 * e / (one_minus_e * one_minus_e);
+  return {(x > 0 ? coth_abs : -coth_abs) - inv_x, inv_x * inv_x - inv_sinh2};
 }
-
-// dL/dx = 1/x^2 - 1/sinh^2 x.
-inline double langevin_derivative(double x) {
-  const double ax = std::fabs(x);
-  if (ax < 0.1) {  // derivative of the series above
-    const double x2 = x * x;
-    return 1.0 / 3.0 -
-           x2 * (1.0 / 15.0 - x2 * (2.0 / 189.0 - x2 * (1.0 / 675.0 - x2 * (2.0 / 10395.0))));
-  }
-  if (ax > 20.0) return 1.0 / (x * x);
-  const double s = std::sinh(x);
-  return 1.0 / (x * x) - 1.0 / (s * s);
-}
+inline double langevin(double x) { return langevin_pair(x).L; }
+inline double langevin_derivative(double x) { return langevin_pair(x).dL; }
 
 // The four JA coefficients at one temperature (eq. 10 evaluated).
 struct JaCoefficients {
@@ -109,10 +109,11 @@ inline double ja_irreversible_slope(double H_A_per_m, double M_A_per_m, double M
 // exact update as the eddy lag (magnetic.hpp), which is unconditionally stable however
 // small k or large the field step. The guard of Jiles (1992), no change while
 // (M_an - M_irr) delta <= 0, holds M_irr until M_an crosses it.
-// Returns M_irr at the end; `weight` receives dM_irr/dM_an1 (for the Newton Jacobian).
-inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, double dHe,
-                                     double k_A_per_m, double& weight) {
-  weight = 0.0;
+// Returns M_irr at the end of the step and, in dMirr_dHe1, its derivative with respect to
+// the end field H_e1 given dMan1 = dM_an/dH_e there (for Newton's method in ja_step).
+inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, double dMan1,
+                                     double dHe, double k_A_per_m, double& dMirr_dHe1) {
+  dMirr_dHe1 = 0.0;
   if (dHe == 0.0) return Mirr0;
   const double delta = dHe > 0.0 ? 1.0 : -1.0;
   const double d0 = (Man0 - Mirr0) * delta, d1 = (Man1 - Mirr0) * delta;
@@ -123,43 +124,49 @@ inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, dou
     u0 = Mirr0;
   }
   const double r = s / k_A_per_m;
-  const double E = std::exp(-r);
-  const double q = r < 1e-8 ? 1.0 - 0.5 * r : -std::expm1(-r) / r;  // (1 - E)/r
-  weight = 1.0 - q;
-  return Man1 + (Mirr0 - u0) * E - (Man1 - u0) * q;
+  const LagWeights w = lag_weights(r);
+  // d/dHe1 through M_an1 (weight 1 - q) and through r = s/k (dq/dr = (E - q)/r).
+  const double dq_dr = r > 1e-12 ? (w.E - w.q) / r : -0.5;
+  dMirr_dHe1 = (1.0 - w.q) * dMan1 +
+               delta / k_A_per_m * (-(Mirr0 - u0) * w.E - (Man1 - u0) * dq_dr);
+  return Man1 + (Mirr0 - u0) * w.E - (Man1 - u0) * w.q;
 }
 
 // One step of eq. (9) from applied field H0 to H1. Solves for the end magnetisation M1
-// the scalar equation  M1 = (1-c) M_irr1(M1) + c M_an(H1 + alpha M1)  by Newton's method
-// (H_e depends on M through alpha), with M_irr1 from ja_irreversible_update.
+// the scalar equation  g(M1) = M1 - (1-c) M_irr1(M1) - c M_an(H1 + alpha M1) = 0  by
+// Newton's method with its exact derivative (H_e depends on M through alpha), M_irr1 from
+// ja_irreversible_update. M_guess is the starting point (e.g. linear extrapolation).
 // On entry M must be consistent with (H0, Mirr); on exit Mirr and M hold the values at H1.
 inline void ja_step(double H0, double H1, double MsT_A_per_m, const JaCoefficients& p,
-                    double& Mirr, double& M) {
+                    double& Mirr, double& M, double M_guess) {
   if (H1 == H0) return;
   const double inv_a = 1.0 / p.a_A_per_m;
   const double He0 = H0 + p.alpha * M;
   const double Man0 = MsT_A_per_m * langevin(He0 * inv_a);
-  double M1 = M;
-  double Mirr1 = Mirr;
-  for (int it = 0; it < 40; ++it) {
+  const double tol = 1e-12 * MsT_A_per_m;
+  double M1 = M_guess;
+  for (int it = 0; it < 60; ++it) {
     const double He1 = H1 + p.alpha * M1;
-    const double x = He1 * inv_a;
-    const double Man1 = MsT_A_per_m * langevin(x);
-    const double dMan = MsT_A_per_m * inv_a * langevin_derivative(x);
-    double w = 0.0;
-    Mirr1 = ja_irreversible_update(Mirr, Man0, Man1, He1 - He0, p.k_A_per_m, w);
-    const double g = M1 - (1.0 - p.c) * Mirr1 - p.c * Man1;
-    double dg = 1.0 - p.alpha * ((1.0 - p.c) * w + p.c) * dMan;
+    const LangevinValue lv = langevin_pair(He1 * inv_a);
+    const double Man1 = MsT_A_per_m * lv.L;
+    const double dMan = MsT_A_per_m * inv_a * lv.dL;
+    double dMirr = 0.0;
+    const double Mirr1 = ja_irreversible_update(Mirr, Man0, Man1, dMan, He1 - He0, p.k_A_per_m, dMirr);
+    const double Mnew = (1.0 - p.c) * Mirr1 + p.c * Man1;
+    const double g = M1 - Mnew;
+    if (std::fabs(g) <= tol || it == 59) {
+      Mirr = Mirr1;
+      M = Mnew;
+      return;
+    }
+    double dg = 1.0 - p.alpha * ((1.0 - p.c) * dMirr + p.c * dMan);
     if (dg < 0.2) dg = 0.2;  // alpha > 0 (positive feedback): damp the Newton step
     M1 -= g / dg;
-    if (std::fabs(g) <= 1e-12 * MsT_A_per_m) break;
   }
-  // Final consistent evaluation at the converged M1.
-  const double He1 = H1 + p.alpha * M1;
-  const double Man1 = MsT_A_per_m * langevin(He1 * inv_a);
-  double w = 0.0;
-  Mirr = ja_irreversible_update(Mirr, Man0, Man1, He1 - He0, p.k_A_per_m, w);
-  M = (1.0 - p.c) * Mirr + p.c * Man1;
+}
+inline void ja_step(double H0, double H1, double MsT_A_per_m, const JaCoefficients& p,
+                    double& Mirr, double& M) {
+  ja_step(H0, H1, MsT_A_per_m, p, Mirr, M, M);
 }
 
 }  // namespace gmasim::physics

@@ -94,15 +94,28 @@ inline double resistivity(double rho0_ohm_m, double drho_dT_ohm_m_per_K, double 
   return rho0_ohm_m + drho_dT_ohm_m_per_K * dT_K;
 }
 
+// exp(-r) and q(r) = (1 - exp(-r))/r with one exponential; q by its Taylor series for
+// small r (truncation below 1e-16 relative), where 1 - exp(-r) would cancel.
+struct LagWeights {
+  double E, q;
+};
+inline LagWeights lag_weights(double r) {
+  const double E = std::exp(-r);
+  if (r < 1e-2) {
+    const double q = 1.0 - r * (1.0 / 2 - r * (1.0 / 6 - r * (1.0 / 24 - r * (1.0 / 120 - r * (1.0 / 720)))));
+    return {E, q};
+  }
+  return {E, (1.0 - E) / r};
+}
+
 // Exact update of the first-order lag  tau dH/dt = u(t) - H  over one step h with u
-// linear from u0 to u1 (first-order hold). Exact for ramps; E = exp(-h/tau).
+// linear from u0 to u1 (first-order hold):
+//   H1 = u1 + (H0 - u0) E - (u1 - u0) q,   E = exp(-h/tau), q = (1 - E) tau/h.
+// Exact for ramps, unconditionally stable.
 inline double first_order_lag_step(double H0, double u0, double u1, double h_s, double tau_s) {
   if (tau_s <= 0.0) return u1;
-  const double r = h_s / tau_s;
-  const double E = std::exp(-r);
-  // (1-E)/r computed stably for small r.
-  const double one_minus_E_over_r = r < 1e-8 ? 1.0 - 0.5 * r : -std::expm1(-r) / r;
-  return u1 + (H0 - u0) * E - (u1 - u0) * one_minus_E_over_r;
+  const LagWeights w = lag_weights(h_s / tau_s);
+  return u1 + (H0 - u0) * w.E - (u1 - u0) * w.q;
 }
 
 }  // namespace gmasim::physics
