@@ -103,6 +103,27 @@ TEST(Circuit, SolvedFluxesSatisfyAll15RowsOfEq23) {
   EXPECT_LE(worst, 1e-10);  // observed ~1e-15
 }
 
+TEST(Circuit, LowRankSolveEqualsFullFactorisation) {
+  const Model& m = mdma();
+  ASSERT_TRUE(m.circuit.lowrank.enabled);
+  CircuitWorkspace a, b;
+  a.resize(m.circuit);
+  b.resize(m.circuit);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> logR(5.0, 9.5), cur(-3.0, 9.0);
+  double worst = 0.0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const std::vector<double> Rr{std::pow(10.0, logR(rng)), std::pow(10.0, logR(rng)), std::pow(10.0, logR(rng))};
+    const double I = cur(rng);
+    ASSERT_TRUE(solve_circuit(m.circuit, Rr, I, 0.97, a));
+    ASSERT_TRUE(solve_circuit_full(m.circuit, Rr, I, 0.97, b));
+    double scale = 0.0;
+    for (double p : b.phi) scale = std::max(scale, std::fabs(p));
+    for (std::size_t k = 0; k < a.phi.size(); ++k) worst = std::max(worst, std::fabs(a.phi[k] - b.phi[k]) / scale);
+  }
+  EXPECT_LE(worst, 1e-10);  // observed ~1e-14
+}
+
 TEST(Circuit, LinearSeriesParallelAnalytic) {
   // Source F in series with R1, then R2 || R3 back to the reference.
   Circuit c;

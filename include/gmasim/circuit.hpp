@@ -7,7 +7,14 @@
 // where psi are magnetic scalar potentials [A-turns], zero at the reference node.
 // Flux conservation at every non-reference node gives the nodal (graph-Laplacian) system
 //     sum_b A_nb phi_b = 0   =>   (A R^-1 A^T) psi = -A R^-1 F
-// solved by Cholesky every step. Node index -1 is the reference node.
+// Node index -1 is the reference node.
+//
+// Only the rod branches change from step to step (their reluctance follows M through
+// eq. 2-3). When the fixed branches alone already tie every node to the reference (true
+// of the MDMA), the Laplacian is G = G0 + B D B^T with G0 constant, B the incidence of the
+// k rod branches and D = diag(1/R_rod). The Woodbury identity then reduces each step to a
+// k x k solve with matrices precomputed once (LowRank); otherwise the full n x n system is
+// factorised every step. Both give the same fluxes (tested).
 #pragma once
 
 #include <Eigen/Cholesky>
@@ -28,12 +35,24 @@ struct CircuitBranch {
   double pm_mmf_At = 0.0;     // permanent-magnet MMF F_pm at T0 [A-turns], scaled by eq. (1)
 };
 
+// Precomputed pieces of the low-rank (Woodbury) solve, see above.
+struct LowRank {
+  bool enabled = false;
+  Eigen::MatrixXd W;            // G0^-1 B            (n x k)
+  Eigen::MatrixXd S;            // B^T G0^-1 B        (k x k)
+  Eigen::VectorXd psi_coil;     // G0^-1 b per ampere of coil current (fixed branches)
+  Eigen::VectorXd psi_pm;       // G0^-1 b per unit PM scale (fixed branches)
+  Eigen::VectorXd Bt_psi_coil;  // B^T psi_coil (k)
+  Eigen::VectorXd Bt_psi_pm;    // B^T psi_pm (k)
+};
+
 struct Circuit {
   std::vector<std::string> node_names;   // non-reference nodes, index = position
   std::string reference_node;
   std::vector<CircuitBranch> branches;
   std::vector<int> rod_branch;           // rod index -> branch index
   Eigen::MatrixXd fixed_laplacian;       // contribution of the fixed-reluctance branches
+  LowRank lowrank;
 
   int node_count() const { return static_cast<int>(node_names.size()); }
   int branch_count() const { return static_cast<int>(branches.size()); }
@@ -45,10 +64,16 @@ struct Circuit {
 void finalize_circuit(Circuit& c, int rod_count, const std::string& where);
 
 // Buffers of the nodal solve, sized once.
+using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 8, 8>;
+using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 8, 1>;
+
 struct CircuitWorkspace {
   Eigen::MatrixXd G;
-  Eigen::VectorXd rhs;
+  Eigen::VectorXd rhs;  // holds the node potentials psi after a solve
   Eigen::LLT<Eigen::MatrixXd> llt;
+  SmallMatrix K;        // low-rank path: D^-1 + S
+  SmallVector v, z, F_rod;
+  Eigen::LLT<SmallMatrix> small_llt;
   std::vector<double> reluctance;  // per branch, this step [1/H]
   std::vector<double> mmf;         // per branch, this step [A-turns]
   std::vector<double> phi;         // per branch, solved flux [Wb]
@@ -61,5 +86,8 @@ struct CircuitWorkspace {
 // Returns false if the nodal matrix is not positive definite.
 bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_H,
                    double current_A, double pm_scale, CircuitWorkspace& ws);
+// The same solve, always by factorising the full nodal matrix (reference for tests).
+bool solve_circuit_full(const Circuit& c, std::span<const double> rod_reluctance_per_H,
+                        double current_A, double pm_scale, CircuitWorkspace& ws);
 
 }  // namespace gmasim

@@ -55,6 +55,32 @@ void finalize_circuit(Circuit& c, int rod_count, const std::string& where) {
       c.fixed_laplacian(br.to, br.from) -= g;
     }
   }
+  // Low-rank pieces, when the fixed branches alone ground every node (G0 SPD).
+  c.lowrank = LowRank{};
+  Eigen::LLT<Eigen::MatrixXd> llt0(c.fixed_laplacian);
+  if (llt0.info() != Eigen::Success || rod_count == 0) return;
+  const int k = rod_count;
+  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(n, k);
+  Eigen::VectorXd b_coil = Eigen::VectorXd::Zero(n), b_pm = Eigen::VectorXd::Zero(n);
+  for (int r = 0; r < k; ++r) {
+    const auto& br = c.branches[static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)])];
+    if (br.from >= 0) B(br.from, r) += 1.0;
+    if (br.to >= 0) B(br.to, r) -= 1.0;
+  }
+  for (const auto& br : c.branches) {
+    if (br.rod >= 0) continue;
+    const double g = 1.0 / br.fixed_reluctance_per_H;
+    if (br.from >= 0) { b_coil(br.from) -= br.coil_turns * g; b_pm(br.from) -= br.pm_mmf_At * g; }
+    if (br.to >= 0) { b_coil(br.to) += br.coil_turns * g; b_pm(br.to) += br.pm_mmf_At * g; }
+  }
+  auto& L = c.lowrank;
+  L.W = llt0.solve(B);
+  L.S = B.transpose() * L.W;
+  L.psi_coil = llt0.solve(b_coil);
+  L.psi_pm = llt0.solve(b_pm);
+  L.Bt_psi_coil = B.transpose() * L.psi_coil;
+  L.Bt_psi_pm = B.transpose() * L.psi_pm;
+  L.enabled = true;
 }
 
 void CircuitWorkspace::resize(const Circuit& c) {
@@ -62,6 +88,13 @@ void CircuitWorkspace::resize(const Circuit& c) {
   G = Eigen::MatrixXd::Zero(n, n);
   rhs = Eigen::VectorXd::Zero(n);
   llt = Eigen::LLT<Eigen::MatrixXd>(n);
+  const int k = static_cast<int>(c.rod_branch.size());
+  K = SmallMatrix::Zero(k, k);
+  v = SmallVector::Zero(k);
+  z = SmallVector::Zero(k);
+  F_rod = SmallVector::Zero(k);
+  K.setIdentity();
+  small_llt.compute(K);  // sizes its buffers (fixed capacity: no heap)
   reluctance.assign(c.branches.size(), 0.0);
   mmf.assign(c.branches.size(), 0.0);
   phi.assign(c.branches.size(), 0.0);
@@ -69,6 +102,43 @@ void CircuitWorkspace::resize(const Circuit& c) {
 
 bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_H,
                    double current_A, double pm_scale, CircuitWorkspace& ws) {
+  const LowRank& L = c.lowrank;
+  if (!L.enabled) return solve_circuit_full(c, rod_reluctance_per_H, current_A, pm_scale, ws);
+  // With g = diag(1/R_rod), F the rods' own MMFs, u = I psi_coil + pm psi_pm:
+  //   v = B^T u - S D F,  (D^-1 + S) z = v,  psi = u - W (D F + z).
+  const int k = static_cast<int>(c.rod_branch.size());
+  for (int r = 0; r < k; ++r) {
+    const auto& br = c.branches[static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)])];
+    ws.F_rod(r) = (br.coil_turns * current_A + br.pm_mmf_At * pm_scale) / rod_reluctance_per_H[static_cast<std::size_t>(r)];  // D F
+  }
+  ws.v.noalias() = current_A * L.Bt_psi_coil + pm_scale * L.Bt_psi_pm;
+  ws.v.noalias() -= L.S * ws.F_rod;
+  ws.K = L.S;
+  for (int r = 0; r < k; ++r) ws.K(r, r) += rod_reluctance_per_H[static_cast<std::size_t>(r)];
+  ws.small_llt.compute(ws.K);
+  if (ws.small_llt.info() != Eigen::Success) return false;
+  ws.z = ws.v;
+  ws.small_llt.solveInPlace(ws.z);
+  ws.z += ws.F_rod;  // D F + z
+  ws.rhs.noalias() = current_A * L.psi_coil + pm_scale * L.psi_pm;
+  ws.rhs.noalias() -= L.W * ws.z;
+  const std::size_t nb = c.branches.size();
+  for (std::size_t b = 0; b < nb; ++b) {
+    const auto& br = c.branches[b];
+    const double R = br.rod >= 0 ? rod_reluctance_per_H[static_cast<std::size_t>(br.rod)]
+                                 : br.fixed_reluctance_per_H;
+    const double F = br.coil_turns * current_A + br.pm_mmf_At * pm_scale;
+    ws.reluctance[b] = R;
+    ws.mmf[b] = F;
+    const double pf = br.from >= 0 ? ws.rhs(br.from) : 0.0;
+    const double pt = br.to >= 0 ? ws.rhs(br.to) : 0.0;
+    ws.phi[b] = (pf - pt + F) / R;
+  }
+  return true;
+}
+
+bool solve_circuit_full(const Circuit& c, std::span<const double> rod_reluctance_per_H,
+                        double current_A, double pm_scale, CircuitWorkspace& ws) {
   ws.G = c.fixed_laplacian;
   ws.rhs.setZero();
   const std::size_t nb = c.branches.size();
