@@ -66,7 +66,8 @@ void BM_PeriodRk4At2us(benchmark::State& bs) {
     State s = s0;
     for (long k = 0; k < n; ++k) {
       const double t = static_cast<double>(k) * dt;
-      rk4_reference_step(m, c, s, w.current_at(t), w.current_at(t + 0.5 * dt), w.current_at(t + dt), dt);
+      rk4_reference_step(m, c, s, w.current_at(t), w.current_at(t + 0.5 * dt), w.current_at(t + dt),
+                         dt);
     }
     benchmark::DoNotOptimize(s.y_m);
   }

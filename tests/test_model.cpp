@@ -74,17 +74,22 @@ TEST(Circuit, SolvedFluxesSatisfyAll15RowsOfEq23) {
   std::uniform_real_distribution<double> logR(5.0, 9.5), cur(-3.0, 9.0);
   double worst = 0.0;
   for (int trial = 0; trial < 200; ++trial) {
-    const std::vector<double> Rr{std::pow(10.0, logR(rng)), std::pow(10.0, logR(rng)), std::pow(10.0, logR(rng))};
+    const std::vector<double> Rr{std::pow(10.0, logR(rng)), std::pow(10.0, logR(rng)),
+                                 std::pow(10.0, logR(rng))};
     const double I = cur(rng);
     ASSERT_TRUE(solve_circuit(m.circuit, Rr, I, 1.0, ws));
     std::map<int, double> p;
-    for (int k = 1; k <= 15; ++k) p[k] = ws.phi[static_cast<std::size_t>(branch(m, "phi" + std::to_string(k)))];
+    for (int k = 1; k <= 15; ++k)
+      p[k] = ws.phi[static_cast<std::size_t>(branch(m, "phi" + std::to_string(k)))];
     const double NI = N * I;
     double phimax = 0.0;
     for (auto& [k, v] : p) phimax = std::max(phimax, std::fabs(v));
-    const double kcl[7] = {p[7] + p[10] - p[4], p[1] + p[5] + p[6] - p[10],
+    const double kcl[7] = {p[7] + p[10] - p[4],
+                           p[1] + p[5] + p[6] - p[10],
                            p[2] + p[8] + p[9] - p[5] - p[6],  // row 3 as corrected (READING-NOTES)
-                           p[3] - p[8] - p[9], p[11] + p[15] - p[1], p[13] - p[3] - p[12],
+                           p[3] - p[8] - p[9],
+                           p[11] + p[15] - p[1],
+                           p[13] - p[3] - p[12],
                            p[12] + p[14] - p[2] - p[11]};
     const double kvl[8] = {
         p[4] * (R("R_shell") + R("R_m") + R("R_pm")) + p[7] * R("R_L") - NI - Fpm,
@@ -113,13 +118,15 @@ TEST(Circuit, LowRankSolveEqualsFullFactorisation) {
   std::uniform_real_distribution<double> logR(5.0, 9.5), cur(-3.0, 9.0);
   double worst = 0.0;
   for (int trial = 0; trial < 200; ++trial) {
-    const std::vector<double> Rr{std::pow(10.0, logR(rng)), std::pow(10.0, logR(rng)), std::pow(10.0, logR(rng))};
+    const std::vector<double> Rr{std::pow(10.0, logR(rng)), std::pow(10.0, logR(rng)),
+                                 std::pow(10.0, logR(rng))};
     const double I = cur(rng);
     ASSERT_TRUE(solve_circuit(m.circuit, Rr, I, 0.97, a));
     ASSERT_TRUE(solve_circuit_full(m.circuit, Rr, I, 0.97, b));
     double scale = 0.0;
     for (double p : b.phi) scale = std::max(scale, std::fabs(p));
-    for (std::size_t k = 0; k < a.phi.size(); ++k) worst = std::max(worst, std::fabs(a.phi[k] - b.phi[k]) / scale);
+    for (std::size_t k = 0; k < a.phi.size(); ++k)
+      worst = std::max(worst, std::fabs(a.phi[k] - b.phi[k]) / scale);
   }
   EXPECT_LE(worst, 1e-10);  // observed ~1e-14
 }
@@ -129,7 +136,8 @@ TEST(Circuit, LinearSeriesParallelAnalytic) {
   Circuit c;
   c.node_names = {"a"};
   c.reference_node = "0";
-  c.branches = {{"src", -1, 0, 2.0e6, -1, 100.0, 500.0}, {"b2", 0, -1, 3.0e6, -1, 0, 0},
+  c.branches = {{"src", -1, 0, 2.0e6, -1, 100.0, 500.0},
+                {"b2", 0, -1, 3.0e6, -1, 0, 0},
                 {"b3", 0, -1, 6.0e6, -1, 0, 0}};
   finalize_circuit(c, 0, "test");
   CircuitWorkspace ws;
@@ -212,7 +220,8 @@ TEST(Model, StaticDeflectionEqualsForceOverStiffness) {
   for (int r = 0; r < m.rod_count(); ++r) {
     const auto& rs = s.rods[static_cast<std::size_t>(r)];
     const double K = oscillator_stiffness(c, s, r);
-    EXPECT_NEAR(rs.x_m, rs.F_N / K, 1e-9 * std::fabs(rs.F_N / K)) << m.rods[static_cast<std::size_t>(r)].name;
+    EXPECT_NEAR(rs.x_m, rs.F_N / K, 1e-9 * std::fabs(rs.F_N / K))
+        << m.rods[static_cast<std::size_t>(r)].name;
     EXPECT_GT(rs.x_m, 0.0);
   }
 }
@@ -225,7 +234,8 @@ TEST(Model, EddyTimeConstantIsEq7) {
   for (std::size_t i = 0; i < s.rods.size(); ++i) {
     const auto& rc = c.rods[i];
     const double mu = s.rods[i].mu_r * physics::kMu0;
-    const double tau = mu * (rc.r_outer_m * rc.r_outer_m - rc.r_inner_m * rc.r_inner_m) / (4 * rc.k_j * rc.rho_ohm_m);
+    const double tau = mu * (rc.r_outer_m * rc.r_outer_m - rc.r_inner_m * rc.r_inner_m) /
+                       (4 * rc.k_j * rc.rho_ohm_m);
     EXPECT_NEAR(s.rods[i].tau_s, tau, 1e-12 * tau);
     EXPECT_GT(tau, 1e-5);
     EXPECT_LT(tau, 1e-1);
@@ -255,11 +265,16 @@ TEST(Numerics, HalvingDtChangesStrokeAndHysteresisByLessThan0p1Percent) {
     const Result b = simulate(m, s);
     ASSERT_FALSE(a.diverged) << a.error;
     const double ds = std::fabs(a.metrics.stroke_um - b.metrics.stroke_um) / b.metrics.stroke_um;
-    const double dh = std::fabs(a.metrics.hysteresis_um - b.metrics.hysteresis_um) / b.metrics.hysteresis_um;
-    EXPECT_LT(ds, 1e-3) << f << " Hz: stroke " << a.metrics.stroke_um << " vs " << b.metrics.stroke_um;
-    EXPECT_LT(dh, 1e-3) << f << " Hz: hysteresis " << a.metrics.hysteresis_um << " vs " << b.metrics.hysteresis_um;
-    RecordProperty(("stroke_rel_change_" + std::to_string(int(f)) + "Hz").c_str(), std::to_string(ds));
-    RecordProperty(("hyst_rel_change_" + std::to_string(int(f)) + "Hz").c_str(), std::to_string(dh));
+    const double dh =
+        std::fabs(a.metrics.hysteresis_um - b.metrics.hysteresis_um) / b.metrics.hysteresis_um;
+    EXPECT_LT(ds, 1e-3) << f << " Hz: stroke " << a.metrics.stroke_um << " vs "
+                        << b.metrics.stroke_um;
+    EXPECT_LT(dh, 1e-3) << f << " Hz: hysteresis " << a.metrics.hysteresis_um << " vs "
+                        << b.metrics.hysteresis_um;
+    RecordProperty(("stroke_rel_change_" + std::to_string(int(f)) + "Hz").c_str(),
+                   std::to_string(ds));
+    RecordProperty(("hyst_rel_change_" + std::to_string(int(f)) + "Hz").c_str(),
+                   std::to_string(dh));
   }
 }
 

@@ -13,7 +13,8 @@ using namespace gmasim::physics;
 
 TEST(Langevin, DerivativeMatchesFiniteDifference) {
   // Central differences, h = 1e-5: truncation ~1e-11; observed max error ~2e-11.
-  for (double x : {-30.0, -5.0, -1.0, -0.02, -0.009, -1e-4, 0.0, 3e-3, 0.011, 0.5, 2.0, 19.0, 25.0}) {
+  for (double x :
+       {-30.0, -5.0, -1.0, -0.02, -0.009, -1e-4, 0.0, 3e-3, 0.011, 0.5, 2.0, 19.0, 25.0}) {
     const double h = 1e-5;
     const double fd = (langevin(x + h) - langevin(x - h)) / (2 * h);
     EXPECT_NEAR(langevin_derivative(x), fd, 2e-10) << "x = " << x;
@@ -131,7 +132,8 @@ TEST(Magnetostriction, PrestressFactorBranchesAreContinuous) {
   EXPECT_NEAR(prestress_factor(ss, ss, smax), prestress_factor(ss * (1 + 1e-12), ss, smax), 1e-9);
   EXPECT_DOUBLE_EQ(prestress_factor(0.0, ss, smax), 1.0);
   // lambda scales with m^2 (eq. 11).
-  EXPECT_NEAR(magnetostriction(0.5, 1e-3, 5e6, 30e9) / magnetostriction(1.0, 1e-3, 5e6, 30e9), 0.25, 1e-15);
+  EXPECT_NEAR(magnetostriction(0.5, 1e-3, 5e6, 30e9) / magnetostriction(1.0, 1e-3, 5e6, 30e9), 0.25,
+              1e-15);
   EXPECT_DOUBLE_EQ(rod_force(1e-3, 30e9, 1e-4), 3000.0);
 }
 
@@ -170,12 +172,16 @@ TEST(Oscillator, ExactUpdateMatchesFineRk4) {
     oscillator_step(m, c, k, F0, F1, h, x, v);
     const int n = 20000;
     const double dt = h / n;
-    auto acc = [&](double t, double xx, double vv) { return (F0 + (F1 - F0) * t / h - c * vv - k * xx) / m; };
+    auto acc = [&](double t, double xx, double vv) {
+      return (F0 + (F1 - F0) * t / h - c * vv - k * xx) / m;
+    };
     for (int i = 0; i < n; ++i) {
       const double t = i * dt;
       const double k1x = vr, k1v = acc(t, xr, vr);
-      const double k2x = vr + 0.5 * dt * k1v, k2v = acc(t + 0.5 * dt, xr + 0.5 * dt * k1x, vr + 0.5 * dt * k1v);
-      const double k3x = vr + 0.5 * dt * k2v, k3v = acc(t + 0.5 * dt, xr + 0.5 * dt * k2x, vr + 0.5 * dt * k2v);
+      const double k2x = vr + 0.5 * dt * k1v,
+                   k2v = acc(t + 0.5 * dt, xr + 0.5 * dt * k1x, vr + 0.5 * dt * k1v);
+      const double k3x = vr + 0.5 * dt * k2v,
+                   k3v = acc(t + 0.5 * dt, xr + 0.5 * dt * k2x, vr + 0.5 * dt * k2v);
       const double k4x = vr + dt * k3v, k4v = acc(t + dt, xr + dt * k3x, vr + dt * k3v);
       xr += dt / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
       vr += dt / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
@@ -194,13 +200,15 @@ TEST(Mechanics, SeriesAndSleeveLaws) {
   EXPECT_NEAR(Et, 193.0e9, 1e6);
   EXPECT_NEAR(sleeve_stiffness(Et, l, a), 156e6, 0.01 * 156e6);
   // Eq. (21) with the model file's lengths gives the paper's 0.662 um/degC.
-  EXPECT_NEAR(thermal_expansion(12.9e-6 * 0.09, 12.2e-6 * 0.012, 12.2e-6 * 0.02, 17.2e-6 * 0.05171, 1.0),
-              0.662e-6, 1e-10);
+  EXPECT_NEAR(
+      thermal_expansion(12.9e-6 * 0.09, 12.2e-6 * 0.012, 12.2e-6 * 0.02, 17.2e-6 * 0.05171, 1.0),
+      0.662e-6, 1e-10);
 }
 
 TEST(PermanentMagnet, Eq1) {
   EXPECT_DOUBLE_EQ(pm_mmf(2520.0, 0.0, 0.0, 50.0), 2520.0);
   EXPECT_NEAR(pm_mmf(2520.0, -3e-4, 1e-7, 50.0), 2520.0 * (1 - 0.015 + 2.5e-4), 1e-9);
-  EXPECT_NEAR(saturation_magnetisation(7.65e5, 50.0, 360.0, 0.001), 7.65e5 * std::pow(1 - 50.0 / 360.0, 0.001), 1e-9);
+  EXPECT_NEAR(saturation_magnetisation(7.65e5, 50.0, 360.0, 0.001),
+              7.65e5 * std::pow(1 - 50.0 / 360.0, 0.001), 1e-9);
   EXPECT_NEAR(resistivity(6e-7, 2.5e-9, 50.0), 6e-7 + 1.25e-7, 1e-20);
 }

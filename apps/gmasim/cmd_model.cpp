@@ -14,13 +14,15 @@ Runner add_model(CLI::App& app) {
   sub->require_subcommand(1);
   auto show_path = std::make_shared<std::string>();
   auto check_path = std::make_shared<std::string>();
-  auto* show = sub->add_subcommand("show", "List every parameter with its value, unit and provenance");
+  auto* show =
+      sub->add_subcommand("show", "List every parameter with its value, unit and provenance");
   show->add_option("--model", *show_path, "Model file (TOML); default: the built-in MDMA model");
   auto* check = sub->add_subcommand("check", "Validate a model file and explain each problem");
   check->add_option("file", *check_path, "Model file (TOML)")->required();
   return [=]() -> int {
     if (show->parsed()) {
-      const ModelSpec spec = show_path->empty() ? builtin_model_spec() : load_model_spec(*show_path);
+      const ModelSpec spec =
+          show_path->empty() ? builtin_model_spec() : load_model_spec(*show_path);
       (void)compile(spec);  // show only valid models
       fmt::print("# {}\n", spec.source);
       fmt::print("{:<48} {:>14}  {:<10} {}\n", "parameter", "value", "unit", "provenance");
@@ -33,7 +35,8 @@ Runner add_model(CLI::App& app) {
         const Model m = compile(load_model_spec(*check_path));
         (void)make_conditions(m, m.T_ref_C);
         fmt::print("{}: OK ({} parameters, {} rods, {} circuit nodes, {} branches)\n", *check_path,
-                   m.spec.params.size(), m.rods.size(), m.circuit.node_count(), m.circuit.branch_count());
+                   m.spec.params.size(), m.rods.size(), m.circuit.node_count(),
+                   m.circuit.branch_count());
         return 0;
       } catch (const InputError& e) {
         fmt::print(stderr, "{}: INVALID\n{}\n", *check_path, e.what());

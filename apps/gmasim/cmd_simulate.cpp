@@ -42,7 +42,8 @@ Waveform make_waveform(const SimulateArgs& a) {
     w.offset_A = a.offset_A;
     w.duration_s = a.duration_s;
     if (!(a.duration_s > 0)) throw InputError("--duration: a chirp needs a duration > 0 s");
-    if (!(a.f0_Hz > 0 && a.f1_Hz > 0)) throw InputError("--f0/--f1: chirp frequencies must be > 0 Hz");
+    if (!(a.f0_Hz > 0 && a.f1_Hz > 0))
+      throw InputError("--f0/--f1: chirp frequencies must be > 0 Hz");
   }
   return w;
 }
@@ -67,17 +68,21 @@ int run_simulate(const SimulateArgs& a) {
   fmt::print("  temperature {:.1f} degC, dt {:.4g} us, {} steps, wall time {:.3f} s\n",
              s.temperature_C, r.dt_s * 1e6, r.steps, r.wall_time_s);
   if (r.has_metrics) {
-    fmt::print("  stroke      {:9.3f} um   (peak-to-peak of y over the last period)\n", r.metrics.stroke_um);
-    fmt::print("  hysteresis  {:9.3f} um   (widest rising/falling gap at equal current)\n", r.metrics.hysteresis_um);
+    fmt::print("  stroke      {:9.3f} um   (peak-to-peak of y over the last period)\n",
+               r.metrics.stroke_um);
+    fmt::print("  hysteresis  {:9.3f} um   (widest rising/falling gap at equal current)\n",
+               r.metrics.hysteresis_um);
     fmt::print("  B p-p       {:9.4f} T    (induction coil)\n", r.metrics.B_pp_T);
   }
   for (const auto& q : r.quantities)
-    fmt::print("  {:<22} rms {:.6g}  peak {:.6g}  p-p {:.6g}  mean {:.6g}\n", q.name, q.rms, q.peak, q.pp, q.mean);
+    fmt::print("  {:<22} rms {:.6g}  peak {:.6g}  p-p {:.6g}  mean {:.6g}\n", q.name, q.rms, q.peak,
+               q.pp, q.mean);
   fmt::print("  thermal expansion {:.3f} um ({} the output y)\n", r.thermal_expansion_um,
              model.options.thermal_expansion_in_output ? "included in" : "not in");
   fmt::print("  wrote {}/timeseries.csv and {}/metrics.json\n", a.out, a.out);
   if (r.diverged) {
-    print_error(r.error + fmt::format(" (the {} steps before it are in {}/timeseries.csv)", r.steps, a.out));
+    print_error(r.error +
+                fmt::format(" (the {} steps before it are in {}/timeseries.csv)", r.steps, a.out));
     return 3;
   }
   return 0;
@@ -87,27 +92,47 @@ int run_simulate(const SimulateArgs& a) {
 
 Runner add_simulate(CLI::App& app) {
   auto a = std::make_shared<SimulateArgs>();
-  auto* sub = app.add_subcommand("simulate", "Run the model in the time domain; writes timeseries.csv and metrics.json");
+  auto* sub = app.add_subcommand(
+      "simulate", "Run the model in the time domain; writes timeseries.csv and metrics.json");
   sub->add_option("--model", a->model, "Model file (TOML); default: the built-in MDMA model");
-  sub->add_option("--temperature", a->temperature_C, "Operating temperature [degC]")->capture_default_str();
-  sub->add_option("--waveform-kind", a->kind, "Current waveform: sine (biased, Fig. 11), dc, step, chirp")
-      ->check(CLI::IsMember({"sine", "dc", "step", "chirp"}))->capture_default_str();
-  sub->add_option("--current-pp", a->pp_A, "Biased sine: current peak-to-peak [A]")->capture_default_str();
-  sub->add_option("--current-min", a->min_A, "Biased sine: current minimum [A] (paper: -3 A)")->capture_default_str();
-  sub->add_option("--frequency", a->frequency_Hz, "Biased sine: frequency [Hz]")->capture_default_str();
-  sub->add_option("--periods", a->periods, "Biased sine: number of periods to run [-]; metrics use the last")->capture_default_str();
-  sub->add_option("--level", a->level_A, "DC level, or step initial level [A]")->capture_default_str();
-  sub->add_option("--step-to", a->step_to_A, "Step: level after the step [A]")->capture_default_str();
-  sub->add_option("--step-time", a->step_time_s, "Step: time of the step [s]")->capture_default_str();
+  sub->add_option("--temperature", a->temperature_C, "Operating temperature [degC]")
+      ->capture_default_str();
+  sub->add_option("--waveform-kind", a->kind,
+                  "Current waveform: sine (biased, Fig. 11), dc, step, chirp")
+      ->check(CLI::IsMember({"sine", "dc", "step", "chirp"}))
+      ->capture_default_str();
+  sub->add_option("--current-pp", a->pp_A, "Biased sine: current peak-to-peak [A]")
+      ->capture_default_str();
+  sub->add_option("--current-min", a->min_A, "Biased sine: current minimum [A] (paper: -3 A)")
+      ->capture_default_str();
+  sub->add_option("--frequency", a->frequency_Hz, "Biased sine: frequency [Hz]")
+      ->capture_default_str();
+  sub->add_option("--periods", a->periods,
+                  "Biased sine: number of periods to run [-]; metrics use the last")
+      ->capture_default_str();
+  sub->add_option("--level", a->level_A, "DC level, or step initial level [A]")
+      ->capture_default_str();
+  sub->add_option("--step-to", a->step_to_A, "Step: level after the step [A]")
+      ->capture_default_str();
+  sub->add_option("--step-time", a->step_time_s, "Step: time of the step [s]")
+      ->capture_default_str();
   sub->add_option("--f0", a->f0_Hz, "Chirp: start frequency [Hz]")->capture_default_str();
   sub->add_option("--f1", a->f1_Hz, "Chirp: end frequency [Hz]")->capture_default_str();
-  sub->add_option("--amplitude", a->amplitude_A, "Chirp: current amplitude [A]")->capture_default_str();
+  sub->add_option("--amplitude", a->amplitude_A, "Chirp: current amplitude [A]")
+      ->capture_default_str();
   sub->add_option("--offset", a->offset_A, "Chirp: current offset [A]")->capture_default_str();
-  sub->add_option("--duration", a->duration_s, "Run length for dc/step/chirp/CSV waveforms [s] (CSV: default its last time)")->capture_default_str();
-  sub->add_option("--waveform", a->waveform_csv, "Arbitrary current waveform, CSV with header t_s,current_A [s, A]");
-  sub->add_option("--dt", a->dt_s, "Time step [s]; 0 = automatic rule (T/2000, at most 10 us)")->capture_default_str();
-  sub->add_option("--record-every", a->record_every, "Record every N-th step [-]")->capture_default_str();
-  sub->add_option("--quantity", a->quantities, "Also report RMS, peak, p-p and mean of these columns (e.g. rod1_F_N) [column units]");
+  sub->add_option("--duration", a->duration_s,
+                  "Run length for dc/step/chirp/CSV waveforms [s] (CSV: default its last time)")
+      ->capture_default_str();
+  sub->add_option("--waveform", a->waveform_csv,
+                  "Arbitrary current waveform, CSV with header t_s,current_A [s, A]");
+  sub->add_option("--dt", a->dt_s, "Time step [s]; 0 = automatic rule (T/2000, at most 10 us)")
+      ->capture_default_str();
+  sub->add_option("--record-every", a->record_every, "Record every N-th step [-]")
+      ->capture_default_str();
+  sub->add_option(
+      "--quantity", a->quantities,
+      "Also report RMS, peak, p-p and mean of these columns (e.g. rod1_F_N) [column units]");
   sub->add_option("--out", a->out, "Output directory")->capture_default_str();
   return [a, sub]() -> int { return sub->parsed() ? run_simulate(*a) : -1; };
 }

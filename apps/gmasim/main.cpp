@@ -1,8 +1,8 @@
 // gmasim: command-line front end. Exit codes: 0 ok, 1 usage, 2 bad input,
 // 3 numerical divergence (partial output written), 4 internal error.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 #include <vector>
@@ -12,7 +12,9 @@
 
 namespace gmasim::cli {
 
-void print_error(const std::string& what) { std::fprintf(stderr, "gmasim: error: %s\n", what.c_str()); }
+void print_error(const std::string& what) {
+  std::fprintf(stderr, "gmasim: error: %s\n", what.c_str());
+}
 
 std::string model_label(const std::string& path) {
   return path.empty() ? std::string("models/mdma.toml (built-in)") : path;

@@ -27,12 +27,12 @@ namespace gmasim {
 
 struct CircuitBranch {
   std::string name;
-  int from = -1;              // node index, -1 = reference
-  int to = -1;                // node index, -1 = reference
+  int from = -1;                        // node index, -1 = reference
+  int to = -1;                          // node index, -1 = reference
   double fixed_reluctance_per_H = 0.0;  // used when rod < 0
-  int rod = -1;               // index of the rod whose reluctance (eq. 2) this branch is
-  double coil_turns = 0.0;    // MMF contribution N * I [A-turns per A]
-  double pm_mmf_At = 0.0;     // permanent-magnet MMF F_pm at T0 [A-turns], scaled by eq. (1)
+  int rod = -1;                         // index of the rod whose reluctance (eq. 2) this branch is
+  double coil_turns = 0.0;              // MMF contribution N * I [A-turns per A]
+  double pm_mmf_At = 0.0;  // permanent-magnet MMF F_pm at T0 [A-turns], scaled by eq. (1)
 };
 
 // Precomputed pieces of the low-rank (Woodbury) solve, see above.
@@ -47,11 +47,11 @@ struct LowRank {
 };
 
 struct Circuit {
-  std::vector<std::string> node_names;   // non-reference nodes, index = position
+  std::vector<std::string> node_names;  // non-reference nodes, index = position
   std::string reference_node;
   std::vector<CircuitBranch> branches;
-  std::vector<int> rod_branch;           // rod index -> branch index
-  Eigen::MatrixXd fixed_laplacian;       // contribution of the fixed-reluctance branches
+  std::vector<int> rod_branch;      // rod index -> branch index
+  Eigen::MatrixXd fixed_laplacian;  // contribution of the fixed-reluctance branches
   LowRank lowrank;
 
   int node_count() const { return static_cast<int>(node_names.size()); }
@@ -71,7 +71,7 @@ struct CircuitWorkspace {
   Eigen::MatrixXd G;
   Eigen::VectorXd rhs;  // holds the node potentials psi after a solve
   Eigen::LLT<Eigen::MatrixXd> llt;
-  SmallMatrix K;        // low-rank path: D^-1 + S
+  SmallMatrix K;  // low-rank path: D^-1 + S
   SmallVector v, z, F_rod;
   Eigen::LLT<SmallMatrix> small_llt;
   std::vector<double> reluctance;  // per branch, this step [1/H]
@@ -82,10 +82,11 @@ struct CircuitWorkspace {
 };
 
 // Solves the circuit for the given rod reluctances, coil current and PM MMF (already
-// temperature-scaled by eq. 1). Fills ws.phi. Allocation-free once ws is sized.
-// Returns false if the nodal matrix is not positive definite.
-bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_H,
-                   double current_A, double pm_scale, CircuitWorkspace& ws);
+// temperature-scaled by eq. 1). Fills ws.phi for every branch, or for the rod branches
+// only when all_branches is false (the step needs no more). Allocation-free once ws is
+// sized. Returns false if the nodal matrix is not positive definite.
+bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_H, double current_A,
+                   double pm_scale, CircuitWorkspace& ws, bool all_branches = true);
 // The same solve, always by factorising the full nodal matrix (reference for tests).
 bool solve_circuit_full(const Circuit& c, std::span<const double> rod_reluctance_per_H,
                         double current_A, double pm_scale, CircuitWorkspace& ws);

@@ -42,9 +42,9 @@ struct ModelSpec {
   std::vector<std::string> nodes;  // circuit.nodes: the non-reference nodes
   long nodes_line = 0;
   std::vector<SpecBranch> branches;
-  std::vector<std::string> flux_sensor_branches;  // sensor.flux_branches
-  std::vector<std::string> element_names;         // mechanics.elements.*
-  std::vector<std::string> sleeve_names;          // mechanics.sleeves.*
+  std::vector<std::string> flux_sensor_branches;           // sensor.flux_branches
+  std::vector<std::string> element_names;                  // mechanics.elements.*
+  std::vector<std::string> sleeve_names;                   // mechanics.sleeves.*
   std::map<std::string, std::vector<std::string>> chains;  // rod -> load chain (eq. 18/27/28)
 
   double get(const std::string& dotted) const;        // throws InputError if unknown
@@ -70,13 +70,13 @@ struct Options {
 // One switch per temperature law: a frozen law is evaluated at the reference
 // temperature T_r (20 degC) whatever the operating temperature. Used by ablation.
 struct Freeze {
-  bool pm_mmf = false;         // eq. (1)
-  bool permeability = false;   // eq. (3)-(4) inside mu_G (and the eddy tau through mu_G)
-  bool resistivity = false;    // eq. (8)
-  bool magnetisation = false;  // eq. (10) JA coefficients, M_s^T of eq. (9) and (11)
-  bool modulus = false;        // eq. (13) E_G (its M_s^T and beta dT terms)
-  bool sleeve_modulus = false; // eq. (19) E_t^T
-  bool geometry = false;       // thermal expansion of lengths and areas
+  bool pm_mmf = false;          // eq. (1)
+  bool permeability = false;    // eq. (3)-(4) inside mu_G (and the eddy tau through mu_G)
+  bool resistivity = false;     // eq. (8)
+  bool magnetisation = false;   // eq. (10) JA coefficients, M_s^T of eq. (9) and (11)
+  bool modulus = false;         // eq. (13) E_G (its M_s^T and beta dT terms)
+  bool sleeve_modulus = false;  // eq. (19) E_t^T
+  bool geometry = false;        // thermal expansion of lengths and areas
 };
 
 // ---------------------------------------------------------------------------------------
@@ -89,8 +89,8 @@ struct JaReference {
 struct RodModel {
   std::string name;
   double length_m, r_outer_m, r_inner_m, mass_kg;
-  double k_f, k_j;                 // eq. (7) flux-leakage and eddy-current factors
-  double damping_N_s_per_m;        // c_i of eq. (25)
+  double k_f, k_j;           // eq. (7) flux-leakage and eddy-current factors
+  double damping_N_s_per_m;  // c_i of eq. (25)
   JaReference ja;
 };
 
@@ -99,12 +99,12 @@ struct Material {  // Terfenol-D, shared by the rods
   double beta_per_K, chi_m, x_exponent, alpha_thermal_per_K;
 };
 
-struct ChainElementModel {   // a magnetizer, output rod or disk spring: constant m, k, c
+struct ChainElementModel {  // a magnetizer, output rod or disk spring: constant m, k, c
   std::string name;
   double mass_kg, stiffness_N_per_m, damping_N_s_per_m;
 };
 
-struct SleeveModel {         // eq. (19)
+struct SleeveModel {  // eq. (19)
   std::string name;
   double mass_kg, damping_N_s_per_m;
   std::array<double, 3> lengths_m, areas_m2;
@@ -124,8 +124,8 @@ struct Model {
   Circuit circuit;
   std::vector<int> flux_sensor_branches;
   double flux_sensor_area_m2 = 0.0;
-  double T_ref_C = 20.0;              // T_0 of eq. (1), (8); T_r of eq. (4)
-  double preload_N = 0.0;             // disk-spring preload through the rod stack
+  double T_ref_C = 20.0;   // T_0 of eq. (1), (8); T_r of eq. (4)
+  double preload_N = 0.0;  // disk-spring preload through the rod stack
   double alpha_pm1_per_K = 0.0, alpha_pm2_per_K2 = 0.0;
   double Et_Pa = 0.0, dEt_dT_Pa_per_C = 0.0;  // eq. (19) law
   std::vector<ChainElementModel> elements;
@@ -146,14 +146,14 @@ Model compile(const ModelSpec& spec);
 // ---------------------------------------------------------------------------------------
 struct RodConditions {
   double length_m, area_m2, r_outer_m, r_inner_m;
-  double MsT_mu, MsT_ja, MsT_E;     // M_s^T of eq. (4) as seen by eq. (3), (9)/(11), (13)
-  double S_mu_J_per_m3;             // stress term of eq. (3)
-  physics::DeltaETerms dE;          // eq. (13) constants
-  physics::JaCoefficients ja;       // eq. (10) at T
-  double rho_ohm_m;                 // eq. (8)
-  double eddy_geometry_s_m_per_H;   // tau = mu * this  (eq. 7)
-  double sigma_Pa;                  // signed prestress used in eq. (3), (6), (13)
-  double sigma_p_Pa;                // compressive prestress magnitude of eq. (11)
+  double MsT_mu, MsT_ja, MsT_E;    // M_s^T of eq. (4) as seen by eq. (3), (9)/(11), (13)
+  double S_mu_J_per_m3;            // stress term of eq. (3)
+  physics::DeltaETerms dE;         // eq. (13) constants
+  physics::JaCoefficients ja;      // eq. (10) at T
+  double rho_ohm_m;                // eq. (8)
+  double eddy_geometry_s_m_per_H;  // tau = mu * this  (eq. 7)
+  double sigma_Pa;                 // signed prestress used in eq. (3), (6), (13)
+  double sigma_p_Pa;               // compressive prestress magnitude of eq. (11)
   double k_f, k_j;
   double mass_osc_kg;               // eq. (24) + (27)
   double damping_osc_N_s_per_m;     // eq. (25) + (28)
@@ -165,11 +165,11 @@ struct RodConditions {
 struct Conditions {
   double temperature_C;
   Freeze freeze;
-  double pm_scale;            // F_pm^T / F_pm, eq. (1)
-  double Et_Pa;               // eq. (19) modulus
+  double pm_scale;  // F_pm^T / F_pm, eq. (1)
+  double Et_Pa;     // eq. (19) modulus
   std::vector<double> sleeve_stiffness_N_per_m;
   std::vector<RodConditions> rods;
-  double thermal_expansion_m; // eq. (21)
+  double thermal_expansion_m;  // eq. (21)
 };
 
 // Throws InputError if the temperature is at/above T_c or below absolute zero.
@@ -184,10 +184,10 @@ struct RodState {
   double Mirr_A_per_m = 0;  // irreversible magnetisation (eq. 9)
   double x_m = 0, v_m_per_s = 0;
   // kept for the next step (hold values, warm starts)
-  double Hc_A_per_m = 0;    // static field of eq. (7) at the end of the last step
-  double M_A_per_m = 0;     // total magnetisation consistent with (H, M_irr)
+  double Hc_A_per_m = 0;  // static field of eq. (7) at the end of the last step
+  double M_A_per_m = 0;   // total magnetisation consistent with (H, M_irr)
   double M_prev_A_per_m = 0;
-  double F_N = 0;           // force at the end of the last step
+  double F_N = 0;  // force at the end of the last step
   // reported
   double mu_r = 1, E_Pa = 0, lambda = 0, tau_s = 0, phi_Wb = 0, k_rod_N_per_m = 0,
          k_load_N_per_m = 0;
@@ -196,8 +196,8 @@ struct RodState {
 struct State {
   double t_s = 0;
   double current_A = 0;
-  double y_m = 0;     // total output x1 + x2 + x3 (+ x_T if the option says so)
-  double B_T = 0;     // flux density seen by the induction coil
+  double y_m = 0;  // total output x1 + x2 + x3 (+ x_T if the option says so)
+  double B_T = 0;  // flux density seen by the induction coil
   std::vector<RodState> rods;
   CircuitWorkspace circuit;
   std::vector<double> rod_reluctance;

@@ -43,10 +43,10 @@ Waveform biased_sine(double pp_A, double frequency_Hz, double min_A = -3.0);
 struct SimulationSettings {
   double temperature_C = 20.0;
   Waveform waveform;
-  double periods = 3.0;        // run length for periodic waveforms
-  double duration_s = 0.0;     // run length for the others (Table: its last time if 0)
-  double dt_s = 0.0;           // 0: the automatic rule, auto_dt()
-  int record_every = 1;        // decimation of the recorded time series
+  double periods = 3.0;     // run length for periodic waveforms
+  double duration_s = 0.0;  // run length for the others (Table: its last time if 0)
+  double dt_s = 0.0;        // 0: the automatic rule, auto_dt()
+  int record_every = 1;     // decimation of the recorded time series
   Freeze freeze;
 };
 
@@ -67,14 +67,14 @@ struct TimeSeries {
 
 struct Metrics {
   double window_start_s = 0, window_end_s = 0;  // the last whole period
-  double stroke_um = 0;       // peak-to-peak of y
-  double hysteresis_um = 0;   // max |y_rising - y_falling| at equal current
-  double B_pp_T = 0;          // peak-to-peak of B
+  double stroke_um = 0;                         // peak-to-peak of y
+  double hysteresis_um = 0;                     // max |y_rising - y_falling| at equal current
+  double B_pp_T = 0;                            // peak-to-peak of B
   double y_mean_um = 0;
 };
 
 struct QuantityStats {
-  std::string name;     // a column of the series, e.g. "rod1_F_N"
+  std::string name;  // a column of the series, e.g. "rod1_F_N"
   double rms = 0, peak = 0, pp = 0, mean = 0;
 };
 
@@ -82,12 +82,12 @@ struct Result {
   TimeSeries series;
   std::vector<QuantityStats> quantities;  // filled by add_quantity_stats()
   Metrics metrics;
-  bool has_metrics = false;   // periodic runs only
+  bool has_metrics = false;  // periodic runs only
   double dt_s = 0;
   long steps = 0;
   double wall_time_s = 0;
   bool diverged = false;
-  std::string error;          // DivergenceError message when diverged
+  std::string error;  // DivergenceError message when diverged
   double thermal_expansion_um = 0;
 };
 
@@ -105,7 +105,7 @@ double hysteresis_width(const std::vector<double>& current_A, const std::vector<
                         std::size_t begin, std::size_t end);
 
 struct RmsPeak {
-  double rms = 0, peak = 0;   // RMS of the signal; peak of its absolute value
+  double rms = 0, peak = 0;  // RMS of the signal; peak of its absolute value
 };
 RmsPeak rms_and_peak(const std::vector<double>& v, std::size_t begin, std::size_t end);
 

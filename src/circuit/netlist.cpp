@@ -16,7 +16,8 @@ void finalize_circuit(Circuit& c, int rod_count, const std::string& where) {
   for (int i = 0; i <= n; ++i) parent[static_cast<std::size_t>(i)] = i;
   auto find = [&](int i) {
     while (parent[static_cast<std::size_t>(i)] != i) {
-      parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+      parent[static_cast<std::size_t>(i)] =
+          parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
       i = parent[static_cast<std::size_t>(i)];
     }
     return i;
@@ -25,15 +26,22 @@ void finalize_circuit(Circuit& c, int rod_count, const std::string& where) {
   for (std::size_t b = 0; b < c.branches.size(); ++b) {
     const auto& br = c.branches[b];
     if (br.from == br.to)
-      throw InputError(located(where, 0, fmt::format("circuit branch '{}' starts and ends at the same node", br.name)));
+      throw InputError(located(
+          where, 0, fmt::format("circuit branch '{}' starts and ends at the same node", br.name)));
     if (br.rod >= 0) {
       if (br.rod >= rod_count)
-        throw InputError(located(where, 0, fmt::format("circuit branch '{}' names rod index {} of {}", br.name, br.rod, rod_count)));
+        throw InputError(located(where, 0,
+                                 fmt::format("circuit branch '{}' names rod index {} of {}",
+                                             br.name, br.rod, rod_count)));
       if (c.rod_branch[static_cast<std::size_t>(br.rod)] >= 0)
-        throw InputError(located(where, 0, fmt::format("rod index {} appears in two circuit branches", br.rod)));
+        throw InputError(
+            located(where, 0, fmt::format("rod index {} appears in two circuit branches", br.rod)));
       c.rod_branch[static_cast<std::size_t>(br.rod)] = static_cast<int>(b);
     } else if (!(br.fixed_reluctance_per_H > 0.0)) {
-      throw InputError(located(where, 0, fmt::format("circuit branch '{}' has reluctance {} 1/H; it must be > 0", br.name, br.fixed_reluctance_per_H)));
+      throw InputError(
+          located(where, 0,
+                  fmt::format("circuit branch '{}' has reluctance {} 1/H; it must be > 0", br.name,
+                              br.fixed_reluctance_per_H)));
     }
     parent[static_cast<std::size_t>(find(idx(br.from)))] = find(idx(br.to));
   }
@@ -42,7 +50,11 @@ void finalize_circuit(Circuit& c, int rod_count, const std::string& where) {
       throw InputError(located(where, 0, fmt::format("rod index {} is in no circuit branch", r)));
   for (int i = 0; i < n; ++i)
     if (find(i) != find(n))
-      throw InputError(located(where, 0, fmt::format("circuit node '{}' is floating: no path of branches joins it to the reference node '{}'", c.node_names[static_cast<std::size_t>(i)], c.reference_node)));
+      throw InputError(
+          located(where, 0,
+                  fmt::format("circuit node '{}' is floating: no path of branches joins it to the "
+                              "reference node '{}'",
+                              c.node_names[static_cast<std::size_t>(i)], c.reference_node)));
 
   c.fixed_laplacian = Eigen::MatrixXd::Zero(n, n);
   for (const auto& br : c.branches) {
@@ -63,15 +75,22 @@ void finalize_circuit(Circuit& c, int rod_count, const std::string& where) {
   Eigen::MatrixXd B = Eigen::MatrixXd::Zero(n, k);
   Eigen::VectorXd b_coil = Eigen::VectorXd::Zero(n), b_pm = Eigen::VectorXd::Zero(n);
   for (int r = 0; r < k; ++r) {
-    const auto& br = c.branches[static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)])];
+    const auto& br =
+        c.branches[static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)])];
     if (br.from >= 0) B(br.from, r) += 1.0;
     if (br.to >= 0) B(br.to, r) -= 1.0;
   }
   for (const auto& br : c.branches) {
     if (br.rod >= 0) continue;
     const double g = 1.0 / br.fixed_reluctance_per_H;
-    if (br.from >= 0) { b_coil(br.from) -= br.coil_turns * g; b_pm(br.from) -= br.pm_mmf_At * g; }
-    if (br.to >= 0) { b_coil(br.to) += br.coil_turns * g; b_pm(br.to) += br.pm_mmf_At * g; }
+    if (br.from >= 0) {
+      b_coil(br.from) -= br.coil_turns * g;
+      b_pm(br.from) -= br.pm_mmf_At * g;
+    }
+    if (br.to >= 0) {
+      b_coil(br.to) += br.coil_turns * g;
+      b_pm(br.to) += br.pm_mmf_At * g;
+    }
   }
   auto& L = c.lowrank;
   L.W = llt0.solve(B);
@@ -100,30 +119,79 @@ void CircuitWorkspace::resize(const Circuit& c) {
   phi.assign(c.branches.size(), 0.0);
 }
 
-bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_H,
-                   double current_A, double pm_scale, CircuitWorkspace& ws) {
+namespace {
+
+// (D^-1 + S) z = v for the k rods; fixed-size Eigen factorisations for the common small k.
+template <int K>
+void solve_small_fixed(const SmallMatrix& A, const SmallVector& b, SmallVector& x) {
+  const Eigen::Matrix<double, K, K> Af = A.topLeftCorner<K, K>();
+  const Eigen::Matrix<double, K, 1> bf = b.head<K>();
+  x.head<K>() = Af.llt().solve(bf);
+}
+
+bool solve_small(CircuitWorkspace& ws) {
+  switch (ws.K.rows()) {
+    case 1:
+      ws.z(0) = ws.v(0) / ws.K(0, 0);
+      return ws.K(0, 0) > 0.0;
+    case 2:
+      solve_small_fixed<2>(ws.K, ws.v, ws.z);
+      break;
+    case 3:
+      solve_small_fixed<3>(ws.K, ws.v, ws.z);
+      break;
+    case 4:
+      solve_small_fixed<4>(ws.K, ws.v, ws.z);
+      break;
+    default:
+      ws.small_llt.compute(ws.K);
+      if (ws.small_llt.info() != Eigen::Success) return false;
+      ws.z = ws.v;
+      ws.small_llt.solveInPlace(ws.z);
+  }
+  return ws.z.allFinite();
+}
+
+}  // namespace
+
+bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_H, double current_A,
+                   double pm_scale, CircuitWorkspace& ws, bool all_branches) {
   const LowRank& L = c.lowrank;
   if (!L.enabled) return solve_circuit_full(c, rod_reluctance_per_H, current_A, pm_scale, ws);
   // With g = diag(1/R_rod), F the rods' own MMFs, u = I psi_coil + pm psi_pm:
   //   v = B^T u - S D F,  (D^-1 + S) z = v,  psi = u - W (D F + z).
   const int k = static_cast<int>(c.rod_branch.size());
   for (int r = 0; r < k; ++r) {
-    const auto& br = c.branches[static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)])];
-    ws.F_rod(r) = (br.coil_turns * current_A + br.pm_mmf_At * pm_scale) / rod_reluctance_per_H[static_cast<std::size_t>(r)];  // D F
+    const auto& br =
+        c.branches[static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)])];
+    ws.F_rod(r) = (br.coil_turns * current_A + br.pm_mmf_At * pm_scale) /
+                  rod_reluctance_per_H[static_cast<std::size_t>(r)];  // D F
   }
   ws.v.noalias() = current_A * L.Bt_psi_coil + pm_scale * L.Bt_psi_pm;
   ws.v.noalias() -= L.S * ws.F_rod;
   ws.K = L.S;
   for (int r = 0; r < k; ++r) ws.K(r, r) += rod_reluctance_per_H[static_cast<std::size_t>(r)];
-  ws.small_llt.compute(ws.K);
-  if (ws.small_llt.info() != Eigen::Success) return false;
-  ws.z = ws.v;
-  ws.small_llt.solveInPlace(ws.z);
+  if (!solve_small(ws)) return false;
   ws.z += ws.F_rod;  // D F + z
+  if (!all_branches) {
+    // Rod fluxes need only the potential drops across the rods:
+    //   B^T psi = B^T u - S (D F + z),  phi_r = (drop_r + F_r) / R_r.
+    ws.v.noalias() = current_A * L.Bt_psi_coil + pm_scale * L.Bt_psi_pm;
+    ws.v.noalias() -= L.S * ws.z;
+    for (int r = 0; r < k; ++r) {
+      const auto b = static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)]);
+      const auto& br = c.branches[b];
+      const double R = rod_reluctance_per_H[static_cast<std::size_t>(r)];
+      const double F = br.coil_turns * current_A + br.pm_mmf_At * pm_scale;
+      ws.reluctance[b] = R;
+      ws.mmf[b] = F;
+      ws.phi[b] = (ws.v(r) + F) / R;
+    }
+    return true;
+  }
   ws.rhs.noalias() = current_A * L.psi_coil + pm_scale * L.psi_pm;
   ws.rhs.noalias() -= L.W * ws.z;
-  const std::size_t nb = c.branches.size();
-  for (std::size_t b = 0; b < nb; ++b) {
+  auto flux = [&](std::size_t b) {
     const auto& br = c.branches[b];
     const double R = br.rod >= 0 ? rod_reluctance_per_H[static_cast<std::size_t>(br.rod)]
                                  : br.fixed_reluctance_per_H;
@@ -133,7 +201,8 @@ bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_
     const double pf = br.from >= 0 ? ws.rhs(br.from) : 0.0;
     const double pt = br.to >= 0 ? ws.rhs(br.to) : 0.0;
     ws.phi[b] = (pf - pt + F) / R;
-  }
+  };
+  for (std::size_t b = 0; b < c.branches.size(); ++b) flux(b);
   return true;
 }
 

@@ -41,18 +41,35 @@ struct Reader {
 Options read_options(const Reader& r) {
   Options o;
   const std::string ss = r.opt("stress_sign");
-  if (ss == "compression_negative") o.stress_sign = StressSign::CompressionNegative;
-  else if (ss == "compression_positive") o.stress_sign = StressSign::CompressionPositive;
-  else r.fail(r.opt_line("stress_sign"), fmt::format("options.stress_sign = '{}': must be compression_negative or compression_positive", ss));
+  if (ss == "compression_negative")
+    o.stress_sign = StressSign::CompressionNegative;
+  else if (ss == "compression_positive")
+    o.stress_sign = StressSign::CompressionPositive;
+  else
+    r.fail(r.opt_line("stress_sign"),
+           fmt::format(
+               "options.stress_sign = '{}': must be compression_negative or compression_positive",
+               ss));
   const std::string sc = r.opt("eq10_temperature_scale");
-  if (sc == "room_referenced") o.eq10_scale = Eq10Scale::RoomReferenced;
-  else if (sc == "kelvin") o.eq10_scale = Eq10Scale::Kelvin;
-  else if (sc == "celsius") o.eq10_scale = Eq10Scale::Celsius;
-  else r.fail(r.opt_line("eq10_temperature_scale"), fmt::format("options.eq10_temperature_scale = '{}': must be room_referenced, kelvin or celsius", sc));
+  if (sc == "room_referenced")
+    o.eq10_scale = Eq10Scale::RoomReferenced;
+  else if (sc == "kelvin")
+    o.eq10_scale = Eq10Scale::Kelvin;
+  else if (sc == "celsius")
+    o.eq10_scale = Eq10Scale::Celsius;
+  else
+    r.fail(r.opt_line("eq10_temperature_scale"),
+           fmt::format(
+               "options.eq10_temperature_scale = '{}': must be room_referenced, kelvin or celsius",
+               sc));
   const std::string sl = r.opt("eq10_shape_law");
-  if (sl == "printed") o.shape_law = ShapeLaw::Printed;
-  else if (sl == "mean_field") o.shape_law = ShapeLaw::MeanField;
-  else r.fail(r.opt_line("eq10_shape_law"), fmt::format("options.eq10_shape_law = '{}': must be printed or mean_field", sl));
+  if (sl == "printed")
+    o.shape_law = ShapeLaw::Printed;
+  else if (sl == "mean_field")
+    o.shape_law = ShapeLaw::MeanField;
+  else
+    r.fail(r.opt_line("eq10_shape_law"),
+           fmt::format("options.eq10_shape_law = '{}': must be printed or mean_field", sl));
   o.thermal_expansion_in_output = r.boolean("thermal_expansion_in_output");
   o.geometry_thermal_expansion = r.boolean("geometry_thermal_expansion");
   return o;
@@ -80,7 +97,10 @@ Model compile(const ModelSpec& spec) {
   mat.alpha_thermal_per_K = r.num("material.alpha_thermal_per_K");
   m.T_ref_C = r.num("reference.T_ref_C");
   if (!(mat.Tc_C > m.T_ref_C))
-    r.fail(spec.line_of("material.Tc_C"), fmt::format("material.Tc_C = {} degC: the Curie temperature must exceed reference.T_ref_C = {} degC", mat.Tc_C, m.T_ref_C));
+    r.fail(spec.line_of("material.Tc_C"),
+           fmt::format("material.Tc_C = {} degC: the Curie temperature must exceed "
+                       "reference.T_ref_C = {} degC",
+                       mat.Tc_C, m.T_ref_C));
   m.preload_N = r.num("preload.force_N");
   m.alpha_pm1_per_K = r.num("magnet.alpha_pm1_per_K");
   m.alpha_pm2_per_K2 = r.num("magnet.alpha_pm2_per_K2");
@@ -95,13 +115,16 @@ Model compile(const ModelSpec& spec) {
     rod.r_outer_m = 0.5 * r.num(name + ".outer_diameter_m");
     rod.r_inner_m = 0.5 * r.num(name + ".inner_diameter_m");
     if (!(rod.r_inner_m < rod.r_outer_m) || rod.r_inner_m < 0)
-      r.fail(spec.line_of(name + ".inner_diameter_m"), fmt::format("{}.inner_diameter_m = {} m: must be >= 0 and below outer_diameter_m = {} m", name, 2 * rod.r_inner_m, 2 * rod.r_outer_m));
+      r.fail(
+          spec.line_of(name + ".inner_diameter_m"),
+          fmt::format("{}.inner_diameter_m = {} m: must be >= 0 and below outer_diameter_m = {} m",
+                      name, 2 * rod.r_inner_m, 2 * rod.r_outer_m));
     rod.mass_kg = r.num(name + ".mass_kg");
     rod.k_f = r.num(name + ".k_f");
     rod.k_j = r.num(name + ".k_j");
     rod.damping_N_s_per_m = r.num(name + ".damping_N_s_per_m");
     rod.ja = {r.num(name + ".ja.a0_A_per_m"), r.num(name + ".ja.alpha0"), r.num(name + ".ja.c0"),
-              r.num(name + ".ja.k0_A_per_m"), r.num(name + ".ja.beta1"), r.num(name + ".ja.beta2"),
+              r.num(name + ".ja.k0_A_per_m"), r.num(name + ".ja.beta1"),  r.num(name + ".ja.beta2"),
               r.num(name + ".ja.beta3")};
     m.rods.push_back(rod);
   }
@@ -116,12 +139,15 @@ Model compile(const ModelSpec& spec) {
   c.node_names = spec.nodes;
   for (const auto& n : spec.nodes)
     if (n == spec.reference_node)
-      r.fail(spec.nodes_line, fmt::format("circuit.nodes lists the reference node '{}'; list only the others", n));
+      r.fail(spec.nodes_line,
+             fmt::format("circuit.nodes lists the reference node '{}'; list only the others", n));
   auto node_index = [&](const std::string& name, const SpecBranch& b) -> int {
     if (name == spec.reference_node) return -1;
     auto it = std::find(spec.nodes.begin(), spec.nodes.end(), name);
     if (it == spec.nodes.end())
-      r.fail(b.line, fmt::format("circuit branch '{}' names node '{}', which is neither in circuit.nodes nor the reference node '{}'", b.name, name, spec.reference_node));
+      r.fail(b.line, fmt::format("circuit branch '{}' names node '{}', which is neither in "
+                                 "circuit.nodes nor the reference node '{}'",
+                                 b.name, name, spec.reference_node));
     return static_cast<int>(it - spec.nodes.begin());
   };
   for (const auto& b : spec.branches) {
@@ -131,9 +157,12 @@ Model compile(const ModelSpec& spec) {
     cb.to = node_index(b.to, b);
     if (!b.rod.empty()) {
       cb.rod = rod_index(b.rod);
-      if (cb.rod < 0) r.fail(b.line, fmt::format("circuit branch '{}' names rod '{}', which is not in stack.rods", b.name, b.rod));
+      if (cb.rod < 0)
+        r.fail(b.line, fmt::format("circuit branch '{}' names rod '{}', which is not in stack.rods",
+                                   b.name, b.rod));
     } else {
-      for (const auto& s : b.series) cb.fixed_reluctance_per_H += r.num("circuit.reluctances_per_H." + s);
+      for (const auto& s : b.series)
+        cb.fixed_reluctance_per_H += r.num("circuit.reluctances_per_H." + s);
     }
     cb.coil_turns = r.num_or_zero("circuit.branches." + b.name + ".coil_turns");
     cb.pm_mmf_At = r.num_or_zero("circuit.branches." + b.name + ".pm_mmf_At");
@@ -143,9 +172,14 @@ Model compile(const ModelSpec& spec) {
 
   // Flux sensor.
   for (const auto& name : spec.flux_sensor_branches) {
-    auto it = std::find_if(c.branches.begin(), c.branches.end(), [&](const CircuitBranch& b) { return b.name == name; });
-    if (it == c.branches.end()) r.fail(0, fmt::format("sensor.flux_branches names unknown branch '{}'", name));
-    if (it->rod < 0) r.fail(0, fmt::format("sensor.flux_branches: branch '{}' is not a rod branch; the coil's flux density is the rod flux over the rod area", name));
+    auto it = std::find_if(c.branches.begin(), c.branches.end(),
+                           [&](const CircuitBranch& b) { return b.name == name; });
+    if (it == c.branches.end())
+      r.fail(0, fmt::format("sensor.flux_branches names unknown branch '{}'", name));
+    if (it->rod < 0)
+      r.fail(0, fmt::format("sensor.flux_branches: branch '{}' is not a rod branch; the coil's "
+                            "flux density is the rod flux over the rod area",
+                            name));
     m.flux_sensor_branches.push_back(static_cast<int>(it - c.branches.begin()));
   }
   if (m.flux_sensor_branches.empty()) r.fail(0, "sensor.flux_branches is empty");
@@ -153,7 +187,8 @@ Model compile(const ModelSpec& spec) {
   // Mechanics.
   for (const auto& e : spec.element_names) {
     const std::string p = "mechanics.elements." + e + ".";
-    m.elements.push_back({e, r.num(p + "mass_kg"), r.num(p + "stiffness_N_per_m"), r.num(p + "damping_N_s_per_m")});
+    m.elements.push_back(
+        {e, r.num(p + "mass_kg"), r.num(p + "stiffness_N_per_m"), r.num(p + "damping_N_s_per_m")});
   }
   m.Et_Pa = r.num("mechanics.sleeve_modulus.Et_Pa");
   m.dEt_dT_Pa_per_C = r.num("mechanics.sleeve_modulus.dEt_dT_Pa_per_C");
@@ -171,27 +206,40 @@ Model compile(const ModelSpec& spec) {
   m.chains.resize(m.rods.size());
   for (std::size_t i = 0; i < m.rods.size(); ++i) {
     auto it = spec.chains.find(m.rods[i].name);
-    if (it == spec.chains.end()) r.fail(0, fmt::format("mechanics.chains has no entry for rod '{}'", m.rods[i].name));
+    if (it == spec.chains.end())
+      r.fail(0, fmt::format("mechanics.chains has no entry for rod '{}'", m.rods[i].name));
     for (const auto& name : it->second) {
       ChainLink link{ChainLink::Element, -1};
-      auto e = std::find_if(m.elements.begin(), m.elements.end(), [&](auto& x) { return x.name == name; });
-      auto s = std::find_if(m.sleeves.begin(), m.sleeves.end(), [&](auto& x) { return x.name == name; });
-      if (e != m.elements.end()) link = {ChainLink::Element, static_cast<int>(e - m.elements.begin())};
-      else if (s != m.sleeves.end()) link = {ChainLink::Sleeve, static_cast<int>(s - m.sleeves.begin())};
-      else if (rod_index(name) >= 0) link = {ChainLink::Rod, rod_index(name)};
-      else r.fail(0, fmt::format("mechanics.chains.{} names '{}', which is no element, sleeve or rod", m.rods[i].name, name));
+      auto e = std::find_if(m.elements.begin(), m.elements.end(),
+                            [&](auto& x) { return x.name == name; });
+      auto s =
+          std::find_if(m.sleeves.begin(), m.sleeves.end(), [&](auto& x) { return x.name == name; });
+      if (e != m.elements.end())
+        link = {ChainLink::Element, static_cast<int>(e - m.elements.begin())};
+      else if (s != m.sleeves.end())
+        link = {ChainLink::Sleeve, static_cast<int>(s - m.sleeves.begin())};
+      else if (rod_index(name) >= 0)
+        link = {ChainLink::Rod, rod_index(name)};
+      else
+        r.fail(0, fmt::format("mechanics.chains.{} names '{}', which is no element, sleeve or rod",
+                              m.rods[i].name, name));
       if (link.kind == ChainLink::Rod && link.index == static_cast<int>(i))
         r.fail(0, fmt::format("mechanics.chains.{} contains the rod itself", m.rods[i].name));
       m.chains[i].push_back(link);
     }
-    if (m.chains[i].empty()) r.fail(0, fmt::format("mechanics.chains.{} is empty: the rod needs a load path (eq. 18)", m.rods[i].name));
+    if (m.chains[i].empty())
+      r.fail(0, fmt::format("mechanics.chains.{} is empty: the rod needs a load path (eq. 18)",
+                            m.rods[i].name));
   }
 
   // Eq. (21) products.
   m.xT_rod_m_per_K = mat.alpha_thermal_per_K * r.num("thermal_expansion.rod_length_m");
-  m.xT_magnetizer_m_per_K = r.num("thermal_expansion.magnetizer_alpha_per_K") * r.num("thermal_expansion.magnetizer_length_m");
-  m.xT_output_rod_m_per_K = r.num("thermal_expansion.output_rod_alpha_per_K") * r.num("thermal_expansion.output_rod_length_m");
-  m.xT_sleeve_m_per_K = r.num("thermal_expansion.sleeve_alpha_per_K") * r.num("thermal_expansion.sleeve_length_m");
+  m.xT_magnetizer_m_per_K = r.num("thermal_expansion.magnetizer_alpha_per_K") *
+                            r.num("thermal_expansion.magnetizer_length_m");
+  m.xT_output_rod_m_per_K = r.num("thermal_expansion.output_rod_alpha_per_K") *
+                            r.num("thermal_expansion.output_rod_length_m");
+  m.xT_sleeve_m_per_K =
+      r.num("thermal_expansion.sleeve_alpha_per_K") * r.num("thermal_expansion.sleeve_length_m");
   return m;
 }
 

@@ -21,8 +21,14 @@ JaCoefficients ja_at(const Model& m, const JaReference& j, double T_C) {
   const double Tr_K = m.T_ref_C + kZeroCelsiusInK;
   double t = 0.0, tr = 0.0;
   switch (m.options.eq10_scale) {
-    case Eq10Scale::Celsius: t = T_C / Tc_C; tr = m.T_ref_C / Tc_C; break;
-    default: t = T_K / Tc_K; tr = Tr_K / Tc_K; break;
+    case Eq10Scale::Celsius:
+      t = T_C / Tc_C;
+      tr = m.T_ref_C / Tc_C;
+      break;
+    default:
+      t = T_K / Tc_K;
+      tr = Tr_K / Tc_K;
+      break;
   }
   auto law = [&](double p0, double f_t, double f_tr) {
     return m.options.eq10_scale == Eq10Scale::RoomReferenced ? p0 * f_t / f_tr : p0 * f_t;
@@ -46,9 +52,13 @@ Conditions make_conditions(const Model& m, double temperature_C, const Freeze& f
   if (!std::isfinite(temperature_C))
     throw InputError(fmt::format("temperature {} degC: must be a finite number", temperature_C));
   if (temperature_C < -kZeroCelsiusInK)
-    throw InputError(fmt::format("temperature {} degC: below absolute zero (-273.15 degC)", temperature_C));
+    throw InputError(
+        fmt::format("temperature {} degC: below absolute zero (-273.15 degC)", temperature_C));
   if (temperature_C >= mat.Tc_C)
-    throw InputError(fmt::format("temperature {} degC: at or above the Curie temperature T_c = {} degC of {} (material.Tc_C); the model holds only below T_c", temperature_C, mat.Tc_C, src));
+    throw InputError(
+        fmt::format("temperature {} degC: at or above the Curie temperature T_c = {} degC of {} "
+                    "(material.Tc_C); the model holds only below T_c",
+                    temperature_C, mat.Tc_C, src));
 
   Conditions c;
   c.temperature_C = temperature_C;
@@ -61,11 +71,14 @@ Conditions make_conditions(const Model& m, double temperature_C, const Freeze& f
   c.pm_scale = pm_mmf(1.0, m.alpha_pm1_per_K, m.alpha_pm2_per_K2, dT_if(fz.pm_mmf));  // eq. (1)
   c.Et_Pa = sleeve_modulus(m.Et_Pa, m.dEt_dT_Pa_per_C, fz.sleeve_modulus ? Tr : temperature_C);
   if (!(c.Et_Pa > 0.0))
-    throw InputError(fmt::format("temperature {} degC: eq. (19) gives a non-positive sleeve modulus E_t^T = {} Pa", temperature_C, c.Et_Pa));
+    throw InputError(fmt::format(
+        "temperature {} degC: eq. (19) gives a non-positive sleeve modulus E_t^T = {} Pa",
+        temperature_C, c.Et_Pa));
   for (const auto& s : m.sleeves) {  // eq. (19)
     std::array<double, 3> l{}, a{};
     for (int i = 0; i < 3; ++i) {
-      l[static_cast<std::size_t>(i)] = expanded_length(s.lengths_m[static_cast<std::size_t>(i)], s.alpha_thermal_per_K, dT_geom);
+      l[static_cast<std::size_t>(i)] =
+          expanded_length(s.lengths_m[static_cast<std::size_t>(i)], s.alpha_thermal_per_K, dT_geom);
       const double g = 1.0 + s.alpha_thermal_per_K * dT_geom;
       a[static_cast<std::size_t>(i)] = s.areas_m2[static_cast<std::size_t>(i)] * g * g;
     }
@@ -97,22 +110,36 @@ Conditions make_conditions(const Model& m, double temperature_C, const Freeze& f
     rc.MsT_ja = MsT(fz.magnetisation);
     rc.MsT_E = MsT(fz.modulus);
     const double L0 = Lambda0(rc.sigma_Pa, mat.lambda_s, mat.sigma_lambda_Pa);  // eq. (6)
-    rc.S_mu_J_per_m3 = stress_energy_term(rc.sigma_Pa, mat.lambda_s, L0, mat.beta_per_K, dT_if(fz.permeability));
-    const double S_E = stress_energy_term(rc.sigma_Pa, mat.lambda_s, L0, mat.beta_per_K, dT_if(fz.modulus));
+    rc.S_mu_J_per_m3 =
+        stress_energy_term(rc.sigma_Pa, mat.lambda_s, L0, mat.beta_per_K, dT_if(fz.permeability));
+    const double S_E =
+        stress_energy_term(rc.sigma_Pa, mat.lambda_s, L0, mat.beta_per_K, dT_if(fz.modulus));
     rc.dE = delta_e_terms(mat.Es_Pa, mat.lambda_s, rc.sigma_Pa, mat.sigma_lambda_Pa, mat.beta_per_K,
                           dT_if(fz.modulus), rc.MsT_E, mat.chi_m, S_E);
     // Eq. (3) must give a positive susceptibility at M = 0 (where it is smallest).
     const double inv_chi0 = inverse_susceptibility(0.0, mat.chi_m, rc.S_mu_J_per_m3, rc.MsT_mu);
     if (!(inv_chi0 > 0.0))
-      throw InputError(fmt::format("{}: at {} degC the stress terms of eq. (3) exceed 1/chi_m in rod '{}' (1/chi = {:.4g} at M = 0); check preload.force_N, material.lambda_s, material.sigma_lambda_Pa, options.stress_sign", src, temperature_C, rod.name, inv_chi0));
+      throw InputError(
+          fmt::format("{}: at {} degC the stress terms of eq. (3) exceed 1/chi_m in rod '{}' "
+                      "(1/chi = {:.4g} at M = 0); check preload.force_N, material.lambda_s, "
+                      "material.sigma_lambda_Pa, options.stress_sign",
+                      src, temperature_C, rod.name, inv_chi0));
     const double Tja = fz.magnetisation ? Tr : temperature_C;
     rc.ja = ja_at(m, rod.ja, Tja);  // eq. (10)
-    if (!(rc.ja.a_A_per_m > 0 && rc.ja.k_A_per_m > 0 && rc.ja.c >= 0 && rc.ja.c < 1 && std::isfinite(rc.ja.alpha)))
-      throw InputError(fmt::format("{}: eq. (10) at {} degC gives unphysical JA coefficients in rod '{}' (a = {:.4g} A/m, k = {:.4g} A/m, c = {:.4g}, alpha = {:.4g})", src, temperature_C, rod.name, rc.ja.a_A_per_m, rc.ja.k_A_per_m, rc.ja.c, rc.ja.alpha));
-    rc.rho_ohm_m = resistivity(mat.rho0_ohm_m, mat.drho_dT_ohm_m_per_K, dT_if(fz.resistivity));  // eq. (8)
+    if (!(rc.ja.a_A_per_m > 0 && rc.ja.k_A_per_m > 0 && rc.ja.c >= 0 && rc.ja.c < 1 &&
+          std::isfinite(rc.ja.alpha)))
+      throw InputError(fmt::format(
+          "{}: eq. (10) at {} degC gives unphysical JA coefficients in rod '{}' (a = {:.4g} A/m, k "
+          "= {:.4g} A/m, c = {:.4g}, alpha = {:.4g})",
+          src, temperature_C, rod.name, rc.ja.a_A_per_m, rc.ja.k_A_per_m, rc.ja.c, rc.ja.alpha));
+    rc.rho_ohm_m =
+        resistivity(mat.rho0_ohm_m, mat.drho_dT_ohm_m_per_K, dT_if(fz.resistivity));  // eq. (8)
     if (!(rc.rho_ohm_m > 0))
-      throw InputError(fmt::format("{}: eq. (8) gives a non-positive resistivity {} ohm m at {} degC", src, rc.rho_ohm_m, temperature_C));
-    rc.eddy_geometry_s_m_per_H = eddy_time_constant(1.0, rc.r_outer_m, rc.r_inner_m, rod.k_j, rc.rho_ohm_m);
+      throw InputError(
+          fmt::format("{}: eq. (8) gives a non-positive resistivity {} ohm m at {} degC", src,
+                      rc.rho_ohm_m, temperature_C));
+    rc.eddy_geometry_s_m_per_H =
+        eddy_time_constant(1.0, rc.r_outer_m, rc.r_inner_m, rod.k_j, rc.rho_ohm_m);
 
     // Eq. (24)-(28): oscillator mass, damping and the fixed part of the load compliance.
     double m_load = 0.0, inv_c = 0.0, inv_k_fixed = 0.0;

@@ -30,32 +30,33 @@ double rod_permeability(const RodConditions& rc, double chi_m, double M, double 
 double load_stiffness(const RodConditions& rc, const State& s) {
   double inv_k = rc.fixed_compliance_m_per_N;
   for (int j = 0; j < rc.chain_rod_count; ++j)
-    inv_k += 1.0 / s.rods[static_cast<std::size_t>(rc.chain_rods[static_cast<std::size_t>(j)])].k_rod_N_per_m;
+    inv_k +=
+        1.0 /
+        s.rods[static_cast<std::size_t>(rc.chain_rods[static_cast<std::size_t>(j)])].k_rod_N_per_m;
   return 1.0 / inv_k;
 }
 
 // Magnetostriction, Delta-E modulus and force of rod i at its present M (eq. 11-14, 17).
 void update_rod_mechanics(const Material& mat, const RodConditions& rc, RodState& r) {
-  r.E_Pa = delta_e_modulus(r.M_A_per_m / rc.MsT_E, rc.dE);                       // eq. (13)
-  r.lambda = magnetostriction(r.M_A_per_m / rc.MsT_ja, mat.lambda_s, rc.sigma_p_Pa, r.E_Pa);  // eq. (11)-(12)
-  r.F_N = rod_force(r.lambda, r.E_Pa, rc.area_m2);                                 // eq. (14)
-  r.k_rod_N_per_m = axial_stiffness(r.E_Pa, rc.area_m2, rc.length_m);              // eq. (17)
+  r.E_Pa = delta_e_modulus(r.M_A_per_m / rc.MsT_E, rc.dE);  // eq. (13)
+  r.lambda = magnetostriction(r.M_A_per_m / rc.MsT_ja, mat.lambda_s, rc.sigma_p_Pa,
+                              r.E_Pa);                                 // eq. (11)-(12)
+  r.F_N = rod_force(r.lambda, r.E_Pa, rc.area_m2);                     // eq. (14)
+  r.k_rod_N_per_m = axial_stiffness(r.E_Pa, rc.area_m2, rc.length_m);  // eq. (17)
 }
 
-void check(double value, double t, const std::string& rod, const char* quantity, double limit) {
-  if (!std::isfinite(value) || std::fabs(value) > limit)
-    throw DivergenceError(t, rod, quantity, value,
-                          std::isfinite(value) ? fmt::format("|value| exceeds {:g}", limit)
-                                               : std::string("not finite"));
+inline void check(double value, double t, const std::string& rod, const char* quantity,
+                  double limit) {
+  if (std::fabs(value) <= limit) [[likely]]
+    return;  // false for NaN
+  throw DivergenceError(t, rod, quantity, value,
+                        std::isfinite(value) ? fmt::format("|value| exceeds {:g}", limit)
+                                             : std::string("not finite"));
 }
 
 void finish_outputs(const Model& m, const Conditions& c, State& s) {
   double y = 0.0;
-  for (std::size_t i = 0; i < s.rods.size(); ++i) {
-    auto& r = s.rods[i];
-    r.k_load_N_per_m = load_stiffness(c.rods[i], s);
-    y += r.x_m;
-  }
+  for (const auto& r : s.rods) y += r.x_m;
   if (m.options.thermal_expansion_in_output) y += c.thermal_expansion_m;
   s.y_m = y;
   double phi = 0.0, area = 0.0;
@@ -88,7 +89,8 @@ State make_state(const Model& m, const Conditions& c, double current_A) {
     const double f = static_cast<double>(k) / ramp_steps;
     for (std::size_t i = 0; i < n; ++i) {
       const auto& rc = c.rods[i];
-      const double mu = rod_permeability(rc, m.material.chi_m, s.rods[i].M_A_per_m, 0.0, m.rods[i].name);
+      const double mu =
+          rod_permeability(rc, m.material.chi_m, s.rods[i].M_A_per_m, 0.0, m.rods[i].name);
       s.rod_reluctance[i] = rod_reluctance(rc.length_m, mu, rc.area_m2);
       s.rods[i].mu_r = mu / kMu0;
     }
@@ -112,7 +114,8 @@ State make_state(const Model& m, const Conditions& c, double current_A) {
   }
   for (std::size_t i = 0; i < n; ++i) {  // static equilibrium x = F / K (eq. 15 at rest)
     auto& r = s.rods[i];
-    r.x_m = r.F_N / oscillator_stiffness(c, s, static_cast<int>(i));
+    r.k_load_N_per_m = load_stiffness(c.rods[i], s);
+    r.x_m = r.F_N / (r.k_rod_N_per_m + r.k_load_N_per_m);
     r.v_m_per_s = 0.0;
   }
   finish_outputs(m, c, s);
@@ -137,7 +140,7 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
     r.mu_r = mu / kMu0;
     s.rod_reluctance[i] = rod_reluctance(rc.length_m, mu, rc.area_m2);
   }
-  if (!solve_circuit(m.circuit, s.rod_reluctance, in.current_A, c.pm_scale, s.circuit))
+  if (!solve_circuit(m.circuit, s.rod_reluctance, in.current_A, c.pm_scale, s.circuit, false))
     throw DivergenceError(t1, "", "nodal matrix of the circuit", 0.0, "not positive definite");
 
   // 2. Per rod: static field (eq. 7), eddy lag (eq. 7), JA (eq. 9), force (eq. 11-14).
@@ -168,8 +171,10 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
   for (std::size_t i = 0; i < n; ++i) {
     const auto& rc = c.rods[i];
     auto& r = s.rods[i];
-    const double K = oscillator_stiffness(c, s, static_cast<int>(i));
-    oscillator_step(rc.mass_osc_kg, rc.damping_osc_N_s_per_m, K, F0[i], r.F_N, h, r.x_m, r.v_m_per_s);
+    r.k_load_N_per_m = load_stiffness(rc, s);
+    const double K = r.k_rod_N_per_m + r.k_load_N_per_m;  // eq. (16)
+    oscillator_step(rc.mass_osc_kg, rc.damping_osc_N_s_per_m, K, F0[i], r.F_N, h, r.x_m,
+                    r.v_m_per_s);
     check(r.x_m, t1, m.rods[i].name, "x [m]", 1.0);
   }
   s.t_s = t1;

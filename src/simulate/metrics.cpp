@@ -102,14 +102,19 @@ Metrics compute_metrics(const TimeSeries& ts, double t0, double t1) {
   const auto& B = ts.column("B_T");
   // Samples with t0 <= t < t1 (one whole period when t1 - t0 is the period).
   const double eps = 1e-9 * (t1 - t0);
-  const auto b = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), t0 - eps) - t.begin());
-  const auto e = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), t1 - eps) - t.begin());
+  const auto b =
+      static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), t0 - eps) - t.begin());
+  const auto e =
+      static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), t1 - eps) - t.begin());
   Metrics m;
   m.window_start_s = t0;
   m.window_end_s = t1;
-  if (e <= b + 2) throw InputError(fmt::format("metrics window [{}, {}] s holds fewer than 3 samples", t0, t1));
-  const auto [ymin, ymax] = std::minmax_element(y.begin() + static_cast<long>(b), y.begin() + static_cast<long>(e));
-  const auto [Bmin, Bmax] = std::minmax_element(B.begin() + static_cast<long>(b), B.begin() + static_cast<long>(e));
+  if (e <= b + 2)
+    throw InputError(fmt::format("metrics window [{}, {}] s holds fewer than 3 samples", t0, t1));
+  const auto [ymin, ymax] =
+      std::minmax_element(y.begin() + static_cast<long>(b), y.begin() + static_cast<long>(e));
+  const auto [Bmin, Bmax] =
+      std::minmax_element(B.begin() + static_cast<long>(b), B.begin() + static_cast<long>(e));
   m.stroke_um = *ymax - *ymin;
   m.B_pp_T = *Bmax - *Bmin;
   double s = 0.0;
@@ -128,8 +133,10 @@ void add_quantity_stats(Result& r, const std::vector<std::string>& names) {
   std::size_t b = 0, e = t.size();
   if (r.has_metrics) {
     const double eps = 1e-9 * (r.metrics.window_end_s - r.metrics.window_start_s);
-    b = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), r.metrics.window_start_s - eps) - t.begin());
-    e = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), r.metrics.window_end_s - eps) - t.begin());
+    b = static_cast<std::size_t>(
+        std::lower_bound(t.begin(), t.end(), r.metrics.window_start_s - eps) - t.begin());
+    e = static_cast<std::size_t>(
+        std::lower_bound(t.begin(), t.end(), r.metrics.window_end_s - eps) - t.begin());
   }
   for (const auto& name : names) {
     const auto& v = r.series.column(name);
@@ -139,7 +146,8 @@ void add_quantity_stats(Result& r, const std::vector<std::string>& names) {
     q.rms = rp.rms;
     q.peak = rp.peak;
     if (e > b) {
-      const auto [lo, hi] = std::minmax_element(v.begin() + static_cast<long>(b), v.begin() + static_cast<long>(e));
+      const auto [lo, hi] =
+          std::minmax_element(v.begin() + static_cast<long>(b), v.begin() + static_cast<long>(e));
       q.pp = *hi - *lo;
       double s = 0.0;
       for (std::size_t i = b; i < e; ++i) s += v[i];

@@ -10,8 +10,8 @@ namespace gmasim {
 namespace {
 
 // Column layout of the recorded series: global columns, then per rod.
-constexpr int kGlobal = 5;   // t_s, current_A, y_um, B_T, xT_um
-constexpr int kPerRod = 8;   // H, M, mu_r, E_G, lambda, F, x, tau
+constexpr int kGlobal = 5;  // t_s, current_A, y_um, B_T, xT_um
+constexpr int kPerRod = 8;  // H, M, mu_r, E_G, lambda, F, x, tau
 
 void make_columns(const Model& m, TimeSeries& ts, std::size_t reserve) {
   ts.names = {"t_s", "current_A", "y_um", "B_T", "xT_um"};
@@ -55,7 +55,8 @@ Result simulate(const Model& m, const SimulationSettings& s) {
     throw InputError(fmt::format("current peak-to-peak {} A: must be >= 0", w.pp_A));
   if (!(s.dt_s >= 0.0) || !std::isfinite(s.dt_s))
     throw InputError(fmt::format("dt {} s: must be > 0 (or 0 for the automatic rule)", s.dt_s));
-  if (s.record_every < 1) throw InputError(fmt::format("record_every {}: must be >= 1", s.record_every));
+  if (s.record_every < 1)
+    throw InputError(fmt::format("record_every {}: must be >= 1", s.record_every));
 
   double duration = 0.0;
   double dt = s.dt_s > 0.0 ? s.dt_s : auto_dt(w);
@@ -74,7 +75,8 @@ Result simulate(const Model& m, const SimulationSettings& s) {
   }
   const long nsteps = std::lround(duration / dt);
   if (nsteps > 200'000'000L)
-    throw InputError(fmt::format("{} steps of {} s: too many (limit 2e8); raise dt or shorten the run", nsteps, dt));
+    throw InputError(fmt::format(
+        "{} steps of {} s: too many (limit 2e8); raise dt or shorten the run", nsteps, dt));
 
   const Conditions c = make_conditions(m, s.temperature_C, s.freeze);
   Result r;

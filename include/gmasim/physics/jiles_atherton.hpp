@@ -17,12 +17,14 @@ inline LangevinValue langevin_pair(double x) {
   const double ax = std::fabs(x);
   if (ax < 0.1) {
     const double x2 = x * x;
-    return {x * (1.0 / 3.0 - x2 * (1.0 / 45.0 - x2 * (2.0 / 945.0 - x2 * (1.0 / 4725.0 - x2 * (2.0 / 93555.0))))),
-            1.0 / 3.0 - x2 * (1.0 / 15.0 - x2 * (2.0 / 189.0 - x2 * (1.0 / 675.0 - x2 * (2.0 / 10395.0))))};
+    return {x * (1.0 / 3.0 - x2 * (1.0 / 45.0 - x2 * (2.0 / 945.0 -
+                                                      x2 * (1.0 / 4725.0 - x2 * (2.0 / 93555.0))))),
+            1.0 / 3.0 -
+                x2 * (1.0 / 15.0 - x2 * (2.0 / 189.0 - x2 * (1.0 / 675.0 - x2 * (2.0 / 10395.0))))};
   }
   const double inv_x = 1.0 / x;
   if (ax > 40.0) return {(x > 0 ? 1.0 : -1.0) - inv_x, inv_x * inv_x};
-  const double e = std::exp(-2.0 * ax);          // coth|x| = (1+e)/(1-e)
+  const double e = std::exp(-2.0 * ax);  // coth|x| = (1+e)/(1-e)
   const double one_minus_e = 1.0 - e;
   const double coth_abs = (1.0 + e) / one_minus_e;
   const double inv_sinh2 = 4.0 * e / (one_minus_e * one_minus_e);
@@ -127,8 +129,8 @@ inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, dou
   const LagWeights w = lag_weights(r);
   // d/dHe1 through M_an1 (weight 1 - q) and through r = s/k (dq/dr = (E - q)/r).
   const double dq_dr = r > 1e-12 ? (w.E - w.q) / r : -0.5;
-  dMirr_dHe1 = (1.0 - w.q) * dMan1 +
-               delta / k_A_per_m * (-(Mirr0 - u0) * w.E - (Man1 - u0) * dq_dr);
+  dMirr_dHe1 =
+      (1.0 - w.q) * dMan1 + delta / k_A_per_m * (-(Mirr0 - u0) * w.E - (Man1 - u0) * dq_dr);
   return Man1 + (Mirr0 - u0) * w.E - (Man1 - u0) * w.q;
 }
 
@@ -137,8 +139,8 @@ inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, dou
 // Newton's method with its exact derivative (H_e depends on M through alpha), M_irr1 from
 // ja_irreversible_update. M_guess is the starting point (e.g. linear extrapolation).
 // On entry M must be consistent with (H0, Mirr); on exit Mirr and M hold the values at H1.
-inline void ja_step(double H0, double H1, double MsT_A_per_m, const JaCoefficients& p,
-                    double& Mirr, double& M, double M_guess) {
+inline void ja_step(double H0, double H1, double MsT_A_per_m, const JaCoefficients& p, double& Mirr,
+                    double& M, double M_guess) {
   if (H1 == H0) return;
   const double inv_a = 1.0 / p.a_A_per_m;
   const double He0 = H0 + p.alpha * M;
@@ -151,7 +153,8 @@ inline void ja_step(double H0, double H1, double MsT_A_per_m, const JaCoefficien
     const double Man1 = MsT_A_per_m * lv.L;
     const double dMan = MsT_A_per_m * inv_a * lv.dL;
     double dMirr = 0.0;
-    const double Mirr1 = ja_irreversible_update(Mirr, Man0, Man1, dMan, He1 - He0, p.k_A_per_m, dMirr);
+    const double Mirr1 =
+        ja_irreversible_update(Mirr, Man0, Man1, dMan, He1 - He0, p.k_A_per_m, dMirr);
     const double Mnew = (1.0 - p.c) * Mirr1 + p.c * Man1;
     const double g = M1 - Mnew;
     if (std::fabs(g) <= tol || it == 59) {
@@ -164,8 +167,8 @@ inline void ja_step(double H0, double H1, double MsT_A_per_m, const JaCoefficien
     M1 -= g / dg;
   }
 }
-inline void ja_step(double H0, double H1, double MsT_A_per_m, const JaCoefficients& p,
-                    double& Mirr, double& M) {
+inline void ja_step(double H0, double H1, double MsT_A_per_m, const JaCoefficients& p, double& Mirr,
+                    double& M) {
   ja_step(H0, H1, MsT_A_per_m, p, Mirr, M, M);
 }
 

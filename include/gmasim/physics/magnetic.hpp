@@ -13,8 +13,7 @@ inline constexpr double kZeroCelsiusInK = 273.15;
 
 // Eq. (1): temperature-dependent bias MMF of the permanent magnets [A-turns].
 //   F_pm^T = F_pm (1 + a1 (T - T0) + a2 (T - T0)^2)
-inline double pm_mmf(double F_pm_At, double alpha_pm1_per_K, double alpha_pm2_per_K2,
-                     double dT_K) {
+inline double pm_mmf(double F_pm_At, double alpha_pm1_per_K, double alpha_pm2_per_K2, double dT_K) {
   return F_pm_At * (1.0 + alpha_pm1_per_K * dT_K + alpha_pm2_per_K2 * dT_K * dT_K);
 }
 
@@ -38,9 +37,7 @@ inline double relaxation_factor(double chi_m, double MsT_A_per_m) {
 // Eq. (6): Lambda_0(sigma), the primitive of the domain-rotation strain lambda_0(sigma)
 // [Pa, i.e. J/m^3]. sigma0 = sigma_lambda * artanh(1/3). Compression is negative in this
 // form (Zheng/Zhou convention); see docs/model.md.
-inline double sigma0_of(double sigma_lambda_Pa) {
-  return sigma_lambda_Pa * std::atanh(1.0 / 3.0);
-}
+inline double sigma0_of(double sigma_lambda_Pa) { return sigma_lambda_Pa * std::atanh(1.0 / 3.0); }
 inline double Lambda0(double sigma_Pa, double lambda_s, double sigma_lambda_Pa) {
   const double s = (sigma_Pa - sigma0_of(sigma_lambda_Pa)) / sigma_lambda_Pa;
   // ln((2 sqrt2 / 3) cosh s) computed without overflow for large |s|:
@@ -83,8 +80,8 @@ inline double static_field(double phi_Wb, double k_f, double mu_H_per_m, double 
 // Eq. (7), second line: time constant of the first-order eddy-current lag [s].
 //   H(s) = H_c(s) / (1 + tau s),  tau = mu (r1^2 - r2^2) / (4 k_j rho)
 // (the second "k_f" of the printed eq. 7 is Table 4's k_j: READING-NOTES).
-inline double eddy_time_constant(double mu_H_per_m, double r_outer_m, double r_inner_m,
-                                 double k_j, double rho_ohm_m) {
+inline double eddy_time_constant(double mu_H_per_m, double r_outer_m, double r_inner_m, double k_j,
+                                 double rho_ohm_m) {
   return mu_H_per_m * (r_outer_m * r_outer_m - r_inner_m * r_inner_m) / (4.0 * k_j * rho_ohm_m);
 }
 
@@ -102,7 +99,8 @@ struct LagWeights {
 inline LagWeights lag_weights(double r) {
   const double E = std::exp(-r);
   if (r < 1e-2) {
-    const double q = 1.0 - r * (1.0 / 2 - r * (1.0 / 6 - r * (1.0 / 24 - r * (1.0 / 120 - r * (1.0 / 720)))));
+    const double q =
+        1.0 - r * (1.0 / 2 - r * (1.0 / 6 - r * (1.0 / 24 - r * (1.0 / 120 - r * (1.0 / 720)))));
     return {E, q};
   }
   return {E, (1.0 - E) / r};

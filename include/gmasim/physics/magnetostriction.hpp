@@ -14,7 +14,7 @@ namespace gmasim::physics {
 //   rotation_compliance = 3 lambda_s / (4 sigma_lambda) sech^2 u               [1/Pa]
 //   coupling = (3 lambda_s / 2)(1 - tanh u) + 2 beta dT                         [-]
 struct DeltaETerms {
-  double inverse_Es_per_Pa;         // 1/E_s, the saturated (M = M_s) modulus
+  double inverse_Es_per_Pa;  // 1/E_s, the saturated (M = M_s) modulus
   double rotation_compliance_per_Pa;
   double coupling;
   double mu0_Ms2_over_chi_m_J_per_m3;  // mu0 pi M_s^T/(2k) = mu0 (M_s^T)^2 / chi_m (eq. 5)
@@ -43,8 +43,8 @@ inline double delta_e_modulus(double m, const DeltaETerms& d) {
   const double c = std::cos(0.5 * kPi * m);
   const double c2 = c * c;
   const double m2 = m * m;
-  const double third = d.coupling * d.coupling * m2 * c2 /
-                       (d.mu0_Ms2_over_chi_m_J_per_m3 - c2 * d.S_J_per_m3);
+  const double third =
+      d.coupling * d.coupling * m2 * c2 / (d.mu0_Ms2_over_chi_m_J_per_m3 - c2 * d.S_J_per_m3);
   return 1.0 / (d.inverse_Es_per_Pa + d.rotation_compliance_per_Pa * (1.0 - m2) + third);
 }
 

@@ -42,8 +42,7 @@ inline double oscillator_mass(double rod_mass_kg, double load_mass_kg) {
 // Eq. (21): thermal expansion of the stack [m].
 //   x_T = (alpha_G l_G + alpha_M l_M + alpha_s l_s - alpha_t l_t) dT
 inline double thermal_expansion(double alphaG_lG_m_per_K, double alphaM_lM_m_per_K,
-                                double alphas_ls_m_per_K, double alphat_lt_m_per_K,
-                                double dT_K) {
+                                double alphas_ls_m_per_K, double alphat_lt_m_per_K, double dT_K) {
   return (alphaG_lG_m_per_K + alphaM_lM_m_per_K + alphas_ls_m_per_K - alphat_lt_m_per_K) * dT_K;
 }
 
@@ -59,9 +58,9 @@ inline double expanded_length(double length_m, double alpha_per_K, double dT_K) 
 // or over-damped), the ramp by its particular solution, so the update is exact for
 // piecewise-linear forcing and unconditionally stable: the step is not limited by the
 // 7-20 kHz mechanical modes. Updates x [m] and v [m/s].
-inline void oscillator_step(double m, double c, double k, double F0, double F1, double h,
-                            double& x, double& v) {
-  const double g = (F1 - F0) / h;     // force rate [N/s]
+inline void oscillator_step(double m, double c, double k, double F0, double F1, double h, double& x,
+                            double& v) {
+  const double g = (F1 - F0) / h;  // force rate [N/s]
   // Particular solution x_p(s) = (F0 + g s)/k - g c / k^2, v_p = g / k.
   const double xp0 = (F0 - g * c / k) / k;
   const double vp = g / k;
