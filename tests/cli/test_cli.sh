@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# End-to-end checks of the gmasim CLI: outputs, exit codes and error messages.
+# Usage: test_cli.sh <path to gmasim> ; prints "N passed, N failed".
+set -u
+B="$1"
+T="$(mktemp -d)"
+trap 'rm -rf "$T"' EXIT
+pass=0
+fail=0
+check() {  # name, expected exit code, expected text (grep -E) in stdout+stderr, command...
+  local name="$1" code="$2" text="$3"
+  shift 3
+  local out rc
+  out="$("$@" 2>&1)"
+  rc=$?
+  if [[ $rc -eq $code ]] && grep -qE -- "$text" <<<"$out"; then
+    pass=$((pass + 1))
+  else
+    fail=$((fail + 1))
+    echo "FAIL: $name (exit $rc, expected $code; wanted /$text/)"
+    echo "$out" | head -5
+  fi
+}
+check "simulate default" 0 "stroke +[0-9.]+ um" "$B" simulate --out "$T/a"
+[[ -s "$T/a/timeseries.csv" && -s "$T/a/metrics.json" ]] && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: outputs missing"; }
+head -1 "$T/a/timeseries.csv" | grep -q '^t_s,current_A,y_um,B_T,xT_um,rod1_H_A_per_m' && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: csv header"; }
+grep -q '"stroke_um"' "$T/a/metrics.json" && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: metrics.json"; }
+ls "$T/a" | grep -q tmp && { fail=$((fail + 1)); echo "FAIL: temp files left"; } || pass=$((pass + 1))
+check "quantity stats" 0 "rod2_F_N +rms" "$B" simulate --periods 2 --quantity rod2_F_N --out "$T/q"
+check "unknown quantity" 2 "unknown quantity 'nope'" "$B" simulate --periods 2 --quantity nope --out "$T/q2"
+check "curie" 2 "at or above the Curie temperature" "$B" simulate --temperature 380 --out "$T/b"
+check "below absolute zero" 2 "below absolute zero" "$B" simulate --temperature -300 --out "$T/b"
+check "frequency" 2 "frequency 0 Hz: must be > 0" "$B" simulate --frequency 0 --out "$T/b"
+printf 't_s,current_A\n0,1\n0.001,abc\n' >"$T/w1.csv"
+check "csv non-numeric" 2 "w1.csv:3: non-numeric cell 'abc'" "$B" simulate --waveform "$T/w1.csv" --out "$T/b"
+printf 't_s,current_A\n0,1\n0.002,1\n0.001,2\n' >"$T/w2.csv"
+check "csv non-monotonic" 2 "w2.csv:4: .*does not increase" "$B" simulate --waveform "$T/w2.csv" --out "$T/b"
+: >"$T/w3.csv"
+check "csv empty" 2 "w3.csv.*empty" "$B" simulate --waveform "$T/w3.csv" --out "$T/b"
+printf 't_s,current_A\n0,-3\n0.01,5\n0.02,-3\n' >"$T/w4.csv"
+check "csv waveform runs" 0 "wrote" "$B" simulate --waveform "$T/w4.csv" --out "$T/c"
+touch "$T/file"
+check "unwritable out" 2 "output directory is not writable" "$B" simulate --out "$T/file/sub"
+check "model show" 0 "rod1.ja.k0_A_per_m +3032 +A/m +Table 4" "$B" model show
+check "model check ok" 0 "OK" "$B" model check "$(dirname "$0")/../../models/mdma.toml"
+sed 's/^length_m = 0.030  # derived: k_1/length_m = -0.030  # derived: k_1/' "$(dirname "$0")/../../models/mdma.toml" >"$T/bad.toml"
+check "negative length" 2 "bad.toml:[0-9]+: rod1.length_m = -0.03 m: must be > 0" "$B" model check "$T/bad.toml"
+printf '[meta\nname = 1\n' >"$T/syntax.toml"
+check "malformed toml" 2 "syntax.toml:1" "$B" model check "$T/syntax.toml"
+check "divergence" 3 "diverged at t = 0.001000000 s in rod1: H" "$B" simulate --waveform-kind step --level 1 --step-to 1e9 --step-time 0.001 --duration 0.002 --out "$T/d"
+grep -q '"status": "diverged"' "$T/d/metrics.json" && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: diverged metrics"; }
+check "help has units" 0 "Operating temperature \[degC\]" "$B" simulate --help
+echo "$pass passed, $fail failed"
+[[ $fail -eq 0 ]]
