@@ -143,7 +143,7 @@ std::string json_string(std::string_view s) {
 // JSON has no NaN or Inf: they are written as null.
 std::string json_number(double v) {
   if (!std::isfinite(v)) return "null";
-  return fmt::format("{:.10g}", v);
+  return fmt::format("{}", v);  // shortest representation that round-trips exactly
 }
 
 // Accumulates `"key": value` members of one object at one indentation.
