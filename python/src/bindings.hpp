@@ -1,0 +1,17 @@
+#pragma once
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <string>
+#include <vector>
+
+#include "gmasim/model.hpp"
+#include "gmasim/simulate.hpp"
+
+namespace gmasim::py_bind {
+pybind11::array_t<double> to_numpy(const std::vector<double>& v);
+pybind11::dict series_dict(const TimeSeries& ts);
+pybind11::dict metrics_dict(const Metrics& m);
+Freeze freeze_from(const std::vector<std::string>& laws);
+void bind_experiments(pybind11::module_& mod);  // experiments.cpp
+}  // namespace gmasim::py_bind

@@ -1,0 +1,158 @@
+// pybind11 bindings: gmasim._gmasim. Thin: models, simulate; arrays out as numpy.
+// Experiments are bound in experiments.cpp. No physics here.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+
+#include "bindings.hpp"
+#include "gmasim/errors.hpp"
+#include "gmasim/io.hpp"
+#include "gmasim/simulate.hpp"
+
+namespace py = pybind11;
+using namespace gmasim;
+
+namespace gmasim::py_bind {
+
+py::array_t<double> to_numpy(const std::vector<double>& v) {
+  py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
+  std::copy(v.begin(), v.end(), a.mutable_data());
+  return a;
+}
+
+py::dict series_dict(const TimeSeries& ts) {
+  py::dict d;
+  for (std::size_t i = 0; i < ts.names.size(); ++i) d[py::str(ts.names[i])] = to_numpy(ts.columns[i]);
+  return d;
+}
+
+py::dict metrics_dict(const Metrics& m) {
+  py::dict d;
+  d["stroke_um"] = m.stroke_um;
+  d["hysteresis_um"] = m.hysteresis_um;
+  d["B_pp_T"] = m.B_pp_T;
+  d["y_mean_um"] = m.y_mean_um;
+  d["window_start_s"] = m.window_start_s;
+  d["window_end_s"] = m.window_end_s;
+  return d;
+}
+
+Freeze freeze_from(const std::vector<std::string>& laws) {
+  Freeze f;
+  for (const auto& l : laws) {
+    if (l == "mu_G") f.permeability = true;
+    else if (l == "rho_G") f.resistivity = true;
+    else if (l == "M") f.magnetisation = true;
+    else if (l == "E_G") f.modulus = true;
+    else if (l == "E_t") f.sleeve_modulus = true;
+    else if (l == "F_pm") f.pm_mmf = true;
+    else if (l == "geometry") f.geometry = true;
+    else throw InputError("unknown law '" + l + "' to freeze; known: mu_G, rho_G, M, E_G, E_t, F_pm, geometry");
+  }
+  return f;
+}
+
+}  // namespace gmasim::py_bind
+
+namespace {
+
+using namespace gmasim::py_bind;
+
+py::dict simulate_py(const Model& m, double temperature_C, double current_pp_A, double frequency_Hz,
+                     double periods, double current_min_A, double dt_s, int record_every,
+                     const std::string& kind, py::object waveform, double duration_s,
+                     const std::vector<std::string>& freeze, const std::vector<std::string>& quantities) {
+  SimulationSettings s;
+  s.temperature_C = temperature_C;
+  s.periods = periods;
+  s.dt_s = dt_s;
+  s.record_every = record_every;
+  s.duration_s = duration_s;
+  s.freeze = freeze_from(freeze);
+  if (!waveform.is_none()) {
+    auto tup = waveform.cast<std::pair<std::vector<double>, std::vector<double>>>();
+    Waveform w;
+    w.kind = WaveformKind::Table;
+    w.table_t_s = tup.first;
+    w.table_current_A = tup.second;
+    w.table_source = "<python>";
+    if (w.table_t_s.size() < 2 || w.table_t_s.size() != w.table_current_A.size())
+      throw InputError("waveform: need two equally long arrays (t_s, current_A) of at least 2 samples");
+    for (std::size_t i = 1; i < w.table_t_s.size(); ++i)
+      if (!(w.table_t_s[i] > w.table_t_s[i - 1]))
+        throw InputError("waveform: time must increase strictly (sample " + std::to_string(i) + ")");
+    s.waveform = w;
+  } else if (kind == "sine") {
+    s.waveform = biased_sine(current_pp_A, frequency_Hz, current_min_A);
+  } else if (kind == "dc") {
+    s.waveform.kind = WaveformKind::DC;
+    s.waveform.level_A = current_pp_A;
+  } else {
+    throw InputError("kind '" + kind + "': use 'sine' or 'dc', or pass waveform=(t_s, current_A)");
+  }
+  Result r;
+  {
+    py::gil_scoped_release release;
+    r = simulate(m, s);
+  }
+  if (!r.diverged && !quantities.empty()) add_quantity_stats(r, quantities);
+  py::dict d;
+  d["series"] = series_dict(r.series);
+  if (r.has_metrics) d["metrics"] = metrics_dict(r.metrics);
+  d["dt_s"] = r.dt_s;
+  d["steps"] = r.steps;
+  d["wall_time_s"] = r.wall_time_s;
+  d["diverged"] = r.diverged;
+  d["error"] = r.error;
+  d["thermal_expansion_um"] = r.thermal_expansion_um;
+  py::dict q;
+  for (const auto& qs : r.quantities) {
+    py::dict e;
+    e["rms"] = qs.rms;
+    e["peak"] = qs.peak;
+    e["pp"] = qs.pp;
+    e["mean"] = qs.mean;
+    q[py::str(qs.name)] = e;
+  }
+  d["quantities"] = q;
+  return d;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_gmasim, mod) {
+  mod.doc() = "gmasim: temperature-dependent giant magnetostrictive actuator simulator (MCTD model)";
+  py::register_exception<InputError>(mod, "InputError", PyExc_ValueError);
+  py::register_exception<DivergenceError>(mod, "DivergenceError", PyExc_ArithmeticError);
+
+  py::class_<Model, std::shared_ptr<Model>>(mod, "Model", "A compiled, immutable model")
+      .def(py::init([](const std::string& path) { return std::make_shared<Model>(load_model(path)); }),
+           py::arg("path") = std::string(), "Load a model file (TOML); empty path = built-in MDMA")
+      .def_property_readonly("source", [](const Model& m) { return m.spec.source; })
+      .def_property_readonly("rods", [](const Model& m) {
+        std::vector<std::string> r;
+        for (const auto& rod : m.rods) r.push_back(rod.name);
+        return r;
+      })
+      .def("params", [](const Model& m) {
+        py::dict d;
+        for (const auto& [name, p] : m.spec.params) d[py::str(name)] = py::make_tuple(p.value, p.unit, p.provenance);
+        return d;
+      }, "Every numeric parameter: name -> (value, unit, provenance)")
+      .def("get", [](const Model& m, const std::string& name) { return m.spec.get(name); }, py::arg("name"))
+      .def("with_params", [](const Model& m, const std::map<std::string, double>& values) {
+        ModelSpec spec = m.spec;
+        for (const auto& [k, v] : values) spec.set(k, v);
+        return std::make_shared<Model>(compile(spec));
+      }, py::arg("values"), "A new model with some parameters changed (dotted names)");
+
+  mod.def("simulate", &simulate_py, py::arg("model"), py::arg("temperature_C") = 20.0,
+          py::arg("current_pp_A") = 8.0, py::arg("frequency_Hz") = 10.0, py::arg("periods") = 3.0,
+          py::arg("current_min_A") = -3.0, py::arg("dt_s") = 0.0, py::arg("record_every") = 1,
+          py::arg("kind") = "sine", py::arg("waveform") = py::none(), py::arg("duration_s") = 0.0,
+          py::arg("freeze") = std::vector<std::string>{}, py::arg("quantities") = std::vector<std::string>{},
+          "Time-domain run. Returns {'series': {column: ndarray}, 'metrics': {...}, ...}");
+  gmasim::py_bind::bind_experiments(mod);
+}

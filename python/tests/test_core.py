@@ -1,0 +1,59 @@
+"""The Python API over the core: numbers, equality with the CLI, errors."""
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+import gmasim
+
+
+def test_simulate_returns_numpy_series_and_metrics(mdma):
+    r = gmasim.simulate(mdma, temperature_C=70, current_pp_A=8, frequency_Hz=10, periods=2)
+    s = r["series"]
+    assert isinstance(s["y_um"], np.ndarray)
+    assert s["t_s"].shape == s["y_um"].shape
+    # stroke = peak-to-peak of y over the last period
+    t = s["t_s"]
+    last = (t >= r["metrics"]["window_start_s"] - 1e-12) & (t < r["metrics"]["window_end_s"] - 1e-12)
+    assert np.ptp(s["y_um"][last]) == pytest.approx(r["metrics"]["stroke_um"], rel=1e-12)
+    # y is the sum of the rods' displacements (eq. 20)
+    np.testing.assert_allclose(s["y_um"], s["rod1_x_um"] + s["rod2_x_um"] + s["rod3_x_um"], rtol=1e-12, atol=1e-12)
+
+
+def test_python_equals_cli_to_1e12(mdma, gmasim_bin, tmp_path):
+    r = gmasim.simulate(mdma, temperature_C=45, current_pp_A=10, frequency_Hz=100, periods=3)
+    subprocess.run([gmasim_bin, "simulate", "--temperature", "45", "--current-pp", "10", "--frequency", "100",
+                    "--periods", "3", "--out", str(tmp_path)], check=True, capture_output=True)
+    cli = json.loads((tmp_path / "metrics.json").read_text())["metrics"]
+    for key in ("stroke_um", "hysteresis_um", "B_pp_T", "y_mean_um"):
+        assert r["metrics"][key] == pytest.approx(cli[key], rel=1e-12, abs=1e-12), key
+
+
+def test_with_params_changes_the_model(mdma):
+    base = gmasim.simulate(mdma, periods=2)["metrics"]["stroke_um"]
+    stiff = mdma.with_params({"preload.force_N": 900.0})
+    assert stiff.get("preload.force_N") == 900.0
+    assert gmasim.simulate(stiff, periods=2)["metrics"]["stroke_um"] != pytest.approx(base, rel=1e-3)
+    # prefix resolution of unit-suffixed names
+    assert mdma.with_params({"rod1.ja.k0": 2500.0}).get("rod1.ja.k0_A_per_m") == 2500.0
+
+
+def test_arbitrary_waveform(mdma):
+    t = np.linspace(0, 0.02, 201)
+    i = 1.0 + 2.0 * np.sin(2 * np.pi * 100 * t)
+    r = gmasim.simulate(mdma, waveform=(t, i))
+    np.testing.assert_allclose(np.interp(r["series"]["t_s"], t, i), r["series"]["current_A"], atol=1e-9)
+
+
+def test_bad_requests_raise_clear_errors(mdma):
+    with pytest.raises(gmasim.InputError, match="Curie"):
+        gmasim.simulate(mdma, temperature_C=380)
+    with pytest.raises(gmasim.InputError, match="frequency"):
+        gmasim.simulate(mdma, frequency_Hz=0)
+    with pytest.raises(gmasim.InputError, match="increase"):
+        gmasim.simulate(mdma, waveform=([0.0, 0.0, 1.0], [0.0, 1.0, 2.0]))
+    with pytest.raises(gmasim.InputError, match="unknown parameter"):
+        mdma.with_params({"no.such": 1.0})
+    with pytest.raises(gmasim.InputError, match="must be > 0"):
+        mdma.with_params({"rod1.length_m": -1.0})
