@@ -11,7 +11,10 @@ def _check_axes(fig):
             continue
         xlabel = ax.get_xlabel() or next((o.get_xlabel() for o in ax.get_shared_x_axes().get_siblings(ax)
                                            if o.get_xlabel()), "")
-        assert "(" in xlabel and ")" in xlabel, xlabel
+        categorical = any(t.get_text() and not t.get_text().replace("−", "-").replace(".", "").lstrip("-").isdigit()
+                          for t in ax.get_xticklabels() if "$" not in t.get_text())
+        assert xlabel, "missing x label"
+        assert categorical or ("(" in xlabel and ")" in xlabel), xlabel
         assert "(" in ax.get_ylabel() and ")" in ax.get_ylabel(), ax.get_ylabel()
     assert any(ax.get_title() for ax in fig.axes) or fig._suptitle is not None
 
