@@ -6,6 +6,19 @@
 #include "gmasim/errors.hpp"
 
 namespace gmasim {
+namespace {
+
+// Adds a branch of conductance g between its nodes to a nodal (Laplacian) matrix.
+void stamp_conductance(Eigen::MatrixXd& G, const CircuitBranch& br, double g) {
+  if (br.from >= 0) G(br.from, br.from) += g;
+  if (br.to >= 0) G(br.to, br.to) += g;
+  if (br.from >= 0 && br.to >= 0) {
+    G(br.from, br.to) -= g;
+    G(br.to, br.from) -= g;
+  }
+}
+
+}  // namespace
 
 void finalize_circuit(Circuit& c, int rod_count, const std::string& where) {
   const int n = c.node_count();
@@ -59,13 +72,7 @@ void finalize_circuit(Circuit& c, int rod_count, const std::string& where) {
   c.fixed_laplacian = Eigen::MatrixXd::Zero(n, n);
   for (const auto& br : c.branches) {
     if (br.rod >= 0) continue;
-    const double g = 1.0 / br.fixed_reluctance_per_H;
-    if (br.from >= 0) c.fixed_laplacian(br.from, br.from) += g;
-    if (br.to >= 0) c.fixed_laplacian(br.to, br.to) += g;
-    if (br.from >= 0 && br.to >= 0) {
-      c.fixed_laplacian(br.from, br.to) -= g;
-      c.fixed_laplacian(br.to, br.from) -= g;
-    }
+    stamp_conductance(c.fixed_laplacian, br, 1.0 / br.fixed_reluctance_per_H);
   }
   // Low-rank pieces, when the fixed branches alone ground every node (G0 SPD).
   c.lowrank = LowRank{};
@@ -121,6 +128,24 @@ void CircuitWorkspace::resize(const Circuit& c) {
 
 namespace {
 
+double branch_reluctance(const CircuitBranch& br, std::span<const double> rod_R) {
+  return br.rod >= 0 ? rod_R[static_cast<std::size_t>(br.rod)] : br.fixed_reluctance_per_H;
+}
+double branch_mmf(const CircuitBranch& br, double current_A, double pm_scale) {
+  return br.coil_turns * current_A + br.pm_mmf_At * pm_scale;
+}
+// phi_b = (psi_from - psi_to + F) / R, with the potential drop psi_from - psi_to given.
+void set_flux(const Circuit& c, std::size_t b, std::span<const double> rod_R, double current_A,
+              double pm_scale, double drop, CircuitWorkspace& ws) {
+  const auto& br = c.branches[b];
+  ws.reluctance[b] = branch_reluctance(br, rod_R);
+  ws.mmf[b] = branch_mmf(br, current_A, pm_scale);
+  ws.phi[b] = (drop + ws.mmf[b]) / ws.reluctance[b];
+}
+double potential_drop(const CircuitBranch& br, const Eigen::VectorXd& psi) {
+  return (br.from >= 0 ? psi(br.from) : 0.0) - (br.to >= 0 ? psi(br.to) : 0.0);
+}
+
 // (D^-1 + S) z = v for the k rods; fixed-size Eigen factorisations for the common small k.
 template <int K>
 void solve_small_fixed(const SmallMatrix& A, const SmallVector& b, SmallVector& x) {
@@ -164,7 +189,7 @@ bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_
   for (int r = 0; r < k; ++r) {
     const auto& br =
         c.branches[static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)])];
-    ws.F_rod(r) = (br.coil_turns * current_A + br.pm_mmf_At * pm_scale) /
+    ws.F_rod(r) = branch_mmf(br, current_A, pm_scale) /
                   rod_reluctance_per_H[static_cast<std::size_t>(r)];  // D F
   }
   ws.v.noalias() = current_A * L.Bt_psi_coil + pm_scale * L.Bt_psi_pm;
@@ -178,31 +203,15 @@ bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_
     //   B^T psi = B^T u - S (D F + z),  phi_r = (drop_r + F_r) / R_r.
     ws.v.noalias() = current_A * L.Bt_psi_coil + pm_scale * L.Bt_psi_pm;
     ws.v.noalias() -= L.S * ws.z;
-    for (int r = 0; r < k; ++r) {
-      const auto b = static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)]);
-      const auto& br = c.branches[b];
-      const double R = rod_reluctance_per_H[static_cast<std::size_t>(r)];
-      const double F = br.coil_turns * current_A + br.pm_mmf_At * pm_scale;
-      ws.reluctance[b] = R;
-      ws.mmf[b] = F;
-      ws.phi[b] = (ws.v(r) + F) / R;
-    }
+    for (int r = 0; r < k; ++r)
+      set_flux(c, static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)]), rod_reluctance_per_H,
+               current_A, pm_scale, ws.v(r), ws);
     return true;
   }
   ws.rhs.noalias() = current_A * L.psi_coil + pm_scale * L.psi_pm;
   ws.rhs.noalias() -= L.W * ws.z;
-  auto flux = [&](std::size_t b) {
-    const auto& br = c.branches[b];
-    const double R = br.rod >= 0 ? rod_reluctance_per_H[static_cast<std::size_t>(br.rod)]
-                                 : br.fixed_reluctance_per_H;
-    const double F = br.coil_turns * current_A + br.pm_mmf_At * pm_scale;
-    ws.reluctance[b] = R;
-    ws.mmf[b] = F;
-    const double pf = br.from >= 0 ? ws.rhs(br.from) : 0.0;
-    const double pt = br.to >= 0 ? ws.rhs(br.to) : 0.0;
-    ws.phi[b] = (pf - pt + F) / R;
-  };
-  for (std::size_t b = 0; b < c.branches.size(); ++b) flux(b);
+  for (std::size_t b = 0; b < c.branches.size(); ++b)
+    set_flux(c, b, rod_reluctance_per_H, current_A, pm_scale, potential_drop(c.branches[b], ws.rhs), ws);
   return true;
 }
 
@@ -210,38 +219,19 @@ bool solve_circuit_full(const Circuit& c, std::span<const double> rod_reluctance
                         double current_A, double pm_scale, CircuitWorkspace& ws) {
   ws.G = c.fixed_laplacian;
   ws.rhs.setZero();
-  const std::size_t nb = c.branches.size();
-  for (std::size_t b = 0; b < nb; ++b) {
-    const auto& br = c.branches[b];
-    const double R = br.rod >= 0 ? rod_reluctance_per_H[static_cast<std::size_t>(br.rod)]
-                                 : br.fixed_reluctance_per_H;
-    const double F = br.coil_turns * current_A + br.pm_mmf_At * pm_scale;
-    ws.reluctance[b] = R;
-    ws.mmf[b] = F;
-    const double g = 1.0 / R;
-    if (br.rod >= 0) {
-      if (br.from >= 0) ws.G(br.from, br.from) += g;
-      if (br.to >= 0) ws.G(br.to, br.to) += g;
-      if (br.from >= 0 && br.to >= 0) {
-        ws.G(br.from, br.to) -= g;
-        ws.G(br.to, br.from) -= g;
-      }
-    }
-    if (F != 0.0) {
-      // phi_b = (psi_from - psi_to + F)/R; KCL at `from` (outflow) and `to` (inflow).
-      if (br.from >= 0) ws.rhs(br.from) -= F * g;
-      if (br.to >= 0) ws.rhs(br.to) += F * g;
-    }
+  for (const auto& br : c.branches) {
+    const double g = 1.0 / branch_reluctance(br, rod_reluctance_per_H);
+    const double F = branch_mmf(br, current_A, pm_scale);
+    if (br.rod >= 0) stamp_conductance(ws.G, br, g);
+    // phi_b = (psi_from - psi_to + F)/R; KCL at `from` (outflow) and `to` (inflow).
+    if (br.from >= 0) ws.rhs(br.from) -= F * g;
+    if (br.to >= 0) ws.rhs(br.to) += F * g;
   }
   ws.llt.compute(ws.G);
   if (ws.llt.info() != Eigen::Success) return false;
   ws.llt.solveInPlace(ws.rhs);  // rhs now holds psi
-  for (std::size_t b = 0; b < nb; ++b) {
-    const auto& br = c.branches[b];
-    const double pf = br.from >= 0 ? ws.rhs(br.from) : 0.0;
-    const double pt = br.to >= 0 ? ws.rhs(br.to) : 0.0;
-    ws.phi[b] = (pf - pt + ws.mmf[b]) / ws.reluctance[b];
-  }
+  for (std::size_t b = 0; b < c.branches.size(); ++b)
+    set_flux(c, b, rod_reluctance_per_H, current_A, pm_scale, potential_drop(c.branches[b], ws.rhs), ws);
   return true;
 }
 
