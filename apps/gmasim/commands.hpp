@@ -12,6 +12,12 @@ using Runner = std::function<int()>;
 
 Runner add_simulate(CLI::App& app);
 Runner add_model(CLI::App& app);
+Runner add_sweep(CLI::App& app);    // cmd_sweep.cpp
+Runner add_frf(CLI::App& app);      // cmd_frf.cpp
+Runner add_track(CLI::App& app);    // cmd_track.cpp
+Runner add_ablate(CLI::App& app);   // cmd_ablate.cpp
+Runner add_params(CLI::App& app);   // cmd_params.cpp: params-vs-temperature
+Runner add_thermal(CLI::App& app);  // cmd_params.cpp: thermal
 
 // Shared helpers.
 std::string model_label(const std::string& path);  // "models/mdma.toml (built-in)" or path

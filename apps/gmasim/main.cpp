@@ -31,6 +31,12 @@ int main(int argc, char** argv) {
   std::vector<gmasim::cli::Runner> runners;
   runners.push_back(gmasim::cli::add_simulate(app));
   runners.push_back(gmasim::cli::add_model(app));
+  runners.push_back(gmasim::cli::add_sweep(app));
+  runners.push_back(gmasim::cli::add_frf(app));
+  runners.push_back(gmasim::cli::add_track(app));
+  runners.push_back(gmasim::cli::add_ablate(app));
+  runners.push_back(gmasim::cli::add_params(app));
+  runners.push_back(gmasim::cli::add_thermal(app));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

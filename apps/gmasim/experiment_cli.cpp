@@ -1,0 +1,102 @@
+#include "experiment_cli.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/io.hpp"
+
+namespace gmasim::cli {
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return "";
+  const auto e = s.find_last_not_of(" \t");
+  return s.substr(b, e - b + 1);
+}
+
+double parse_number(const std::string& item, const std::string& flag, const std::string& unit,
+                    const std::string& text) {
+  const std::string t = trim(item);
+  char* end = nullptr;
+  const double v = t.empty() ? 0.0 : std::strtod(t.c_str(), &end);
+  if (t.empty() || end != t.c_str() + t.size() || !std::isfinite(v))
+    throw InputError(fmt::format("{} '{}': '{}' is not a number [{}]", flag, text, t, unit));
+  return v;
+}
+
+}  // namespace
+
+std::vector<double> parse_list(const std::string& text, const std::string& flag,
+                               const std::string& unit) {
+  std::vector<double> out;
+  if (trim(text).empty()) return out;
+  std::size_t pos = 0;
+  while (pos <= text.size()) {
+    const std::size_t comma = text.find(',', pos);
+    const std::string item =
+        text.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
+    const std::size_t c1 = item.find(':');
+    if (c1 == std::string::npos) {
+      out.push_back(parse_number(item, flag, unit, text));
+    } else {
+      const std::size_t c2 = item.find(':', c1 + 1);
+      if (c2 == std::string::npos)
+        throw InputError(fmt::format("{} '{}': a range is start:step:stop [{}]", flag, text, unit));
+      const double a = parse_number(item.substr(0, c1), flag, unit, text);
+      const double step = parse_number(item.substr(c1 + 1, c2 - c1 - 1), flag, unit, text);
+      const double b = parse_number(item.substr(c2 + 1), flag, unit, text);
+      if (!(step > 0.0) || b < a)
+        throw InputError(fmt::format("{} '{}': range {}: needs step > 0 and stop >= start [{}]",
+                                     flag, text, trim(item), unit));
+      const long n = std::lround(std::floor((b - a) / step + 1e-9));
+      if (n > 100000)
+        throw InputError(
+            fmt::format("{} '{}': range {} has too many values", flag, text, trim(item)));
+      for (long k = 0; k <= n; ++k) out.push_back(a + static_cast<double>(k) * step);
+    }
+    if (comma == std::string::npos) break;
+    pos = comma + 1;
+  }
+  return out;
+}
+
+ProgressFn stderr_progress(const std::string& label, bool force) {
+  const bool tty = ::isatty(STDERR_FILENO) == 1;
+  if (!tty && !force) return {};
+  return [label, tty](std::size_t done, std::size_t total) {
+    // Serialised by the caller; a terminal gets one updating line, a pipe one line each.
+    if (tty)
+      std::fprintf(stderr, "\r%s: %zu/%zu%s", label.c_str(), done, total,
+                   done == total ? "\n" : "");
+    else
+      std::fprintf(stderr, "%s: %zu/%zu\n", label.c_str(), done, total);
+    std::fflush(stderr);
+  };
+}
+
+std::vector<std::string> write_report(const std::string& dir, const std::string& stem,
+                                      const Report& r) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> paths;
+  for (std::size_t i = 0; i < r.tables.size(); ++i) {
+    const std::string name = i == 0 ? stem + ".csv" : stem + "_" + r.tables[i].name + ".csv";
+    const std::string path = (fs::path(dir) / name).string();
+    write_file_atomic(path, table_csv(r.tables[i]));
+    paths.push_back(path);
+  }
+  const std::string json = (fs::path(dir) / (stem + ".json")).string();
+  write_file_atomic(json, report_json(r));
+  paths.push_back(json);
+  return paths;
+}
+
+}  // namespace gmasim::cli

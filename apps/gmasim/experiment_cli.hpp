@@ -1,0 +1,26 @@
+// Shared pieces of the experiment subcommands (sweep, frf, track, ablate,
+// params-vs-temperature, thermal): list parsing, progress on stderr, report files.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "gmasim/experiments.hpp"
+
+namespace gmasim::cli {
+
+// "20,30,40" or "20:10:70" (start:step:stop, inclusive) or a mix "6,8:2:12"; "" -> empty.
+// Throws InputError naming the flag and its unit.
+std::vector<double> parse_list(const std::string& text, const std::string& flag,
+                               const std::string& unit);
+
+// Progress on stderr ("label: 12/24 points"), when stderr is a terminal or `force`.
+// Returns an empty function when progress is off.
+ProgressFn stderr_progress(const std::string& label, bool force);
+
+// Writes DIR/<stem>.json (every table) and one CSV per table: DIR/<stem>.csv for the
+// first, DIR/<stem>_<table>.csv for the others. Returns the paths written.
+std::vector<std::string> write_report(const std::string& dir, const std::string& stem,
+                                      const Report& r);
+
+}  // namespace gmasim::cli

@@ -1,0 +1,128 @@
+// gmasim ablate (Fig. 20): each temperature law frozen at T_ref (20 degC), one at a time;
+// the deviation of the frozen model from the full model at the operating temperature.
+// docs/experiments.md, "Ablation".
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "experiments/parallel.hpp"
+#include "gmasim/errors.hpp"
+#include "gmasim/experiments.hpp"
+
+namespace gmasim {
+
+std::vector<AblationLaw> ablation_laws() {
+  std::vector<AblationLaw> laws;
+  auto add = [&](const char* name, const char* what, auto set) {
+    AblationLaw l;
+    l.name = name;
+    l.description = what;
+    set(l.freeze);
+    laws.push_back(l);
+  };
+  add("mu_G", "permeability of the rods, eq. (3)-(4) (and the eddy time constant through mu)",
+      [](Freeze& f) { f.permeability = true; });
+  add("rho_G", "resistivity of the rods, eq. (8)", [](Freeze& f) { f.resistivity = true; });
+  add("M", "magnetisation process: JA coefficients of eq. (10), M_s^T in eq. (9) and (11)",
+      [](Freeze& f) { f.magnetisation = true; });
+  add("E_G", "Delta-E modulus of the rods, eq. (13)", [](Freeze& f) { f.modulus = true; });
+  add("E_t", "sleeve modulus, eq. (19)", [](Freeze& f) { f.sleeve_modulus = true; });
+  add("F_pm", "permanent-magnet MMF, eq. (1)", [](Freeze& f) { f.pm_mmf = true; });
+  add("geometry", "thermal expansion of lengths and areas (eq. 2, 7, 17, 19)",
+      [](Freeze& f) { f.geometry = true; });
+  add("all", "every law above at once: the 20 degC model run at the operating temperature",
+      [](Freeze& f) {
+        f.permeability = f.resistivity = f.magnetisation = f.modulus = f.sleeve_modulus = f.pm_mmf =
+            f.geometry = true;
+      });
+  return laws;
+}
+
+AblateResult run_ablate(const Model& m, const AblateRequest& r) {
+  if (r.frequencies_Hz.empty()) throw InputError("ablate: no frequency given");
+  for (double f : r.frequencies_Hz)
+    if (!(f > 0.0) || !std::isfinite(f))
+      throw InputError(fmt::format("frequency {} Hz: must be > 0", f));
+  if (!(r.current_pp_A >= 0.0) || !std::isfinite(r.current_pp_A))
+    throw InputError(fmt::format("current peak-to-peak {} A: must be >= 0", r.current_pp_A));
+  if (!(r.periods >= 1.0) || !std::isfinite(r.periods))
+    throw InputError(fmt::format("periods {}: must be >= 1", r.periods));
+  (void)make_conditions(m, r.temperature_C);  // T < T_c
+
+  const auto laws = ablation_laws();
+  const std::size_t per_f = laws.size() + 1;  // the full model, then each law
+  const std::size_t n = r.frequencies_Hz.size() * per_f;
+  struct Run {  // only what the comparison needs (a full Result holds every column)
+    std::vector<double> t, y;
+    Metrics metrics;
+    bool diverged = false;
+    std::string error;
+  };
+  std::vector<Run> runs(n);
+  detail::parallel_for(n, resolve_thread_count(r.threads, n),
+                       [&](std::size_t i) {
+                         const std::size_t fi = i / per_f, li = i % per_f;
+                         SimulationSettings s;
+                         s.temperature_C = r.temperature_C;
+                         s.waveform =
+                             biased_sine(r.current_pp_A, r.frequencies_Hz[fi], r.current_min_A);
+                         s.periods = r.periods;
+                         if (li > 0) s.freeze = laws[li - 1].freeze;
+                         Result out = simulate(m, s);
+                         Run& run = runs[i];
+                         run.diverged = out.diverged;
+                         run.error = out.error;
+                         run.metrics = out.metrics;
+                         run.t = out.series.column("t_s");
+                         run.y = out.series.column("y_um");
+                       },
+                       {});
+
+  AblateResult res;
+  const double nan = std::nan("");
+  for (std::size_t fi = 0; fi < r.frequencies_Hz.size(); ++fi) {
+    const Run& full = runs[fi * per_f];
+    if (full.diverged)
+      throw DivergenceError(0.0, "", "full model at the ablation point", 0.0, full.error);
+    res.full.push_back(full.metrics);
+    const auto& t = full.t;
+    const auto& yf = full.y;
+    const double eps = 1e-9 * (full.metrics.window_end_s - full.metrics.window_start_s);
+    const auto b = static_cast<std::size_t>(
+        std::lower_bound(t.begin(), t.end(), full.metrics.window_start_s - eps) - t.begin());
+    const auto e = static_cast<std::size_t>(
+        std::lower_bound(t.begin(), t.end(), full.metrics.window_end_s - eps) - t.begin());
+    for (std::size_t li = 0; li < laws.size(); ++li) {
+      const Run& fr = runs[fi * per_f + li + 1];
+      AblationRow row;
+      row.law = laws[li].name;
+      row.frequency_Hz = r.frequencies_Hz[fi];
+      row.diverged = fr.diverged;
+      row.error = fr.error;
+      if (fr.diverged || fr.y.size() != full.y.size()) {
+        row.error_rms_um = row.error_peak_um = row.error_pct_of_stroke = nan;
+        row.stroke_um = row.hysteresis_um = row.stroke_change_pct = row.hysteresis_change_pct = nan;
+        res.rows.push_back(row);
+        continue;
+      }
+      // Same waveform, same dt: the two runs share the time grid sample for sample.
+      const auto& yz = fr.y;
+      std::vector<double> d(yz.size());
+      for (std::size_t k = b; k < e; ++k) d[k] = yz[k] - yf[k];
+      const RmsPeak rp = rms_and_peak(d, b, e);
+      row.error_rms_um = rp.rms;
+      row.error_peak_um = rp.peak;
+      row.error_pct_of_stroke = rp.rms / full.metrics.stroke_um * 100.0;
+      row.stroke_um = fr.metrics.stroke_um;
+      row.hysteresis_um = fr.metrics.hysteresis_um;
+      row.stroke_change_pct = detail::change_pct(full.metrics.stroke_um, fr.metrics.stroke_um);
+      row.hysteresis_change_pct =
+          detail::change_pct(full.metrics.hysteresis_um, fr.metrics.hysteresis_um);
+      res.rows.push_back(row);
+    }
+  }
+  return res;
+}
+
+}  // namespace gmasim

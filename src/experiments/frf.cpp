@@ -1,0 +1,448 @@
+// gmasim frf (Fig. 15): frequency response current -> displacement about a DC bias, by a
+// stepped sine (time-domain runs of step()) and by a small-signal linearisation of the
+// same model, and the modes of eq. (15). docs/experiments.md, "Frequency response".
+#include <fmt/format.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <complex>
+
+#include "experiments/parallel.hpp"
+#include "gmasim/errors.hpp"
+#include "gmasim/experiments.hpp"
+#include "gmasim/physics/jiles_atherton.hpp"
+#include "gmasim/physics/magnetic.hpp"
+#include "gmasim/physics/magnetostriction.hpp"
+#include "gmasim/physics/mechanics.hpp"
+
+namespace gmasim {
+namespace {
+
+using namespace physics;
+using cd = std::complex<double>;
+
+constexpr double kTwoPi = 2.0 * kPi;
+constexpr double kSettleDt_s = 10e-6;
+
+// The eq. (3) permeability of rod i at magnetisation M (as step() evaluates it).
+double mu_at(const Model& m, const RodConditions& rc, double M) {
+  return permeability(
+      inverse_susceptibility(M / rc.MsT_mu, m.material.chi_m, rc.S_mu_J_per_m3, rc.MsT_mu));
+}
+
+// Static fields H_c,i (eq. 7 first line) of every rod for coil current I and rod
+// magnetisations M (through mu(M), eq. 2-3, and the nodal solve of eq. 23).
+std::vector<double> static_fields(const Model& m, const Conditions& c, CircuitWorkspace& ws,
+                                  double I, const std::vector<double>& M) {
+  const std::size_t n = M.size();
+  std::vector<double> R(n), mu(n), Hc(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    mu[i] = mu_at(m, c.rods[i], M[i]);
+    R[i] = rod_reluctance(c.rods[i].length_m, mu[i], c.rods[i].area_m2);
+  }
+  if (!solve_circuit(m.circuit, R, I, c.pm_scale, ws, false))
+    throw DivergenceError(0.0, "", "nodal matrix of the circuit", 0.0, "not positive definite");
+  for (std::size_t i = 0; i < n; ++i) {
+    const double phi = ws.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
+    Hc[i] = static_field(phi, c.rods[i].k_f, mu[i], c.rods[i].area_m2);
+  }
+  return Hc;
+}
+
+// Rod force (eq. 11-14) and rod stiffness (eq. 17) at magnetisation M, as step() does.
+struct ForceStiffness {
+  double F, k_rod;
+};
+ForceStiffness force_at(const Model& m, const RodConditions& rc, double M) {
+  const double E = delta_e_modulus(M / rc.MsT_E, rc.dE);
+  const double lambda = magnetostriction(M / rc.MsT_ja, m.material.lambda_s, rc.sigma_p_Pa, E);
+  return {rod_force(lambda, E, rc.area_m2), axial_stiffness(E, rc.area_m2, rc.length_m)};
+}
+
+void run_dc(const Model& m, const Conditions& c, State& s, double I, double duration_s) {
+  const long n = std::lround(duration_s / kSettleDt_s);
+  for (long k = 0; k < n; ++k) step(m, c, s, {I, kSettleDt_s});
+}
+
+double unwrap_deg(double prev, double now) {
+  while (now - prev > 180.0) now -= 360.0;
+  while (now - prev < -180.0) now += 360.0;
+  return now;
+}
+
+std::vector<double> log_grid(double f0, double f1, int n) {
+  std::vector<double> f(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k)
+    f[static_cast<std::size_t>(k)] = f0 * std::pow(f1 / f0, static_cast<double>(k) / (n - 1));
+  return f;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// Bias point
+// ---------------------------------------------------------------------------------------
+State settle_at_bias(const Model& m, const Conditions& c, double bias_A, BiasState bias_state) {
+  State s = make_state(m, c, bias_A);  // virgin curve, static equilibrium
+  const std::size_t n = s.rods.size();
+  double tau_max = 0.0;
+  for (const auto& r : s.rods) tau_max = std::max(tau_max, r.tau_s);
+  if (bias_state == BiasState::Anhysteretic) {
+    // Put each rod on its anhysteretic curve, M_irr = M = M_an(H + alpha M), at the field it
+    // sees; the circuit then moves the field (mu depends on M), so repeat until the fixed
+    // point holds. DC steps in between let H, the circuit and the mechanics follow.
+    for (int it = 0; it < 60; ++it) {
+      double change = 0.0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const auto& rc = c.rods[i];
+        auto& r = s.rods[i];
+        JaCoefficients anh = rc.ja;
+        anh.c = 1.0;  // M = M_an(H + alpha M)
+        const double M =
+            ja_total_magnetisation(r.H_A_per_m, r.M_A_per_m, r.M_A_per_m, rc.MsT_ja, anh);
+        change = std::max(change, std::fabs(M - r.Mirr_A_per_m) / rc.MsT_ja);
+        r.Mirr_A_per_m = M;
+        r.M_A_per_m = M;
+        r.M_prev_A_per_m = M;
+      }
+      run_dc(m, c, s, bias_A, std::max(5.0 * tau_max, 1e-3));
+      if (change < 1e-10) break;
+    }
+  }
+  // Let H (eddy lag), M and the oscillators come to rest at the bias.
+  run_dc(m, c, s, bias_A, std::max(20.0 * tau_max, 10e-3));
+  s.t_s = 0.0;
+  return s;
+}
+
+// ---------------------------------------------------------------------------------------
+// Linearisation
+// ---------------------------------------------------------------------------------------
+SmallSignalModel linearise(const Model& m, const Conditions& c, const State& s) {
+  const std::size_t n = s.rods.size();
+  SmallSignalModel L;
+  L.temperature_C = c.temperature_C;
+  L.bias_A = s.current_A;
+  L.n = static_cast<int>(n);
+  L.y0_m = s.y_m;
+  std::vector<double> M0(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    M0[i] = s.rods[i].M_A_per_m;
+    L.M0_A_per_m.push_back(M0[i]);
+    L.H0_A_per_m.push_back(s.rods[i].H_A_per_m);
+    L.x0_m.push_back(s.rods[i].x_m);
+  }
+  CircuitWorkspace ws;
+  ws.resize(m.circuit);
+  const double I0 = s.current_A;
+
+  // Circuit: dHc/dI at fixed M (linear in I, so any step is exact), dHc/dM_j at fixed I.
+  {
+    const double dI = 1e-2;
+    const auto Hp = static_fields(m, c, ws, I0 + dI, M0);
+    const auto Hm = static_fields(m, c, ws, I0 - dI, M0);
+    for (std::size_t i = 0; i < n; ++i) L.g_A_per_m_per_A.push_back((Hp[i] - Hm[i]) / (2 * dI));
+  }
+  L.G.assign(n * n, 0.0);
+  for (std::size_t j = 0; j < n; ++j) {
+    const double dM = 1e-5 * c.rods[j].MsT_mu;
+    auto Mp = M0, Mm = M0;
+    Mp[j] += dM;
+    Mm[j] -= dM;
+    const auto Hp = static_fields(m, c, ws, I0, Mp);
+    const auto Hm = static_fields(m, c, ws, I0, Mm);
+    for (std::size_t i = 0; i < n; ++i) L.G[i * n + j] = (Hp[i] - Hm[i]) / (2 * dM);
+  }
+  // Eddy lag (eq. 7) and JA with M_irr pinned (eq. 9): M = (1-c) M_irr + c M_an(H + alpha M).
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& rc = c.rods[i];
+    const auto& r = s.rods[i];
+    L.tau_s.push_back(mu_at(m, rc, r.M_A_per_m) * rc.eddy_geometry_s_m_per_H);
+    const double He = r.H_A_per_m + rc.ja.alpha * r.M_A_per_m;
+    const double dMan = anhysteretic_slope(He, rc.MsT_ja, rc.ja.a_A_per_m);
+    L.chi.push_back(rc.ja.c * dMan / (1.0 - rc.ja.alpha * rc.ja.c * dMan));
+  }
+  // Force and stiffness: F_net,i = F_i(M_i) - K_i(M) x0_i (eq. 14-18 about the bias).
+  L.D_N_per_A_per_m.assign(n * n, 0.0);
+  for (std::size_t j = 0; j < n; ++j) {
+    const double dM = 1e-5 * c.rods[j].MsT_ja;
+    State sp = s, sm = s;
+    const auto fp = force_at(m, c.rods[j], M0[j] + dM);
+    const auto fm = force_at(m, c.rods[j], M0[j] - dM);
+    sp.rods[j].k_rod_N_per_m = fp.k_rod;
+    sm.rods[j].k_rod_N_per_m = fm.k_rod;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double dK = (oscillator_stiffness(c, sp, static_cast<int>(i)) -
+                         oscillator_stiffness(c, sm, static_cast<int>(i))) /
+                        (2 * dM);
+      double d = -dK * s.rods[i].x_m;
+      if (i == j) d += (fp.F - fm.F) / (2 * dM);
+      L.D_N_per_A_per_m[i * n + j] = d;
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    L.mass_kg.push_back(c.rods[i].mass_osc_kg);
+    L.damping_N_s_per_m.push_back(c.rods[i].damping_osc_N_s_per_m);
+    L.stiffness_N_per_m.push_back(oscillator_stiffness(c, s, static_cast<int>(i)));
+  }
+  return L;
+}
+
+std::complex<double> SmallSignalModel::response(double f_Hz) const {
+  const auto N = static_cast<Eigen::Index>(n);
+  const cd sj(0.0, kTwoPi * f_Hz);
+  Eigen::MatrixXcd A = Eigen::MatrixXcd::Identity(N, N);
+  Eigen::VectorXcd b(N);
+  for (Eigen::Index i = 0; i < N; ++i) {
+    const auto ui = static_cast<std::size_t>(i);
+    const cd lag_chi = chi[ui] / (1.0 + tau_s[ui] * sj);  // dM_i / dHc_i
+    b(i) = lag_chi * g_A_per_m_per_A[ui];
+    for (Eigen::Index j = 0; j < N; ++j)
+      A(i, j) -= lag_chi * G[ui * static_cast<std::size_t>(n) + static_cast<std::size_t>(j)];
+  }
+  const Eigen::VectorXcd dM = A.partialPivLu().solve(b);
+  cd Y = 0.0;
+  for (Eigen::Index i = 0; i < N; ++i) {
+    const auto ui = static_cast<std::size_t>(i);
+    cd dF = 0.0;
+    for (Eigen::Index j = 0; j < N; ++j)
+      dF += D_N_per_A_per_m[ui * static_cast<std::size_t>(n) + static_cast<std::size_t>(j)] * dM(j);
+    Y += dF / (mass_kg[ui] * sj * sj + damping_N_s_per_m[ui] * sj + stiffness_N_per_m[ui]);
+  }
+  return Y;
+}
+
+// ---------------------------------------------------------------------------------------
+// Modes of eq. (15)
+// ---------------------------------------------------------------------------------------
+std::vector<Mode> mechanical_modes(const Model& m, const Conditions& c, const State& s) {
+  (void)m;
+  const auto N = static_cast<Eigen::Index>(s.rods.size());
+  // Eq. (15) with the diagonal M, C, K of eq. (16), (24), (25); assembled as full
+  // matrices so a model with coupling terms would be handled the same way.
+  Eigen::MatrixXd Mm = Eigen::MatrixXd::Zero(N, N), Cm = Mm, Km = Mm;
+  for (Eigen::Index i = 0; i < N; ++i) {
+    const auto& rc = c.rods[static_cast<std::size_t>(i)];
+    Mm(i, i) = rc.mass_osc_kg;
+    Cm(i, i) = rc.damping_osc_N_s_per_m;
+    Km(i, i) = oscillator_stiffness(c, s, static_cast<int>(i));
+  }
+  // Undamped modes: K v = w^2 M v; classical modal damping zeta = v'Cv / (2 w v'Mv).
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(Km, Mm);
+  std::vector<Mode> modes;
+  for (Eigen::Index k = 0; k < N; ++k) {
+    const double w = std::sqrt(std::max(es.eigenvalues()(k), 0.0));
+    const Eigen::VectorXd v = es.eigenvectors().col(k);
+    Mode md;
+    md.frequency_Hz = w / kTwoPi;
+    md.damping_ratio = w > 0 ? v.dot(Cm * v) / (2.0 * w * v.dot(Mm * v)) : 0.0;
+    md.damped_frequency_Hz =
+        md.damping_ratio < 1.0
+            ? md.frequency_Hz * std::sqrt(1.0 - md.damping_ratio * md.damping_ratio)
+            : 0.0;
+    modes.push_back(md);
+  }
+  std::sort(modes.begin(), modes.end(),
+            [](const Mode& a, const Mode& b) { return a.frequency_Hz < b.frequency_Hz; });
+  return modes;
+}
+
+// ---------------------------------------------------------------------------------------
+// Measurement helpers
+// ---------------------------------------------------------------------------------------
+std::complex<double> first_harmonic_ratio(const std::vector<double>& t_s,
+                                          const std::vector<double>& y,
+                                          const std::vector<double>& i, double f_Hz) {
+  cd Y = 0.0, I = 0.0;
+  for (std::size_t k = 0; k < t_s.size(); ++k) {
+    const cd e = std::polar(1.0, -kTwoPi * f_Hz * t_s[k]);
+    Y += y[k] * e;
+    I += i[k] * e;
+  }
+  return Y / I;
+}
+
+double find_resonance_Hz(const std::vector<double>& f, const std::vector<double>& mag) {
+  if (mag.size() < 3) return 0.0;
+  double best = 0.0, f_best = 0.0;
+  for (std::size_t k = 1; k + 1 < mag.size(); ++k) {
+    if (mag[k] > mag[k - 1] && mag[k] >= mag[k + 1] && mag[k] > best) {
+      best = mag[k];
+      // Parabolic refinement in log f.
+      const double a = mag[k - 1], b = mag[k], cc = mag[k + 1];
+      const double den = a - 2 * b + cc;
+      const double off = den != 0.0 ? 0.5 * (a - cc) / den : 0.0;
+      const double lf = std::log(f[k]) + off * 0.5 * (std::log(f[k + 1]) - std::log(f[k - 1]));
+      f_best = std::exp(lf);
+    }
+  }
+  return f_best;
+}
+
+double find_bandwidth_3dB_Hz(const std::vector<double>& f, const std::vector<double>& mag) {
+  if (mag.size() < 2) return 0.0;
+  const double level = mag.front() / std::sqrt(2.0);
+  for (std::size_t k = 1; k < mag.size(); ++k) {
+    if (mag[k] < level) {
+      const double u = (mag[k - 1] - level) / (mag[k - 1] - mag[k]);
+      return std::exp(std::log(f[k - 1]) + u * (std::log(f[k]) - std::log(f[k - 1])));
+    }
+  }
+  return 0.0;
+}
+
+// ---------------------------------------------------------------------------------------
+// The experiment
+// ---------------------------------------------------------------------------------------
+FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progress) {
+  if (r.temperatures_C.empty()) throw InputError("frf: no temperature given");
+  if (!(r.f_min_Hz > 0.0) || !std::isfinite(r.f_min_Hz))
+    throw InputError(fmt::format("frequency {} Hz: must be > 0", r.f_min_Hz));
+  if (!(r.f_max_Hz > r.f_min_Hz) || !std::isfinite(r.f_max_Hz))
+    throw InputError(fmt::format("frequency range {} .. {} Hz: the maximum must exceed the minimum",
+                                 r.f_min_Hz, r.f_max_Hz));
+  if (r.points < 2) throw InputError(fmt::format("points {}: need at least 2", r.points));
+  if (!(r.amplitude_A > 0.0) || !std::isfinite(r.amplitude_A))
+    throw InputError(fmt::format("amplitude {} A: must be > 0", r.amplitude_A));
+  if (!std::isfinite(r.bias_A)) throw InputError("bias current: not a finite number");
+  if (r.min_steps_per_period < 20)
+    throw InputError(fmt::format("steps per period {}: need at least 20", r.min_steps_per_period));
+  if (r.settle_periods < 1 || r.measure_periods < 1)
+    throw InputError(fmt::format("settle periods {} / measure periods {}: must be >= 1",
+                                 r.settle_periods, r.measure_periods));
+  if (!r.stepped_sine && !r.small_signal)
+    throw InputError("frf: neither the stepped sine nor the small-signal method is selected");
+  std::vector<Conditions> conds;
+  for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
+
+  const auto wall0 = std::chrono::steady_clock::now();
+  const std::vector<double> f = log_grid(r.f_min_Hz, r.f_max_Hz, r.points);
+  const std::size_t nT = r.temperatures_C.size(), nf = f.size();
+
+  // Bias points, linearisations and modes (cheap; one per temperature).
+  std::vector<State> bias;
+  std::vector<SmallSignalModel> lin;
+  FrfResult res;
+  for (std::size_t ti = 0; ti < nT; ++ti) {
+    bias.push_back(settle_at_bias(m, conds[ti], r.bias_A, r.bias_state));
+    lin.push_back(linearise(m, conds[ti], bias.back()));
+    FrfCurve cv;
+    cv.temperature_C = r.temperatures_C[ti];
+    cv.f_Hz = f;
+    cv.y_bias_um = bias.back().y_m * 1e6;
+    for (const auto& rd : bias.back().rods) cv.eddy_tau_ms.push_back(rd.tau_s * 1e3);
+    for (const Mode& md : mechanical_modes(m, conds[ti], bias.back())) {
+      cv.mode_frequencies_Hz.push_back(md.frequency_Hz);
+      cv.mode_damping_ratios.push_back(md.damping_ratio);
+    }
+    cv.static_gain_um_per_A = std::abs(lin.back().response(0.0)) * 1e6;
+    res.curves.push_back(cv);
+  }
+
+  // Stepped sine: one work item per (temperature, frequency).
+  std::vector<cd> stepped(nT * nf);
+  if (r.stepped_sine) {
+    const std::size_t n = nT * nf;
+    detail::parallel_for(
+        n, resolve_thread_count(r.threads, n),
+        [&](std::size_t idx) {
+          const std::size_t ti = idx / nf, fi = idx % nf;
+          const double fr = f[fi];
+          const Conditions& c = conds[ti];
+          State s = bias[ti];
+          // >= min_steps_per_period steps per period, dt <= 10 us; whole steps per period.
+          const long per = std::max<long>(
+              r.min_steps_per_period, static_cast<long>(std::ceil(1.0 / (fr * kMaxDt_s) - 1e-9)));
+          const double dt = 1.0 / (fr * static_cast<double>(per));
+          // Settling: the transient of switching the sine on decays with the slowest of the
+          // eddy lags and the mechanical modes. Settle for 10 of those time constants (the
+          // transient is then below 5e-5 of its start) and at least settle_periods periods:
+          // low frequencies need few periods, high frequencies many.
+          double t_settle = 0.0;
+          for (std::size_t i = 0; i < lin[ti].tau_s.size(); ++i) {
+            const double zw = lin[ti].damping_N_s_per_m[i] / (2.0 * lin[ti].mass_kg[i]);
+            t_settle = std::max({t_settle, 10.0 * lin[ti].tau_s[i], 10.0 / zw});
+          }
+          const long settle =
+              std::max<long>(r.settle_periods, static_cast<long>(std::ceil(t_settle * fr - 1e-9)));
+          const long measure = r.measure_periods;
+          const double w = kTwoPi * fr;
+          std::vector<double> ts, ys, is;
+          ts.reserve(static_cast<std::size_t>(measure * per));
+          ys.reserve(ts.capacity());
+          is.reserve(ts.capacity());
+          const long total = (settle + measure) * per;
+          for (long k = 1; k <= total; ++k) {
+            const double t = static_cast<double>(k) * dt;
+            const double I = r.bias_A + r.amplitude_A * std::sin(w * t);
+            step(m, c, s, {I, dt});
+            if (k > settle * per) {  // samples settle*per+1 .. total: whole periods
+              ts.push_back(t);
+              ys.push_back(s.y_m - lin[ti].y0_m);
+              is.push_back(I - r.bias_A);
+            }
+          }
+          stepped[idx] = first_harmonic_ratio(ts, ys, is, fr);
+        },
+        progress);
+  } else if (progress) {
+    progress(nT, nT);
+  }
+
+  for (std::size_t ti = 0; ti < nT; ++ti) {
+    FrfCurve& cv = res.curves[ti];
+    double prev_l = 0.0, prev_s = 0.0;
+    for (std::size_t fi = 0; fi < nf; ++fi) {
+      if (r.small_signal) {
+        const cd Y = lin[ti].response(f[fi]);
+        cv.linear_mag_um_per_A.push_back(std::abs(Y) * 1e6);
+        const double ph = std::arg(Y) * 180.0 / kPi;
+        prev_l = fi == 0 ? ph : unwrap_deg(prev_l, ph);
+        cv.linear_phase_deg.push_back(prev_l);
+      }
+      if (r.stepped_sine) {
+        const cd Y = stepped[ti * nf + fi];
+        cv.stepped_mag_um_per_A.push_back(std::abs(Y) * 1e6);
+        const double ph = std::arg(Y) * 180.0 / kPi;
+        prev_s = fi == 0 ? ph : unwrap_deg(prev_s, ph);
+        cv.stepped_phase_deg.push_back(prev_s);
+      }
+      if (r.small_signal && r.stepped_sine) {
+        const cd d = stepped[ti * nf + fi] - lin[ti].response(f[fi]);
+        cv.max_mismatch_pct =
+            std::max(cv.max_mismatch_pct, std::abs(d) / std::abs(lin[ti].response(f[fi])) * 100.0);
+      }
+    }
+    if (r.stepped_sine) {
+      cv.stepped_first_resonance_Hz = find_resonance_Hz(f, cv.stepped_mag_um_per_A);
+      cv.stepped_bandwidth_3dB_Hz = find_bandwidth_3dB_Hz(f, cv.stepped_mag_um_per_A);
+    }
+    if (r.small_signal) {
+      // Resonance and bandwidth of the linear model on a dense grid (cheap to evaluate).
+      const std::vector<double> fd = log_grid(r.f_min_Hz, r.f_max_Hz, 4000);
+      std::vector<double> md(fd.size());
+      for (std::size_t k = 0; k < fd.size(); ++k) md[k] = std::abs(lin[ti].response(fd[k]));
+      cv.first_resonance_Hz = find_resonance_Hz(fd, md);
+      cv.bandwidth_3dB_Hz = find_bandwidth_3dB_Hz(fd, md);
+      // The same search beyond the band, up to twice the highest mode.
+      double f_top = r.f_max_Hz;
+      for (double fm : cv.mode_frequencies_Hz) f_top = std::max(f_top, 2.0 * fm);
+      const std::vector<double> fe = log_grid(r.f_min_Hz, f_top, 8000);
+      std::vector<double> me(fe.size());
+      for (std::size_t k = 0; k < fe.size(); ++k) me[k] = std::abs(lin[ti].response(fe[k]));
+      cv.linear_peak_extended_Hz = find_resonance_Hz(fe, me);
+      cv.linear_peak_search_max_Hz = f_top;
+    } else {
+      cv.first_resonance_Hz = cv.stepped_first_resonance_Hz;
+      cv.bandwidth_3dB_Hz = cv.stepped_bandwidth_3dB_Hz;
+    }
+  }
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  for (auto& cv : res.curves) cv.wall_time_s = wall;
+  return res;
+}
+
+}  // namespace gmasim

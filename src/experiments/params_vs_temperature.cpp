@@ -1,0 +1,143 @@
+// gmasim params-vs-temperature: mu_G, rho_G, M_G, E_G, E_t from 20 to 150 degC (Fig. 19)
+// and the stroke retention at high temperature (Fig. 18). docs/experiments.md.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "experiments/parallel.hpp"
+#include "gmasim/errors.hpp"
+#include "gmasim/experiments.hpp"
+
+namespace gmasim {
+namespace {
+
+struct RodStats {
+  double mu_r_mean = 0, M_peak = 0, E_mean_GPa = 0;
+};
+
+struct Run {
+  Metrics metrics;
+  bool diverged = false;
+  std::string error;
+  std::vector<RodStats> rods;  // filled for the Fig. 19 operating point only
+};
+
+double mean_of(const std::vector<double>& v, std::size_t b, std::size_t e) {
+  double s = 0.0;
+  for (std::size_t i = b; i < e; ++i) s += v[i];
+  return e > b ? s / static_cast<double>(e - b) : 0.0;
+}
+
+}  // namespace
+
+ParamsVsTemperatureResult run_params_vs_temperature(const Model& m,
+                                                    const ParamsVsTemperatureRequest& r) {
+  if (r.temperatures_C.empty()) throw InputError("params-vs-temperature: no temperature given");
+  if (!(r.frequency_Hz > 0.0) || !std::isfinite(r.frequency_Hz))
+    throw InputError(fmt::format("frequency {} Hz: must be > 0", r.frequency_Hz));
+  for (double pp : r.retention_currents_pp_A)
+    if (!(pp >= 0.0) || !std::isfinite(pp))
+      throw InputError(fmt::format("current peak-to-peak {} A: must be >= 0", pp));
+  if (!(r.current_pp_A >= 0.0) || !std::isfinite(r.current_pp_A))
+    throw InputError(fmt::format("current peak-to-peak {} A: must be >= 0", r.current_pp_A));
+  if (!(r.periods >= 1.0)) throw InputError(fmt::format("periods {}: must be >= 1", r.periods));
+  std::vector<Conditions> conds;
+  for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
+
+  // Currents per temperature: the retention currents, plus the Fig. 19 point if it is not
+  // one of them.
+  std::vector<double> currents = r.retention_currents_pp_A;
+  std::size_t op = currents.size();
+  for (std::size_t k = 0; k < currents.size(); ++k)
+    if (currents[k] == r.current_pp_A) op = k;
+  if (op == currents.size()) currents.push_back(r.current_pp_A);
+  const std::size_t nc = currents.size(), n = r.temperatures_C.size() * nc;
+
+  std::vector<Run> runs(n);
+  detail::parallel_for(
+      n, resolve_thread_count(r.threads, n),
+      [&](std::size_t i) {
+        const std::size_t ti = i / nc, ci = i % nc;
+        SimulationSettings s;
+        s.temperature_C = r.temperatures_C[ti];
+        s.waveform = biased_sine(currents[ci], r.frequency_Hz, r.current_min_A);
+        s.periods = r.periods;
+        const Result out = simulate(m, s);
+        Run& run = runs[i];
+        run.diverged = out.diverged;
+        run.error = out.error;
+        run.metrics = out.metrics;
+        if (ci != op || out.diverged) return;
+        const auto& t = out.series.column("t_s");
+        const double eps = 1e-9 / r.frequency_Hz;
+        const auto b = static_cast<std::size_t>(
+            std::lower_bound(t.begin(), t.end(), out.metrics.window_start_s - eps) - t.begin());
+        const auto e = static_cast<std::size_t>(
+            std::lower_bound(t.begin(), t.end(), out.metrics.window_end_s - eps) - t.begin());
+        for (const auto& rod : m.rods) {
+          RodStats st;
+          st.mu_r_mean = mean_of(out.series.column(rod.name + "_mu_r"), b, e);
+          st.E_mean_GPa = mean_of(out.series.column(rod.name + "_E_GPa"), b, e);
+          st.M_peak = rms_and_peak(out.series.column(rod.name + "_M_A_per_m"), b, e).peak;
+          run.rods.push_back(st);
+        }
+      },
+      {});
+
+  ParamsVsTemperatureResult res;
+  const double nan = std::nan("");
+  for (std::size_t ti = 0; ti < r.temperatures_C.size(); ++ti) {
+    const Run& run = runs[ti * nc + op];
+    const Conditions& c = conds[ti];
+    for (std::size_t k = 0; k < m.rods.size(); ++k) {
+      ParamsVsTemperatureRow row;
+      row.temperature_C = r.temperatures_C[ti];
+      row.rod = m.rods[k].name;
+      row.rho_ohm_m = c.rods[k].rho_ohm_m;
+      row.MsT_A_per_m = c.rods[k].MsT_ja;
+      row.E_t_GPa = c.Et_Pa * 1e-9;
+      if (run.diverged) {
+        row.mu_r_mean = row.M_peak_A_per_m = row.E_G_mean_GPa = nan;
+      } else {
+        row.mu_r_mean = run.rods[k].mu_r_mean;
+        row.M_peak_A_per_m = run.rods[k].M_peak;
+        row.E_G_mean_GPa = run.rods[k].E_mean_GPa;
+      }
+      res.rows.push_back(row);
+    }
+  }
+  const std::size_t nr = m.rods.size();
+  for (std::size_t i = 0; i < res.rows.size(); ++i) {
+    const auto& first = res.rows[i % nr];
+    auto& row = res.rows[i];
+    row.mu_r_change_pct = detail::change_pct(first.mu_r_mean, row.mu_r_mean);
+    row.rho_change_pct = detail::change_pct(first.rho_ohm_m, row.rho_ohm_m);
+    row.M_peak_change_pct = detail::change_pct(first.M_peak_A_per_m, row.M_peak_A_per_m);
+    row.E_G_change_pct = detail::change_pct(first.E_G_mean_GPa, row.E_G_mean_GPa);
+    row.E_t_change_pct = detail::change_pct(first.E_t_GPa, row.E_t_GPa);
+  }
+  for (std::size_t ci = 0; ci < r.retention_currents_pp_A.size(); ++ci) {
+    const Run& first = runs[ci];
+    for (std::size_t ti = 0; ti < r.temperatures_C.size(); ++ti) {
+      const Run& run = runs[ti * nc + ci];
+      RetentionRow row;
+      row.current_pp_A = currents[ci];
+      row.temperature_C = r.temperatures_C[ti];
+      if (run.diverged || first.diverged) {
+        row.stroke_um = row.hysteresis_um = row.stroke_retention_pct =
+            row.hysteresis_retention_pct = nan;
+      } else {
+        row.stroke_um = run.metrics.stroke_um;
+        row.hysteresis_um = run.metrics.hysteresis_um;
+        row.stroke_retention_pct = run.metrics.stroke_um / first.metrics.stroke_um * 100.0;
+        row.hysteresis_retention_pct =
+            run.metrics.hysteresis_um / first.metrics.hysteresis_um * 100.0;
+      }
+      res.retention.push_back(row);
+    }
+  }
+  return res;
+}
+
+}  // namespace gmasim
