@@ -1,0 +1,464 @@
+// gmasim identify: measured data + fit spec -> calibrated model file and fit report.
+// gmasim identify synthesize: synthetic measurements from a model (validation, examples).
+// Only this command initialises MPI, and only when launched by mpirun/srun (or --mpi on).
+#include <fmt/format.h>
+
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <sstream>
+#include <thread>
+
+#include "commands.hpp"
+#include "gmasim/errors.hpp"
+#include "gmasim/identify.hpp"
+#include "gmasim/io.hpp"
+
+namespace gmasim::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Set by SIGINT / SIGTERM / SIGUSR1 (mpirun forwards SIGUSR1 to every rank); the search
+// stops at the end of the current epoch and writes the best model so far.
+std::atomic<bool> g_stop{false};
+
+extern "C" void on_stop_signal(int sig) {
+  g_stop.store(true);
+  std::signal(sig, SIG_DFL);  // a second signal ends the process at once
+}
+
+constexpr const char* kPlotScript = R"PY(#!/usr/bin/env python3
+"""Plots a gmasim identify fit report: overlay_*.png (measured vs simulated loop and time
+series per condition) and convergence.png. Usage: /usr/bin/python3 plot_fit.py REPORT_DIR"""
+import csv
+import json
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        rows = csv.reader(f)
+        head = next(rows)
+        cols = {h: [] for h in head}
+        for row in rows:
+            for h, v in zip(head, row):
+                try:
+                    cols[h].append(float(v))
+                except ValueError:
+                    cols[h].append(v)
+    return cols
+
+
+def main():
+    d = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
+    with open(os.path.join(d, "fit_report.json")) as f:
+        rep = json.load(f)
+    for c in rep["conditions"]:
+        if c["failed"]:
+            continue
+        o = read_csv(os.path.join(d, c["overlay"]))
+        idx = [i for i, k in enumerate(o["compared"]) if k > 0.5]
+        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
+        cur = [o["current_A"][i] for i in idx]
+        a1.plot(cur, [o["measured_um"][i] for i in idx], ".", ms=2.5, label="measured")
+        a1.plot(cur, [o["simulated_um"][i] for i in idx], "-", lw=1.2, label="simulated")
+        a1.set_xlabel("current [A]")
+        a1.set_ylabel("displacement [um]")
+        a1.legend(loc="upper left")
+        a1.set_title("loop (compared samples)")
+        t = o["t_s"]
+        a2.plot(t, o["measured_um"], ".", ms=2.0, label="measured")
+        a2.plot(t, o["simulated_um"], "-", lw=1.0, label="simulated")
+        if idx:
+            a2.axvspan(t[0], t[idx[0]], color="0.9", label="not compared")
+        a2.set_xlabel("t [s]")
+        a2.set_ylabel("displacement [um]")
+        a2.legend(loc="upper left")
+        freq = c["frequency_Hz"]
+        cond = f'{c["temperature_C"]:g} degC' + (
+            f', {c["current_pp_A"]:g} A p-p, {freq:g} Hz' if freq else "")
+        fig.suptitle(f'{c["label"]}: {cond}; RMS {c["rms_um"]:.3f} um = {c["rms_pct"]:.2f} % of p-p')
+        fig.tight_layout()
+        fig.savefig(os.path.join(d, c["overlay"][:-4] + ".png"), dpi=110)
+        plt.close(fig)
+    h = read_csv(os.path.join(d, "convergence.csv"))
+    if h["step"]:
+        fig, ax = plt.subplots(figsize=(7, 4.2))
+        for phase, style in (("ga", "o-"), ("refine", "s-")):
+            idx = [i for i, p in enumerate(h["phase"]) if p == phase]
+            if idx:
+                ax.semilogy([h["evaluations"][i] for i in idx],
+                            [h["best_rms_pct"][i] for i in idx], style, ms=3, label=phase)
+        ax.set_xlabel("model evaluations (all ranks)")
+        ax.set_ylabel("best weighted RMS error [%]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(os.path.join(d, "convergence.png"), dpi=110)
+        plt.close(fig)
+
+
+if __name__ == "__main__":
+    main()
+)PY";
+
+struct IdentifyArgs {
+  std::string data, fit, out, model, report, mpi = "auto";
+  IdentifyOptions opt;
+  bool no_refine = false, no_plots = false, quiet = false;
+};
+
+struct SynthArgs {
+  std::string out, model;
+  std::vector<std::string> sets;
+  SyntheticRequest req;
+  bool no_flux = false;
+};
+
+// The command line, for provenance (Linux: /proc/self/cmdline).
+std::string command_line() {
+  std::ifstream f("/proc/self/cmdline", std::ios::binary);
+  std::string all((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  std::string cmd;
+  std::size_t start = 0;
+  bool first = true;
+  while (start < all.size()) {
+    const auto end = all.find('\0', start);
+    std::string a = all.substr(start, end - start);
+    if (first) a = fs::path(a).filename().string();
+    first = false;
+    const bool plain = !a.empty() && a.find_first_of(" \t'\"\\$`!*?;&|<>()") == std::string::npos;
+    if (!cmd.empty()) cmd += ' ';
+    cmd += plain ? a : "'" + a + "'";
+    if (end == std::string::npos) break;
+    start = end + 1;
+  }
+  return cmd.empty() ? "gmasim identify" : cmd;
+}
+
+std::string read_file_text(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw InputError(located(path, 0, "cannot open the model file"));
+  std::ostringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+int env_int(const char* name, int fallback) {
+  const char* v = std::getenv(name);
+  return v ? std::atoi(v) : fallback;
+}
+
+void write_outputs(const IdentifyArgs& a, const IdentifyResult& r, const ModelSpec& start) {
+  FitProvenance p;
+  p.command = command_line();
+  p.data = a.data;
+  p.fit = a.fit;
+  p.start_model = model_label(a.model);
+  p.report_dir = a.report;
+  const std::string start_text =
+      a.model.empty() ? std::string(kBuiltinModelToml) : read_file_text(a.model);
+  const fs::path out(a.out);
+  if (out.has_parent_path()) ensure_output_dir(out.parent_path().string());
+  write_file_atomic(a.out, fitted_model_toml(start_text, start, r, p));
+  ensure_output_dir(a.report);
+  const fs::path dir(a.report);
+  write_file_atomic((dir / "fit_report.json").string(), fit_report_json(r, p));
+  write_file_atomic((dir / "fit_report.md").string(), fit_report_markdown(r, p));
+  write_file_atomic((dir / "convergence.csv").string(), convergence_csv(r));
+  for (const auto& c : r.conditions)
+    if (!c.failed) write_file_atomic((dir / c.overlay_file).string(), timeseries_csv(c.overlay));
+  const std::string script = (dir / "plot_fit.py").string();
+  write_file_atomic(script, kPlotScript);
+  if (!a.no_plots) {
+    std::error_code ec;
+    if (fs::exists("/usr/bin/python3", ec)) {
+      const std::string cmd = fmt::format(
+          "MPLBACKEND=Agg /usr/bin/python3 '{}' '{}' >/dev/null 2>&1", script, a.report);
+      if (std::system(cmd.c_str()) != 0) {
+        std::fprintf(stderr,
+                     "gmasim identify: note: plotting failed (matplotlib missing?); the CSV "
+                     "overlays are written; run %s by hand\n",
+                     script.c_str());
+      }
+    }
+  }
+}
+
+void print_summary(const IdentifyArgs& a, const IdentifyResult& r) {
+  fmt::print("gmasim identify  {} parameters, {} conditions, {} targets\n", r.parameters.size(),
+             r.conditions.size(), r.targets.size());
+  fmt::print("  {} x {} islands x {} individuals ({}), {} generations{}; {}\n", r.ranks, r.islands,
+             r.population, r.algorithm, r.generations_done, r.resumed ? " (resumed)" : "",
+             r.refine_summary);
+  fmt::print("  weighted RMS error {:.4g} % of p-p (start {:.4g} %, GA {:.4g} %)\n", r.rms_pct,
+             r.start_rms_pct, r.ga_rms_pct);
+  fmt::print("  {} evaluations in {:.1f} s; GA {:.1f} evaluations/s\n", r.evaluations, r.wall_s,
+             r.ga_evals_per_s);
+  fmt::print("  {:<34} {:>13} {:>13}  {}\n", "parameter", "start", "fitted", "95 % CI");
+  for (const auto& p : r.parameters) {
+    std::string ci = std::isnan(p.ci_low) ? "no interval (interrupted)"
+                     : !std::isfinite(p.ci_low) || !std::isfinite(p.ci_high)
+                         ? "not determined"
+                         : fmt::format("[{:.5g}, {:.5g}]{}", p.ci_low, p.ci_high,
+                                       p.determined ? "" : " not determined");
+    if (p.at_bound) ci += " (at a bound)";
+    fmt::print("  {:<34} {:>13.6g} {:>13.6g}  {}\n", p.name, p.start, p.value, ci);
+  }
+  for (const auto& c : r.conditions) {
+    if (c.failed)
+      fmt::print("  {:<34} failed: {}\n", c.label, c.error);
+    else
+      fmt::print("  {:<34} RMS {:8.4f} um = {:6.3f} %\n", c.label, c.rms_um, c.rms_pct);
+  }
+  for (const auto& t : r.targets)
+    fmt::print("  {:<34} target {:.5g}, simulated {:.5g} ({:+.2f} %)\n", t.label, t.value,
+               t.simulated, t.error_pct);
+  for (const auto& n : r.notes) fmt::print("  note: {}\n", n);
+  fmt::print("  wrote {} and {}/ (fit_report.md, fit_report.json, overlays, convergence)\n", a.out,
+             a.report);
+}
+
+int run_identify_body(IdentifyArgs& a, Communicator& comm) {
+  const bool root = comm.rank() == 0;
+  if (a.data.empty() && a.fit.empty())
+    throw InputError("identify: give --data MANIFEST and --fit SPEC (see docs/identify.md)");
+  if (a.fit.empty()) throw InputError("identify: --fit SPEC is required");
+  if (a.out.empty()) throw InputError("identify: --out model.toml is required");
+  if (a.report.empty()) {
+    fs::path p(a.out);
+    a.report = (p.parent_path() / (p.stem().string() + "_report")).string();
+  }
+  const ModelSpec start = a.model.empty() ? builtin_model_spec() : load_model_spec(a.model);
+  const MeasurementSet data = a.data.empty() ? MeasurementSet{} : load_manifest(a.data);
+  const FitSpec fit = load_fit_spec(a.fit);
+  IdentifyOptions o = a.opt;
+  o.refine = !a.no_refine;
+  o.comm = &comm;
+  o.stop = &g_stop;
+  if (o.threads <= 0) {
+    const int local =
+        std::max(1, env_int("OMPI_COMM_WORLD_LOCAL_SIZE", comm.size() > 1 ? comm.size() : 1));
+    o.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / local);
+  }
+  if (root) {
+    // Fail on an unwritable destination before hours of search, not after.
+    const fs::path out(a.out);
+    if (out.has_parent_path()) ensure_output_dir(out.parent_path().string());
+    ensure_output_dir(a.report);
+  }
+  if (root && !a.quiet) {
+    o.progress = [](const IdentifyProgress& p) {
+      if (p.phase == "ga") {
+        std::fprintf(stderr,
+                     "gmasim identify: generation %d/%d  best %.4g %%  %ld evaluations  %.0f "
+                     "evaluations/s  %.1f s\n",
+                     p.generation, p.generations, p.best_rms_pct, p.evaluations, p.evals_per_s,
+                     p.wall_s);
+      } else {
+        std::fprintf(stderr,
+                     "gmasim identify: refine iteration %d  RMS %.5g %%  %ld evaluations  %.1f s\n",
+                     p.generation, p.best_rms_pct, p.evaluations, p.wall_s);
+      }
+    };
+  }
+  std::signal(SIGINT, on_stop_signal);
+  std::signal(SIGTERM, on_stop_signal);
+  std::signal(SIGUSR1, on_stop_signal);
+  const IdentifyResult r = identify(start, data, fit, o);
+  if (root) {
+    write_outputs(a, r, start);
+    if (!a.quiet) print_summary(a, r);
+    if (r.interrupted) {
+      std::fprintf(
+          stderr, "gmasim identify: interrupted: wrote the best model so far (%s)%s\n",
+          a.out.c_str(),
+          o.checkpoint_path.empty() ? "" : "; continue with the same command and --resume");
+    }
+  }
+  return r.interrupted ? 130 : 0;
+}
+
+int run_identify(IdentifyArgs& a) {
+  const bool launched = launched_by_mpi();
+  const bool use_mpi = a.mpi == "on" || (a.mpi == "auto" && launched);
+  if (!use_mpi && launched && env_int("OMPI_COMM_WORLD_SIZE", 1) > 1) {
+    throw InputError(mpi_compiled()
+                         ? "identify: launched by mpirun with --mpi off: every rank would run the "
+                           "same search and write the same files"
+                         : "identify: launched by mpirun, but this gmasim was built without MPI");
+  }
+  std::unique_ptr<Communicator> comm =
+      use_mpi ? make_mpi_communicator(nullptr, nullptr) : make_serial_communicator();
+  const bool root = comm->rank() == 0;
+  try {
+    return run_identify_body(a, *comm);
+  } catch (const InputError& e) {
+    if (root) print_error(e.what());
+    if (comm->size() > 1) comm->abort(2);
+    return 2;
+  } catch (const std::exception& e) {
+    print_error(fmt::format("internal error (rank {}): {}", comm->rank(), e.what()));
+    if (comm->size() > 1) comm->abort(4);
+    return 4;
+  }
+}
+
+int run_synthesize(SynthArgs& a) {
+  ModelSpec spec = a.model.empty() ? builtin_model_spec() : load_model_spec(a.model);
+  std::string truth =
+      fmt::format("# truth of the synthetic measurements\nmodel = \"{}\"\n", model_label(a.model));
+  for (const auto& s : a.sets) {
+    const auto eq = s.find('=');
+    if (eq == std::string::npos)
+      throw InputError(fmt::format("--set '{}': expected name=value", s));
+    const std::string name = s.substr(0, eq);
+    double v = 0;
+    try {
+      std::size_t used = 0;
+      v = std::stod(s.substr(eq + 1), &used);
+      if (used != s.size() - eq - 1) throw std::invalid_argument("trailing");
+    } catch (const std::exception&) {
+      throw InputError(fmt::format("--set '{}': the value is not a number", s));
+    }
+    spec.set(name, v);
+    truth += fmt::format("{} = {:.17g}\n", name, v);
+  }
+  if (a.no_flux) a.req.with_flux = false;
+  const Model m = compile(spec);
+  const MeasurementSet set = synthesize_measurements(m, a.req);
+  write_measurement_set(set, a.out);
+  write_file_atomic((fs::path(a.out) / "truth.toml").string(), truth);
+  fmt::print(
+      "gmasim identify synthesize: {} conditions ({} samples each, noise {:g} % of p-p) "
+      "from {}\n  wrote {}/manifest.toml, the CSV files and truth.toml\n",
+      set.items.size(), set.items.empty() ? 0 : set.items.front().t_s.size(), a.req.noise_pct,
+      model_label(a.model), a.out);
+  return 0;
+}
+
+}  // namespace
+
+Runner add_identify(CLI::App& app) {
+  auto a = std::make_shared<IdentifyArgs>();
+  auto s = std::make_shared<SynthArgs>();
+  auto* sub = app.add_subcommand(
+      "identify",
+      "Identify model parameters from measurements: multi-island GA (pagmo2; MPI ranks under "
+      "mpirun) + Levenberg-Marquardt; writes a calibrated model file and a fit report");
+  sub->require_subcommand(0, 1);
+  auto& o = a->opt;
+  sub->add_option("--data", a->data, "Measurement manifest (TOML, docs/data.md)");
+  sub->add_option("--fit", a->fit,
+                  "Fit spec: TOML file ([[parameter]], [[target]]) or inline "
+                  "'name:lower:upper[:log],...'");
+  sub->add_option("--out", a->out, "Calibrated model file to write (TOML)");
+  sub->add_option("--model", a->model, "Start model (TOML); default: the built-in MDMA model");
+  sub->add_option("--report", a->report,
+                  "Fit report directory; default: <out>_report next to --out");
+  sub->add_option("--algorithm", o.algorithm,
+                  "Island algorithm: sga (the paper's GA), de, sade, cmaes")
+      ->check(CLI::IsMember({"sga", "de", "sade", "cmaes"}))
+      ->capture_default_str();
+  sub->add_option("--islands", o.islands, "Islands per rank (one thread each)")
+      ->capture_default_str();
+  sub->add_option("--population", o.population, "Individuals per island")->capture_default_str();
+  sub->add_option("--generations", o.generations,
+                  "Total GA generations (a resumed run continues up to this)")
+      ->capture_default_str();
+  sub->add_option("--migrate-every", o.migrate_every, "Generations between ring migrations")
+      ->capture_default_str();
+  sub->add_option("--migrants", o.migrants, "Individuals per migration (best out, worst replaced)")
+      ->capture_default_str();
+  sub->add_option("--mpi-every", o.mpi_every,
+                  "Generations between champion exchanges over the MPI ring (0: --migrate-every)")
+      ->capture_default_str();
+  sub->add_option("--seed", o.seed, "Random seed")->capture_default_str();
+  sub->add_option("--threads", o.threads,
+                  "Threads for the refinement's Jacobian batches (0: cores / ranks per node)")
+      ->capture_default_str();
+  sub->add_flag("--no-refine", a->no_refine, "Skip the Levenberg-Marquardt refinement");
+  sub->add_option("--refine-iterations", o.refine_iterations,
+                  "Levenberg-Marquardt iterations (max)")
+      ->capture_default_str();
+  sub->add_option("--fd-step", o.fd_step,
+                  "Finite-difference step of the Jacobian, fraction of each parameter's range")
+      ->capture_default_str();
+  sub->add_option("--dt", o.objective.dt_s,
+                  "Simulation time step [s]; 0: period / --steps-per-period")
+      ->capture_default_str();
+  sub->add_option("--steps-per-period", o.objective.steps_per_period,
+                  "Time steps per period of periodic conditions and targets")
+      ->capture_default_str();
+  sub->add_option("--flux-weight", o.objective.flux_weight,
+                  "Weight of the flux_T residuals of files that have them (0: ignore flux)")
+      ->capture_default_str();
+  sub->add_option("--target-periods", o.objective.target_periods,
+                  "Periods simulated for scalar targets (the last is measured)")
+      ->capture_default_str();
+  sub->add_option("--checkpoint", o.checkpoint_path, "Checkpoint file (written atomically)");
+  sub->add_option("--checkpoint-every", o.checkpoint_every, "Generations between checkpoints")
+      ->capture_default_str();
+  sub->add_option("--resume", o.resume_path, "Continue from a checkpoint (same data, spec, flags)");
+  sub->add_option("--mpi", a->mpi, "MPI: auto (when launched by mpirun/srun), on, off")
+      ->check(CLI::IsMember({"auto", "on", "off"}))
+      ->capture_default_str();
+  sub->add_flag("--no-plots", a->no_plots, "Do not run plot_fit.py (the CSV overlays are written)");
+  sub->add_flag("--quiet", a->quiet, "No progress on stderr, no summary");
+
+  auto* syn = sub->add_subcommand(
+      "synthesize",
+      "Write synthetic measurements (CSV + manifest) from a model: biased sines at every "
+      "temperature x current x frequency, with Gaussian noise");
+  syn->add_option("--out", s->out, "Output directory")->required();
+  syn->add_option("--model", s->model, "Model (TOML); default: the built-in MDMA model");
+  syn->add_option("--set", s->sets, "Override a model parameter: name=value (repeatable)");
+  syn->add_option("--temperatures", s->req.temperatures_C, "Temperatures [degC]")
+      ->delimiter(',')
+      ->capture_default_str();
+  syn->add_option("--currents", s->req.currents_pp_A, "Current peak-to-peak values [A]")
+      ->delimiter(',')
+      ->capture_default_str();
+  syn->add_option("--frequencies", s->req.frequencies_Hz, "Frequencies [Hz]")
+      ->delimiter(',')
+      ->capture_default_str();
+  syn->add_option("--current-min", s->req.current_min_A, "Current minimum [A] (Fig. 11)")
+      ->capture_default_str();
+  syn->add_option("--periods", s->req.periods, "Record length [periods]; the first is not compared")
+      ->capture_default_str();
+  syn->add_option("--samples-per-period", s->req.samples_per_period, "Samples per period")
+      ->capture_default_str();
+  syn->add_option("--noise", s->req.noise_pct,
+                  "Displacement noise: Gaussian sigma in % of each condition's p-p")
+      ->capture_default_str();
+  syn->add_option("--flux-noise", s->req.flux_noise_pct, "Flux noise: sigma in % of p-p")
+      ->capture_default_str();
+  syn->add_flag("--no-flux", s->no_flux, "Do not write the flux_T column");
+  syn->add_option("--seed", s->req.seed, "Noise seed")->capture_default_str();
+  syn->add_option("--dt", s->req.objective.dt_s, "Simulation time step [s]; 0: period / steps")
+      ->capture_default_str();
+  syn->add_option("--steps-per-period", s->req.objective.steps_per_period,
+                  "Time steps per period (use the same value for identify)")
+      ->capture_default_str();
+
+  return [a, s, sub, syn]() -> int {
+    if (syn->parsed()) return run_synthesize(*s);
+    if (sub->parsed()) return run_identify(*a);
+    return -1;
+  };
+}
+
+}  // namespace gmasim::cli

@@ -1,0 +1,343 @@
+// Parameter identification (issue 4): measured data -> calibrated model file.
+//
+//   MeasurementSet (docs/data.md)  +  FitSpec (which parameters, bounds, scalar targets)
+//     -> Objective: weighted RMS of simulated vs measured displacement, % of peak-to-peak
+//     -> identify(): multi-island GA (pagmo2 archipelago, ring migration; optionally one
+//        archipelago per MPI rank with a champion ring between ranks), then
+//        Levenberg-Marquardt refinement of the champion (Ceres), then the 95 % confidence
+//        intervals and correlations from the Jacobian at the optimum.
+//
+// See docs/identify.md for the algorithms and why, and docs/data.md for the file formats.
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "gmasim/model.hpp"
+#include "gmasim/simulate.hpp"
+
+namespace gmasim {
+
+// =======================================================================================
+// Measurements (docs/data.md)
+// =======================================================================================
+struct MeasurementCondition {
+  double temperature_C = 0.0;
+  // Periodic (biased-sine) excitation when frequency_Hz > 0: then current_pp_A is set.
+  double frequency_Hz = 0.0;
+  double current_pp_A = 0.0;
+  double current_min_A = -3.0;  // Fig. 11; used only with current_source = "sine"
+  // Samples with t_s < compare_from_s are simulated but not compared (the transient from
+  // the demagnetised start). Default: t0 + one period if periodic, else t0.
+  double compare_from_s = 0.0;
+  std::string current_source = "measured";  // "measured" (the CSV current) or "sine"
+  std::string label;                        // default: the file name without extension
+};
+
+struct Measurement {
+  std::string path;  // the CSV file
+  MeasurementCondition condition;
+  double weight = 1.0;
+  std::vector<double> t_s, current_A, displacement_um;
+  std::vector<double> flux_T;  // empty if the file has no flux_T column
+  bool periodic() const { return condition.frequency_Hz > 0.0; }
+};
+
+struct MeasurementSet {
+  std::string manifest;  // path of the manifest ("" if built in memory)
+  std::vector<Measurement> items;
+};
+
+// One CSV "t_s,current_A,displacement_um[,flux_T]" with its condition in "# key = value"
+// header comments and/or the sidecar <name>.toml. Throws InputError "file:line: ..." for an
+// empty file, a bad header, mismatched columns, non-numeric cells, NaN/Inf, duplicate or
+// decreasing time, fewer than 4 rows, a missing or contradictory condition.
+Measurement load_measurement_csv(const std::string& path);
+// The manifest (TOML, [[measurement]] file + weight); every file is loaded and checked.
+MeasurementSet load_manifest(const std::string& path);
+
+// Writes the CSV (with the condition as header comments), exact to the last bit for t_s and
+// current_A, and a manifest listing the files; used for synthetic data and examples.
+std::string measurement_csv(const Measurement& m);
+void write_measurement_set(const MeasurementSet& set, const std::string& dir);
+
+// =======================================================================================
+// What to fit
+// =======================================================================================
+enum class ParamScale { Linear, Log };
+
+struct FitParameter {
+  std::string name;  // dotted model name; unit suffix optional ("rod1.ja.k0")
+  double lower = 0.0, upper = 0.0;
+  ParamScale scale = ParamScale::Linear;
+  bool has_start = false;  // start value given in the spec (else: the model's value)
+  double start = 0.0;
+  long line = 0;
+};
+
+// Scalar targets computed from a biased-sine run (or, for resonance, the bias point).
+enum class TargetKind {
+  StrokeUm,             // stroke at (T, pp, f) [um]
+  HysteresisUm,         // hysteresis width at (T, pp, f) [um]
+  BppT,                 // induction-coil flux density peak-to-peak at (T, pp, f) [T]
+  StrokeChangePct,      // 100 (stroke(T) / stroke(T_ref) - 1) [%]
+  HysteresisChangePct,  // the same for the hysteresis width [%]
+  BppChangePct,         // the same for B p-p [%]
+  RetentionPct,         // 100 stroke(T) / stroke(T_ref) [%]
+  ResonanceHz           // lowest natural frequency of eq. (15) at (T, bias current) [Hz]
+};
+std::string target_kind_name(TargetKind k);
+
+struct FitTarget {
+  TargetKind kind = TargetKind::StrokeUm;
+  std::string label;
+  double temperature_C = 20.0, reference_temperature_C = 20.0;
+  double current_pp_A = 8.0, current_min_A = -3.0, frequency_Hz = 10.0, bias_A = 1.0;
+  double value = 0.0;   // the target value, in the kind's unit
+  double weight = 1.0;  // relative to a measurement file of weight 1
+  double scale = 0.0;   // normaliser: error % = 100 (sim - value) / scale; 0: |value|
+  long line = 0;
+};
+
+struct FitSpec {
+  std::string source;
+  std::vector<FitParameter> parameters;
+  std::vector<FitTarget> targets;
+};
+
+// A TOML file ([[parameter]] and [[target]] tables), or inline
+// "name:lower:upper[:log][,name:lower:upper...]". Throws InputError.
+FitSpec load_fit_spec(const std::string& file_or_inline);
+FitSpec parse_fit_spec(const std::string& toml_text, const std::string& source_name);
+
+// =======================================================================================
+// Objective
+// =======================================================================================
+struct ObjectiveSettings {
+  double dt_s = 0.0;                // fixed time step; 0: the rules below
+  double steps_per_period = 500.0;  // periodic conditions and targets: dt = period / this
+  double flux_weight = 0.0;         // weight of the flux_T residuals (files that have them)
+  double target_periods = 2.0;      // run length of the scalar-target simulations
+};
+
+// Per-condition outcome at one parameter vector.
+struct ConditionFit {
+  std::string label, path;
+  std::string overlay_file;  // "overlay_<label>.csv", unique and file-name safe
+  MeasurementCondition condition;
+  double weight = 1.0;
+  std::size_t samples = 0, compared = 0;
+  double pp_um = 0.0;    // peak-to-peak of the measured displacement (compared samples)
+  double rms_um = 0.0;   // RMS of simulated - measured
+  double rms_pct = 0.0;  // rms_um / pp_um [%] (the paper's normalisation)
+  double max_err_um = 0.0;
+  double flux_rms_pct = -1.0;  // -1: no flux column (or flux not fitted)
+  bool failed = false;         // the simulation diverged or a value was invalid
+  std::string error;
+  // Overlay: t_s, current_A, measured_um, simulated_um, compared (1/0)
+  TimeSeries overlay;
+};
+
+struct TargetFit {
+  std::string label, kind;
+  double value = 0.0, simulated = 0.0, error_pct = 0.0, weight = 1.0;
+  bool failed = false;
+};
+
+// The least-squares objective over a normalised parameter vector u in [0, 1]^n
+// (u_j = 0 at the lower bound, 1 at the upper; log parameters are linear in log|p|).
+// Immutable and cheap to copy (shared state); every method is const and thread-safe:
+// each evaluation builds its own Model and State.
+class Objective {
+ public:
+  // Throws InputError: unknown parameter, bad bounds, bounds that break model rules, a
+  // measurement temperature at/above T_c, no data and no targets.
+  Objective(const ModelSpec& start, const MeasurementSet& data, const FitSpec& fit,
+            const ObjectiveSettings& settings = {});
+
+  std::size_t dim() const;
+  std::size_t residual_count() const;
+  const std::vector<std::string>& names() const;  // resolved dotted names
+  const std::vector<std::string>& units() const;
+  const FitSpec& fit() const;
+  const MeasurementSet& data() const;
+  const ObjectiveSettings& settings() const;
+  const ModelSpec& start_spec() const;
+  const std::vector<std::string>& notes() const;  // e.g. start values clamped into bounds
+
+  std::vector<double> start_unit() const;  // the start values in u-space
+  std::vector<double> to_params(const std::vector<double>& u) const;
+  std::vector<double> to_unit(const std::vector<double>& p) const;
+  // d theta_j / d u_j where theta = p (linear) or ln|p| (log).
+  std::vector<double> theta_per_unit() const;
+
+  // Normalised residuals: sum of squares = (weighted RMS %)^2. False if the parameters are
+  // invalid for the model or the simulation diverged (r is then unspecified).
+  bool residuals(const double* u, double* r) const;
+  // sqrt(sum r^2): the weighted RMS error [%]; kPenalty when residuals() fails.
+  double rms_pct(const std::vector<double>& u) const;
+  static constexpr double kPenalty = 1e6;
+
+  ModelSpec spec_at(const std::vector<double>& u) const;  // the start spec with u applied
+  std::vector<ConditionFit> condition_fits(const std::vector<double>& u) const;
+  std::vector<TargetFit> target_fits(const std::vector<double>& u) const;
+
+  struct Impl;
+
+ private:
+  std::shared_ptr<const Impl> impl_;
+};
+
+// Simulates one measurement's excitation with the objective's rules (measured current as a
+// table, or the biased sine) and returns y [um] (and B [T] if B_T != nullptr) at every
+// measured sample time. Throws DivergenceError / InputError.
+void simulate_measurement(const Model& m, const Measurement& meas, const ObjectiveSettings& s,
+                          std::vector<double>& y_um, std::vector<double>* B_T = nullptr);
+
+// =======================================================================================
+// Synthetic measurements (validation, examples)
+// =======================================================================================
+struct SyntheticRequest {
+  std::vector<double> temperatures_C{20, 45, 70};
+  std::vector<double> currents_pp_A{6, 8};
+  std::vector<double> frequencies_Hz{10, 100};
+  double current_min_A = -3.0;
+  double periods = 2.0;  // record length; the first period is not compared
+  int samples_per_period = 200;
+  double noise_pct = 1.0;  // Gaussian noise, sigma = this % of each condition's y p-p
+  bool with_flux = true;
+  double flux_noise_pct = 1.0;
+  unsigned seed = 1;
+  ObjectiveSettings objective;  // the same rules as the fit: an exact-model test
+};
+MeasurementSet synthesize_measurements(const Model& truth, const SyntheticRequest& r);
+
+// =======================================================================================
+// Communicator: a thin layer over MPI (or a single process)
+// =======================================================================================
+class Communicator {
+ public:
+  virtual ~Communicator() = default;
+  virtual int rank() const = 0;
+  virtual int size() const = 0;
+  // Element-wise sum / max over ranks, in place; every rank gets the result.
+  virtual void allreduce_sum(double* data, std::size_t n) = 0;
+  virtual void allreduce_max(double* data, std::size_t n) = 0;
+  virtual void broadcast(double* data, std::size_t n, int root) = 0;
+  // Ring: sends `send` to rank+1, returns what rank-1 sent (the same size on every rank).
+  virtual std::vector<double> ring_shift(const std::vector<double>& send) = 0;
+  // Gathers one string per rank on root (others get an empty vector).
+  virtual std::vector<std::string> gather(const std::string& s, int root) = 0;
+  virtual void barrier() = 0;
+  [[noreturn]] virtual void abort(int code) = 0;
+};
+
+std::unique_ptr<Communicator> make_serial_communicator();
+bool mpi_compiled();     // built with GMASIM_WITH_MPI
+bool launched_by_mpi();  // the environment of mpirun / srun (OMPI_*, PMIX_RANK, PMI_RANK)
+// MPI_Init_thread (funneled); MPI_Finalize when destroyed. Throws if not compiled with MPI.
+std::unique_ptr<Communicator> make_mpi_communicator(int* argc, char*** argv);
+
+// =======================================================================================
+// identify()
+// =======================================================================================
+struct IdentifyProgress {
+  std::string phase;                    // "ga" or "refine"
+  int generation = 0, generations = 0;  // GA; refine: iteration
+  double best_rms_pct = 0.0;
+  long evaluations = 0;  // all ranks
+  double evals_per_s = 0.0;
+  double wall_s = 0.0;
+};
+
+struct IdentifyOptions {
+  std::string algorithm = "sga";  // sga (the paper's multi-island GA), de, sade, cmaes
+  int islands = 4;
+  int population = 24;
+  int generations = 60;   // total GA generations (a resumed run continues to this)
+  int migrate_every = 5;  // generations between migrations along the island ring
+  int migrants = 2;       // individuals per migration
+  int mpi_every = 0;      // generations between champion exchanges over MPI (0: migrate_every)
+  unsigned seed = 1;
+  int threads = 0;     // threads for the refinement / Jacobian batches (0: hardware)
+  bool refine = true;  // Levenberg-Marquardt refinement of the champion
+  int refine_iterations = 40;
+  double fd_step = 1e-4;  // central-difference step in u-space
+  std::string checkpoint_path;
+  int checkpoint_every = 10;  // generations
+  std::string resume_path;
+  ObjectiveSettings objective;
+  // Called on rank 0 after every migration epoch and refinement iteration.
+  std::function<void(const IdentifyProgress&)> progress;
+  // Polled between epochs / iterations: true stops cleanly (SIGINT). May be null.
+  const std::atomic<bool>* stop = nullptr;
+  Communicator* comm = nullptr;  // null: one process
+};
+
+struct FittedParameter {
+  std::string name, unit;
+  ParamScale scale = ParamScale::Linear;
+  double lower = 0, upper = 0, start = 0, value = 0;
+  double std_error = 0;            // in the parameter's unit (delta method for log scale)
+  double ci_low = 0, ci_high = 0;  // 95 % confidence interval
+  bool determined = true;          // false: the data hardly constrain it (CI wider than bounds)
+  bool at_bound = false;
+};
+
+struct HistoryEntry {
+  std::string phase;  // "ga", "refine"
+  int step = 0;       // generation or refinement iteration
+  long evaluations = 0;
+  double best_rms_pct = 0.0, wall_s = 0.0, evals_per_s = 0.0;
+};
+
+struct IdentifyResult {
+  ModelSpec spec;  // the start spec with the fitted values
+  std::vector<FittedParameter> parameters;
+  std::vector<double> unit_optimum;
+  double start_rms_pct = 0, ga_rms_pct = 0, rms_pct = 0;
+  std::vector<ConditionFit> conditions;
+  std::vector<TargetFit> targets;
+  std::vector<std::vector<double>> correlation;  // n x n, from the Jacobian at the optimum
+  double residual_sigma = 0;                     // sqrt(sum r^2 / (m - n))
+  std::size_t residual_count = 0;
+  bool covariance_ok = false;
+  std::string covariance_note;
+  std::vector<HistoryEntry> history;
+  long evaluations = 0;  // all ranks
+  double wall_s = 0, ga_evals_per_s = 0;
+  int generations_done = 0, ranks = 1, islands = 0, population = 0;
+  std::string algorithm;
+  bool interrupted = false, resumed = false;
+  std::string refine_summary;
+  std::vector<std::string> notes;
+};
+
+// Runs the whole identification. With a communicator of size R every rank must call it with
+// the same arguments; every rank returns the same result. Throws InputError.
+IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, const FitSpec& fit,
+                        const IdentifyOptions& options);
+
+// =======================================================================================
+// Outputs
+// =======================================================================================
+struct FitProvenance {
+  std::string command;      // the command line
+  std::string data;         // manifest path
+  std::string fit;          // fit spec source
+  std::string report_dir;   // where the fit report is
+  std::string start_model;  // start model label
+};
+
+// The start model's text with each fitted value replaced and its provenance comment set;
+// a header names the data, the command and the fit. Re-parsed and checked before return.
+std::string fitted_model_toml(const std::string& start_text, const ModelSpec& start,
+                              const IdentifyResult& r, const FitProvenance& p);
+std::string fit_report_json(const IdentifyResult& r, const FitProvenance& p);
+std::string fit_report_markdown(const IdentifyResult& r, const FitProvenance& p);
+std::string convergence_csv(const IdentifyResult& r);
+
+}  // namespace gmasim

@@ -1,0 +1,256 @@
+// The checkpoint file: a versioned text format with every island's population (decision
+// vectors and fitness, 17 significant digits: exact round trip), the seeds, the champion
+// and the convergence history. Written atomically (write_file_atomic) by rank 0.
+#include <fmt/format.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <sstream>
+
+#include "gmasim/errors.hpp"
+#include "internal.hpp"
+
+namespace gmasim::identify_detail {
+namespace {
+
+constexpr const char* kMagic = "gmasim-identify-checkpoint";
+
+std::string fnv_hex(const std::string& s) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (unsigned char c : s) {
+    h ^= c;
+    h *= 0x100000001b3ULL;
+  }
+  return fmt::format("{:016x}", h);
+}
+
+void hash_values(std::string& s, const std::vector<double>& v) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (double d : v) {
+    unsigned char b[sizeof(double)];
+    std::memcpy(b, &d, sizeof d);
+    for (unsigned char c : b) {
+      h ^= c;
+      h *= 0x100000001b3ULL;
+    }
+  }
+  s += fmt::format("{:016x};", h);
+}
+
+std::string numbers(const std::vector<double>& v) {
+  std::string s;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (i) s += ' ';
+    s += fmt::format("{:.17g}", v[i]);
+  }
+  return s;
+}
+
+struct LineReader {
+  std::string path;
+  std::vector<std::string> lines;
+  std::size_t pos = 0;
+
+  [[noreturn]] void fail(const std::string& msg) const {
+    throw InputError(
+        located(path, static_cast<long>(pos), fmt::format("damaged checkpoint: {}", msg)));
+  }
+  std::string next() {
+    if (pos >= lines.size()) fail("unexpected end of file");
+    return lines[pos++];
+  }
+  // "key rest"
+  std::string expect(const std::string& key) {
+    const std::string l = next();
+    if (l.rfind(key + " ", 0) != 0 && l != key)
+      fail(fmt::format("expected '{}', got '{}'", key, l));
+    return l.size() > key.size() ? l.substr(key.size() + 1) : std::string();
+  }
+  std::vector<double> nums(const std::string& s, std::size_t expected) {
+    std::vector<double> v;
+    const char* p = s.data();
+    const char* e = s.data() + s.size();
+    while (p < e) {
+      while (p < e && *p == ' ') ++p;
+      if (p >= e) break;
+      double d = 0;
+      const auto r = std::from_chars(p, e, d);
+      if (r.ec != std::errc()) fail(fmt::format("not a number in '{}'", s));
+      v.push_back(d);
+      p = r.ptr;
+    }
+    if (expected != static_cast<std::size_t>(-1) && v.size() != expected)
+      fail(fmt::format("expected {} numbers, got {}", expected, v.size()));
+    return v;
+  }
+  long integer(const std::string& key) {
+    const auto v = nums(expect(key), 1);
+    return static_cast<long>(v[0]);
+  }
+};
+
+}  // namespace
+
+Fingerprints fingerprints(const Objective& obj, const IdentifyOptions& o, int ranks) {
+  Fingerprints fp;
+  std::string p;
+  const auto& fit = obj.fit();
+  for (std::size_t j = 0; j < obj.dim(); ++j) {
+    const auto& fpar = fit.parameters[j];
+    p += fmt::format("{}|{:.17g}|{:.17g}|{};", obj.names()[j], fpar.lower, fpar.upper,
+                     fpar.scale == ParamScale::Log ? "log" : "linear");
+  }
+  fp.parameters = fnv_hex(p);
+  std::string d;
+  for (const auto& m : obj.data().items) {
+    const auto& c = m.condition;
+    d += fmt::format("{}|{}|{:.17g}|{:.17g}|{:.17g}|{:.17g}|{:.17g}|{:.17g}|{};",
+                     std::filesystem::path(m.path).filename().string(), m.t_s.size(), m.weight,
+                     c.temperature_C, c.frequency_Hz, c.current_pp_A, c.current_min_A,
+                     c.compare_from_s, c.current_source);
+    hash_values(d, m.t_s);
+    hash_values(d, m.current_A);
+    hash_values(d, m.displacement_um);
+    hash_values(d, m.flux_T);
+  }
+  fp.data = fnv_hex(d);
+  const auto& s = obj.settings();
+  std::string st = fmt::format("{:.17g}|{:.17g}|{:.17g}|{:.17g};", s.dt_s, s.steps_per_period,
+                               s.flux_weight, s.target_periods);
+  for (const auto& t : fit.targets) {
+    st += fmt::format("{}|{:.17g}|{:.17g}|{:.17g}|{:.17g}|{:.17g}|{:.17g}|{:.17g}|{:.17g}|{:.17g};",
+                      target_kind_name(t.kind), t.temperature_C, t.reference_temperature_C,
+                      t.current_pp_A, t.current_min_A, t.frequency_Hz, t.bias_A, t.value, t.weight,
+                      t.scale);
+  }
+  fp.settings = fnv_hex(st);
+  fp.layout = fmt::format("{}-r{}-i{}-p{}-k{}-m{}-x{}-s{}", o.algorithm, ranks, o.islands,
+                          o.population, o.migrate_every, o.migrants,
+                          o.mpi_every > 0 ? o.mpi_every : o.migrate_every, o.seed);
+  return fp;
+}
+
+std::string islands_text(const std::vector<IslandPopulation>& islands) {
+  std::string s;
+  for (std::size_t i = 0; i < islands.size(); ++i) {
+    const auto& isl = islands[i];
+    s += fmt::format("island {} seed {} size {}\n", i, isl.seed, isl.x.size());
+    for (std::size_t k = 0; k < isl.x.size(); ++k)
+      s += fmt::format("{:.17g} {}\n", isl.f[k], numbers(isl.x[k]));
+  }
+  return s;
+}
+
+std::string checkpoint_text(const Checkpoint& c, const std::vector<std::string>& rank_blocks) {
+  std::string s = fmt::format("{} {}\n", kMagic, c.version);
+  s += fmt::format("fp_parameters {}\nfp_data {}\nfp_settings {}\nfp_layout {}\n", c.fp_parameters,
+                   c.fp_data, c.fp_settings, c.fp_layout);
+  s += fmt::format("algorithm {}\nranks {}\nislands {}\npopulation {}\ndim {}\nseed {}\n",
+                   c.algorithm, c.ranks, c.islands, c.population, c.dim, c.seed);
+  s += fmt::format("generation {}\nevaluations {}\nwall_s {:.17g}\n", c.generation, c.evaluations,
+                   c.wall_s);
+  s += fmt::format("best_f {:.17g}\nbest_u {}\n", c.best_f, numbers(c.best_u));
+  s += fmt::format("history {}\n", c.history.size());
+  for (const auto& h : c.history) {
+    s += fmt::format("{} {} {} {:.17g} {:.17g} {:.17g}\n", h.phase, h.step, h.evaluations,
+                     h.best_rms_pct, h.wall_s, h.evals_per_s);
+  }
+  for (std::size_t r = 0; r < rank_blocks.size(); ++r) {
+    s += fmt::format("rank {}\n", r);
+    s += rank_blocks[r];
+  }
+  s += "end\n";
+  return s;
+}
+
+Checkpoint read_checkpoint(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f)
+    throw InputError(
+        located(path, 0, fmt::format("cannot open checkpoint ({})", std::strerror(errno))));
+  std::string text;
+  char buf[1 << 14];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+  std::fclose(f);
+  LineReader in{path, {}, 0};
+  std::istringstream ss(text);
+  for (std::string l; std::getline(ss, l);) in.lines.push_back(l);
+
+  Checkpoint c;
+  const std::string head = in.next();
+  if (head.rfind(kMagic, 0) != 0) in.fail("not a gmasim identify checkpoint");
+  c.version = static_cast<int>(in.nums(head.substr(std::strlen(kMagic)), 1)[0]);
+  if (c.version != 1) in.fail(fmt::format("version {} is not supported (expected 1)", c.version));
+  c.fp_parameters = in.expect("fp_parameters");
+  c.fp_data = in.expect("fp_data");
+  c.fp_settings = in.expect("fp_settings");
+  c.fp_layout = in.expect("fp_layout");
+  c.algorithm = in.expect("algorithm");
+  c.ranks = static_cast<int>(in.integer("ranks"));
+  c.islands = static_cast<int>(in.integer("islands"));
+  c.population = static_cast<int>(in.integer("population"));
+  c.dim = static_cast<int>(in.integer("dim"));
+  c.seed = static_cast<unsigned>(in.integer("seed"));
+  c.generation = static_cast<int>(in.integer("generation"));
+  c.evaluations = in.integer("evaluations");
+  c.wall_s = in.nums(in.expect("wall_s"), 1)[0];
+  c.best_f = in.nums(in.expect("best_f"), 1)[0];
+  c.best_u = in.nums(in.expect("best_u"), static_cast<std::size_t>(c.dim));
+  const long nh = in.integer("history");
+  for (long k = 0; k < nh; ++k) {
+    const std::string l = in.next();
+    const auto sp = l.find(' ');
+    if (sp == std::string::npos) in.fail("bad history line");
+    const auto v = in.nums(l.substr(sp + 1), 5);
+    c.history.push_back(
+        {l.substr(0, sp), static_cast<int>(v[0]), static_cast<long>(v[1]), v[2], v[3], v[4]});
+  }
+  for (int r = 0; r < c.ranks; ++r) {
+    if (in.integer("rank") != r) in.fail(fmt::format("expected rank {}", r));
+    std::vector<IslandPopulation> isl;
+    for (int i = 0; i < c.islands; ++i) {
+      const std::string il = in.next();
+      long v[3] = {0, 0, 0};
+      if (std::sscanf(il.c_str(), "island %ld seed %ld size %ld", &v[0], &v[1], &v[2]) != 3)
+        in.fail(fmt::format("expected 'island N seed S size P', got '{}'", il));
+      if (static_cast<int>(v[0]) != i) in.fail(fmt::format("expected island {}", i));
+      IslandPopulation ip;
+      ip.seed = static_cast<unsigned>(v[1]);
+      const auto size = static_cast<std::size_t>(v[2]);
+      for (std::size_t k = 0; k < size; ++k) {
+        const auto row = in.nums(in.next(), static_cast<std::size_t>(c.dim) + 1);
+        ip.f.push_back(row[0]);
+        ip.x.emplace_back(row.begin() + 1, row.end());
+      }
+      isl.push_back(std::move(ip));
+    }
+    c.rank_islands.push_back(std::move(isl));
+  }
+  if (in.next() != "end") in.fail("missing 'end' line");
+  return c;
+}
+
+void check_compatible(const Checkpoint& c, const Fingerprints& fp, const std::string& path) {
+  auto fail = [&](const std::string& what) {
+    throw InputError(located(path, 0,
+                             fmt::format("cannot resume: the checkpoint was written for {}; resume "
+                                         "with the same data, fit spec, model and flags",
+                                         what)));
+  };
+  if (c.fp_parameters != fp.parameters) fail("other fitted parameters or bounds");
+  if (c.fp_data != fp.data) fail("other measurement data");
+  if (c.fp_settings != fp.settings) fail("other objective settings or targets");
+  if (c.fp_layout != fp.layout) {
+    fail(
+        fmt::format("another algorithm layout ({} ; now {}: algorithm, ranks, islands, "
+                    "population, migration, seed)",
+                    c.fp_layout, fp.layout));
+  }
+}
+
+}  // namespace gmasim::identify_detail

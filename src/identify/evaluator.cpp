@@ -1,0 +1,78 @@
+// Batch evaluation of the objective over worker threads and MPI ranks.
+#include <algorithm>
+#include <atomic>
+#include <thread>
+
+#include "internal.hpp"
+
+namespace gmasim::identify_detail {
+
+std::vector<char> BatchEvaluator::run(const std::vector<std::vector<double>>& points,
+                                      std::vector<std::vector<double>>& res) {
+  const std::size_t P = points.size();
+  const std::size_t m = obj_.residual_count();
+  const int R = comm_.size(), me = comm_.rank();
+  res.assign(P, std::vector<double>(m, 0.0));
+  std::vector<char> ok(P, 0);
+  std::vector<std::size_t> mine;
+  for (std::size_t i = 0; i < P; ++i)
+    if (static_cast<int>(i % static_cast<std::size_t>(R)) == me) mine.push_back(i);
+
+  // Each worker writes only its own points' slots: nothing mutable is shared but the index.
+  std::atomic<std::size_t> next{0};
+  auto work = [&]() {
+    for (std::size_t k = next.fetch_add(1); k < mine.size(); k = next.fetch_add(1)) {
+      const std::size_t i = mine[k];
+      ok[i] = obj_.residuals(points[i].data(), res[i].data()) ? 1 : 0;
+      if (!ok[i]) std::fill(res[i].begin(), res[i].end(), 0.0);
+    }
+  };
+  const std::size_t nt = std::min<std::size_t>(static_cast<std::size_t>(threads_), mine.size());
+  std::vector<std::thread> pool;
+  for (std::size_t t = 1; t < nt; ++t) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+
+  if (R > 1) {  // every slot is non-zero on exactly one rank: the sum is exact
+    std::vector<double> flat(P * (m + 1), 0.0);
+    for (std::size_t i : mine) {
+      std::copy(res[i].begin(), res[i].end(),
+                flat.begin() + static_cast<std::ptrdiff_t>(i * (m + 1)));
+      flat[i * (m + 1) + m] = ok[i] ? 1.0 : 0.0;
+    }
+    comm_.allreduce_sum(flat.data(), flat.size());
+    for (std::size_t i = 0; i < P; ++i) {
+      std::copy(flat.begin() + static_cast<std::ptrdiff_t>(i * (m + 1)),
+                flat.begin() + static_cast<std::ptrdiff_t>(i * (m + 1) + m), res[i].begin());
+      ok[i] = flat[i * (m + 1) + m] > 0.5 ? 1 : 0;
+    }
+  }
+  evaluations_ += static_cast<long>(P);
+  return ok;
+}
+
+void global_best(Communicator& comm, double& f, std::vector<double>& u) {
+  if (comm.size() == 1) return;
+  double neg = -f;
+  comm.allreduce_max(&neg, 1);
+  const double fmin = -neg;
+  double owner = f == fmin ? static_cast<double>(comm.size() - comm.rank()) : 0.0;
+  comm.allreduce_max(&owner, 1);
+  const int root = comm.size() - static_cast<int>(owner);
+  comm.broadcast(u.data(), u.size(), root);
+  f = fmin;
+}
+
+bool any_rank(Communicator& comm, bool flag) {
+  double v = flag ? 1.0 : 0.0;
+  comm.allreduce_max(&v, 1);
+  return v > 0.5;
+}
+
+long sum_ranks(Communicator& comm, long v) {
+  double d = static_cast<double>(v);
+  comm.allreduce_sum(&d, 1);
+  return static_cast<long>(d);
+}
+
+}  // namespace gmasim::identify_detail

@@ -1,0 +1,299 @@
+// The fit specification: which model parameters to identify (bounds, scale) and which scalar
+// targets to match. TOML file or inline "name:lower:upper[:log],...". docs/identify.md.
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+#include <string_view>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/identify.hpp"
+
+namespace gmasim {
+namespace {
+
+struct KindName {
+  TargetKind kind;
+  std::string_view name;
+  bool needs_reference;  // a change/retention target: also runs at reference_temperature_C
+  bool sine;             // computed from a biased-sine run (else: resonance at the bias)
+};
+constexpr KindName kKinds[] = {
+    {TargetKind::StrokeUm, "stroke_um", false, true},
+    {TargetKind::HysteresisUm, "hysteresis_um", false, true},
+    {TargetKind::BppT, "B_pp_T", false, true},
+    {TargetKind::StrokeChangePct, "stroke_change_pct", true, true},
+    {TargetKind::HysteresisChangePct, "hysteresis_change_pct", true, true},
+    {TargetKind::BppChangePct, "B_pp_change_pct", true, true},
+    {TargetKind::RetentionPct, "retention_pct", true, true},
+    {TargetKind::ResonanceHz, "resonance_Hz", false, false},
+};
+
+std::string kind_list() {
+  std::string s;
+  for (const auto& k : kKinds) {
+    if (!s.empty()) s += ", ";
+    s += k.name;
+  }
+  return s;
+}
+
+long line_of(const toml::node& n) {
+  const auto l = static_cast<long>(n.source().begin.line);
+  return l > 0 ? l : 1;
+}
+
+void check_bounds(const FitParameter& p, const std::string& src) {
+  auto fail = [&](const std::string& msg) {
+    throw InputError(located(src, p.line, fmt::format("parameter {}: {}", p.name, msg)));
+  };
+  if (!std::isfinite(p.lower) || !std::isfinite(p.upper)) fail("bounds must be finite");
+  if (!(p.lower < p.upper))
+    fail(fmt::format("lower bound {:g} must be < upper bound {:g}", p.lower, p.upper));
+  if (p.scale == ParamScale::Log && !(p.lower * p.upper > 0.0)) {
+    fail(
+        fmt::format("log scale needs bounds of one sign, both non-zero (got {:g} .. {:g}); use "
+                    "scale = \"linear\"",
+                    p.lower, p.upper));
+  }
+  if (p.has_start && !std::isfinite(p.start)) fail("start must be finite");
+}
+
+double number(const toml::table& t, std::string_view key, const std::string& src, bool& found) {
+  const toml::node* n = t.get(key);
+  found = n != nullptr;
+  if (!n) return 0.0;
+  const auto v = n->value<double>();
+  if (!v) throw InputError(located(src, line_of(*n), fmt::format("{}: expected a number", key)));
+  if (!std::isfinite(*v))
+    throw InputError(located(src, line_of(*n), fmt::format("{}: must be finite", key)));
+  return *v;
+}
+
+void check_keys(const toml::table& t, std::initializer_list<std::string_view> allowed,
+                const std::string& where, const std::string& src) {
+  for (const auto& [k, v] : t) {
+    bool ok = false;
+    for (auto a : allowed) ok = ok || a == k.str();
+    if (!ok) {
+      std::string list;
+      for (auto a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+      throw InputError(located(
+          src, line_of(v),
+          fmt::format("unknown key '{}' in {}; expected one of: {}", k.str(), where, list)));
+    }
+  }
+}
+
+FitParameter read_parameter(const toml::table& t, const std::string& src) {
+  check_keys(t, {"name", "lower", "upper", "scale", "start"}, "[[parameter]]", src);
+  FitParameter p;
+  p.line = line_of(t);
+  const auto name = t["name"].value<std::string>();
+  if (!name || name->empty())
+    throw InputError(located(src, p.line, "[[parameter]]: missing name = \"dotted.model.name\""));
+  p.name = *name;
+  bool has_lo = false, has_hi = false;
+  p.lower = number(t, "lower", src, has_lo);
+  p.upper = number(t, "upper", src, has_hi);
+  if (!has_lo || !has_hi) {
+    throw InputError(
+        located(src, p.line,
+                fmt::format("parameter {}: missing {} bound", p.name, has_lo ? "upper" : "lower")));
+  }
+  p.start = number(t, "start", src, p.has_start);
+  if (const toml::node* s = t.get("scale")) {
+    const auto v = s->value<std::string>();
+    if (v && *v == "log") {
+      p.scale = ParamScale::Log;
+    } else if (v && *v == "linear") {
+      p.scale = ParamScale::Linear;
+    } else {
+      throw InputError(
+          located(src, line_of(*s),
+                  fmt::format("parameter {}: scale must be \"linear\" or \"log\"", p.name)));
+    }
+  }
+  check_bounds(p, src);
+  return p;
+}
+
+FitTarget read_target(const toml::table& t, const std::string& src) {
+  check_keys(t,
+             {"kind", "label", "temperature_C", "reference_temperature_C", "current_pp_A",
+              "current_min_A", "frequency_Hz", "bias_A", "value", "weight", "scale"},
+             "[[target]]", src);
+  FitTarget g;
+  g.line = line_of(t);
+  const auto kind = t["kind"].value<std::string>();
+  const KindName* kn = nullptr;
+  for (const auto& k : kKinds)
+    if (kind && k.name == *kind) kn = &k;
+  if (!kn) {
+    throw InputError(located(src, g.line,
+                             fmt::format("[[target]]: kind must be one of {}{}", kind_list(),
+                                         kind ? fmt::format(" (got '{}')", *kind) : "")));
+  }
+  g.kind = kn->kind;
+  bool f = false;
+  auto req = [&](std::string_view key) {
+    const double v = number(t, key, src, f);
+    if (!f) {
+      throw InputError(
+          located(src, g.line, fmt::format("[[target]] {}: missing {}", kn->name, key)));
+    }
+    return v;
+  };
+  auto opt = [&](std::string_view key, double def) {
+    const double v = number(t, key, src, f);
+    return f ? v : def;
+  };
+  g.value = req("value");
+  g.temperature_C = req("temperature_C");
+  if (kn->sine) {
+    g.current_pp_A = req("current_pp_A");
+    g.frequency_Hz = req("frequency_Hz");
+    g.current_min_A = opt("current_min_A", -3.0);
+    if (!(g.current_pp_A > 0.0) || !(g.frequency_Hz > 0.0)) {
+      throw InputError(located(src, g.line,
+                               fmt::format("[[target]] {}: current_pp_A and "
+                                           "frequency_Hz must be > 0",
+                                           kn->name)));
+    }
+  } else {
+    g.bias_A = opt("bias_A", 1.0);
+  }
+  if (kn->needs_reference) g.reference_temperature_C = opt("reference_temperature_C", 20.0);
+  g.weight = opt("weight", 1.0);
+  if (!(g.weight > 0.0))
+    throw InputError(
+        located(src, g.line, fmt::format("[[target]] {}: weight must be > 0", kn->name)));
+  g.scale = opt("scale", 0.0);
+  if (g.scale < 0.0)
+    throw InputError(
+        located(src, g.line, fmt::format("[[target]] {}: scale must be > 0", kn->name)));
+  if (g.scale == 0.0) g.scale = std::fabs(g.value);
+  if (!(g.scale > 0.0)) {
+    throw InputError(located(src, g.line,
+                             fmt::format("[[target]] {}: value 0 needs an explicit "
+                                         "scale (the error is 100 (sim - value) / "
+                                         "scale %)",
+                                         kn->name)));
+  }
+  const auto label = t["label"].value<std::string>();
+  g.label = label ? *label
+                  : (kn->sine ? fmt::format("{} {:g}C {:g}A {:g}Hz", kn->name, g.temperature_C,
+                                            g.current_pp_A, g.frequency_Hz)
+                              : fmt::format("{} {:g}C {:g}A", kn->name, g.temperature_C, g.bias_A));
+  return g;
+}
+
+bool parse_double(std::string_view s, double& v) {
+  if (s.starts_with('+')) s.remove_prefix(1);
+  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  return ec == std::errc() && p == s.data() + s.size() && std::isfinite(v);
+}
+
+FitSpec parse_inline(const std::string& text) {
+  FitSpec spec;
+  spec.source = "--fit";
+  std::string_view rest = text;
+  while (!rest.empty()) {
+    const auto comma = rest.find(',');
+    std::string_view item = rest.substr(0, comma);
+    rest = comma == std::string_view::npos ? std::string_view{} : rest.substr(comma + 1);
+    std::vector<std::string_view> f;
+    while (true) {
+      const auto c = item.find(':');
+      f.push_back(item.substr(0, c));
+      if (c == std::string_view::npos) break;
+      item = item.substr(c + 1);
+    }
+    auto bad = [&](const std::string& why) {
+      throw InputError(
+          fmt::format("--fit '{}': {}; expected name:lower:upper[:log] items "
+                      "separated by commas, or a TOML fit file",
+                      text, why));
+    };
+    if (f.size() < 3 || f.size() > 4) bad(fmt::format("item '{}' has {} fields", f[0], f.size()));
+    FitParameter p;
+    p.name = std::string(f[0]);
+    if (p.name.empty()) bad("empty parameter name");
+    if (!parse_double(f[1], p.lower) || !parse_double(f[2], p.upper))
+      bad(fmt::format("bounds of '{}' are not numbers", p.name));
+    if (f.size() == 4) {
+      if (f[3] == "log")
+        p.scale = ParamScale::Log;
+      else if (f[3] != "linear")
+        bad(fmt::format("scale '{}' of '{}' must be log or linear", f[3], p.name));
+    }
+    check_bounds(p, spec.source);
+    spec.parameters.push_back(p);
+  }
+  return spec;
+}
+
+}  // namespace
+
+std::string target_kind_name(TargetKind k) {
+  for (const auto& kn : kKinds)
+    if (kn.kind == k) return std::string(kn.name);
+  return "?";
+}
+
+FitSpec parse_fit_spec(const std::string& toml_text, const std::string& source_name) {
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, std::string_view(source_name));
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}:{}:{}: TOML syntax error: {}", source_name,
+                                 e.source().begin.line, e.source().begin.column, e.description()));
+  }
+  FitSpec spec;
+  spec.source = source_name;
+  check_keys(root, {"parameter", "target"}, "the fit spec", source_name);
+  auto tables = [&](std::string_view key) {
+    std::vector<const toml::table*> out;
+    if (const toml::node* n = root.get(key)) {
+      const toml::array* a = n->as_array();
+      if (!a) {
+        throw InputError(
+            located(source_name, line_of(*n), fmt::format("{}: expected [[{}]] tables", key, key)));
+      }
+      for (const auto& e : *a) {
+        if (!e.as_table())
+          throw InputError(
+              located(source_name, line_of(e), fmt::format("[[{}]]: expected a table", key)));
+        out.push_back(e.as_table());
+      }
+    }
+    return out;
+  };
+  for (const auto* t : tables("parameter"))
+    spec.parameters.push_back(read_parameter(*t, source_name));
+  for (const auto* t : tables("target")) spec.targets.push_back(read_target(*t, source_name));
+  if (spec.parameters.empty())
+    throw InputError(located(source_name, 1, "no [[parameter]] to fit: name at least one"));
+  return spec;
+}
+
+FitSpec load_fit_spec(const std::string& file_or_inline) {
+  std::error_code ec;
+  const bool looks_like_file =
+      file_or_inline.ends_with(".toml") || std::filesystem::is_regular_file(file_or_inline, ec);
+  if (!looks_like_file) return parse_inline(file_or_inline);
+  std::FILE* f = std::fopen(file_or_inline.c_str(), "rb");
+  if (!f) throw InputError(located(file_or_inline, 0, "cannot open the fit spec"));
+  std::string text;
+  char buf[1 << 14];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+  std::fclose(f);
+  return parse_fit_spec(text, file_or_inline);
+}
+
+}  // namespace gmasim

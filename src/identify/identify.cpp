@@ -1,0 +1,140 @@
+// identify(): GA (archipelago.cpp) -> Levenberg-Marquardt (refine.cpp) -> covariance
+// (covariance.cpp) -> per-condition report at the optimum.
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "gmasim/errors.hpp"
+#include "internal.hpp"
+
+namespace gmasim {
+
+using namespace identify_detail;
+
+IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, const FitSpec& fit,
+                        const IdentifyOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto serial = make_serial_communicator();
+  Communicator& comm = o.comm ? *o.comm : *serial;
+
+  // ---- options ------------------------------------------------------------------------
+  if (o.algorithm != "sga" && o.algorithm != "de" && o.algorithm != "sade" &&
+      o.algorithm != "cmaes")
+    throw InputError(fmt::format("--algorithm {}: must be sga, de, sade or cmaes", o.algorithm));
+  auto positive = [](int v, const char* what) {
+    if (v < 1) throw InputError(fmt::format("{} {}: must be >= 1", what, v));
+  };
+  positive(o.islands, "--islands");
+  positive(o.migrate_every, "--migrate-every");
+  positive(o.migrants, "--migrants");
+  if (o.population < 8)
+    throw InputError(fmt::format("--population {}: must be >= 8", o.population));
+  if (o.migrants >= o.population)
+    throw InputError(
+        fmt::format("--migrants {}: must be < the population {}", o.migrants, o.population));
+  if (o.generations < 0)
+    throw InputError(fmt::format("--generations {}: must be >= 0", o.generations));
+  if (o.refine_iterations < 0) throw InputError("--refine-iterations: must be >= 0");
+  if (!(o.fd_step > 0.0 && o.fd_step < 0.1)) throw InputError("--fd-step: must be in (0, 0.1)");
+  if (o.mpi_every < 0) throw InputError("--mpi-every: must be >= 0");
+
+  const Objective obj(start, data, fit, o.objective);
+  const int threads = o.threads > 0
+                          ? o.threads
+                          : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  BatchEvaluator ev(obj, threads, comm);
+
+  IdentifyResult res;
+  res.ranks = comm.size();
+  res.islands = o.islands;
+  res.population = o.population;
+  res.algorithm = o.algorithm;
+  res.notes = obj.notes();
+
+  const std::vector<double> u_start = obj.start_unit();
+  const double f_start = obj.rms_pct(u_start);
+  res.start_rms_pct = f_start;
+  if (f_start >= Objective::kPenalty)
+    res.notes.push_back("the start model cannot be evaluated (invalid or diverges)");
+
+  // ---- global search ------------------------------------------------------------------
+  GaOutcome ga = run_ga(obj, o, comm, u_start, f_start);
+  res.history = ga.history;
+  res.generations_done = ga.generation;
+  res.resumed = ga.resumed;
+  res.interrupted = ga.interrupted;
+  res.ga_rms_pct = ga.best_f;
+  res.ga_evals_per_s = ga.wall_s > 0 ? static_cast<double>(ga.run_evaluations) / ga.wall_s : 0.0;
+  std::vector<double> u = ga.best_u;
+  double f = ga.best_f;
+
+  // ---- local refinement ---------------------------------------------------------------
+  const double wall_before = ga.history.empty() ? 0.0 : ga.history.back().wall_s - ga.wall_s;
+  const long ga_evals = ga.evaluations;
+  if (o.refine && !res.interrupted && o.refine_iterations > 0) {
+    auto on_iter = [&](int it, double rms) {
+      HistoryEntry h;
+      h.phase = "refine";
+      h.step = it;
+      h.evaluations = ga_evals + ev.evaluations();
+      h.best_rms_pct = rms;
+      h.wall_s = wall_before +
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      res.history.push_back(h);
+      if (comm.rank() == 0 && o.progress)
+        o.progress({"refine", it, o.refine_iterations, rms, h.evaluations, 0.0, h.wall_s});
+    };
+    RefineOutcome ro = refine_lm(obj, ev, u, o, comm, on_iter);
+    res.refine_summary = ro.summary;
+    res.interrupted = ro.interrupted;
+    if (ro.f < f) {  // never worse than the GA champion
+      f = ro.f;
+      u = ro.u;
+    }
+  } else if (!o.refine || o.refine_iterations == 0) {
+    res.refine_summary = "no refinement (--no-refine)";
+  } else {
+    res.refine_summary = "interrupted before the refinement";
+  }
+
+  // ---- result -------------------------------------------------------------------------
+  res.unit_optimum = u;
+  res.rms_pct = f;
+  res.spec = obj.spec_at(u);
+  if (!res.interrupted) {
+    fill_covariance(obj, ev, u, o.fd_step, res);
+  } else {
+    // Interrupted: the values without intervals (a clean, fast stop).
+    const auto p = obj.to_params(u);
+    for (std::size_t j = 0; j < obj.dim(); ++j) {
+      FittedParameter fp;
+      fp.name = obj.names()[j];
+      fp.unit = obj.units()[j];
+      fp.scale = fit.parameters[j].scale;
+      fp.lower = fit.parameters[j].lower;
+      fp.upper = fit.parameters[j].upper;
+      fp.value = p[j];
+      fp.std_error = std::nan("");
+      fp.ci_low = fp.ci_high = std::nan("");
+      fp.determined = false;
+      res.parameters.push_back(fp);
+    }
+    res.covariance_note = "interrupted: no confidence intervals";
+  }
+  const auto p_start = obj.to_params(u_start);
+  for (std::size_t j = 0; j < res.parameters.size(); ++j) {
+    res.parameters[j].start = p_start[j];
+    if (j < res.correlation.size()) res.correlation[j][j] = 1.0;
+  }
+  if (comm.rank() == 0) {
+    res.conditions = obj.condition_fits(u);
+    res.targets = obj.target_fits(u);
+  }
+  res.evaluations = ga.evaluations + ev.evaluations() + 1;
+  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return res;
+}
+
+}  // namespace gmasim

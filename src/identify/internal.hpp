@@ -1,0 +1,108 @@
+// Internal pieces of identify(): batch evaluation over threads and ranks, the GA driver,
+// the checkpoint file, the Levenberg-Marquardt refinement and the covariance.
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "gmasim/identify.hpp"
+
+namespace gmasim::identify_detail {
+
+// Evaluates residual vectors at a batch of points: point i on rank i % R, and on each rank
+// over `threads` worker threads. Every rank gets every result, bit-identical.
+class BatchEvaluator {
+ public:
+  BatchEvaluator(const Objective& obj, int threads, Communicator& comm)
+      : obj_(obj), threads_(threads < 1 ? 1 : threads), comm_(comm) {}
+  // ok[i] = residuals(points[i]) succeeded; res[i] has residual_count() values.
+  std::vector<char> run(const std::vector<std::vector<double>>& points,
+                        std::vector<std::vector<double>>& res);
+  long evaluations() const { return evaluations_; }
+
+ private:
+  const Objective& obj_;
+  int threads_;
+  Communicator& comm_;
+  long evaluations_ = 0;
+};
+
+// Reduces (f, u) to the best over ranks (lowest f, then lowest rank); every rank gets it.
+void global_best(Communicator& comm, double& f, std::vector<double>& u);
+bool any_rank(Communicator& comm, bool flag);
+long sum_ranks(Communicator& comm, long v);
+
+// ---- checkpoint -------------------------------------------------------------------------
+struct IslandPopulation {
+  unsigned seed = 0;
+  std::vector<std::vector<double>> x;
+  std::vector<double> f;
+};
+
+struct Checkpoint {
+  int version = 1;
+  std::string fp_parameters, fp_data, fp_settings, fp_layout;  // fingerprints
+  std::string algorithm;
+  int ranks = 1, islands = 0, population = 0, dim = 0;
+  unsigned seed = 0;
+  int generation = 0;
+  long evaluations = 0;
+  double wall_s = 0.0;
+  double best_f = 0.0;
+  std::vector<double> best_u;
+  std::vector<HistoryEntry> history;
+  std::vector<std::vector<IslandPopulation>> rank_islands;  // [rank][island]
+};
+
+struct Fingerprints {
+  std::string parameters, data, settings, layout;
+};
+Fingerprints fingerprints(const Objective& obj, const IdentifyOptions& o, int ranks);
+
+// Text of one rank's islands (gathered to rank 0), and the whole file.
+std::string islands_text(const std::vector<IslandPopulation>& islands);
+std::string checkpoint_text(const Checkpoint& header, const std::vector<std::string>& rank_blocks);
+// Throws InputError "file:line: ..." for a damaged file.
+Checkpoint read_checkpoint(const std::string& path);
+// Throws InputError naming what differs.
+void check_compatible(const Checkpoint& c, const Fingerprints& fp, const std::string& path);
+
+// ---- GA ---------------------------------------------------------------------------------
+struct GaOutcome {
+  std::vector<double> best_u;
+  double best_f = 0.0;
+  int generation = 0;
+  long evaluations = 0;  // all ranks, GA only (including the resumed part)
+  double wall_s = 0.0;   // this run's GA wall time
+  long run_evaluations = 0;
+  bool interrupted = false;
+  bool resumed = false;
+  std::vector<HistoryEntry> history;
+};
+
+GaOutcome run_ga(const Objective& obj, const IdentifyOptions& o, Communicator& comm,
+                 const std::vector<double>& start_u, double start_f);
+
+// ---- refinement and covariance ------------------------------------------------------------
+struct RefineOutcome {
+  std::vector<double> u;
+  double f = 0.0;
+  int iterations = 0;
+  bool interrupted = false;
+  std::string summary;
+};
+
+RefineOutcome refine_lm(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u0,
+                        const IdentifyOptions& o, Communicator& comm,
+                        const std::function<void(int, double)>& on_iteration);
+
+// Central-difference Jacobian at u (m x n, row-major) and the residuals at u.
+bool jacobian(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u, double h,
+              std::vector<double>& r, std::vector<double>& J);
+
+void fill_covariance(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u,
+                     double h, IdentifyResult& out);
+
+}  // namespace gmasim::identify_detail

@@ -1,0 +1,495 @@
+// Measurement files (docs/data.md): one CSV per test condition, the condition in header
+// comments and/or a TOML sidecar, and a TOML manifest listing the files and their weights.
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/identify.hpp"
+#include "gmasim/io.hpp"
+
+namespace gmasim {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string_view trim(std::string_view s) {
+  const auto b = s.find_first_not_of(" \t\r");
+  if (b == std::string_view::npos) return {};
+  const auto e = s.find_last_not_of(" \t\r");
+  return s.substr(b, e - b + 1);
+}
+
+std::vector<std::string_view> split_cells(std::string_view line) {
+  std::vector<std::string_view> cells;
+  std::size_t start = 0;
+  while (true) {
+    const auto comma = line.find(',', start);
+    cells.push_back(trim(line.substr(start, comma - start)));
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  return cells;
+}
+
+std::string read_text(const std::string& path, std::string_view what) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f)
+    throw InputError(
+        located(path, 0, fmt::format("cannot open {} ({})", what, std::strerror(errno))));
+  std::string text;
+  char buf[1 << 14];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+  const bool failed = std::ferror(f) != 0;
+  const int err = errno;
+  std::fclose(f);
+  if (failed)
+    throw InputError(
+        located(path, 0, fmt::format("cannot read {} ({})", what, std::strerror(err))));
+  return text;
+}
+
+// A finite number, or the reason it is not one.
+std::optional<std::string> parse_number(std::string_view cell, double& v) {
+  if (cell.empty()) return std::string("empty cell");
+  const std::string_view digits = cell.starts_with('+') ? cell.substr(1) : cell;
+  const auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), v);
+  if (ec != std::errc() || ptr != digits.data() + digits.size()) {
+    return fmt::format("{} value '{}'",
+                       ec == std::errc::result_out_of_range ? "out-of-range" : "non-numeric", cell);
+  }
+  if (std::isnan(v)) return fmt::format("NaN ('{}')", cell);
+  if (std::isinf(v)) return fmt::format("Inf ('{}')", cell);
+  return std::nullopt;
+}
+
+// ---- condition keys ------------------------------------------------------------------
+enum class KeyType { Number, Text };
+struct ConditionKey {
+  std::string_view name;
+  KeyType type;
+};
+constexpr ConditionKey kConditionKeys[] = {
+    {"temperature_C", KeyType::Number},
+    {"frequency_Hz", KeyType::Number},
+    {"current_pp_A", KeyType::Number},
+    {"current_min_A", KeyType::Number},
+    {"compare_from_s", KeyType::Number},
+    {"current_source", KeyType::Text},
+    {"label", KeyType::Text},
+};
+
+std::string known_keys() {
+  std::string s;
+  for (const auto& k : kConditionKeys) {
+    if (!s.empty()) s += ", ";
+    s += k.name;
+  }
+  return s;
+}
+
+const ConditionKey* find_key(std::string_view name) {
+  for (const auto& k : kConditionKeys)
+    if (k.name == name) return &k;
+  return nullptr;
+}
+
+struct KeyValue {
+  std::string text;  // as written (numbers are re-parsed)
+  double number = 0.0;
+  std::string file;
+  long line = 0;
+};
+using KeyMap = std::map<std::string, KeyValue>;
+
+bool is_identifier(std::string_view s) {
+  if (s.empty()) return false;
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+  });
+}
+
+// "# key = value" / "# key: value" in a CSV comment; free-text comments are ignored.
+void read_comment_key(std::string_view comment, const std::string& path, long line, KeyMap& keys) {
+  const auto sep = comment.find_first_of("=:");
+  if (sep == std::string_view::npos) return;
+  const std::string_view key = trim(comment.substr(0, sep));
+  if (!is_identifier(key)) return;  // free text such as "# note: ..." with spaces
+  std::string_view value = trim(comment.substr(sep + 1));
+  const ConditionKey* k = find_key(key);
+  if (!k) {
+    // An identifier followed by '=' is a condition key: a typo must not pass silently.
+    if (comment[sep] == '=' || key.find('_') != std::string_view::npos) {
+      throw InputError(
+          located(path, line,
+                  fmt::format("unknown condition key '{}'; known keys: {}", key, known_keys())));
+    }
+    return;
+  }
+  if (keys.count(std::string(key))) {
+    throw InputError(located(path, line, fmt::format("condition key '{}' is given twice", key)));
+  }
+  if (value.size() >= 2 && (value.front() == '"' || value.front() == '\'') &&
+      value.back() == value.front())
+    value = value.substr(1, value.size() - 2);
+  KeyValue kv{std::string(value), 0.0, path, line};
+  if (k->type == KeyType::Number) {
+    if (auto bad = parse_number(value, kv.number))
+      throw InputError(located(path, line, fmt::format("condition key {}: {}", key, *bad)));
+  }
+  keys[std::string(key)] = kv;
+}
+
+std::string sidecar_path(const std::string& csv) {
+  fs::path p(csv);
+  p.replace_extension(".toml");
+  return p.string();
+}
+
+void read_sidecar(const std::string& path, KeyMap& keys) {
+  const std::string text = read_text(path, "condition sidecar");
+  toml::table root;
+  try {
+    root = toml::parse(text, std::string_view(path));
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}:{}:{}: TOML syntax error: {}", path, e.source().begin.line,
+                                 e.source().begin.column, e.description()));
+  }
+  for (const auto& [key, node] : root) {
+    const std::string name(key.str());
+    const long line = static_cast<long>(node.source().begin.line);
+    const ConditionKey* k = find_key(name);
+    if (!k) {
+      throw InputError(
+          located(path, line,
+                  fmt::format("unknown condition key '{}'; known keys: {}", name, known_keys())));
+    }
+    KeyValue kv{"", 0.0, path, line};
+    if (k->type == KeyType::Number) {
+      if (auto v = node.value<double>()) {
+        kv.number = *v;
+        kv.text = fmt::format("{:g}", *v);
+      } else {
+        throw InputError(located(path, line, fmt::format("{}: expected a number", name)));
+      }
+      if (!std::isfinite(kv.number))
+        throw InputError(located(path, line, fmt::format("{}: must be finite", name)));
+    } else {
+      if (auto v = node.value<std::string>()) {
+        kv.text = *v;
+      } else {
+        throw InputError(located(path, line, fmt::format("{}: expected a string", name)));
+      }
+    }
+    const auto it = keys.find(name);
+    if (it != keys.end()) {
+      const bool same =
+          k->type == KeyType::Number ? it->second.number == kv.number : it->second.text == kv.text;
+      if (!same) {
+        throw InputError(
+            located(path, line,
+                    fmt::format("{} = {} contradicts {} = {} at {}:{}", name, kv.text, name,
+                                it->second.text, it->second.file, it->second.line)));
+      }
+      continue;
+    }
+    keys[name] = kv;
+  }
+}
+
+MeasurementCondition make_condition(const KeyMap& keys, const Measurement& m,
+                                    const std::string& path, long header_line) {
+  MeasurementCondition c;
+  auto where = [&](const std::string& key) -> std::pair<std::string, long> {
+    const auto it = keys.find(key);
+    return it == keys.end() ? std::pair{path, header_line}
+                            : std::pair{it->second.file, it->second.line};
+  };
+  auto fail = [&](const std::string& key, const std::string& msg) {
+    const auto [f, l] = where(key);
+    throw InputError(located(f, l, msg));
+  };
+  const std::string side = sidecar_path(path);
+  if (!keys.count("temperature_C")) {
+    fail("temperature_C",
+         fmt::format("condition missing: temperature_C (write '# temperature_C = 20' above the "
+                     "header, or temperature_C = 20.0 in the sidecar {})",
+                     side));
+  }
+  c.temperature_C = keys.at("temperature_C").number;
+  if (!(c.temperature_C > -273.15))
+    fail("temperature_C",
+         fmt::format("temperature_C = {:g}: must be > -273.15 degC", c.temperature_C));
+  const bool has_f = keys.count("frequency_Hz") > 0;
+  const bool has_pp = keys.count("current_pp_A") > 0;
+  if (has_f) {
+    c.frequency_Hz = keys.at("frequency_Hz").number;
+    if (!(c.frequency_Hz > 0.0))
+      fail("frequency_Hz", fmt::format("frequency_Hz = {:g}: must be > 0", c.frequency_Hz));
+    if (!has_pp) {
+      fail("frequency_Hz",
+           "condition missing: current_pp_A (a periodic condition, with frequency_Hz, also "
+           "names its current peak-to-peak)");
+    }
+  }
+  if (has_pp) {
+    if (!has_f) {
+      fail("current_pp_A",
+           "condition missing: frequency_Hz (current_pp_A describes a periodic excitation)");
+    }
+    c.current_pp_A = keys.at("current_pp_A").number;
+    if (!(c.current_pp_A > 0.0))
+      fail("current_pp_A", fmt::format("current_pp_A = {:g}: must be > 0", c.current_pp_A));
+  }
+  if (keys.count("current_min_A")) c.current_min_A = keys.at("current_min_A").number;
+  if (keys.count("current_source")) {
+    c.current_source = keys.at("current_source").text;
+    if (c.current_source != "measured" && c.current_source != "sine")
+      fail("current_source",
+           fmt::format("current_source = '{}': must be measured or sine", c.current_source));
+    if (c.current_source == "sine" && !has_f)
+      fail("current_source", "current_source = sine needs frequency_Hz and current_pp_A");
+  }
+  c.label = keys.count("label") ? keys.at("label").text : fs::path(path).stem().string();
+  const double t0 = m.t_s.front(), t1 = m.t_s.back();
+  if (keys.count("compare_from_s")) {
+    c.compare_from_s = keys.at("compare_from_s").number;
+  } else {
+    c.compare_from_s = has_f ? t0 + 1.0 / c.frequency_Hz : t0;
+  }
+  // At least 3 compared samples.
+  const auto first =
+      std::lower_bound(m.t_s.begin(), m.t_s.end(), c.compare_from_s - 1e-12 * (t1 - t0));
+  if (m.t_s.end() - first < 3) {
+    if (keys.count("compare_from_s")) {
+      fail("compare_from_s", fmt::format("compare_from_s = {:g} s leaves fewer than 3 samples to "
+                                         "compare (the record ends at {:g} s)",
+                                         c.compare_from_s, t1));
+    }
+    throw InputError(located(path, header_line,
+                             fmt::format("the record ({:g} .. {:g} s) is shorter than one period "
+                                         "({:g} s) plus 3 samples: nothing is left to compare "
+                                         "after the first period (set compare_from_s)",
+                                         t0, t1, has_f ? 1.0 / c.frequency_Hz : 0.0)));
+  }
+  return c;
+}
+
+}  // namespace
+
+Measurement load_measurement_csv(const std::string& path) {
+  const std::string text = read_text(path, "measurement file");
+  Measurement m;
+  m.path = path;
+  KeyMap keys;
+
+  enum Col { T, I, Y, B };
+  int col_of[4] = {-1, -1, -1, -1};
+  std::size_t ncols = 0;
+  long header_line = 0;
+
+  std::string_view rest = text;
+  if (rest.starts_with("\xEF\xBB\xBF")) rest.remove_prefix(3);
+  long line_no = 0;
+  while (!rest.empty()) {
+    const auto nl = rest.find('\n');
+    const std::string_view raw = rest.substr(0, nl);
+    rest = nl == std::string_view::npos ? std::string_view{} : rest.substr(nl + 1);
+    ++line_no;
+    const std::string_view line = trim(raw);
+    if (line.empty()) continue;
+    if (line.front() == '#') {
+      read_comment_key(trim(line.substr(1)), path, line_no, keys);
+      continue;
+    }
+    const auto cells = split_cells(line);
+    if (header_line == 0) {
+      static constexpr std::string_view kNames[4] = {"t_s", "current_A", "displacement_um",
+                                                     "flux_T"};
+      for (std::size_t c = 0; c < cells.size(); ++c) {
+        const auto it = std::find(std::begin(kNames), std::end(kNames), cells[c]);
+        if (it == std::end(kNames)) {
+          throw InputError(located(path, line_no,
+                                   fmt::format("unknown column '{}' in the header; expected "
+                                               "t_s,current_A,displacement_um and optionally "
+                                               "flux_T",
+                                               cells[c])));
+        }
+        const auto k = static_cast<std::size_t>(it - std::begin(kNames));
+        if (col_of[k] >= 0)
+          throw InputError(
+              located(path, line_no, fmt::format("column '{}' appears twice", cells[c])));
+        col_of[k] = static_cast<int>(c);
+      }
+      for (int k = 0; k < 3; ++k) {
+        if (col_of[k] < 0) {
+          throw InputError(located(path, line_no,
+                                   fmt::format("missing column '{}' in the header '{}'; expected "
+                                               "t_s,current_A,displacement_um[,flux_T]",
+                                               kNames[k], line)));
+        }
+      }
+      ncols = cells.size();
+      header_line = line_no;
+      continue;
+    }
+    if (cells.size() != ncols) {
+      throw InputError(located(path, line_no,
+                               fmt::format("mismatched columns: {} cells, the header has {} ('{}')",
+                                           cells.size(), ncols, line)));
+    }
+    double v[4] = {0, 0, 0, 0};
+    static constexpr std::string_view kCol[4] = {"t_s", "current_A", "displacement_um", "flux_T"};
+    for (int k = 0; k < 4; ++k) {
+      if (col_of[k] < 0) continue;
+      if (auto bad = parse_number(cells[static_cast<std::size_t>(col_of[k])], v[k]))
+        throw InputError(located(path, line_no, fmt::format("{} in column {}", *bad, kCol[k])));
+    }
+    if (!m.t_s.empty()) {
+      const double prev = m.t_s.back();
+      if (v[T] == prev) {
+        throw InputError(
+            located(path, line_no, fmt::format("duplicate timestamp t_s = {:g} s", v[T])));
+      }
+      if (v[T] < prev) {
+        throw InputError(
+            located(path, line_no,
+                    fmt::format("time {:g} s does not increase (previous {:g} s)", v[T], prev)));
+      }
+    }
+    m.t_s.push_back(v[T]);
+    m.current_A.push_back(v[I]);
+    m.displacement_um.push_back(v[Y]);
+    if (col_of[B] >= 0) m.flux_T.push_back(v[B]);
+  }
+  if (header_line == 0) {
+    throw InputError(
+        located(path, line_no > 0 ? line_no : 1,
+                line_no > 0 ? "no header: expected t_s,current_A,displacement_um" : "empty file"));
+  }
+  if (m.t_s.size() < 4) {
+    throw InputError(
+        located(path, line_no, fmt::format("needs at least 4 data rows, found {}", m.t_s.size())));
+  }
+  const std::string side = sidecar_path(path);
+  std::error_code ec;
+  if (fs::exists(side, ec)) read_sidecar(side, keys);
+  m.condition = make_condition(keys, m, path, header_line);
+  return m;
+}
+
+MeasurementSet load_manifest(const std::string& path) {
+  const std::string text = read_text(path, "manifest");
+  toml::table root;
+  try {
+    root = toml::parse(text, std::string_view(path));
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}:{}:{}: TOML syntax error: {}", path, e.source().begin.line,
+                                 e.source().begin.column, e.description()));
+  }
+  MeasurementSet set;
+  set.manifest = path;
+  for (const auto& [key, node] : root) {
+    if (key.str() != "measurement") {
+      throw InputError(located(path, static_cast<long>(node.source().begin.line),
+                               fmt::format("unknown key '{}'; a manifest holds [[measurement]] "
+                                           "tables with file and weight",
+                                           key.str())));
+    }
+  }
+  const toml::array* list = root["measurement"].as_array();
+  if (!list || list->empty()) {
+    throw InputError(located(path, 1,
+                             "no [[measurement]] entries: list at least one file "
+                             "([[measurement]] file = \"...\", weight = 1.0)"));
+  }
+  const fs::path base = fs::path(path).parent_path();
+  std::set<std::string> seen;
+  for (const auto& node : *list) {
+    const long line = static_cast<long>(node.source().begin.line);
+    const toml::table* t = node.as_table();
+    if (!t) throw InputError(located(path, line, "[[measurement]]: expected a table"));
+    for (const auto& [k, v] : *t) {
+      if (k.str() != "file" && k.str() != "weight") {
+        throw InputError(located(path, static_cast<long>(v.source().begin.line),
+                                 fmt::format("unknown key '{}' in [[measurement]]; expected file, "
+                                             "weight",
+                                             k.str())));
+      }
+    }
+    const auto file = (*t)["file"].value<std::string>();
+    if (!file || file->empty())
+      throw InputError(located(path, line, "[[measurement]]: missing file = \"name.csv\""));
+    double weight = 1.0;
+    if (const toml::node* w = t->get("weight")) {
+      const auto wv = w->value<double>();
+      const long wl = static_cast<long>(w->source().begin.line);
+      if (!wv) throw InputError(located(path, wl, "weight: expected a number"));
+      if (!(*wv > 0.0) || !std::isfinite(*wv))
+        throw InputError(located(path, wl, fmt::format("weight = {:g}: must be > 0", *wv)));
+      weight = *wv;
+    }
+    const fs::path fp = fs::path(*file).is_absolute() ? fs::path(*file) : base / *file;
+    const std::string full = fp.lexically_normal().string();
+    if (!seen.insert(full).second)
+      throw InputError(located(path, line, fmt::format("file '{}' is listed twice", *file)));
+    std::error_code ec;
+    if (!fs::exists(fp, ec)) {
+      throw InputError(located(
+          path, line, fmt::format("measurement file '{}' does not exist ({})", *file, full)));
+    }
+    Measurement m = load_measurement_csv(full);
+    m.weight = weight;
+    set.items.push_back(std::move(m));
+  }
+  return set;
+}
+
+std::string measurement_csv(const Measurement& m) {
+  const auto& c = m.condition;
+  std::string s = "# gmasim measurement file (docs/data.md)\n";
+  s += fmt::format("# label = {}\n", c.label);
+  s += fmt::format("# temperature_C = {:.17g}\n", c.temperature_C);
+  if (m.periodic()) {
+    s += fmt::format("# frequency_Hz = {:.17g}\n", c.frequency_Hz);
+    s += fmt::format("# current_pp_A = {:.17g}\n", c.current_pp_A);
+    s += fmt::format("# current_min_A = {:.17g}\n", c.current_min_A);
+  }
+  s += fmt::format("# compare_from_s = {:.17g}\n", c.compare_from_s);
+  if (c.current_source != "measured") s += fmt::format("# current_source = {}\n", c.current_source);
+  const bool flux = !m.flux_T.empty();
+  s += flux ? "t_s,current_A,displacement_um,flux_T\n" : "t_s,current_A,displacement_um\n";
+  for (std::size_t i = 0; i < m.t_s.size(); ++i) {
+    s += fmt::format("{:.17g},{:.17g},{:.17g}", m.t_s[i], m.current_A[i], m.displacement_um[i]);
+    if (flux) s += fmt::format(",{:.17g}", m.flux_T[i]);
+    s += '\n';
+  }
+  return s;
+}
+
+void write_measurement_set(const MeasurementSet& set, const std::string& dir) {
+  ensure_output_dir(dir);
+  std::string manifest =
+      "# gmasim measurement manifest (docs/data.md): one [[measurement]] per CSV file\n";
+  for (const auto& m : set.items) {
+    const std::string name = fs::path(m.path).filename().string();
+    write_file_atomic((fs::path(dir) / name).string(), measurement_csv(m));
+    manifest += fmt::format("\n[[measurement]]\nfile = \"{}\"\nweight = {:.6g}\n", name, m.weight);
+  }
+  write_file_atomic((fs::path(dir) / "manifest.toml").string(), manifest);
+}
+
+}  // namespace gmasim

@@ -1,0 +1,696 @@
+// The identification objective: normalised residuals of simulated vs measured displacement
+// (and optionally flux density) at every compared sample, plus scalar targets. The sum of
+// squares of the residuals is the square of the weighted RMS error in % of peak-to-peak.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <set>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/identify.hpp"
+#include "gmasim/io.hpp"
+#include "gmasim/physics/magnetic.hpp"
+
+namespace gmasim {
+namespace {
+
+struct Param {
+  std::string key, unit;
+  ParamScale scale = ParamScale::Linear;
+  double lo = 0, hi = 0;
+  double tlo = 0, thi = 0;  // theta bounds: p, or ln|p|
+  double sign = 1.0;
+};
+
+struct CondData {
+  std::size_t index = 0;          // in data.items
+  std::size_t compare_begin = 0;  // first compared sample
+  double pp_um = 0, y_scale = 0;
+  bool flux = false;
+  double ppB = 0, B_scale = 0;
+  std::size_t r_offset = 0, rB_offset = 0;
+};
+
+struct SineRun {
+  double T, pp, f, min;
+  bool operator==(const SineRun&) const = default;
+};
+struct ResonanceRun {
+  double T, bias;
+  bool operator==(const ResonanceRun&) const = default;
+};
+
+struct TargetData {
+  FitTarget t;
+  int run = -1, ref_run = -1, res_run = -1;
+  double r_scale = 0;
+  std::size_t r_index = 0;
+};
+
+struct SineMetrics {
+  double stroke_um = 0, hysteresis_um = 0, B_pp_T = 0;
+};
+
+// Resolves a dotted name to the model's full key, with the library's prefix rule.
+std::string resolve_key(const ModelSpec& spec, const std::string& name) {
+  if (spec.params.count(name)) return name;
+  const std::string prefix = name + "_";
+  std::vector<std::string> matches;
+  for (auto it = spec.params.lower_bound(prefix);
+       it != spec.params.end() && it->first.starts_with(prefix); ++it) {
+    if (it->first.find('.', prefix.size()) == std::string::npos) matches.push_back(it->first);
+  }
+  if (matches.size() == 1) return matches.front();
+  (void)spec.get(name);  // throws the library's "unknown/ambiguous parameter" message
+  throw InputError(fmt::format("unknown parameter '{}'", name));
+}
+
+// Linear interpolation of the measured current, with a forward-moving index (time only
+// increases during a run): O(1) per call, no allocation.
+struct TableCurrent {
+  const std::vector<double>& t;
+  const std::vector<double>& i;
+  std::size_t j = 1;
+  double operator()(double time) {
+    if (time <= t.front()) return i.front();
+    if (time >= t.back()) return i.back();
+    while (j + 1 < t.size() && t[j] < time) ++j;
+    while (j > 1 && t[j - 1] > time) --j;
+    const double f = (time - t[j - 1]) / (t[j] - t[j - 1]);
+    return i[j - 1] + f * (i[j] - i[j - 1]);
+  }
+};
+
+double step_for(const ObjectiveSettings& s, double period_s) {
+  if (s.dt_s > 0.0) return s.dt_s;
+  if (period_s > 0.0) return period_s / s.steps_per_period;
+  return kMaxDt_s;
+}
+
+SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings& s,
+                     std::vector<double>& I, std::vector<double>& y, std::vector<double>& B) {
+  const Waveform w = biased_sine(run.pp, run.f, run.min);
+  const double per = w.period_s();
+  const long n_per = std::max(8L, static_cast<long>(std::ceil(per / step_for(s, per) - 1e-9)));
+  const double dt = per / static_cast<double>(n_per);
+  const long periods = std::max(1L, std::lround(s.target_periods));
+  const long total = periods * n_per;
+  const Conditions c = make_conditions(m, run.T);
+  State st = make_state(m, c, w.current_at(0.0));
+  I.assign(static_cast<std::size_t>(n_per), 0.0);
+  y.assign(static_cast<std::size_t>(n_per), 0.0);
+  B.assign(static_cast<std::size_t>(n_per), 0.0);
+  const long first = total - n_per;  // record samples k in [first, total)
+  auto rec = [&](long k) {
+    if (k < first || k >= total) return;
+    const auto i = static_cast<std::size_t>(k - first);
+    I[i] = st.current_A;
+    y[i] = st.y_m * 1e6;
+    B[i] = st.B_T;
+  };
+  rec(0);
+  for (long k = 1; k <= total; ++k) {
+    const double t = static_cast<double>(k) * dt;
+    step(m, c, st, {w.current_at(t), dt});
+    st.t_s = t;
+    rec(k);
+  }
+  SineMetrics r;
+  const auto [ylo, yhi] = std::minmax_element(y.begin(), y.end());
+  const auto [blo, bhi] = std::minmax_element(B.begin(), B.end());
+  r.stroke_um = *yhi - *ylo;
+  r.B_pp_T = *bhi - *blo;
+  r.hysteresis_um = hysteresis_width(I, y, 0, y.size());
+  return r;
+}
+
+double lowest_resonance_Hz(const Model& m, const ResonanceRun& run) {
+  const Conditions c = make_conditions(m, run.T);
+  const State st = make_state(m, c, run.bias);
+  double f = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < m.rod_count(); ++i) {
+    const double K = oscillator_stiffness(c, st, i);
+    const double mass = c.rods[static_cast<std::size_t>(i)].mass_osc_kg;
+    f = std::min(f, std::sqrt(K / mass) / (2.0 * physics::kPi));
+  }
+  return f;
+}
+
+}  // namespace
+
+// =======================================================================================
+void simulate_measurement(const Model& m, const Measurement& meas, const ObjectiveSettings& s,
+                          std::vector<double>& y_um, std::vector<double>* B_T) {
+  const auto& ts = meas.t_s;
+  const std::size_t n = ts.size();
+  const double t0 = ts.front(), t1 = ts.back();
+  const auto& cond = meas.condition;
+  const bool sine = cond.current_source == "sine";
+  const Waveform w =
+      sine ? biased_sine(cond.current_pp_A, cond.frequency_Hz, cond.current_min_A) : Waveform{};
+  TableCurrent table{ts, meas.current_A};
+  auto current = [&](double t) { return sine ? w.current_at(t) : table(t); };
+
+  const double dt_target = step_for(s, meas.periodic() ? 1.0 / cond.frequency_Hz : 0.0);
+  const long nsteps = std::max(1L, static_cast<long>(std::ceil((t1 - t0) / dt_target - 1e-9)));
+  if (nsteps > 50'000'000L)
+    throw InputError(
+        fmt::format("{}: {} steps: the time step is too small for the record", meas.path, nsteps));
+  const double dt = (t1 - t0) / static_cast<double>(nsteps);
+
+  const Conditions c = make_conditions(m, cond.temperature_C);
+  State st = make_state(m, c, current(t0));
+  st.t_s = t0;
+  y_um.resize(n);
+  if (B_T) B_T->resize(n);
+  std::size_t j = 0;
+  while (j < n && ts[j] <= t0) {
+    y_um[j] = st.y_m * 1e6;
+    if (B_T) (*B_T)[j] = st.B_T;
+    ++j;
+  }
+  double y_prev = st.y_m, B_prev = st.B_T, t_prev = t0;
+  for (long k = 1; k <= nsteps; ++k) {
+    const double t = k == nsteps ? t1 : t0 + static_cast<double>(k) * dt;
+    step(m, c, st, {current(t), t - t_prev});
+    st.t_s = t;
+    while (j < n && ts[j] <= t) {
+      const double f = (ts[j] - t_prev) / (t - t_prev);
+      y_um[j] = (y_prev + f * (st.y_m - y_prev)) * 1e6;
+      if (B_T) (*B_T)[j] = B_prev + f * (st.B_T - B_prev);
+      ++j;
+    }
+    y_prev = st.y_m;
+    B_prev = st.B_T;
+    t_prev = t;
+  }
+  for (; j < n; ++j) {
+    y_um[j] = st.y_m * 1e6;
+    if (B_T) (*B_T)[j] = st.B_T;
+  }
+}
+
+// =======================================================================================
+struct Objective::Impl {
+  ModelSpec start;
+  MeasurementSet data;
+  FitSpec fit;
+  ObjectiveSettings settings;
+  std::vector<Param> params;
+  std::vector<std::string> names, units, notes;
+  std::vector<double> start_u;
+  std::vector<CondData> conds;
+  std::vector<SineRun> sine_runs;
+  std::vector<ResonanceRun> res_runs;
+  std::vector<TargetData> targets;
+  std::size_t m = 0;
+
+  double to_param(std::size_t j, double u) const {
+    const Param& p = params[j];
+    const double th = p.tlo + u * (p.thi - p.tlo);
+    return p.scale == ParamScale::Log ? p.sign * std::exp(th) : th;
+  }
+  double to_u(std::size_t j, double v) const {
+    const Param& p = params[j];
+    const double th = p.scale == ParamScale::Log ? std::log(std::fabs(v)) : v;
+    return std::clamp((th - p.tlo) / (p.thi - p.tlo), 0.0, 1.0);
+  }
+
+  // Model at u; throws InputError if a value breaks a model rule.
+  Model model_at(const double* u) const {
+    ModelSpec spec = start;
+    for (std::size_t j = 0; j < params.size(); ++j) spec.set(params[j].key, to_param(j, u[j]));
+    return compile(spec);
+  }
+
+  bool residuals(const double* u, double* r) const {
+    try {
+      const Model model = model_at(u);
+      std::vector<double> y, B;
+      for (const auto& cd : conds) {
+        const Measurement& meas = data.items[cd.index];
+        simulate_measurement(model, meas, settings, y, cd.flux ? &B : nullptr);
+        const std::size_t n = meas.t_s.size();
+        for (std::size_t i = cd.compare_begin; i < n; ++i) {
+          r[cd.r_offset + i - cd.compare_begin] = cd.y_scale * (y[i] - meas.displacement_um[i]);
+          if (cd.flux)
+            r[cd.rB_offset + i - cd.compare_begin] = cd.B_scale * (B[i] - meas.flux_T[i]);
+        }
+      }
+      if (!targets.empty()) {
+        std::vector<double> I, yy, BB;
+        std::vector<SineMetrics> sm(sine_runs.size());
+        for (std::size_t k = 0; k < sine_runs.size(); ++k)
+          sm[k] = run_sine(model, sine_runs[k], settings, I, yy, BB);
+        std::vector<double> res(res_runs.size());
+        for (std::size_t k = 0; k < res_runs.size(); ++k)
+          res[k] = lowest_resonance_Hz(model, res_runs[k]);
+        for (const auto& td : targets) {
+          const double sim = target_value(td, sm, res);
+          r[td.r_index] = td.r_scale * (sim - td.t.value);
+        }
+      }
+    } catch (const InputError&) {
+      return false;
+    } catch (const DivergenceError&) {
+      return false;
+    }
+    for (std::size_t i = 0; i < m; ++i)
+      if (!std::isfinite(r[i])) return false;
+    return true;
+  }
+
+  static double target_value(const TargetData& td, const std::vector<SineMetrics>& sm,
+                             const std::vector<double>& res) {
+    auto change = [&](auto get) {
+      const double ref = get(sm[static_cast<std::size_t>(td.ref_run)]);
+      return 100.0 * (get(sm[static_cast<std::size_t>(td.run)]) / ref - 1.0);
+    };
+    auto stroke = [](const SineMetrics& s) { return s.stroke_um; };
+    auto hyst = [](const SineMetrics& s) { return s.hysteresis_um; };
+    auto bpp = [](const SineMetrics& s) { return s.B_pp_T; };
+    switch (td.t.kind) {
+      case TargetKind::StrokeUm:
+        return sm[static_cast<std::size_t>(td.run)].stroke_um;
+      case TargetKind::HysteresisUm:
+        return sm[static_cast<std::size_t>(td.run)].hysteresis_um;
+      case TargetKind::BppT:
+        return sm[static_cast<std::size_t>(td.run)].B_pp_T;
+      case TargetKind::StrokeChangePct:
+        return change(stroke);
+      case TargetKind::HysteresisChangePct:
+        return change(hyst);
+      case TargetKind::BppChangePct:
+        return change(bpp);
+      case TargetKind::RetentionPct:
+        return 100.0 + change(stroke);
+      case TargetKind::ResonanceHz:
+        return res[static_cast<std::size_t>(td.res_run)];
+    }
+    return 0.0;
+  }
+};
+
+Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const FitSpec& fit,
+                     const ObjectiveSettings& settings) {
+  auto impl = std::make_shared<Impl>();
+  Impl& I = *impl;
+  I.start = start;
+  I.data = data;
+  I.fit = fit;
+  I.settings = settings;
+  if (!(settings.steps_per_period >= 8.0))
+    throw InputError(fmt::format("steps per period {:g}: must be >= 8", settings.steps_per_period));
+  if (!(settings.dt_s >= 0.0) || !std::isfinite(settings.dt_s))
+    throw InputError(fmt::format("dt {:g} s: must be >= 0", settings.dt_s));
+  if (!(settings.flux_weight >= 0.0))
+    throw InputError(fmt::format("flux weight {:g}: must be >= 0", settings.flux_weight));
+  if (!(settings.target_periods >= 1.0))
+    throw InputError(fmt::format("target periods {:g}: must be >= 1", settings.target_periods));
+  if (fit.parameters.empty()) throw InputError(located(fit.source, 0, "no parameter to fit"));
+  if (data.items.empty() && fit.targets.empty()) {
+    throw InputError(
+        "nothing to fit against: give measurements (--data) or [[target]] entries "
+        "in the fit spec");
+  }
+
+  // ---- parameters ----
+  std::set<std::string> seen;
+  for (const auto& fp : fit.parameters) {
+    std::string key;
+    try {
+      key = resolve_key(start, fp.name);
+    } catch (const InputError& e) {
+      throw InputError(located(fit.source, fp.line, e.what()));
+    }
+    if (!seen.insert(key).second) {
+      throw InputError(located(fit.source, fp.line,
+                               fmt::format("parameter {} ({}) is listed twice", fp.name, key)));
+    }
+    Param p;
+    p.key = key;
+    p.unit = start.params.at(key).unit;
+    p.scale = fp.scale;
+    p.lo = fp.lower;
+    p.hi = fp.upper;
+    if (p.scale == ParamScale::Log) {
+      p.sign = p.lo < 0 ? -1.0 : 1.0;
+      p.tlo = std::log(std::fabs(p.lo));
+      p.thi = std::log(std::fabs(p.hi));
+    } else {
+      p.tlo = p.lo;
+      p.thi = p.hi;
+    }
+    // Both bounds must be values the model accepts.
+    for (double b : {p.lo, p.hi}) {
+      ModelSpec probe = start;
+      try {
+        probe.set(key, b);
+      } catch (const InputError& e) {
+        throw InputError(located(fit.source, fp.line,
+                                 fmt::format("parameter {}: bound {:g} is not a valid model value "
+                                             "({})",
+                                             fp.name, b, e.what())));
+      }
+    }
+    I.params.push_back(p);
+    I.names.push_back(key);
+    I.units.push_back(p.unit);
+  }
+  // ---- start point ----
+  for (std::size_t j = 0; j < I.params.size(); ++j) {
+    const auto& fp = fit.parameters[j];
+    const Param& p = I.params[j];
+    double v = fp.has_start ? fp.start : start.params.at(p.key).value;
+    if (v < p.lo || v > p.hi) {
+      const double c = std::clamp(v, p.lo, p.hi);
+      I.notes.push_back(
+          fmt::format("start value {} = {:g} lies outside [{:g}, {:g}]: the search "
+                      "starts from {:g}",
+                      p.key, v, p.lo, p.hi, c));
+      v = c;
+    }
+    I.start_u.push_back(I.to_u(j, v));
+  }
+  // ---- measurements ----
+  const Model start_model = compile(start);
+  double W = 0.0;
+  for (std::size_t k = 0; k < data.items.size(); ++k) {
+    const Measurement& meas = data.items[k];
+    try {
+      (void)make_conditions(start_model, meas.condition.temperature_C);
+    } catch (const InputError& e) {
+      throw InputError(located(meas.path, 0, e.what()));
+    }
+    CondData cd;
+    cd.index = k;
+    const double span = meas.t_s.back() - meas.t_s.front();
+    cd.compare_begin =
+        static_cast<std::size_t>(std::lower_bound(meas.t_s.begin(), meas.t_s.end(),
+                                                  meas.condition.compare_from_s - 1e-12 * span) -
+                                 meas.t_s.begin());
+    const std::size_t nc = meas.t_s.size() - cd.compare_begin;
+    if (nc < 3) {
+      throw InputError(located(meas.path, 0, "fewer than 3 samples after compare_from_s"));
+    }
+    const auto [lo, hi] = std::minmax_element(
+        meas.displacement_um.begin() + static_cast<std::ptrdiff_t>(cd.compare_begin),
+        meas.displacement_um.end());
+    cd.pp_um = *hi - *lo;
+    if (!(cd.pp_um > 0.0)) {
+      throw InputError(located(meas.path, 0,
+                               "the measured displacement does not vary over the compared "
+                               "samples: the RMS / peak-to-peak error is undefined"));
+    }
+    cd.flux = settings.flux_weight > 0.0 && !meas.flux_T.empty();
+    if (cd.flux) {
+      const auto [blo, bhi] = std::minmax_element(
+          meas.flux_T.begin() + static_cast<std::ptrdiff_t>(cd.compare_begin), meas.flux_T.end());
+      cd.ppB = *bhi - *blo;
+      if (!(cd.ppB > 0.0)) {
+        throw InputError(located(meas.path, 0, "flux_T does not vary: set the flux weight to 0"));
+      }
+    }
+    W += meas.weight * (1.0 + (cd.flux ? settings.flux_weight : 0.0));
+    I.conds.push_back(cd);
+  }
+  // ---- targets ----
+  auto sine_index = [&](const SineRun& r) {
+    const auto it = std::find(I.sine_runs.begin(), I.sine_runs.end(), r);
+    if (it != I.sine_runs.end()) return static_cast<int>(it - I.sine_runs.begin());
+    I.sine_runs.push_back(r);
+    return static_cast<int>(I.sine_runs.size() - 1);
+  };
+  for (const auto& t : fit.targets) {
+    TargetData td;
+    td.t = t;
+    for (double T : {t.temperature_C, t.reference_temperature_C}) {
+      try {
+        (void)make_conditions(start_model, T);
+      } catch (const InputError& e) {
+        throw InputError(located(fit.source, t.line, e.what()));
+      }
+    }
+    if (t.kind == TargetKind::ResonanceHz) {
+      const ResonanceRun rr{t.temperature_C, t.bias_A};
+      const auto it = std::find(I.res_runs.begin(), I.res_runs.end(), rr);
+      td.res_run = static_cast<int>(it - I.res_runs.begin());
+      if (it == I.res_runs.end()) I.res_runs.push_back(rr);
+    } else {
+      td.run = sine_index({t.temperature_C, t.current_pp_A, t.frequency_Hz, t.current_min_A});
+      const bool change = t.kind == TargetKind::StrokeChangePct ||
+                          t.kind == TargetKind::HysteresisChangePct ||
+                          t.kind == TargetKind::BppChangePct || t.kind == TargetKind::RetentionPct;
+      if (change) {
+        td.ref_run = sine_index(
+            {t.reference_temperature_C, t.current_pp_A, t.frequency_Hz, t.current_min_A});
+      }
+    }
+    W += t.weight;
+    I.targets.push_back(td);
+  }
+  // ---- residual layout and scales ----
+  std::size_t off = 0;
+  for (auto& cd : I.conds) {
+    const Measurement& meas = data.items[cd.index];
+    const std::size_t nc = meas.t_s.size() - cd.compare_begin;
+    cd.y_scale = 100.0 / cd.pp_um * std::sqrt(meas.weight / (W * static_cast<double>(nc)));
+    cd.r_offset = off;
+    off += nc;
+    if (cd.flux) {
+      cd.B_scale = 100.0 / cd.ppB *
+                   std::sqrt(meas.weight * settings.flux_weight / (W * static_cast<double>(nc)));
+      cd.rB_offset = off;
+      off += nc;
+    }
+  }
+  for (auto& td : I.targets) {
+    td.r_scale = 100.0 / td.t.scale * std::sqrt(td.t.weight / W);
+    td.r_index = off++;
+  }
+  I.m = off;
+  if (I.m < I.params.size()) {
+    throw InputError(
+        fmt::format("{} residuals for {} parameters: the fit is underdetermined; "
+                    "add data or targets, or fit fewer parameters",
+                    I.m, I.params.size()));
+  }
+  impl_ = std::move(impl);
+}
+
+std::size_t Objective::dim() const { return impl_->params.size(); }
+std::size_t Objective::residual_count() const { return impl_->m; }
+const std::vector<std::string>& Objective::names() const { return impl_->names; }
+const std::vector<std::string>& Objective::units() const { return impl_->units; }
+const FitSpec& Objective::fit() const { return impl_->fit; }
+const MeasurementSet& Objective::data() const { return impl_->data; }
+const ObjectiveSettings& Objective::settings() const { return impl_->settings; }
+const ModelSpec& Objective::start_spec() const { return impl_->start; }
+const std::vector<std::string>& Objective::notes() const { return impl_->notes; }
+std::vector<double> Objective::start_unit() const { return impl_->start_u; }
+
+std::vector<double> Objective::to_params(const std::vector<double>& u) const {
+  std::vector<double> p(u.size());
+  for (std::size_t j = 0; j < u.size(); ++j) p[j] = impl_->to_param(j, u[j]);
+  return p;
+}
+
+std::vector<double> Objective::to_unit(const std::vector<double>& p) const {
+  std::vector<double> u(p.size());
+  for (std::size_t j = 0; j < p.size(); ++j) u[j] = impl_->to_u(j, p[j]);
+  return u;
+}
+
+std::vector<double> Objective::theta_per_unit() const {
+  std::vector<double> d;
+  for (const auto& p : impl_->params) d.push_back(p.thi - p.tlo);
+  return d;
+}
+
+bool Objective::residuals(const double* u, double* r) const { return impl_->residuals(u, r); }
+
+double Objective::rms_pct(const std::vector<double>& u) const {
+  std::vector<double> r(impl_->m);
+  if (!impl_->residuals(u.data(), r.data())) return kPenalty;
+  double ss = 0.0;
+  for (double v : r) ss += v * v;
+  return std::sqrt(ss);
+}
+
+ModelSpec Objective::spec_at(const std::vector<double>& u) const {
+  ModelSpec spec = impl_->start;
+  for (std::size_t j = 0; j < impl_->params.size(); ++j)
+    spec.set(impl_->params[j].key, impl_->to_param(j, u[j]));
+  return spec;
+}
+
+std::vector<ConditionFit> Objective::condition_fits(const std::vector<double>& u) const {
+  const Impl& I = *impl_;
+  std::vector<ConditionFit> out;
+  std::optional<Model> model;
+  std::string model_error;
+  try {
+    model.emplace(I.model_at(u.data()));
+  } catch (const InputError& e) {
+    model_error = e.what();
+  }
+  for (const auto& cd : I.conds) {
+    const Measurement& meas = I.data.items[cd.index];
+    ConditionFit f;
+    f.label = meas.condition.label;
+    f.path = meas.path;
+    {
+      std::string safe;
+      for (char ch : f.label) {
+        const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
+                        (ch >= '0' && ch <= '9') || ch == '_' || ch == '-' || ch == '.';
+        safe += ok ? ch : '_';
+      }
+      std::string name = "overlay_" + safe;
+      for (int k = 2;
+           std::any_of(out.begin(), out.end(),
+                       [&](const ConditionFit& o) { return o.overlay_file == name + ".csv"; });
+           ++k)
+        name = fmt::format("overlay_{}_{}", safe, k);
+      f.overlay_file = name + ".csv";
+    }
+    f.condition = meas.condition;
+    f.weight = meas.weight;
+    f.samples = meas.t_s.size();
+    f.compared = f.samples - cd.compare_begin;
+    f.pp_um = cd.pp_um;
+    std::vector<double> y, B;
+    const bool has_flux = !meas.flux_T.empty();
+    try {
+      if (!model) throw InputError(model_error);
+      simulate_measurement(*model, meas, I.settings, y, has_flux ? &B : nullptr);
+    } catch (const std::exception& e) {
+      f.failed = true;
+      f.error = e.what();
+      out.push_back(std::move(f));
+      continue;
+    }
+    double ss = 0.0, ssB = 0.0;
+    for (std::size_t i = cd.compare_begin; i < f.samples; ++i) {
+      const double d = y[i] - meas.displacement_um[i];
+      ss += d * d;
+      f.max_err_um = std::max(f.max_err_um, std::fabs(d));
+      if (has_flux) ssB += (B[i] - meas.flux_T[i]) * (B[i] - meas.flux_T[i]);
+    }
+    f.rms_um = std::sqrt(ss / static_cast<double>(f.compared));
+    f.rms_pct = 100.0 * f.rms_um / f.pp_um;
+    if (has_flux) {
+      const auto [blo, bhi] = std::minmax_element(
+          meas.flux_T.begin() + static_cast<std::ptrdiff_t>(cd.compare_begin), meas.flux_T.end());
+      if (*bhi > *blo)
+        f.flux_rms_pct = 100.0 * std::sqrt(ssB / static_cast<double>(f.compared)) / (*bhi - *blo);
+    }
+    TimeSeries& ts = f.overlay;
+    ts.names = {"t_s", "current_A", "measured_um", "simulated_um", "compared"};
+    ts.columns = {meas.t_s, meas.current_A, meas.displacement_um, y,
+                  std::vector<double>(f.samples, 0.0)};
+    for (std::size_t i = cd.compare_begin; i < f.samples; ++i) ts.columns[4][i] = 1.0;
+    if (has_flux) {
+      ts.names.insert(ts.names.end(), {"measured_flux_T", "simulated_flux_T"});
+      ts.columns.push_back(meas.flux_T);
+      ts.columns.push_back(B);
+    }
+    out.push_back(std::move(f));
+  }
+  return out;
+}
+
+std::vector<TargetFit> Objective::target_fits(const std::vector<double>& u) const {
+  const Impl& I = *impl_;
+  std::vector<TargetFit> out;
+  if (I.targets.empty()) return out;
+  std::vector<SineMetrics> sm(I.sine_runs.size());
+  std::vector<double> res(I.res_runs.size());
+  bool failed = false;
+  try {
+    const Model model = I.model_at(u.data());
+    std::vector<double> a, b, c;
+    for (std::size_t k = 0; k < I.sine_runs.size(); ++k)
+      sm[k] = run_sine(model, I.sine_runs[k], I.settings, a, b, c);
+    for (std::size_t k = 0; k < I.res_runs.size(); ++k)
+      res[k] = lowest_resonance_Hz(model, I.res_runs[k]);
+  } catch (const std::exception&) {
+    failed = true;
+  }
+  for (const auto& td : I.targets) {
+    TargetFit f;
+    f.label = td.t.label;
+    f.kind = target_kind_name(td.t.kind);
+    f.value = td.t.value;
+    f.weight = td.t.weight;
+    f.failed = failed;
+    if (!failed) {
+      f.simulated = Impl::target_value(td, sm, res);
+      f.error_pct = 100.0 * (f.simulated - f.value) / td.t.scale;
+    }
+    out.push_back(f);
+  }
+  return out;
+}
+
+// =======================================================================================
+MeasurementSet synthesize_measurements(const Model& truth, const SyntheticRequest& r) {
+  if (r.samples_per_period < 8) throw InputError("samples per period: must be >= 8");
+  if (!(r.periods >= 1.5)) throw InputError("periods: must be >= 1.5 (the first is not compared)");
+  MeasurementSet set;
+  std::uint64_t state = 0x9E3779B97F4A7C15ULL ^ r.seed;
+  auto next_u01 = [&]() {  // splitmix64: the same numbers on every platform
+    state += 0x9E3779B97F4A7C15ULL;
+    std::uint64_t z = state;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    z ^= z >> 31;
+    return (static_cast<double>(z >> 11) + 0.5) * 0x1.0p-53;
+  };
+  auto gauss = [&]() {  // Box-Muller
+    const double u1 = next_u01(), u2 = next_u01();
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * physics::kPi * u2);
+  };
+  for (double T : r.temperatures_C) {
+    for (double pp : r.currents_pp_A) {
+      for (double f : r.frequencies_Hz) {
+        Measurement m;
+        auto& c = m.condition;
+        c.temperature_C = T;
+        c.frequency_Hz = f;
+        c.current_pp_A = pp;
+        c.current_min_A = r.current_min_A;
+        c.compare_from_s = 1.0 / f;
+        c.label = fmt::format("T{:g}_I{:g}_f{:g}", T, pp, f);
+        m.path = c.label + ".csv";
+        const Waveform w = biased_sine(pp, f, r.current_min_A);
+        const long n = std::lround(r.periods * r.samples_per_period);
+        for (long k = 0; k <= n; ++k) {
+          const double t = static_cast<double>(k) / (f * r.samples_per_period);
+          m.t_s.push_back(t);
+          m.current_A.push_back(w.current_at(t));
+        }
+        std::vector<double> y, B;
+        simulate_measurement(truth, m, r.objective, y, r.with_flux ? &B : nullptr);
+        const auto [ylo, yhi] = std::minmax_element(y.begin(), y.end());
+        const double sy = r.noise_pct / 100.0 * (*yhi - *ylo);
+        m.displacement_um = y;
+        for (double& v : m.displacement_um) v += sy * gauss();
+        if (r.with_flux) {
+          const auto [blo, bhi] = std::minmax_element(B.begin(), B.end());
+          const double sb = r.flux_noise_pct / 100.0 * (*bhi - *blo);
+          m.flux_T = B;
+          for (double& v : m.flux_T) v += sb * gauss();
+        }
+        set.items.push_back(std::move(m));
+      }
+    }
+  }
+  return set;
+}
+
+}  // namespace gmasim

@@ -1,0 +1,341 @@
+// Outputs of identify(): the calibrated model file (the start model's text with the fitted
+// values and provenance comments), the fit report (JSON and markdown) and the convergence
+// history (CSV).
+#include <fmt/format.h>
+
+#include <cmath>
+#include <ctime>
+#include <string_view>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/identify.hpp"
+#include "gmasim/io.hpp"
+#include "io/schema.hpp"
+
+namespace gmasim {
+namespace {
+
+std::vector<std::string> split_lines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    auto end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    lines.push_back(text.substr(start, end - start));
+    start = end + 1;
+  }
+  if (!lines.empty() && lines.back().empty()) lines.pop_back();
+  return lines;
+}
+
+std::string toml_number(double v) {
+  std::string s = fmt::format("{:.12g}", v);
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+std::string json_str(std::string_view s) {
+  std::string o = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '"':
+        o += "\\\"";
+        break;
+      case '\\':
+        o += "\\\\";
+        break;
+      case '\n':
+        o += "\\n";
+        break;
+      case '\t':
+        o += "\\t";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20)
+          o += fmt::format("\\u{:04x}", static_cast<int>(c));
+        else
+          o += c;
+    }
+  }
+  return o + "\"";
+}
+
+std::string jnum(double v) { return std::isfinite(v) ? fmt::format("{:.10g}", v) : "null"; }
+
+std::string ci_text(const FittedParameter& p) {
+  if (std::isnan(p.ci_low)) return "no interval";
+  if (!p.determined || !std::isfinite(p.ci_low) || !std::isfinite(p.ci_high))
+    return "not determined";
+  return fmt::format("[{:.6g}, {:.6g}]", p.ci_low, p.ci_high);
+}
+
+std::string data_label(const IdentifyResult& r, const FitProvenance& p) {
+  if (!p.data.empty()) return fmt::format("{} ({} files)", p.data, r.conditions.size());
+  return "scalar targets only";
+}
+
+}  // namespace
+
+std::string fitted_model_toml(const std::string& start_text, const ModelSpec& start,
+                              const IdentifyResult& r, const FitProvenance& p) {
+  std::vector<std::string> lines = split_lines(start_text);
+  for (const auto& fp : r.parameters) {
+    const auto it = start.params.find(fp.name);
+    if (it == start.params.end() || it->second.line < 1 ||
+        it->second.line > static_cast<long>(lines.size())) {
+      throw std::runtime_error(fmt::format("fitted_model_toml: no source line for {}", fp.name));
+    }
+    std::string& line = lines[static_cast<std::size_t>(it->second.line - 1)];
+    const std::string leaf = fp.name.substr(fp.name.rfind('.') + 1);
+    // Find "leaf = value" on the line (plain or inside an inline table).
+    std::size_t pos = 0, vbeg = std::string::npos;
+    while ((pos = line.find(leaf, pos)) != std::string::npos) {
+      const bool left_ok =
+          pos == 0 || std::string_view(" \t{,").find(line[pos - 1]) != std::string_view::npos;
+      std::size_t q = pos + leaf.size();
+      while (q < line.size() && (line[q] == ' ' || line[q] == '\t')) ++q;
+      if (left_ok && q < line.size() && line[q] == '=') {
+        ++q;
+        while (q < line.size() && (line[q] == ' ' || line[q] == '\t')) ++q;
+        vbeg = q;
+        break;
+      }
+      pos += leaf.size();
+    }
+    if (vbeg == std::string::npos) {
+      throw std::runtime_error(fmt::format("fitted_model_toml: '{} =' not found on line {} of {}",
+                                           leaf, it->second.line, start.source));
+    }
+    std::size_t vend = vbeg;
+    while (vend < line.size() &&
+           std::string_view(" \t,}#").find(line[vend]) == std::string_view::npos)
+      ++vend;
+    const std::string old_comment = schema::trailing_comment(line);
+    const bool simple = line.find('{') == std::string::npos;
+    std::string ci = ci_text(fp);
+    if (ci.front() == '[') ci = "95 % CI " + ci;
+    if (r.interrupted) ci = "interrupted run, no interval";
+    const std::string comment =
+        fmt::format("identified: gmasim identify, data {}, {} (start {:.6g}){}",
+                    p.data.empty() ? "targets" : p.data, ci, fp.start,
+                    old_comment.empty()
+                        ? ""
+                        : fmt::format("; was {} ({})", toml_number(it->second.value), old_comment));
+    if (simple) {
+      line = line.substr(0, vbeg) + toml_number(fp.value) + "  # " + comment;
+    } else {
+      line = line.substr(0, vbeg) + toml_number(fp.value) + line.substr(vend);
+    }
+  }
+  std::string head;
+  head += fmt::format("# Calibrated by `gmasim identify` on {} (docs/identify.md).\n", utc_now());
+  if (!p.command.empty()) head += fmt::format("# command: {}\n", p.command);
+  head += fmt::format("# start model: {}\n", p.start_model.empty() ? start.source : p.start_model);
+  head += fmt::format("# data: {}\n", p.data.empty() ? "none (scalar targets only)" : p.data);
+  for (const auto& c : r.conditions)
+    head += fmt::format("#   {} (weight {:g}): RMS {:.3f} % of p-p\n", c.path, c.weight, c.rms_pct);
+  if (!p.fit.empty()) head += fmt::format("# fit spec: {}\n", p.fit);
+  head += fmt::format("# fit: {} parameters, weighted RMS {:.4g} % (start {:.4g} %), {}{}\n",
+                      r.parameters.size(), r.rms_pct, r.start_rms_pct,
+                      r.interrupted ? "interrupted (best so far)" : "converged run",
+                      p.report_dir.empty() ? "" : fmt::format("; report: {}", p.report_dir));
+  head += "# Fitted values carry an 'identified:' provenance comment.\n#\n";
+  std::string text = head;
+  for (const auto& l : lines) text += l + "\n";
+
+  // The file must load and carry exactly the fitted values.
+  const ModelSpec check = parse_model_spec(text, "fitted model");
+  for (const auto& fp : r.parameters) {
+    const double v = check.params.at(fp.name).value;
+    if (!(std::fabs(v - fp.value) <= 1e-9 * std::max(1.0, std::fabs(fp.value)) ||
+          std::fabs(v - fp.value) <= 1e-10 * std::fabs(fp.value))) {
+      throw std::runtime_error(fmt::format("fitted_model_toml: {} reads back as {} instead of {}",
+                                           fp.name, v, fp.value));
+    }
+  }
+  (void)compile(check);
+  return text;
+}
+
+std::string fit_report_json(const IdentifyResult& r, const FitProvenance& p) {
+  std::string s = "{\n  \"gmasim_identify_report\": 1,\n";
+  s += fmt::format("  \"command\": {},\n  \"data\": {},\n  \"fit\": {},\n  \"start_model\": {},\n",
+                   json_str(p.command), json_str(p.data), json_str(p.fit), json_str(p.start_model));
+  s += fmt::format(
+      "  \"rms_pct\": {},\n  \"start_rms_pct\": {},\n  \"ga_rms_pct\": {},\n  \"interrupted\": "
+      "{},\n"
+      "  \"resumed\": {},\n",
+      jnum(r.rms_pct), jnum(r.start_rms_pct), jnum(r.ga_rms_pct), r.interrupted, r.resumed);
+  s += fmt::format(
+      "  \"algorithm\": {{\"name\": {}, \"ranks\": {}, \"islands\": {}, \"population\": {}, "
+      "\"generations\": {}, \"refine\": {}}},\n",
+      json_str(r.algorithm), r.ranks, r.islands, r.population, r.generations_done,
+      json_str(r.refine_summary));
+  s += fmt::format("  \"evaluations\": {},\n  \"wall_s\": {},\n  \"ga_evals_per_s\": {},\n",
+                   r.evaluations, jnum(r.wall_s), jnum(r.ga_evals_per_s));
+  s += "  \"parameters\": [\n";
+  for (std::size_t j = 0; j < r.parameters.size(); ++j) {
+    const auto& fp = r.parameters[j];
+    s += fmt::format(
+        "    {{\"name\": {}, \"unit\": {}, \"scale\": {}, \"lower\": {}, \"upper\": {}, "
+        "\"start\": {}, \"value\": {}, \"std_error\": {}, \"ci95\": [{}, {}], \"determined\": {}, "
+        "\"at_bound\": {}}}{}\n",
+        json_str(fp.name), json_str(fp.unit),
+        json_str(fp.scale == ParamScale::Log ? "log" : "linear"), jnum(fp.lower), jnum(fp.upper),
+        jnum(fp.start), jnum(fp.value), jnum(fp.std_error), jnum(fp.ci_low), jnum(fp.ci_high),
+        fp.determined, fp.at_bound, j + 1 < r.parameters.size() ? "," : "");
+  }
+  s += "  ],\n  \"correlation\": [\n";
+  for (std::size_t j = 0; j < r.correlation.size(); ++j) {
+    s += "    [";
+    for (std::size_t k = 0; k < r.correlation[j].size(); ++k)
+      s += (k ? ", " : "") + jnum(r.correlation[j][k]);
+    s += j + 1 < r.correlation.size() ? "],\n" : "]\n";
+  }
+  s += fmt::format(
+      "  ],\n  \"covariance\": {{\"ok\": {}, \"residuals\": {}, \"residual_sigma_pct\": {}, "
+      "\"note\": {}}},\n",
+      r.covariance_ok, r.residual_count, jnum(r.residual_sigma), json_str(r.covariance_note));
+  s += "  \"conditions\": [\n";
+  for (std::size_t i = 0; i < r.conditions.size(); ++i) {
+    const auto& c = r.conditions[i];
+    s += fmt::format(
+        "    {{\"label\": {}, \"file\": {}, \"temperature_C\": {}, \"frequency_Hz\": {}, "
+        "\"current_pp_A\": {}, \"weight\": {}, \"samples\": {}, \"compared\": {}, \"pp_um\": {}, "
+        "\"rms_um\": {}, \"rms_pct\": {}, \"max_err_um\": {}, \"flux_rms_pct\": {}, \"failed\": "
+        "{}, "
+        "\"error\": {}, \"overlay\": {}}}{}\n",
+        json_str(c.label), json_str(c.path), jnum(c.condition.temperature_C),
+        jnum(c.condition.frequency_Hz), jnum(c.condition.current_pp_A), jnum(c.weight), c.samples,
+        c.compared, jnum(c.pp_um), jnum(c.rms_um), jnum(c.rms_pct), jnum(c.max_err_um),
+        c.flux_rms_pct >= 0 ? jnum(c.flux_rms_pct) : "null", c.failed, json_str(c.error),
+        json_str(c.overlay_file), i + 1 < r.conditions.size() ? "," : "");
+  }
+  s += "  ],\n  \"targets\": [\n";
+  for (std::size_t i = 0; i < r.targets.size(); ++i) {
+    const auto& t = r.targets[i];
+    s += fmt::format(
+        "    {{\"label\": {}, \"kind\": {}, \"value\": {}, \"simulated\": {}, \"error_pct\": {}, "
+        "\"weight\": {}, \"failed\": {}}}{}\n",
+        json_str(t.label), json_str(t.kind), jnum(t.value), jnum(t.simulated), jnum(t.error_pct),
+        jnum(t.weight), t.failed, i + 1 < r.targets.size() ? "," : "");
+  }
+  s += "  ],\n  \"history\": [\n";
+  for (std::size_t i = 0; i < r.history.size(); ++i) {
+    const auto& h = r.history[i];
+    s += fmt::format(
+        "    {{\"phase\": {}, \"step\": {}, \"evaluations\": {}, \"best_rms_pct\": {}, "
+        "\"wall_s\": {}, \"evals_per_s\": {}}}{}\n",
+        json_str(h.phase), h.step, h.evaluations, jnum(h.best_rms_pct), jnum(h.wall_s),
+        jnum(h.evals_per_s), i + 1 < r.history.size() ? "," : "");
+  }
+  s += "  ],\n  \"notes\": [";
+  for (std::size_t i = 0; i < r.notes.size(); ++i) s += (i ? ", " : "") + json_str(r.notes[i]);
+  s += "]\n}\n";
+  return s;
+}
+
+std::string fit_report_markdown(const IdentifyResult& r, const FitProvenance& p) {
+  std::string s = "# gmasim identify: fit report\n\n";
+  if (!p.command.empty()) s += fmt::format("Command: `{}`\n\n", p.command);
+  s += fmt::format("- data: {}\n- fit spec: {}\n- start model: {}\n", data_label(r, p),
+                   p.fit.empty() ? "-" : p.fit, p.start_model);
+  s += fmt::format(
+      "- **weighted RMS error {:.4g} %** of peak-to-peak (start {:.4g} %, after the "
+      "GA {:.4g} %)\n",
+      r.rms_pct, r.start_rms_pct, r.ga_rms_pct);
+  s += fmt::format("- {}: {} rank(s) x {} islands x {} individuals, {} generations{}{}\n",
+                   r.algorithm, r.ranks, r.islands, r.population, r.generations_done,
+                   r.resumed ? " (resumed from a checkpoint)" : "",
+                   r.interrupted ? ", **interrupted: best so far**" : "");
+  s += fmt::format("- refinement: {}\n", r.refine_summary);
+  s += fmt::format("- {} model evaluations, {:.1f} s wall, GA {:.1f} evaluations/s\n\n",
+                   r.evaluations, r.wall_s, r.ga_evals_per_s);
+
+  s += "## Parameters\n\n";
+  s += "95 % confidence intervals from the Jacobian of the normalised residuals at the optimum "
+       "(central differences; cov = s^2 (J^T J)^-1; log-scale parameters have multiplicative "
+       "intervals). *Not determined* means the data hardly constrain the parameter.\n\n";
+  s += "| parameter | unit | start | fitted | 95 % CI | std. error | bounds | |\n";
+  s += "|---|---|---|---|---|---|---|---|\n";
+  for (const auto& fp : r.parameters) {
+    std::string flag = fp.at_bound ? "at a bound" : (fp.determined ? "" : "not determined");
+    const std::string ci = fp.determined || !std::isfinite(fp.ci_low) || !std::isfinite(fp.ci_high)
+                               ? ci_text(fp)
+                               : fmt::format("[{:.6g}, {:.6g}]", fp.ci_low, fp.ci_high);
+    s += fmt::format("| {} | {} | {:.6g} | {:.6g} | {} | {:.3g} | [{:.4g}, {:.4g}]{} | {} |\n",
+                     fp.name, fp.unit, fp.start, fp.value, ci, fp.std_error, fp.lower, fp.upper,
+                     fp.scale == ParamScale::Log ? " log" : "", flag);
+  }
+  s += fmt::format("\n{}\n\n", r.covariance_note);
+  if (!r.correlation.empty()) {
+    s += "## Correlation matrix\n\n|   |";
+    for (std::size_t j = 0; j < r.parameters.size(); ++j) s += fmt::format(" {} |", j + 1);
+    s += "\n|---|";
+    for (std::size_t j = 0; j < r.parameters.size(); ++j) s += "---|";
+    s += "\n";
+    for (std::size_t j = 0; j < r.correlation.size(); ++j) {
+      s += fmt::format("| {} {} |", j + 1, r.parameters[j].name);
+      for (double c : r.correlation[j]) s += fmt::format(" {:+.2f} |", c);
+      s += "\n";
+    }
+    s += "\n|correlation| close to 1 means the data determine only a combination of the two "
+         "parameters.\n\n";
+  }
+  if (!r.conditions.empty()) {
+    s += "## Conditions\n\n| condition | T [degC] | f [Hz] | I p-p [A] | weight | p-p [um] | RMS "
+         "[um] | RMS [%] | max err [um] | flux RMS [%] "
+         "|\n|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const auto& c : r.conditions) {
+      if (c.failed) {
+        s += fmt::format("| {} | {:g} | {:g} | {:g} | {:g} | - | failed: {} | | | |\n", c.label,
+                         c.condition.temperature_C, c.condition.frequency_Hz,
+                         c.condition.current_pp_A, c.weight, c.error);
+        continue;
+      }
+      s += fmt::format(
+          "| {} | {:g} | {:g} | {:g} | {:g} | {:.3f} | {:.4f} | {:.3f} | {:.4f} | {} |\n", c.label,
+          c.condition.temperature_C, c.condition.frequency_Hz, c.condition.current_pp_A, c.weight,
+          c.pp_um, c.rms_um, c.rms_pct, c.max_err_um,
+          c.flux_rms_pct >= 0 ? fmt::format("{:.3f}", c.flux_rms_pct) : "-");
+    }
+    s += "\nOverlays (measured vs simulated): `overlay_<condition>.csv`, plotted by "
+         "`plot_fit.py` into `overlay_<condition>.png`.\n\n";
+  }
+  if (!r.targets.empty()) {
+    s += "## Scalar targets\n\n| target | kind | value | simulated | error [%] | weight |\n"
+         "|---|---|---|---|---|---|\n";
+    for (const auto& t : r.targets) {
+      s += fmt::format("| {} | {} | {:.6g} | {} | {} | {:g} |\n", t.label, t.kind, t.value,
+                       t.failed ? "failed" : fmt::format("{:.6g}", t.simulated),
+                       t.failed ? "-" : fmt::format("{:+.3f}", t.error_pct), t.weight);
+    }
+    s += "\n";
+  }
+  s += "## Convergence\n\n`convergence.csv` (and `convergence.png`): best weighted RMS error "
+       "against generations (GA) and iterations (refinement).\n";
+  if (!r.notes.empty()) {
+    s += "\n## Notes\n\n";
+    for (const auto& n : r.notes) s += "- " + n + "\n";
+  }
+  return s;
+}
+
+std::string convergence_csv(const IdentifyResult& r) {
+  std::string s = "phase,step,evaluations,best_rms_pct,wall_s,evals_per_s\n";
+  for (const auto& h : r.history)
+    s += fmt::format("{},{},{},{:.10g},{:.6g},{:.6g}\n", h.phase, h.step, h.evaluations,
+                     h.best_rms_pct, h.wall_s, h.evals_per_s);
+  return s;
+}
+
+}  // namespace gmasim

@@ -1,0 +1,15 @@
+# Shared by the identify CLI tests: strict mode, the synthetic data (12 conditions,
+# 20/45/70 degC x 6/8 A x 10/100 Hz, 1 % noise) and the CI-sized search settings.
+set -euo pipefail
+GMASIM="$1"
+WORK="$2"
+SRC="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+PY=/usr/bin/python3
+rm -rf "$WORK"
+mkdir -p "$WORK"
+cd "$WORK"
+"$GMASIM" identify synthesize --out data --steps-per-period 200 --samples-per-period 100 \
+  --noise 1 --seed 2 >/dev/null
+FIT="$SRC/examples/identify_synthetic/fit.toml"
+COMMON=(identify --data data/manifest.toml --fit "$FIT" --steps-per-period 200 --islands 2
+        --population 12 --no-plots)
