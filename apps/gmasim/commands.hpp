@@ -12,6 +12,7 @@ using Runner = std::function<int()>;
 
 Runner add_simulate(CLI::App& app);
 Runner add_model(CLI::App& app);
+Runner add_reproduce(CLI::App& app);
 Runner add_identify(CLI::App& app);  // cmd_identify.cpp: identify, identify synthesize
 Runner add_sweep(CLI::App& app);    // cmd_sweep.cpp
 Runner add_frf(CLI::App& app);      // cmd_frf.cpp

@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   std::vector<gmasim::cli::Runner> runners;
   runners.push_back(gmasim::cli::add_simulate(app));
   runners.push_back(gmasim::cli::add_model(app));
+  runners.push_back(gmasim::cli::add_reproduce(app));
   runners.push_back(gmasim::cli::add_identify(app));
   runners.push_back(gmasim::cli::add_sweep(app));
   runners.push_back(gmasim::cli::add_frf(app));

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "gmasim/experiments.hpp"
 #include "gmasim/model.hpp"
 #include "gmasim/simulate.hpp"
 
@@ -45,6 +46,12 @@ void write_file_atomic(const std::string& path, const std::string& content);
 void ensure_output_dir(const std::string& dir);
 
 std::string timeseries_csv(const TimeSeries& ts);
+
+// Writes an experiment's report: DIR/<stem>.json (every table) and one CSV per table,
+// DIR/<stem>.csv for the first and DIR/<stem>_<table>.csv for the others, atomically.
+// Returns the paths written.
+std::vector<std::string> write_report_files(const std::string& dir, const std::string& stem,
+                                            const Report& r);
 // metrics.json: settings, metrics, status; `extra` holds more "key": value lines.
 std::string metrics_json(const Result& r, const SimulationSettings& s, const Model& m);
 

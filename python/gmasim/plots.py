@@ -21,10 +21,23 @@ Columns = Mapping[str, np.ndarray]
 
 
 def read_csv(path) -> dict:
-    """A CSV written by gmasim (header row of names with units) as {name: ndarray}."""
-    data = np.genfromtxt(path, delimiter=",", names=True, dtype=float)
-    data = np.atleast_1d(data)
-    return {name: np.asarray(data[name], dtype=float) for name in data.dtype.names}
+    """A CSV written by gmasim (header row of names with units) as {name: ndarray}.
+
+    Numeric columns become float arrays (empty cells NaN); text columns (status, law, rod)
+    stay arrays of str."""
+    import csv
+
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    header, body = rows[0], rows[1:]
+    out = {}
+    for j, name in enumerate(header):
+        cells = [r[j] if j < len(r) else "" for r in body]
+        try:
+            out[name] = np.array([float(c) if c not in ("", "null") else np.nan for c in cells], dtype=float)
+        except ValueError:
+            out[name] = np.array(cells, dtype=str)
+    return out
 
 
 def save(fig, directory, stem: str) -> list[pathlib.Path]:
@@ -89,13 +102,14 @@ def sweep_vs_temperature(sweep: Columns, frequency_Hz: float | None = None,
 
 
 def bode(frf: Columns, title="Frequency response, current to displacement"):
-    """Columns temperature_C, f_Hz, stepped_mag_um_per_A, stepped_phase_deg,
+    """Columns temperature_C, frequency_Hz, stepped_mag_um_per_A, stepped_phase_deg,
     linear_mag_um_per_A, linear_phase_deg (NaN where a method was not run)."""
     temps, norm, cmap = _temperature_colors(frf["temperature_C"])
+    freq = frf["frequency_Hz"] if "frequency_Hz" in frf else frf["f_Hz"]
     fig, (am, ap) = plt.subplots(2, 1, figsize=(6.8, 6), sharex=True)
     for T in temps:
         sel = np.isclose(frf["temperature_C"], T)
-        f = frf["f_Hz"][sel]
+        f = freq[sel]
         c = cmap(norm(T))
         if np.any(np.isfinite(frf["linear_mag_um_per_A"][sel])):
             am.loglog(f, frf["linear_mag_um_per_A"][sel], "-", color=c, label=f"{T:g} °C, linearised")
@@ -152,16 +166,16 @@ def retention(ret: Columns, title="Stroke retention against temperature (10 Hz)"
 
 
 def params_vs_temperature(p: Columns, title="Model parameters against temperature (8 A, 10 Hz)"):
-    """Columns temperature_C, rod_index, mu_r_mean, rho_ohm_m, M_peak_A_per_m, E_G_mean_GPa, E_t_GPa."""
+    """Columns temperature_C, rod (name), mu_r_mean, rho_ohm_m, M_peak_A_per_m, E_G_mean_GPa, E_t_GPa."""
     panels = [("mu_r_mean", "μ_G/μ0, mean (-)"), ("rho_ohm_m", "ρ_G (Ω m)"),
               ("M_peak_A_per_m", "M_G, peak (A/m)"), ("E_G_mean_GPa", "E_G, mean (GPa)"),
               ("E_t_GPa", "E_t (GPa)")]
     fig, axes = plt.subplots(1, 5, figsize=(17, 3.6))
     for ax, (key, lab) in zip(axes, panels):
-        for rod in sorted(set(p["rod_index"])):
-            sel = np.isclose(p["rod_index"], rod)
+        for rod in sorted(set(p["rod"])):
+            sel = p["rod"] == rod
             order = np.argsort(p["temperature_C"][sel])
-            ax.plot(p["temperature_C"][sel][order], p[key][sel][order], "o-", ms=3, label=f"rod {rod:g}")
+            ax.plot(p["temperature_C"][sel][order], p[key][sel][order], "o-", ms=3, label=str(rod))
         ax.set_xlabel("temperature (°C)")
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3)
@@ -171,8 +185,11 @@ def params_vs_temperature(p: Columns, title="Model parameters against temperatur
     return fig
 
 
-def ablation(ab: Columns, laws: Sequence[str], title="Ablation: one temperature law frozen at 20 °C"):
-    """Columns frequency_Hz, error_rms_um; `laws` names the rows in order."""
+def ablation(ab: Columns, laws: Sequence[str] | None = None,
+             title="Ablation: one temperature law frozen at 20 °C"):
+    """Columns law, frequency_Hz, error_rms_um (or `laws` naming the rows in order)."""
+    if laws is None:
+        laws = list(ab["law"])
     freqs = sorted(set(ab["frequency_Hz"]))
     names = list(dict.fromkeys(laws))
     x = np.arange(len(names))

@@ -31,14 +31,13 @@ def render(out_dir) -> list[pathlib.Path]:
         written += plots.save(plots.bode(plots.read_csv(data / "frf.csv")), figs, "frf")
     if have("track.csv"):
         written += plots.save(plots.tracking_error(plots.read_csv(data / "track.csv")), figs, "track")
-    if have("retention.csv"):
-        written += plots.save(plots.retention(plots.read_csv(data / "retention.csv")), figs, "retention")
-    if have("params_vs_temperature.csv"):
-        written += plots.save(plots.params_vs_temperature(plots.read_csv(data / "params_vs_temperature.csv")), figs,
+    if have("params_retention.csv"):
+        written += plots.save(plots.retention(plots.read_csv(data / "params_retention.csv")), figs, "retention")
+    if have("params.csv"):
+        written += plots.save(plots.params_vs_temperature(plots.read_csv(data / "params.csv")), figs,
                               "params_vs_temperature")
-    if have("ablate.csv") and have("ablate_laws.txt"):
-        laws = (data / "ablate_laws.txt").read_text().strip().split(",")
-        written += plots.save(plots.ablation(plots.read_csv(data / "ablate.csv"), laws), figs, "ablate")
+    if have("ablate.csv"):
+        written += plots.save(plots.ablation(plots.read_csv(data / "ablate.csv")), figs, "ablate")
     return written
 
 

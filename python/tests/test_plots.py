@@ -43,7 +43,7 @@ def test_sweep_bode_tracking_retention_params_ablation_figures(tmp_path):
              "stroke_um": 10 + I - T / 10, "hysteresis_um": 5 - T / 50, "B_pp_T": 1.0 - T / 1000}
     _check_axes(plots.sweep_vs_temperature(sweep))
     f = np.logspace(0, 3.7, 10)
-    frf = {"temperature_C": np.repeat([20.0, 70.0], 10), "f_Hz": np.tile(f, 2),
+    frf = {"temperature_C": np.repeat([20.0, 70.0], 10), "frequency_Hz": np.tile(f, 2),
            "stepped_mag_um_per_A": np.tile(5 / np.sqrt(1 + (f / 300) ** 2), 2),
            "stepped_phase_deg": np.tile(-np.degrees(np.arctan(f / 300)), 2),
            "linear_mag_um_per_A": np.tile(5 / np.sqrt(1 + (f / 300) ** 2), 2),
@@ -54,12 +54,13 @@ def test_sweep_bode_tracking_retention_params_ablation_figures(tmp_path):
     _check_axes(plots.tracking_error(track))
     ret = {"current_pp_A": I, "temperature_C": T, "stroke_retention_pct": 100 - (T - 20) / 2}
     _check_axes(plots.retention(ret))
-    params = {"temperature_C": np.repeat([20.0, 70.0], 3), "rod_index": np.tile([1.0, 2.0, 3.0], 2),
+    params = {"temperature_C": np.repeat([20.0, 70.0], 3), "rod": np.tile(["rod1", "rod2", "rod3"], 2),
               "mu_r_mean": np.ones(6), "rho_ohm_m": np.ones(6), "M_peak_A_per_m": np.ones(6),
               "E_G_mean_GPa": np.ones(6), "E_t_GPa": np.ones(6)}
     _check_axes(plots.params_vs_temperature(params))
-    ab = {"frequency_Hz": np.array([10.0, 10.0, 200.0, 200.0]), "error_rms_um": np.array([0.5, 0.2, 0.1, 0.4])}
-    fig = plots.ablation(ab, ["M", "E_G", "M", "E_G"])
+    ab = {"law": np.array(["M", "E_G", "M", "E_G"]), "frequency_Hz": np.array([10.0, 10.0, 200.0, 200.0]),
+          "error_rms_um": np.array([0.5, 0.2, 0.1, 0.4])}
+    fig = plots.ablation(ab)
     _check_axes(fig)
     plots.save(fig, tmp_path, "ablate")
     assert (tmp_path / "ablate.svg").read_text().startswith("<?xml")

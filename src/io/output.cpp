@@ -273,4 +273,20 @@ std::string metrics_json(const Result& r, const SimulationSettings& s, const Mod
   return o.str() + "\n";
 }
 
+std::vector<std::string> write_report_files(const std::string& dir, const std::string& stem,
+                                            const Report& r) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> paths;
+  for (std::size_t i = 0; i < r.tables.size(); ++i) {
+    const std::string name = i == 0 ? stem + ".csv" : stem + "_" + r.tables[i].name + ".csv";
+    const std::string path = (fs::path(dir) / name).string();
+    write_file_atomic(path, table_csv(r.tables[i]));
+    paths.push_back(path);
+  }
+  const std::string json = (fs::path(dir) / (stem + ".json")).string();
+  write_file_atomic(json, report_json(r));
+  paths.push_back(json);
+  return paths;
+}
+
 }  // namespace gmasim

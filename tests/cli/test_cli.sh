@@ -49,6 +49,9 @@ printf '[meta\nname = 1\n' >"$T/syntax.toml"
 check "malformed toml" 2 "syntax.toml:1" "$B" model check "$T/syntax.toml"
 check "divergence" 3 "diverged at t = 0.001000000 s in rod1: H" "$B" simulate --waveform-kind step --level 1 --step-to 1e9 --step-time 0.001 --duration 0.002 --out "$T/d"
 grep -q '"status": "diverged"' "$T/d/metrics.json" && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: diverged metrics"; }
+check "reproduce quick" 0 "applicable claims pass" "$B" reproduce --quick --no-figures --out "$T/r"
+[[ -s "$T/r/report.md" && $(grep -c '^stroke_drop_\|^hysteresis_drop_\|^flux_drop_' "$T/r/claims.csv") -eq 12 ]] && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: reproduce outputs"; }
+grep -q '| first resonant frequency |' "$T/r/report.md" && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: claims table in report"; }
 check "help has units" 0 "Operating temperature \[degC\]" "$B" simulate --help
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]

@@ -1,0 +1,74 @@
+// `gmasim reproduce`: the whole study of the paper on one model, and the claims table
+// (READING-NOTES' list of the paper's numbers, each beside ours with a stated tolerance).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "gmasim/experiments.hpp"
+#include "gmasim/model.hpp"
+
+namespace gmasim {
+
+struct Claim {
+  std::string id;          // short stable key, e.g. "stroke_drop_8A"
+  std::string claim;       // what the paper says, in words
+  std::string source;      // "section 4.4.4, Fig. 13"
+  double paper = 0.0;      // the paper's value (NaN when the claim is not a number)
+  double ours = 0.0;       // our value (NaN when we cannot compute it)
+  std::string unit;        // "%", "um", "Hz", ...
+  std::string tolerance;   // the rule, in words ("|ours - paper| <= 3 pp")
+  bool pass = false;
+  bool applicable = true;  // false: needs measurements we do not have
+  std::string note;        // why it passes/fails, or why it is not applicable
+  double rel_diff() const;  // (ours - paper)/|paper|, NaN if not applicable
+};
+
+struct ReproduceOptions {
+  int threads = 0;
+  bool quick = false;  // smaller grids (tests)
+};
+
+struct ReproduceResult {
+  // The requests, kept for the reports.
+  SweepRequest sweep_10Hz_request, sweep_dynamic_request;
+  FrfRequest frf_request;
+  TrackRequest track_request;
+  AblateRequest ablate_request;
+  ParamsVsTemperatureRequest params_request;
+
+  SweepResult sweep_10Hz;        // the paper's grid, 20-70 degC x 6/8/10/12 A x 10 Hz
+  SweepResult sweep_dynamic;     // 20-70 degC x 6/8 A x 100/200/400 Hz (Fig. 17 conditions)
+  FrfResult frf;
+  TrackResult track;
+  AblateResult ablate;
+  ParamsVsTemperatureResult params;
+  ThermalExpansionResult thermal;
+  // Hysteresis loops y(I) over the last period, 8 A 10 Hz, one per temperature
+  // (columns temperature_C, current_A, y_um, B_T).
+  TimeSeries loops;
+  std::vector<Claim> claims;
+  double wall_time_s = 0.0;
+  std::string model_source;
+  std::string model_readings;    // the options in force, e.g. "eq10: mean_field, kelvin"
+};
+
+ReproduceResult run_reproduce(const Model& m, const ReproduceOptions& o,
+                              const ProgressFn& progress = {});
+
+// The claims table as markdown (one row per claim) and the summary line "N of M pass".
+std::string claims_markdown(const std::vector<Claim>& claims);
+
+// The claims as a report table (columns id, claim, source, paper, ours, unit, rel_diff,
+// tolerance, result, note).
+Report claims_report(const std::vector<Claim>& claims);
+
+// Writes DIR/report.md, DIR/claims.{csv,json}, and every experiment's data as CSV and JSON
+// in DIR/data (atomically). Figures are rendered by the Python package (gmasim.report_figures) into
+// DIR/figures/*.png|svg when python_exe is not empty; the report links them.
+// Returns the markdown of the report.
+std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
+                                    const std::string& dir, const std::string& python_exe,
+                                    const std::string& python_path);
+
+}  // namespace gmasim
