@@ -8,8 +8,13 @@ adds plotting helpers (``gmasim.plots``). Units are SI and named in every key
     m = gmasim.Model()                       # the built-in MDMA model
     r = gmasim.simulate(m, temperature_C=70, current_pp_A=8, frequency_Hz=10)
     r["metrics"]["stroke_um"], r["series"]["y_um"]
+    s = gmasim.sweep(m, temperatures_C=[20, 70])   # {'meta', 'points': {column: ndarray}}
+    gmasim.plots.sweep_vs_temperature(s["points"])
 """
 from ._gmasim import *  # noqa: F401,F403
-from ._gmasim import DivergenceError, InputError, Model, simulate  # noqa: F401
+from ._gmasim import (DivergenceError, InputError, Model, ablate, claims, frf,  # noqa: F401
+                      params_vs_temperature, simulate, sweep, thermal_expansion, track)
+from . import plots  # noqa: F401
 
-__all__ = ["Model", "simulate", "InputError", "DivergenceError"]
+__all__ = ["Model", "simulate", "sweep", "frf", "track", "ablate", "params_vs_temperature",
+           "thermal_expansion", "claims", "plots", "InputError", "DivergenceError"]

@@ -1,6 +1,160 @@
-// Bindings of the experiments (filled in with the experiments library).
+// Bindings of the experiments: each returns the experiment's report (the same tables the
+// CLI writes as CSV) as {"meta": {...}, "<table>": {column: ndarray or list of str}}.
+#include <pybind11/stl.h>
+
 #include "bindings.hpp"
+#include "gmasim/experiments.hpp"
+#include "gmasim/reproduce.hpp"
+
+namespace py = pybind11;
 
 namespace gmasim::py_bind {
-void bind_experiments(pybind11::module_& /*mod*/) {}
+namespace {
+
+py::object cell_value(const Cell& c) {
+  if (c.is_bool) return py::bool_(c.text == "true");
+  if (c.is_text) return py::str(c.text);
+  return py::float_(c.number);
+}
+
+py::dict report_dict(const Report& r) {
+  py::dict out, meta;
+  for (const auto& [k, v] : r.meta) meta[py::str(k)] = cell_value(v);
+  out["meta"] = meta;
+  for (const auto& t : r.tables) {
+    py::dict cols;
+    for (std::size_t j = 0; j < t.columns.size(); ++j) {
+      bool numeric = true;
+      for (const auto& row : t.rows) numeric = numeric && !row[j].is_text;
+      if (numeric) {
+        std::vector<double> v;
+        v.reserve(t.rows.size());
+        for (const auto& row : t.rows) v.push_back(row[j].number);
+        cols[py::str(t.columns[j])] = to_numpy(v);
+      } else {
+        py::list l;
+        for (const auto& row : t.rows) l.append(cell_value(row[j]));
+        cols[py::str(t.columns[j])] = l;
+      }
+    }
+    out[py::str(t.name)] = cols;
+  }
+  return out;
+}
+
+template <class F>
+auto without_gil(F&& f) {
+  py::gil_scoped_release release;
+  return f();
+}
+
+}  // namespace
+
+void bind_experiments(py::module_& mod) {
+  mod.def(
+      "sweep",
+      [](const Model& m, std::vector<double> temperatures_C, std::vector<double> currents_pp_A,
+         std::vector<double> frequencies_Hz, double reference_temperature_C, double periods, double dt_s,
+         int threads, const std::vector<std::string>& freeze) {
+        SweepRequest r;
+        r.temperatures_C = std::move(temperatures_C);
+        r.currents_pp_A = std::move(currents_pp_A);
+        r.frequencies_Hz = std::move(frequencies_Hz);
+        r.reference_temperature_C = reference_temperature_C;
+        r.periods = periods;
+        r.dt_s = dt_s;
+        r.threads = threads;
+        r.freeze = freeze_from(freeze);
+        const SweepResult res = without_gil([&] { return run_sweep(m, r); });
+        return report_dict(sweep_report(m, r, res));
+      },
+      py::arg("model"), py::arg("temperatures_C") = SweepRequest{}.temperatures_C,
+      py::arg("currents_pp_A") = SweepRequest{}.currents_pp_A, py::arg("frequencies_Hz") = SweepRequest{}.frequencies_Hz,
+      py::arg("reference_temperature_C") = 20.0, py::arg("periods") = 3.0, py::arg("dt_s") = 0.0,
+      py::arg("threads") = 0, py::arg("freeze") = std::vector<std::string>{},
+      "Temperature x current x frequency grid (Fig. 12-14). Returns {'meta', 'points': {column: array}, ...}");
+  mod.def(
+      "frf",
+      [](const Model& m, std::vector<double> temperatures_C, double f_min_Hz, double f_max_Hz, int points,
+         double bias_A, double amplitude_A, bool stepped_sine, bool small_signal, int threads) {
+        FrfRequest r;
+        r.temperatures_C = std::move(temperatures_C);
+        r.f_min_Hz = f_min_Hz;
+        r.f_max_Hz = f_max_Hz;
+        r.points = points;
+        r.bias_A = bias_A;
+        r.amplitude_A = amplitude_A;
+        r.stepped_sine = stepped_sine;
+        r.small_signal = small_signal;
+        r.threads = threads;
+        const FrfResult res = without_gil([&] { return run_frf(m, r); });
+        return report_dict(frf_report(m, r, res));
+      },
+      py::arg("model"), py::arg("temperatures_C") = FrfRequest{}.temperatures_C, py::arg("f_min_Hz") = 1.0,
+      py::arg("f_max_Hz") = 5000.0, py::arg("points") = 40, py::arg("bias_A") = 1.0,
+      py::arg("amplitude_A") = FrfRequest{}.amplitude_A, py::arg("stepped_sine") = true,
+      py::arg("small_signal") = true, py::arg("threads") = 0,
+      "Frequency response current -> displacement (Fig. 15): stepped sine and small-signal, modes of eq. 15");
+  mod.def(
+      "track",
+      [](const Model& m, std::vector<double> temperatures_C, std::vector<double> amplitudes_um,
+         std::vector<double> frequencies_Hz, double kp, double ki, double kd, double sample_rate_Hz, double bias_A,
+         double sensor_noise_um, double periods, int threads) {
+        TrackRequest r;
+        r.temperatures_C = std::move(temperatures_C);
+        r.amplitudes_um = std::move(amplitudes_um);
+        r.frequencies_Hz = std::move(frequencies_Hz);
+        r.gains = {kp, ki, kd};
+        r.sample_rate_Hz = sample_rate_Hz;
+        r.bias_A = bias_A;
+        r.sensor_noise_um = sensor_noise_um;
+        r.periods = periods;
+        r.threads = threads;
+        const TrackResult res = without_gil([&] { return run_track(m, r); });
+        return report_dict(track_report(m, r, res));
+      },
+      py::arg("model"), py::arg("temperatures_C") = TrackRequest{}.temperatures_C,
+      py::arg("amplitudes_um") = TrackRequest{}.amplitudes_um, py::arg("frequencies_Hz") = TrackRequest{}.frequencies_Hz,
+      py::arg("kp") = 0.2, py::arg("ki") = 0.03, py::arg("kd") = 0.007, py::arg("sample_rate_Hz") = 10000.0,
+      py::arg("bias_A") = 1.0, py::arg("sensor_noise_um") = 0.0, py::arg("periods") = 4.0, py::arg("threads") = 0,
+      "Closed-loop tracking with the discrete PID (Fig. 16); gains' units in docs/experiments.md");
+  mod.def(
+      "ablate",
+      [](const Model& m, double temperature_C, std::vector<double> frequencies_Hz, double current_pp_A) {
+        AblateRequest r;
+        r.temperature_C = temperature_C;
+        r.frequencies_Hz = std::move(frequencies_Hz);
+        r.current_pp_A = current_pp_A;
+        const AblateResult res = without_gil([&] { return run_ablate(m, r); });
+        return report_dict(ablate_report(m, r, res));
+      },
+      py::arg("model"), py::arg("temperature_C") = 70.0, py::arg("frequencies_Hz") = AblateRequest{}.frequencies_Hz,
+      py::arg("current_pp_A") = 6.0, "Freeze one temperature law at 20 degC at a time (Fig. 20)");
+  mod.def(
+      "params_vs_temperature",
+      [](const Model& m, std::vector<double> temperatures_C, double current_pp_A, double frequency_Hz) {
+        ParamsVsTemperatureRequest r;
+        r.temperatures_C = std::move(temperatures_C);
+        r.current_pp_A = current_pp_A;
+        r.frequency_Hz = frequency_Hz;
+        const ParamsVsTemperatureResult res = without_gil([&] { return run_params_vs_temperature(m, r); });
+        return report_dict(params_report(m, r, res));
+      },
+      py::arg("model"), py::arg("temperatures_C") = ParamsVsTemperatureRequest{}.temperatures_C,
+      py::arg("current_pp_A") = 8.0, py::arg("frequency_Hz") = 10.0,
+      "mu_G, rho_G, M_G, E_G, E_t against temperature (Fig. 19) and stroke retention (Fig. 18)");
+  mod.def(
+      "thermal_expansion", [](const Model& m) { return report_dict(thermal_report(m, thermal_expansion_coefficient(m))); },
+      py::arg("model"), "Eq. (21): the stack's thermal expansion in um/degC");
+  mod.def(
+      "claims",
+      [](const Model& m, bool quick) {
+        ReproduceOptions o;
+        o.quick = quick;
+        const ReproduceResult res = without_gil([&] { return run_reproduce(m, o); });
+        return report_dict(claims_report(res.claims));
+      },
+      py::arg("model"), py::arg("quick") = false, "The whole study's claims table (as `gmasim reproduce`)");
+}
+
 }  // namespace gmasim::py_bind

@@ -1,0 +1,61 @@
+"""The Python experiments API: numbers equal to the CLI's, sane physics, errors."""
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+import gmasim
+
+
+def test_sweep_equals_cli_to_1e12(mdma, gmasim_bin, tmp_path):
+    py = gmasim.sweep(mdma, temperatures_C=[20, 70], currents_pp_A=[6, 10], frequencies_Hz=[10], periods=2)
+    subprocess.run([gmasim_bin, "sweep", "--temperatures", "20,70", "--currents", "6,10", "--frequencies", "10",
+                    "--periods", "2", "--out", str(tmp_path)], check=True, capture_output=True)
+    cli = json.loads((tmp_path / "sweep.json").read_text())["tables"]["points"]["rows"]
+    pts = py["points"]
+    assert len(cli) == len(pts["stroke_um"]) == 4
+    for i, row in enumerate(cli):
+        for key in ("stroke_um", "hysteresis_um", "B_pp_T", "stroke_change_pct"):
+            assert pts[key][i] == pytest.approx(row[key], rel=1e-12, abs=1e-12), key
+
+
+def test_sweep_relative_change_is_against_the_reference_temperature(mdma):
+    r = gmasim.sweep(mdma, temperatures_C=[20, 70], currents_pp_A=[8], periods=2)["points"]
+    s20, s70 = r["stroke_um"]
+    assert r["stroke_change_pct"][1] == pytest.approx(100 * (s70 / s20 - 1), rel=1e-9)
+    assert r["stroke_change_pct"][0] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_frf_linear_and_stepped_agree_and_modes_are_reported(mdma):
+    r = gmasim.frf(mdma, temperatures_C=[20], f_min_Hz=10, f_max_Hz=2000, points=5)
+    curves = r["response"]
+    mag_l, mag_s = np.asarray(curves["linear_mag_um_per_A"]), np.asarray(curves["stepped_mag_um_per_A"])
+    np.testing.assert_allclose(mag_s, mag_l, rtol=0.02)
+    modes = r["modes"]["frequency_Hz"]
+    assert 5000 < min(modes) < 8000 and max(modes) < 15000
+
+
+def test_track_params_ablate_thermal(mdma):
+    t = gmasim.track(mdma, temperatures_C=[20, 70], amplitudes_um=[10], frequencies_Hz=[10])
+    tab = t[[k for k in t if k != "meta"][0]]
+    assert np.all(np.asarray(tab["error_rms_um"]) < 2.0)
+    p = gmasim.params_vs_temperature(mdma, temperatures_C=[20, 150])
+    assert "retention" in p
+    a = gmasim.ablate(mdma, frequencies_Hz=[10])
+    laws = list(a[[k for k in a if k != "meta"][0]]["law"])
+    assert {"mu_G", "rho_G", "M", "E_G", "E_t"} <= set(laws)
+    th = gmasim.thermal_expansion(mdma)
+    assert th["meta"]["um_per_C"] == pytest.approx(0.662, abs=1e-3)
+    assert th["eq21_terms"]["um_per_C"][:4].sum() == pytest.approx(th["meta"]["um_per_C"], rel=1e-12)
+
+
+def test_bad_requests(mdma):
+    with pytest.raises(gmasim.InputError, match="empty"):
+        gmasim.sweep(mdma, temperatures_C=[])
+    with pytest.raises(gmasim.InputError, match="frequency"):
+        gmasim.sweep(mdma, frequencies_Hz=[0.0])
+    with pytest.raises(gmasim.InputError, match="Curie"):
+        gmasim.sweep(mdma, temperatures_C=[400.0])
+    with pytest.raises(gmasim.InputError, match="sample rate"):
+        gmasim.track(mdma, frequencies_Hz=[100.0], sample_rate_Hz=150.0)
