@@ -155,12 +155,12 @@ TEST(Sweep, BadRequestsAreClearInputErrors) {
   EXPECT_NE(run([](SweepRequest& r) { r.frequencies_Hz = {-5}; }).find("must be > 0"),
             std::string::npos);
   EXPECT_NE(run([](SweepRequest& r) {
-              r.temperatures_C = {20, 380};
+              r.temperatures_C = {20, 400};
             }).find("Curie"),
             std::string::npos);
   EXPECT_NE(run([](SweepRequest& r) { r.temperatures_C = {500}; }).find("Curie"),
             std::string::npos);
-  EXPECT_NE(run([](SweepRequest& r) { r.reference_temperature_C = 390; }).find("Curie"),
+  EXPECT_NE(run([](SweepRequest& r) { r.reference_temperature_C = 400; }).find("Curie"),
             std::string::npos);
 }
 
@@ -321,7 +321,7 @@ TEST(Frf, BadRequestsAreClearInputErrors) {
   };
   EXPECT_NE(run([](FrfRequest& r) { r.f_min_Hz = 0; }).find("must be > 0"), std::string::npos);
   EXPECT_NE(run([](FrfRequest& r) { r.f_max_Hz = 0.5; }).find("must exceed"), std::string::npos);
-  EXPECT_NE(run([](FrfRequest& r) { r.temperatures_C = {380}; }).find("Curie"), std::string::npos);
+  EXPECT_NE(run([](FrfRequest& r) { r.temperatures_C = {400}; }).find("Curie"), std::string::npos);
   EXPECT_NE(run([](FrfRequest& r) { r.temperatures_C.clear(); }).find("no temperature"),
             std::string::npos);
   EXPECT_NE(run([](FrfRequest& r) { r.amplitude_A = 0; }).find("amplitude"), std::string::npos);
@@ -610,7 +610,7 @@ TEST(ExperimentsCli, BadRequestsExitWithCode2AndSayWhy) {
   EXPECT_NE(text.find("empty grid"), std::string::npos) << text;
   EXPECT_EQ(run_cli("sweep --temperatures 20,abc" + out, text), 2);
   EXPECT_NE(text.find("'abc' is not a number [degC]"), std::string::npos) << text;
-  EXPECT_EQ(run_cli("frf --temperatures 380" + out, text), 2);
+  EXPECT_EQ(run_cli("frf --temperatures 400" + out, text), 2);
   EXPECT_NE(text.find("Curie"), std::string::npos) << text;
   EXPECT_EQ(run_cli("track --sample-rate 150 --frequencies 100" + out, text), 2);
   EXPECT_NE(text.find("below twice the reference frequency"), std::string::npos) << text;

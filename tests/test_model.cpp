@@ -183,7 +183,7 @@ TEST(Conditions, TemperatureOutsideTheModelIsRejected) {
       EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
     }
   };
-  expect_error(380.0, "Curie");
+  expect_error(m.material.Tc_C, "Curie");
   expect_error(400.0, "Curie");
   expect_error(-274.0, "absolute zero");
   expect_error(std::nan(""), "finite");
@@ -208,7 +208,9 @@ TEST(Conditions, FrozenLawsEqualTheReferenceTemperature) {
   EXPECT_NEAR(ref.rods[0].ja.a_A_per_m, m.rods[0].ja.a0_A_per_m, 1e-9);
   // Eq. (10) in kelvin: k^T = k0 exp(-(T/T_c)/beta2) with T, T_c in K.
   EXPECT_NEAR(ref.rods[0].ja.k_A_per_m,
-              m.rods[0].ja.k0_A_per_m * std::exp(-(293.15 / 653.15) / m.rods[0].ja.beta2), 1e-9);
+              m.rods[0].ja.k0_A_per_m *
+                  std::exp(-((m.T_ref_C + 273.15) / (m.material.Tc_C + 273.15)) / m.rods[0].ja.beta2),
+              1e-9);
 }
 
 // ---- analytic limits of the assembled model ---------------------------------------------

@@ -1,6 +1,7 @@
 // gmasim reproduce: the whole study of the paper, the claims table, the report.
 #include <fmt/format.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -20,13 +21,55 @@ namespace {
 
 struct ReproduceArgs {
   std::string model, out = "out/reproduce", doc, python = "/usr/bin/python3";
+  std::vector<std::string> compare;  // other model files (readings) scored on the same claims
   std::string python_path = GMASIM_PYTHON_PACKAGE_DIR;
   int threads = 0;
   bool quick = false, no_figures = false;
 };
 
+struct Compared {
+  std::string name, readings;
+  std::vector<Claim> claims;
+};
+
+// One row per claim, one column per compared model: which claims each reading meets.
+std::string comparison_markdown(const std::vector<Compared>& models) {
+  if (models.empty()) return "";
+  std::string md = "\n## Readings compared\n\nThe same claims scored on each calibrated reading "
+                   "(calibration/calibrate.sh; docs/calibration.md). A cell is our value and PASS/FAIL.\n\n";
+  md += "| claim | paper |";
+  for (const auto& m : models) md += " " + m.name + " |";
+  md += "\n|---|---|";
+  for (std::size_t i = 0; i < models.size(); ++i) md += "---|";
+  md += "\n";
+  auto num = [](double v) { return std::isfinite(v) ? fmt::format("{:.4g}", v) : std::string("-"); };
+  for (std::size_t k = 0; k < models.front().claims.size(); ++k) {
+    const Claim& c0 = models.front().claims[k];
+    if (!c0.applicable) continue;
+    md += fmt::format("| {} | {} |", c0.claim, num(c0.paper));
+    for (const auto& m : models) {
+      const Claim& c = m.claims[k];
+      md += fmt::format(" {} {} |", num(c.ours), c.pass ? "PASS" : "FAIL");
+    }
+    md += "\n";
+  }
+  md += "| **claims met** | |";
+  for (const auto& m : models) {
+    int pass = 0, n = 0;
+    for (const auto& c : m.claims) {
+      n += c.applicable;
+      pass += c.pass;
+    }
+    md += fmt::format(" **{} of {}** |", pass, n);
+  }
+  md += "\n\nReadings: ";
+  for (const auto& m : models) md += fmt::format("`{}` = {}; ", m.name, m.readings);
+  md += "\n";
+  return md;
+}
+
 // docs/reproduction.md: the claims table and the figures, with links relative to docs/.
-void write_doc(const ReproduceResult& r, const ReproduceArgs& a) {
+void write_doc(const ReproduceResult& r, const ReproduceArgs& a, const std::vector<Compared>& compared) {
   namespace fs = std::filesystem;
   const fs::path doc(a.doc);
   const fs::path doc_dir = doc.parent_path().empty() ? fs::path(".") : doc.parent_path();
@@ -47,6 +90,7 @@ void write_doc(const ReproduceResult& r, const ReproduceArgs& a) {
   md += "Each row is one number of the paper from READING-NOTES, beside ours, with the tolerance that decides "
         "pass or fail. Claims that need the paper's measurements are marked n/a.\n\n";
   md += claims_markdown(r.claims);
+  md += comparison_markdown(compared);
   if (figures) {
     md += "\n## Figures\n\n";
     for (const char* f : {"loops_8A_10Hz", "sweep_10Hz", "frf", "track", "retention", "params_vs_temperature",
@@ -69,7 +113,13 @@ int run_reproduce_cmd(const ReproduceArgs& a) {
   });
   const std::string py_path = std::getenv("GMASIM_PYTHONPATH") ? std::getenv("GMASIM_PYTHONPATH") : a.python_path;
   write_reproduce_outputs(model, r, a.out, a.no_figures ? std::string() : a.python, py_path);
-  if (!a.doc.empty()) write_doc(r, a);
+  std::vector<Compared> compared;
+  for (const auto& path : a.compare) {
+    const Model other = load_model(path);
+    const ReproduceResult o2 = run_reproduce(other, o);
+    compared.push_back({std::filesystem::path(path).stem().string(), o2.model_readings, o2.claims});
+  }
+  if (!a.doc.empty()) write_doc(r, a, compared);
   int pass = 0, applicable = 0;
   for (const auto& c : r.claims) {
     applicable += c.applicable;
@@ -95,6 +145,9 @@ Runner add_reproduce(CLI::App& app) {
   sub->add_option("--doc", a->doc, "Also write this markdown page (e.g. docs/reproduction.md) with the claims table");
   sub->add_option("--threads", a->threads, "Worker threads for the sweeps [-]; 0 = all cores")->capture_default_str();
   sub->add_flag("--quick", a->quick, "Smaller grids (for tests)");
+  sub->add_option("--compare", a->compare,
+                  "Also score these model files (e.g. each calibrated reading) on the claims; with --doc, "
+                  "adds a table of which claims each meets");
   sub->add_flag("--no-figures", a->no_figures, "Do not render figures (no Python)");
   sub->add_option("--python", a->python, "Python interpreter that renders the figures")->capture_default_str();
   return [a, sub]() -> int { return sub->parsed() ? run_reproduce_cmd(*a) : -1; };

@@ -48,7 +48,7 @@ def test_arbitrary_waveform(mdma):
 
 def test_bad_requests_raise_clear_errors(mdma):
     with pytest.raises(gmasim.InputError, match="Curie"):
-        gmasim.simulate(mdma, temperature_C=380)
+        gmasim.simulate(mdma, temperature_C=400)
     with pytest.raises(gmasim.InputError, match="frequency"):
         gmasim.simulate(mdma, frequency_Hz=0)
     with pytest.raises(gmasim.InputError, match="increase"):

@@ -28,7 +28,7 @@ grep -q '"stroke_um"' "$T/a/metrics.json" && pass=$((pass + 1)) || { fail=$((fai
 ls "$T/a" | grep -q tmp && { fail=$((fail + 1)); echo "FAIL: temp files left"; } || pass=$((pass + 1))
 check "quantity stats" 0 "rod2_F_N +rms" "$B" simulate --periods 2 --quantity rod2_F_N --out "$T/q"
 check "unknown quantity" 2 "unknown quantity 'nope'" "$B" simulate --periods 2 --quantity nope --out "$T/q2"
-check "curie" 2 "at or above the Curie temperature" "$B" simulate --temperature 380 --out "$T/b"
+check "curie" 2 "at or above the Curie temperature" "$B" simulate --temperature 400 --out "$T/b"
 check "below absolute zero" 2 "below absolute zero" "$B" simulate --temperature -300 --out "$T/b"
 check "frequency" 2 "frequency 0 Hz: must be > 0" "$B" simulate --frequency 0 --out "$T/b"
 printf 't_s,current_A\n0,1\n0.001,abc\n' >"$T/w1.csv"
