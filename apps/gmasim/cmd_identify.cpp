@@ -118,7 +118,7 @@ if __name__ == "__main__":
 struct IdentifyArgs {
   std::string data, fit, out, model, report, mpi = "auto";
   IdentifyOptions opt;
-  bool no_refine = false, no_plots = false, quiet = false;
+  bool no_refine = false, no_profile = false, no_plots = false, quiet = false;
 };
 
 struct SynthArgs {
@@ -210,11 +210,12 @@ void print_summary(const IdentifyArgs& a, const IdentifyResult& r) {
              r.ga_evals_per_s);
   fmt::print("  {:<34} {:>13} {:>13}  {}\n", "parameter", "start", "fitted", "95 % CI");
   for (const auto& p : r.parameters) {
-    std::string ci = std::isnan(p.ci_low) ? "no interval (interrupted)"
-                     : !std::isfinite(p.ci_low) || !std::isfinite(p.ci_high)
-                         ? "not determined"
-                         : fmt::format("[{:.5g}, {:.5g}]{}", p.ci_low, p.ci_high,
-                                       p.determined ? "" : " not determined");
+    std::string ci = "not determined by the data";
+    if (std::isnan(p.ci_low)) ci = "no interval (interrupted)";
+    if (p.determined) {
+      ci = fmt::format("[{:.5g}, {:.5g}]{}", p.ci_low, p.ci_high,
+                       p.ci_method == "profile" ? " profile" : "");
+    }
     if (p.at_bound) ci += " (at a bound)";
     fmt::print("  {:<34} {:>13.6g} {:>13.6g}  {}\n", p.name, p.start, p.value, ci);
   }
@@ -247,6 +248,7 @@ int run_identify_body(IdentifyArgs& a, Communicator& comm) {
   const FitSpec fit = load_fit_spec(a.fit);
   IdentifyOptions o = a.opt;
   o.refine = !a.no_refine;
+  o.profile = !a.no_profile;
   o.comm = &comm;
   o.stop = &g_stop;
   if (o.threads <= 0) {
@@ -391,6 +393,8 @@ Runner add_identify(CLI::App& app) {
                   "Threads for the refinement's Jacobian batches (0: cores / ranks per node)")
       ->capture_default_str();
   sub->add_flag("--no-refine", a->no_refine, "Skip the Levenberg-Marquardt refinement");
+  sub->add_flag("--no-profile", a->no_profile,
+                "Linearised intervals only (no profile likelihood for parameters on a bound)");
   sub->add_option("--refine-iterations", o.refine_iterations,
                   "Levenberg-Marquardt iterations (max)")
       ->capture_default_str();

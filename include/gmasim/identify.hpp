@@ -265,6 +265,7 @@ struct IdentifyOptions {
   int threads = 0;     // threads for the refinement / Jacobian batches (0: hardware)
   bool refine = true;  // Levenberg-Marquardt refinement of the champion
   int refine_iterations = 40;
+  bool profile = true;    // profile-likelihood intervals where the linearisation cannot hold
   double fd_step = 1e-4;  // central-difference step in u-space
   std::string checkpoint_path;
   int checkpoint_every = 10;  // generations
@@ -281,10 +282,22 @@ struct FittedParameter {
   std::string name, unit;
   ParamScale scale = ParamScale::Linear;
   double lower = 0, upper = 0, start = 0, value = 0;
-  double std_error = 0;            // in the parameter's unit (delta method for log scale)
-  double ci_low = 0, ci_high = 0;  // 95 % confidence interval
-  bool determined = true;          // false: the data hardly constrain it (CI wider than bounds)
-  bool at_bound = false;
+  double std_error = 0;  // in the parameter's unit (delta method for log scale)
+  // The linearised (Wald) 95 % interval from the Jacobian: value +- 1.96 sigma, or
+  // value * exp(+-1.96 sigma) for log-scale parameters. Infinite when J^T J is singular in
+  // the parameter's direction.
+  double wald_low = 0, wald_high = 0;
+  // Determined: the Wald interval is narrower than the bounds (log-scale parameters: in
+  // ln|p|). Then the reported interval is the Wald interval; otherwise the data do not
+  // constrain the parameter within its bounds, the linearisation is not valid over such a
+  // range, and the reported interval is the bounds themselves.
+  bool determined = true;
+  double ci_low = 0, ci_high = 0;  // the reported 95 % confidence interval
+  // "linearised" (the Wald interval, or the bounds if not determined), "profile" (profile
+  // likelihood: for a parameter on a bound or whose Wald interval leaves the bounds; not
+  // determined if it spans the bounds), "none" (interrupted run).
+  std::string ci_method = "linearised";
+  bool at_bound = false;  // the optimum lies on a bound
 };
 
 struct HistoryEntry {
@@ -317,7 +330,8 @@ struct IdentifyResult {
 };
 
 // Runs the whole identification. With a communicator of size R every rank must call it with
-// the same arguments; every rank returns the same result. Throws InputError.
+// the same arguments; every rank returns the same parameters, intervals and history, and
+// rank 0 also the per-condition and target fits (for the report). Throws InputError.
 IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, const FitSpec& fit,
                         const IdentifyOptions& options);
 

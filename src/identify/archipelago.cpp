@@ -152,7 +152,10 @@ GaOutcome run_ga(const Objective& obj, const IdentifyOptions& o, Communicator& c
     archi.push_back(pagmo::thread_island{}, make_algorithm(o.algorithm, first_gen, n, s), pop,
                     pagmo::fair_replace{migrants}, pagmo::select_best{migrants});
   }
-  if (!out.resumed) out.evaluations = sum_ranks(comm, static_cast<long>(fevals(archi)));
+  if (!out.resumed) {
+    out.evaluations = sum_ranks(comm, static_cast<long>(fevals(archi)));
+    out.run_evaluations = out.evaluations;
+  }
   {
     double f = std::numeric_limits<double>::infinity();
     std::vector<double> u = out.best_u;

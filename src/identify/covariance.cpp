@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -11,8 +12,80 @@
 
 namespace gmasim::identify_detail {
 
+namespace {
+
+// Profile likelihood of parameter j: the range of u_j over which the weighted sum of squares,
+// minimised over the other parameters, stays within `thr` of its minimum `chi_opt`.
+// Marches out from the optimum to each bound (warm-started LM with u_j held), then refines
+// the crossing by two bisections and a linear interpolation. Returns the interval in u-space.
+std::pair<double, double> profile(const Objective& obj, BatchEvaluator& ev,
+                                  const std::vector<double>& u, double chi_opt, double thr,
+                                  std::size_t j, const IdentifyOptions& o, Communicator& comm,
+                                  double& lowest, std::vector<double>& lowest_u) {
+  constexpr double kSteps[] = {0.04, 0.12, 0.3, 0.6, 1.0};
+  constexpr int kIterations = 20;  // warm-started; the stall rule ends converged solves early
+  const int fj = static_cast<int>(j);
+  auto chi_at = [&](std::vector<double>& warm, double uj) {
+    warm[j] = uj;
+    const RefineOutcome ro = refine_lm(obj, ev, warm, o, comm, {}, fj, kIterations);
+    warm = ro.u;
+    const double chi = ro.f * ro.f;
+    if (chi < lowest) {
+      lowest = chi;
+      lowest_u = ro.u;
+    }
+    return chi;
+  };
+  double edge[2] = {0.0, 1.0};
+  for (int side = 0; side < 2; ++side) {
+    const double bound = side == 0 ? 0.0 : 1.0;
+    const double dir = side == 0 ? -1.0 : 1.0;
+    if (std::fabs(u[j] - bound) < 1e-9) continue;  // the optimum is on this bound
+    std::vector<double> warm = u;
+    double ok_u = u[j], ok_d = 0.0;
+    std::vector<double> ok_warm = u;
+    bool crossed = false;
+    double out_u = bound, out_d = 0.0;
+    for (double st : kSteps) {
+      const double uj = std::clamp(u[j] + dir * st, 0.0, 1.0);
+      const double d = chi_at(warm, uj) - chi_opt;
+      if (d > thr) {
+        crossed = true;
+        out_u = uj;
+        out_d = d;
+        break;
+      }
+      ok_u = uj;
+      ok_d = d;
+      ok_warm = warm;
+      if (uj == bound) break;
+    }
+    if (!crossed) continue;  // within the threshold up to the bound
+    for (int b = 0; b < 2; ++b) {
+      const double mid = 0.5 * (ok_u + out_u);
+      std::vector<double> w = ok_warm;
+      const double d = chi_at(w, mid) - chi_opt;
+      if (d > thr) {
+        out_u = mid;
+        out_d = d;
+      } else {
+        ok_u = mid;
+        ok_d = d;
+        ok_warm = w;
+      }
+    }
+    // Linear interpolation of the excess between the last point inside and the first out.
+    const double f = out_d > ok_d ? (thr - ok_d) / (out_d - ok_d) : 0.5;
+    edge[side] = ok_u + std::clamp(f, 0.0, 1.0) * (out_u - ok_u);
+  }
+  return {edge[0], edge[1]};
+}
+
+}  // namespace
+
 void fill_covariance(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u,
-                     double h, IdentifyResult& out) {
+                     double f, const IdentifyOptions& o, Communicator& comm, IdentifyResult& out) {
+  const double h = o.fd_step;
   const std::size_t n = obj.dim(), m = obj.residual_count();
   const auto p = obj.to_params(u);
   const auto dtheta = obj.theta_per_unit();
@@ -28,9 +101,12 @@ void fill_covariance(const Objective& obj, BatchEvaluator& ev, const std::vector
     fp.value = p[j];
     fp.at_bound = u[j] < 1e-6 || u[j] > 1.0 - 1e-6;
     fp.std_error = std::numeric_limits<double>::infinity();
-    fp.ci_low = -std::numeric_limits<double>::infinity();
-    fp.ci_high = std::numeric_limits<double>::infinity();
+    fp.ci_method = "linearised";
+    fp.wald_low = -std::numeric_limits<double>::infinity();
+    fp.wald_high = std::numeric_limits<double>::infinity();
     fp.determined = false;
+    fp.ci_low = fp.lower;
+    fp.ci_high = fp.upper;
     out.parameters.push_back(fp);
   }
   out.correlation.assign(n, std::vector<double>(n, 0.0));
@@ -94,20 +170,64 @@ void fill_covariance(const Objective& obj, BatchEvaluator& ev, const std::vector
     const double sd = std::sqrt(std::max(cov(jj, jj), 0.0));
     if (fp.scale == ParamScale::Log) {
       const double a = fp.value * std::exp(-1.96 * sd), b = fp.value * std::exp(1.96 * sd);
-      fp.ci_low = std::min(a, b);
-      fp.ci_high = std::max(a, b);
+      fp.wald_low = std::min(a, b);
+      fp.wald_high = std::max(a, b);
       fp.std_error = std::fabs(fp.value) * sd;
+      fp.determined =
+          std::isfinite(sd) && 2.0 * 1.96 * sd < std::fabs(std::log(fp.upper / fp.lower));
     } else {
-      fp.ci_low = fp.value - 1.96 * sd;
-      fp.ci_high = fp.value + 1.96 * sd;
+      fp.wald_low = fp.value - 1.96 * sd;
+      fp.wald_high = fp.value + 1.96 * sd;
       fp.std_error = sd;
+      fp.determined = std::isfinite(sd) && 2.0 * 1.96 * sd < fp.upper - fp.lower;
     }
-    fp.determined = std::isfinite(sd) && (fp.ci_high - fp.ci_low) < (fp.upper - fp.lower);
+    if (fp.determined) {
+      fp.ci_low = fp.wald_low;
+      fp.ci_high = fp.wald_high;
+    }
     for (std::size_t k = 0; k < n; ++k) {
       const auto kk = static_cast<Eigen::Index>(k);
       const double den = std::sqrt(cov(jj, jj) * cov(kk, kk));
       out.correlation[j][k] = den > 0 ? cov(jj, kk) / den : 0.0;
     }
+  }
+
+  // Profile likelihood where the linearisation cannot hold: a parameter on a bound (the
+  // optimum is not stationary there) or whose linearised interval leaves the bounds.
+  if (!o.profile || !(dof > 0)) return;
+  const double chi_opt = f * f;
+  const double thr = 3.841458820694124 * chi_opt / dof;  // chi^2_1(95 %) s^2
+  double lowest = chi_opt;
+  std::vector<double> lowest_u = u;
+  std::vector<std::string> profiled;
+  for (std::size_t j = 0; j < n; ++j) {
+    auto& fp = out.parameters[j];
+    const bool leaves = !(fp.wald_low >= fp.lower && fp.wald_high <= fp.upper);
+    if (!fp.at_bound && !leaves) continue;
+    const auto [ulo, uhi] = profile(obj, ev, u, chi_opt, thr, j, o, comm, lowest, lowest_u);
+    std::vector<double> a = u, b = u;
+    a[j] = ulo;
+    b[j] = uhi;
+    const double pa = obj.to_params(a)[j], pb = obj.to_params(b)[j];
+    fp.ci_low = std::min(pa, pb);
+    fp.ci_high = std::max(pa, pb);
+    fp.ci_method = "profile";
+    fp.determined = !(ulo <= 1e-9 && uhi >= 1.0 - 1e-9);
+    profiled.push_back(fp.name);
+  }
+  if (!profiled.empty()) {
+    std::string names;
+    for (const auto& nm : profiled) names += (names.empty() ? "" : ", ") + nm;
+    out.covariance_note += fmt::format(
+        "; profile-likelihood intervals (the other parameters re-fitted, Delta chi^2 = 3.84 "
+        "s^2) for {}",
+        names);
+  }
+  if (lowest < chi_opt - 0.1 * thr) {
+    out.notes.push_back(fmt::format(
+        "a profile found a lower error (RMS {:.6g} % < {:.6g} %): the optimum is not the global "
+        "one; rerun with more generations or islands",
+        std::sqrt(lowest), f));
   }
 }
 

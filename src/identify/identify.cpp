@@ -104,7 +104,15 @@ IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, cons
   res.rms_pct = f;
   res.spec = obj.spec_at(u);
   if (!res.interrupted) {
-    fill_covariance(obj, ev, u, o.fd_step, res);
+    IdentifyOptions oc = o;
+    if (!o.refine || o.refine_iterations == 0) {
+      // Not refined: the point is not a minimum, a profile around it would mean nothing.
+      oc.profile = false;
+      res.notes.push_back(
+          "not refined: the intervals are linearised at the GA champion, which "
+          "is not a minimum; refine for meaningful intervals");
+    }
+    fill_covariance(obj, ev, u, f, oc, comm, res);
   } else {
     // Interrupted: the values without intervals (a clean, fast stop).
     const auto p = obj.to_params(u);
@@ -117,8 +125,9 @@ IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, cons
       fp.upper = fit.parameters[j].upper;
       fp.value = p[j];
       fp.std_error = std::nan("");
-      fp.ci_low = fp.ci_high = std::nan("");
+      fp.ci_low = fp.ci_high = fp.wald_low = fp.wald_high = std::nan("");
       fp.determined = false;
+      fp.ci_method = "none";
       res.parameters.push_back(fp);
     }
     res.covariance_note = "interrupted: no confidence intervals";

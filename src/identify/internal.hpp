@@ -94,15 +94,22 @@ struct RefineOutcome {
   std::string summary;
 };
 
+// Levenberg-Marquardt from u0 within [0, 1]^n; `fixed` >= 0 holds that component constant
+// (profile likelihood); max_iterations < 0: o.refine_iterations.
 RefineOutcome refine_lm(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u0,
                         const IdentifyOptions& o, Communicator& comm,
-                        const std::function<void(int, double)>& on_iteration);
+                        const std::function<void(int, double)>& on_iteration, int fixed = -1,
+                        int max_iterations = -1);
 
-// Central-difference Jacobian at u (m x n, row-major) and the residuals at u.
+// Central-difference Jacobian at u (m x n, row-major) and the residuals at u; column `fixed`
+// (if >= 0) is left zero.
 bool jacobian(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u, double h,
-              std::vector<double>& r, std::vector<double>& J);
+              std::vector<double>& r, std::vector<double>& J, int fixed = -1);
 
+// Linearised intervals and correlations from the Jacobian at the optimum u (RMS f); then
+// profile-likelihood intervals for the parameters at a bound or whose linearised interval
+// leaves the bounds.
 void fill_covariance(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u,
-                     double h, IdentifyResult& out);
+                     double f, const IdentifyOptions& o, Communicator& comm, IdentifyResult& out);
 
 }  // namespace gmasim::identify_detail

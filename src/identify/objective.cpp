@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <filesystem>
 #include <limits>
 #include <optional>
@@ -91,16 +92,49 @@ double step_for(const ObjectiveSettings& s, double period_s) {
   return kMaxDt_s;
 }
 
+// Conditions and the state at rest per (temperature, initial current): runs that share both
+// (every frequency and amplitude of a biased sine starting at its -3 A minimum) share one
+// make_state(), whose quasi-static ramp costs about as much as 300 steps.
+class StartCache {
+ public:
+  explicit StartCache(const Model& m) : m_(m) {}
+  const std::pair<Conditions, State>& get(double T, double I0) {
+    for (const auto& e : entries_)
+      if (e.T == T && e.I0 == I0) return e.cs;
+    Conditions c = make_conditions(m_, T);
+    State st = make_state(m_, c, I0);
+    entries_.push_back({T, I0, {std::move(c), std::move(st)}});
+    return entries_.back().cs;
+  }
+
+ private:
+  struct Entry {
+    double T, I0;
+    std::pair<Conditions, State> cs;
+  };
+  const Model& m_;
+  std::deque<Entry> entries_;
+};
+
+double initial_current(const Measurement& meas) {
+  const auto& c = meas.condition;
+  if (c.current_source == "sine")
+    return biased_sine(c.current_pp_A, c.frequency_Hz, c.current_min_A)
+        .current_at(meas.t_s.front());
+  return meas.current_A.front();
+}
+
 SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings& s,
-                     std::vector<double>& I, std::vector<double>& y, std::vector<double>& B) {
+                     std::vector<double>& I, std::vector<double>& y, std::vector<double>& B,
+                     StartCache& starts) {
   const Waveform w = biased_sine(run.pp, run.f, run.min);
   const double per = w.period_s();
   const long n_per = std::max(8L, static_cast<long>(std::ceil(per / step_for(s, per) - 1e-9)));
   const double dt = per / static_cast<double>(n_per);
   const long periods = std::max(1L, std::lround(s.target_periods));
   const long total = periods * n_per;
-  const Conditions c = make_conditions(m, run.T);
-  State st = make_state(m, c, w.current_at(0.0));
+  const auto& [c, st0] = starts.get(run.T, w.current_at(0.0));
+  State st = st0;
   I.assign(static_cast<std::size_t>(n_per), 0.0);
   y.assign(static_cast<std::size_t>(n_per), 0.0);
   B.assign(static_cast<std::size_t>(n_per), 0.0);
@@ -143,8 +177,11 @@ double lowest_resonance_Hz(const Model& m, const ResonanceRun& run) {
 }  // namespace
 
 // =======================================================================================
-void simulate_measurement(const Model& m, const Measurement& meas, const ObjectiveSettings& s,
-                          std::vector<double>& y_um, std::vector<double>* B_T) {
+namespace {
+
+void run_measurement(const Model& m, const Conditions& c, State st, const Measurement& meas,
+                     const ObjectiveSettings& s, std::vector<double>& y_um,
+                     std::vector<double>* B_T) {
   const auto& ts = meas.t_s;
   const std::size_t n = ts.size();
   const double t0 = ts.front(), t1 = ts.back();
@@ -162,8 +199,6 @@ void simulate_measurement(const Model& m, const Measurement& meas, const Objecti
         fmt::format("{}: {} steps: the time step is too small for the record", meas.path, nsteps));
   const double dt = (t1 - t0) / static_cast<double>(nsteps);
 
-  const Conditions c = make_conditions(m, cond.temperature_C);
-  State st = make_state(m, c, current(t0));
   st.t_s = t0;
   y_um.resize(n);
   if (B_T) B_T->resize(n);
@@ -192,6 +227,15 @@ void simulate_measurement(const Model& m, const Measurement& meas, const Objecti
     y_um[j] = st.y_m * 1e6;
     if (B_T) (*B_T)[j] = st.B_T;
   }
+}
+
+}  // namespace
+
+void simulate_measurement(const Model& m, const Measurement& meas, const ObjectiveSettings& s,
+                          std::vector<double>& y_um, std::vector<double>* B_T) {
+  StartCache starts(m);
+  const auto& [c, st] = starts.get(meas.condition.temperature_C, initial_current(meas));
+  run_measurement(m, c, st, meas, s, y_um, B_T);
 }
 
 // =======================================================================================
@@ -230,10 +274,12 @@ struct Objective::Impl {
   bool residuals(const double* u, double* r) const {
     try {
       const Model model = model_at(u);
+      StartCache starts(model);
       std::vector<double> y, B;
       for (const auto& cd : conds) {
         const Measurement& meas = data.items[cd.index];
-        simulate_measurement(model, meas, settings, y, cd.flux ? &B : nullptr);
+        const auto& [c, st] = starts.get(meas.condition.temperature_C, initial_current(meas));
+        run_measurement(model, c, st, meas, settings, y, cd.flux ? &B : nullptr);
         const std::size_t n = meas.t_s.size();
         for (std::size_t i = cd.compare_begin; i < n; ++i) {
           r[cd.r_offset + i - cd.compare_begin] = cd.y_scale * (y[i] - meas.displacement_um[i]);
@@ -245,7 +291,7 @@ struct Objective::Impl {
         std::vector<double> I, yy, BB;
         std::vector<SineMetrics> sm(sine_runs.size());
         for (std::size_t k = 0; k < sine_runs.size(); ++k)
-          sm[k] = run_sine(model, sine_runs[k], settings, I, yy, BB);
+          sm[k] = run_sine(model, sine_runs[k], settings, I, yy, BB, starts);
         std::vector<double> res(res_runs.size());
         for (std::size_t k = 0; k < res_runs.size(); ++k)
           res[k] = lowest_resonance_Hz(model, res_runs[k]);
@@ -613,9 +659,10 @@ std::vector<TargetFit> Objective::target_fits(const std::vector<double>& u) cons
   bool failed = false;
   try {
     const Model model = I.model_at(u.data());
+    StartCache starts(model);
     std::vector<double> a, b, c;
     for (std::size_t k = 0; k < I.sine_runs.size(); ++k)
-      sm[k] = run_sine(model, I.sine_runs[k], I.settings, a, b, c);
+      sm[k] = run_sine(model, I.sine_runs[k], I.settings, a, b, c, starts);
     for (std::size_t k = 0; k < I.res_runs.size(); ++k)
       res[k] = lowest_resonance_Hz(model, I.res_runs[k]);
   } catch (const std::exception&) {

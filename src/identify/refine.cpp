@@ -13,28 +13,32 @@
 namespace gmasim::identify_detail {
 
 bool jacobian(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u, double h,
-              std::vector<double>& r, std::vector<double>& J) {
+              std::vector<double>& r, std::vector<double>& J, int fixed) {
   const std::size_t n = obj.dim(), m = obj.residual_count();
+  // Points: the centre, then u + h e_j and u - h e_j for every free column (clipped to the
+  // bounds: one-sided there). A fixed column (a profile) is not differentiated.
   std::vector<std::vector<double>> pts{u};
+  std::vector<std::size_t> cols;
   std::vector<double> up(n), um(n);
   for (std::size_t j = 0; j < n; ++j) {
+    if (static_cast<int>(j) == fixed) continue;
     auto p = u, q = u;
-    up[j] = std::min(1.0, u[j] + h);
-    um[j] = std::max(0.0, u[j] - h);
-    p[j] = up[j];
-    q[j] = um[j];
+    up[j] = p[j] = std::min(1.0, u[j] + h);
+    um[j] = q[j] = std::max(0.0, u[j] - h);
     pts.push_back(std::move(p));
     pts.push_back(std::move(q));
+    cols.push_back(j);
   }
   std::vector<std::vector<double>> res;
   const auto ok = ev.run(pts, res);
   if (!ok[0]) return false;
   r = res[0];
   J.assign(m * n, 0.0);
-  for (std::size_t j = 0; j < n; ++j) {
-    const bool okp = ok[1 + 2 * j] != 0, okm = ok[2 + 2 * j] != 0;
-    const std::vector<double>* a = okp ? &res[1 + 2 * j] : &res[0];
-    const std::vector<double>* b = okm ? &res[2 + 2 * j] : &res[0];
+  for (std::size_t k = 0; k < cols.size(); ++k) {
+    const std::size_t j = cols[k];
+    const bool okp = ok[1 + 2 * k] != 0, okm = ok[2 + 2 * k] != 0;
+    const std::vector<double>* a = okp ? &res[1 + 2 * k] : &res[0];
+    const std::vector<double>* b = okm ? &res[2 + 2 * k] : &res[0];
     const double da = okp ? up[j] : u[j], db = okm ? um[j] : u[j];
     if (da == db) continue;  // neither side evaluates: no information on this column
     for (std::size_t i = 0; i < m; ++i) J[i * n + j] = ((*a)[i] - (*b)[i]) / (da - db);
@@ -46,25 +50,33 @@ namespace {
 
 class FdCost final : public ceres::CostFunction {
  public:
-  FdCost(const Objective& obj, BatchEvaluator& ev, double h) : obj_(obj), ev_(ev), h_(h) {
+  FdCost(const Objective& obj, BatchEvaluator& ev, double h, int fixed = -1)
+      : obj_(obj), ev_(ev), h_(h), fixed_(fixed) {
     set_num_residuals(static_cast<int>(obj.residual_count()));
     mutable_parameter_block_sizes()->push_back(static_cast<int>(obj.dim()));
   }
+  // Ceres asks for the Jacobian at an accepted point twice (and for residuals at points it
+  // has seen): the last point's residuals and Jacobian are kept and reused, since each
+  // Jacobian costs 2n + 1 model evaluations. Ceres calls this from one thread.
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
     const std::size_t n = obj_.dim(), m = obj_.residual_count();
     const std::vector<double> u(parameters[0], parameters[0] + n);
-    if (jacobians && jacobians[0]) {
-      std::vector<double> r, J;
-      if (!jacobian(obj_, ev_, u, h_, r, J)) return false;
-      std::copy(r.begin(), r.end(), residuals);
-      std::copy(J.begin(), J.end(), jacobians[0]);  // row-major m x n, as Ceres wants
-      return true;
+    const bool want_j = jacobians && jacobians[0];
+    if (!(u == last_u_ && (last_has_j_ || !want_j))) {
+      if (want_j) {
+        if (!jacobian(obj_, ev_, u, h_, last_r_, last_J_, fixed_)) return false;
+      } else {
+        std::vector<std::vector<double>> res;
+        const auto ok = ev_.run({u}, res);
+        if (!ok[0]) return false;
+        last_r_ = std::move(res[0]);
+      }
+      last_u_ = u;
+      last_has_j_ = want_j;
     }
-    std::vector<std::vector<double>> res;
-    const auto ok = ev_.run({u}, res);
-    if (!ok[0]) return false;
-    std::copy(res[0].begin(), res[0].begin() + static_cast<std::ptrdiff_t>(m), residuals);
+    std::copy(last_r_.begin(), last_r_.begin() + static_cast<std::ptrdiff_t>(m), residuals);
+    if (want_j) std::copy(last_J_.begin(), last_J_.end(), jacobians[0]);  // row-major m x n
     return true;
   }
 
@@ -72,6 +84,9 @@ class FdCost final : public ceres::CostFunction {
   const Objective& obj_;
   BatchEvaluator& ev_;
   double h_;
+  int fixed_;
+  mutable std::vector<double> last_u_, last_r_, last_J_;
+  mutable bool last_has_j_ = false;
 };
 
 class Callback final : public ceres::IterationCallback {
@@ -112,14 +127,23 @@ class Callback final : public ceres::IterationCallback {
 
 RefineOutcome refine_lm(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u0,
                         const IdentifyOptions& o, Communicator& comm,
-                        const std::function<void(int, double)>& on_iteration) {
+                        const std::function<void(int, double)>& on_iteration, int fixed,
+                        int max_iterations) {
   const std::size_t n = obj.dim();
   std::vector<double> u = u0;
   for (double& v : u) v = std::clamp(v, 0.0, 1.0);
   ceres::Problem::Options po;
   po.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  po.manifold_ownership = ceres::TAKE_OWNERSHIP;
   ceres::Problem problem(po);
-  problem.AddResidualBlock(new FdCost(obj, ev, o.fd_step), nullptr, u.data());
+  problem.AddResidualBlock(new FdCost(obj, ev, o.fd_step, fixed), nullptr, u.data());
+  if (fixed >= 0) {
+    if (n == 1) {
+      problem.SetParameterBlockConstant(u.data());
+    } else {
+      problem.SetManifold(u.data(), new ceres::SubsetManifold(static_cast<int>(n), {fixed}));
+    }
+  }
   for (std::size_t j = 0; j < n; ++j) {
     problem.SetParameterLowerBound(u.data(), static_cast<int>(j), 0.0);
     problem.SetParameterUpperBound(u.data(), static_cast<int>(j), 1.0);
@@ -128,7 +152,7 @@ RefineOutcome refine_lm(const Objective& obj, BatchEvaluator& ev, const std::vec
   so.minimizer_type = ceres::TRUST_REGION;
   so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
   so.linear_solver_type = ceres::DENSE_QR;
-  so.max_num_iterations = o.refine_iterations;
+  so.max_num_iterations = max_iterations >= 0 ? max_iterations : o.refine_iterations;
   so.function_tolerance = 1e-7;
   so.gradient_tolerance = 1e-12;
   so.parameter_tolerance = 1e-8;

@@ -73,9 +73,15 @@ std::string jnum(double v) { return std::isfinite(v) ? fmt::format("{:.10g}", v)
 
 std::string ci_text(const FittedParameter& p) {
   if (std::isnan(p.ci_low)) return "no interval";
-  if (!p.determined || !std::isfinite(p.ci_low) || !std::isfinite(p.ci_high))
-    return "not determined";
-  return fmt::format("[{:.6g}, {:.6g}]", p.ci_low, p.ci_high);
+  if (!p.determined) return "not determined (the bounds)";
+  return fmt::format("[{:.6g}, {:.6g}]{}", p.ci_low, p.ci_high,
+                     p.ci_method == "profile" ? " (profile)" : "");
+}
+
+std::string wald_text(const FittedParameter& p) {
+  if (std::isnan(p.wald_low)) return "-";
+  if (!std::isfinite(p.wald_low) || !std::isfinite(p.wald_high)) return "unbounded";
+  return fmt::format("[{:.4g}, {:.4g}]", p.wald_low, p.wald_high);
 }
 
 std::string data_label(const IdentifyResult& r, const FitProvenance& p) {
@@ -187,12 +193,14 @@ std::string fit_report_json(const IdentifyResult& r, const FitProvenance& p) {
     const auto& fp = r.parameters[j];
     s += fmt::format(
         "    {{\"name\": {}, \"unit\": {}, \"scale\": {}, \"lower\": {}, \"upper\": {}, "
-        "\"start\": {}, \"value\": {}, \"std_error\": {}, \"ci95\": [{}, {}], \"determined\": {}, "
+        "\"start\": {}, \"value\": {}, \"std_error\": {}, \"ci95\": [{}, {}], "
+        "\"ci95_linearised\": [{}, {}], \"ci_method\": {}, \"determined\": {}, "
         "\"at_bound\": {}}}{}\n",
         json_str(fp.name), json_str(fp.unit),
         json_str(fp.scale == ParamScale::Log ? "log" : "linear"), jnum(fp.lower), jnum(fp.upper),
         jnum(fp.start), jnum(fp.value), jnum(fp.std_error), jnum(fp.ci_low), jnum(fp.ci_high),
-        fp.determined, fp.at_bound, j + 1 < r.parameters.size() ? "," : "");
+        jnum(fp.wald_low), jnum(fp.wald_high), json_str(fp.ci_method), fp.determined, fp.at_bound,
+        j + 1 < r.parameters.size() ? "," : "");
   }
   s += "  ],\n  \"correlation\": [\n";
   for (std::size_t j = 0; j < r.correlation.size(); ++j) {
@@ -263,17 +271,24 @@ std::string fit_report_markdown(const IdentifyResult& r, const FitProvenance& p)
 
   s += "## Parameters\n\n";
   s += "95 % confidence intervals from the Jacobian of the normalised residuals at the optimum "
-       "(central differences; cov = s^2 (J^T J)^-1; log-scale parameters have multiplicative "
-       "intervals). *Not determined* means the data hardly constrain the parameter.\n\n";
-  s += "| parameter | unit | start | fitted | 95 % CI | std. error | bounds | |\n";
-  s += "|---|---|---|---|---|---|---|---|\n";
+       "(central differences; cov = s^2 (J^T J)^-1 with s^2 from the residuals; log-scale "
+       "parameters have multiplicative intervals). A parameter whose linearised interval is "
+       "wider than its bounds is *not determined*: the data do not constrain it within the "
+       "bounds, and its reported interval is the bounds. For a parameter on a bound, or whose "
+       "linearised interval leaves the bounds, the linearisation cannot hold and the interval "
+       "is the profile likelihood instead (u_j held at trial values, the others re-fitted, "
+       "the range where the sum of squares stays within 3.84 s^2 of its minimum).\n\n";
+  s += "| parameter | unit | start | fitted | 95 % CI | linearised | std. error | bounds | |\n";
+  s += "|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& fp : r.parameters) {
-    std::string flag = fp.at_bound ? "at a bound" : (fp.determined ? "" : "not determined");
-    const std::string ci = fp.determined || !std::isfinite(fp.ci_low) || !std::isfinite(fp.ci_high)
-                               ? ci_text(fp)
-                               : fmt::format("[{:.6g}, {:.6g}]", fp.ci_low, fp.ci_high);
-    s += fmt::format("| {} | {} | {:.6g} | {:.6g} | {} | {:.3g} | [{:.4g}, {:.4g}]{} | {} |\n",
-                     fp.name, fp.unit, fp.start, fp.value, ci, fp.std_error, fp.lower, fp.upper,
+    std::string flag = fp.determined ? "" : "not determined";
+    if (fp.at_bound) flag += flag.empty() ? "at a bound" : ", at a bound";
+    s += fmt::format("| {} | {} | {:.6g} | {:.6g} | {} | {} | {:.3g} | [{:.4g}, {:.4g}]{} | {} |\n",
+                     fp.name, fp.unit, fp.start, fp.value,
+                     fp.determined || std::isnan(fp.ci_low)
+                         ? ci_text(fp)
+                         : fmt::format("[{:.6g}, {:.6g}] = bounds", fp.ci_low, fp.ci_high),
+                     wald_text(fp), fp.std_error, fp.lower, fp.upper,
                      fp.scale == ParamScale::Log ? " log" : "", flag);
   }
   s += fmt::format("\n{}\n\n", r.covariance_note);

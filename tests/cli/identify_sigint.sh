@@ -24,7 +24,7 @@ grep -q "gmasim identify: generation" stderr.txt  # progress on stderr
 BEST=$(awk '$1 == "best_f" {print $2}' ck.txt)
 GEN=$(awk '$1 == "generation" {print $2}' ck.txt)
 "$GMASIM" "${COMMON[@]}" --generations $((GEN + 5)) --checkpoint ck.txt --out resumed/model.toml \
-  --resume ck.txt --no-refine --quiet
+  --resume ck.txt --no-refine --no-profile --quiet
 "$PY" "$SRC/tests/cli/check_identify.py" resumed/model_report/fit_report.json --gmasim "$GMASIM" \
   --resumed --not-worse-than "$BEST" --max-rms 100 --skip-params
 echo "PASS"
