@@ -3,7 +3,6 @@
 // and the convergence history. Written atomically (write_file_atomic) by rank 0.
 #include <fmt/format.h>
 
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +12,7 @@
 
 #include "gmasim/errors.hpp"
 #include "internal.hpp"
+#include "io/text_io.hpp"
 
 namespace gmasim::identify_detail {
 namespace {
@@ -168,15 +168,10 @@ std::string checkpoint_text(const Checkpoint& c, const std::vector<std::string>&
 }
 
 Checkpoint read_checkpoint(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f)
-    throw InputError(
-        located(path, 0, fmt::format("cannot open checkpoint ({})", std::strerror(errno))));
-  std::string text;
-  char buf[1 << 14];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
-  std::fclose(f);
+  // A read error is not reported as such: the text read so far is parsed, and a short one
+  // fails as a damaged checkpoint.
+  const std::string text =
+      io_detail::read_text_file(path, "checkpoint", io_detail::OnReadError::KeepPartial);
   LineReader in{path, {}, 0};
   std::istringstream ss(text);
   for (std::string l; std::getline(ss, l);) in.lines.push_back(l);

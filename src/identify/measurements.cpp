@@ -4,11 +4,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
-#include <cerrno>
-#include <charconv>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -19,60 +15,44 @@
 #include "gmasim/errors.hpp"
 #include "gmasim/identify.hpp"
 #include "gmasim/io.hpp"
+#include "io/text_io.hpp"
 
 namespace gmasim {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string_view trim(std::string_view s) {
-  const auto b = s.find_first_not_of(" \t\r");
-  if (b == std::string_view::npos) return {};
-  const auto e = s.find_last_not_of(" \t\r");
-  return s.substr(b, e - b + 1);
-}
+using io_detail::read_text_file;
+using io_detail::split_cells;
+using io_detail::trim;
 
-std::vector<std::string_view> split_cells(std::string_view line) {
-  std::vector<std::string_view> cells;
-  std::size_t start = 0;
-  while (true) {
-    const auto comma = line.find(',', start);
-    cells.push_back(trim(line.substr(start, comma - start)));
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
+// The TOML file at `path` (`what` names it in the open/read error).
+toml::table read_toml(const std::string& path, std::string_view what) {
+  const std::string text = read_text_file(path, what);
+  try {
+    return toml::parse(text, std::string_view(path));
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}:{}:{}: TOML syntax error: {}", path, e.source().begin.line,
+                                 e.source().begin.column, e.description()));
   }
-  return cells;
-}
-
-std::string read_text(const std::string& path, std::string_view what) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f)
-    throw InputError(
-        located(path, 0, fmt::format("cannot open {} ({})", what, std::strerror(errno))));
-  std::string text;
-  char buf[1 << 14];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
-  const bool failed = std::ferror(f) != 0;
-  const int err = errno;
-  std::fclose(f);
-  if (failed)
-    throw InputError(
-        located(path, 0, fmt::format("cannot read {} ({})", what, std::strerror(err))));
-  return text;
 }
 
 // A finite number, or the reason it is not one.
 std::optional<std::string> parse_number(std::string_view cell, double& v) {
-  if (cell.empty()) return std::string("empty cell");
-  const std::string_view digits = cell.starts_with('+') ? cell.substr(1) : cell;
-  const auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), v);
-  if (ec != std::errc() || ptr != digits.data() + digits.size()) {
-    return fmt::format("{} value '{}'",
-                       ec == std::errc::result_out_of_range ? "out-of-range" : "non-numeric", cell);
+  switch (io_detail::parse_finite(cell, v)) {
+    case io_detail::CellError::None:
+      return std::nullopt;
+    case io_detail::CellError::Empty:
+      return std::string("empty cell");
+    case io_detail::CellError::NonNumeric:
+      return fmt::format("non-numeric value '{}'", cell);
+    case io_detail::CellError::OutOfRange:
+      return fmt::format("out-of-range value '{}'", cell);
+    case io_detail::CellError::NaN:
+      return fmt::format("NaN ('{}')", cell);
+    case io_detail::CellError::Inf:
+      return fmt::format("Inf ('{}')", cell);
   }
-  if (std::isnan(v)) return fmt::format("NaN ('{}')", cell);
-  if (std::isinf(v)) return fmt::format("Inf ('{}')", cell);
   return std::nullopt;
 }
 
@@ -160,14 +140,7 @@ std::string sidecar_path(const std::string& csv) {
 }
 
 void read_sidecar(const std::string& path, KeyMap& keys) {
-  const std::string text = read_text(path, "condition sidecar");
-  toml::table root;
-  try {
-    root = toml::parse(text, std::string_view(path));
-  } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("{}:{}:{}: TOML syntax error: {}", path, e.source().begin.line,
-                                 e.source().begin.column, e.description()));
-  }
+  const toml::table root = read_toml(path, "condition sidecar");
   for (const auto& [key, node] : root) {
     const std::string name(key.str());
     const long line = static_cast<long>(node.source().begin.line);
@@ -291,7 +264,7 @@ MeasurementCondition make_condition(const KeyMap& keys, const Measurement& m,
 }  // namespace
 
 Measurement load_measurement_csv(const std::string& path) {
-  const std::string text = read_text(path, "measurement file");
+  const std::string text = read_text_file(path, "measurement file");
   Measurement m;
   m.path = path;
   KeyMap keys;
@@ -392,14 +365,7 @@ Measurement load_measurement_csv(const std::string& path) {
 }
 
 MeasurementSet load_manifest(const std::string& path) {
-  const std::string text = read_text(path, "manifest");
-  toml::table root;
-  try {
-    root = toml::parse(text, std::string_view(path));
-  } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("{}:{}:{}: TOML syntax error: {}", path, e.source().begin.line,
-                                 e.source().begin.column, e.description()));
-  }
+  const toml::table root = read_toml(path, "manifest");
   MeasurementSet set;
   set.manifest = path;
   for (const auto& [key, node] : root) {

@@ -4,16 +4,14 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
 #include <limits>
 #include <set>
 #include <utility>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
+#include "io/text_io.hpp"
 #include "schema.hpp"
 
 namespace gmasim {
@@ -947,25 +945,7 @@ class Loader {
   }
 };
 
-std::string read_text_file(const std::string& path, std::string_view what) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) {
-    throw InputError(
-        located(path, 0, fmt::format("cannot open {} ({})", what, std::strerror(errno))));
-  }
-  std::string text;
-  char buf[1 << 14];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
-  const bool failed = std::ferror(f) != 0;
-  const int err = errno;
-  std::fclose(f);
-  if (failed) {
-    throw InputError(
-        located(path, 0, fmt::format("cannot read {} ({})", what, std::strerror(err))));
-  }
-  return text;
-}
+using io_detail::read_text_file;
 
 std::string builtin_source_name() { return std::string(kBuiltinModelName) + " (built-in)"; }
 
