@@ -340,7 +340,7 @@ std::string claims_markdown(const std::vector<Claim>& claims) {
     if (c.pass) ++pass;
     const double rd = c.rel_diff();
     md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", n, cell(c.claim), cell(c.source),
-                      num(c.paper), num(c.ours), c.unit, std::isfinite(rd) ? fmt::format("{:+.1f} %", 100 * rd) : "-", c.tolerance,
+                      num(c.paper), num(c.ours), c.unit, std::isfinite(rd) ? fmt::format("{:+.1f} %", 100 * rd) : "-", cell(c.tolerance),
                       !c.applicable ? "n/a" : (c.pass ? "PASS" : "FAIL"), cell(c.note));
   }
   md += fmt::format("\n**{} of {} applicable claims pass** ({} claims, {} not applicable).\n", pass, applicable, n,
