@@ -98,6 +98,25 @@ unsigned long long fevals(const pagmo::archipelago& archi) {
   return n;
 }
 
+// The best champion over all islands and ranks (a collective call), kept in out if it
+// improves on out.best_f.
+void update_best(const pagmo::archipelago& archi, Communicator& comm, GaOutcome& out) {
+  double f = std::numeric_limits<double>::infinity();
+  std::vector<double> u = out.best_u;
+  for (const auto& isl : archi) {
+    const auto pop = isl.get_population();
+    if (pop.champion_f()[0] < f) {
+      f = pop.champion_f()[0];
+      u = pop.champion_x();
+    }
+  }
+  global_best(comm, f, u);
+  if (f < out.best_f) {
+    out.best_f = f;
+    out.best_u = u;
+  }
+}
+
 }  // namespace
 
 GaOutcome run_ga(const Objective& obj, const IdentifyOptions& o, Communicator& comm,
@@ -156,22 +175,7 @@ GaOutcome run_ga(const Objective& obj, const IdentifyOptions& o, Communicator& c
     out.evaluations = sum_ranks(comm, static_cast<long>(fevals(archi)));
     out.run_evaluations = out.evaluations;
   }
-  {
-    double f = std::numeric_limits<double>::infinity();
-    std::vector<double> u = out.best_u;
-    for (const auto& isl : archi) {
-      const auto pop = isl.get_population();
-      if (pop.champion_f()[0] < f) {
-        f = pop.champion_f()[0];
-        u = pop.champion_x();
-      }
-    }
-    global_best(comm, f, u);
-    if (f < out.best_f) {
-      out.best_f = f;
-      out.best_u = u;
-    }
-  }
+  update_best(archi, comm, out);
   if (!out.resumed) {
     const double wall = std::chrono::duration<double>(clock::now() - t_start).count();
     out.history.push_back({"ga", 0, out.evaluations, out.best_f, wall,
@@ -247,22 +251,7 @@ GaOutcome run_ga(const Objective& obj, const IdentifyOptions& o, Communicator& c
       }
     }
     // Best so far over all islands and ranks.
-    {
-      double f = std::numeric_limits<double>::infinity();
-      std::vector<double> u = out.best_u;
-      for (const auto& isl : archi) {
-        const auto pop = isl.get_population();
-        if (pop.champion_f()[0] < f) {
-          f = pop.champion_f()[0];
-          u = pop.champion_x();
-        }
-      }
-      global_best(comm, f, u);
-      if (f < out.best_f) {
-        out.best_f = f;
-        out.best_u = u;
-      }
-    }
+    update_best(archi, comm, out);
     const auto now = clock::now();
     const double dt = std::chrono::duration<double>(now - t_epoch).count();
     t_epoch = now;
