@@ -83,22 +83,27 @@ std::pair<double, double> profile(const Objective& obj, BatchEvaluator& ev,
 
 }  // namespace
 
+FittedParameter fitted_parameter(const Objective& obj, std::size_t j, double value) {
+  const auto& spec = obj.fit().parameters[j];
+  FittedParameter fp;
+  fp.name = obj.names()[j];
+  fp.unit = obj.units()[j];
+  fp.scale = spec.scale;
+  fp.lower = spec.lower;
+  fp.upper = spec.upper;
+  fp.value = value;
+  return fp;
+}
+
 void fill_covariance(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u,
                      double f, const IdentifyOptions& o, Communicator& comm, IdentifyResult& out) {
   const double h = o.fd_step;
   const std::size_t n = obj.dim(), m = obj.residual_count();
   const auto p = obj.to_params(u);
   const auto dtheta = obj.theta_per_unit();
-  const auto& fit = obj.fit();
   out.parameters.clear();
   for (std::size_t j = 0; j < n; ++j) {
-    FittedParameter fp;
-    fp.name = obj.names()[j];
-    fp.unit = obj.units()[j];
-    fp.scale = fit.parameters[j].scale;
-    fp.lower = fit.parameters[j].lower;
-    fp.upper = fit.parameters[j].upper;
-    fp.value = p[j];
+    FittedParameter fp = fitted_parameter(obj, j, p[j]);
     fp.at_bound = u[j] < 1e-6 || u[j] > 1.0 - 1e-6;
     fp.std_error = std::numeric_limits<double>::infinity();
     fp.ci_method = "linearised";

@@ -117,13 +117,7 @@ IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, cons
     // Interrupted: the values without intervals (a clean, fast stop).
     const auto p = obj.to_params(u);
     for (std::size_t j = 0; j < obj.dim(); ++j) {
-      FittedParameter fp;
-      fp.name = obj.names()[j];
-      fp.unit = obj.units()[j];
-      fp.scale = fit.parameters[j].scale;
-      fp.lower = fit.parameters[j].lower;
-      fp.upper = fit.parameters[j].upper;
-      fp.value = p[j];
+      FittedParameter fp = fitted_parameter(obj, j, p[j]);
       fp.std_error = std::nan("");
       fp.ci_low = fp.ci_high = fp.wald_low = fp.wald_high = std::nan("");
       fp.determined = false;

@@ -106,6 +106,10 @@ RefineOutcome refine_lm(const Objective& obj, BatchEvaluator& ev, const std::vec
 bool jacobian(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u, double h,
               std::vector<double>& r, std::vector<double>& J, int fixed = -1);
 
+// Parameter j of the fit at `value`: name, unit, scale and bounds; the interval fields keep
+// their defaults.
+FittedParameter fitted_parameter(const Objective& obj, std::size_t j, double value);
+
 // Linearised intervals and correlations from the Jacobian at the optimum u (RMS f); then
 // profile-likelihood intervals for the parameters at a bound or whose linearised interval
 // leaves the bounds.
