@@ -8,44 +8,19 @@
 
 #include "gmasim/experiments.hpp"
 #include "gmasim/physics/magnetic.hpp"
+#include "io/json.hpp"
 
 namespace gmasim {
 namespace {
 
 std::string json_string(std::string_view s) {
-  std::string out = "\"";
-  for (const char ch : s) {
-    const auto c = static_cast<unsigned char>(ch);
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (c < 0x20 || c == 0x7f)
-          out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
-        else
-          out += ch;
-    }
-  }
-  out += '"';
-  return out;
+  return io_detail::json_string(s, io_detail::BackspaceFormFeed::Unicode);
 }
 
 // Shortest representation that reads back to the same double; JSON has no NaN/Inf.
 std::string number(double v, bool json) {
-  if (!std::isfinite(v)) return json ? "null" : (std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf"));
+  if (json) return io_detail::json_number(v);
+  if (!std::isfinite(v)) return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
   return fmt::format("{}", v);
 }
 

@@ -18,6 +18,7 @@
 
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
+#include "io/json.hpp"
 
 namespace gmasim {
 
@@ -103,48 +104,10 @@ std::string timeseries_csv(const TimeSeries& ts) {
 namespace {
 
 std::string json_string(std::string_view s) {
-  std::string out = "\"";
-  for (const char ch : s) {
-    const auto c = static_cast<unsigned char>(ch);
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\b':
-        out += "\\b";
-        break;
-      case '\f':
-        out += "\\f";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (c < 0x20 || c == 0x7f) {
-          out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
-        } else {
-          out += ch;  // UTF-8 passes through unchanged
-        }
-    }
-  }
-  out += '"';
-  return out;
+  return io_detail::json_string(s, io_detail::BackspaceFormFeed::Short);
 }
 
-// JSON has no NaN or Inf: they are written as null.
-std::string json_number(double v) {
-  if (!std::isfinite(v)) return "null";
-  return fmt::format("{}", v);  // shortest representation that round-trips exactly
-}
+using io_detail::json_number;
 
 // Accumulates `"key": value` members of one object at one indentation.
 class JsonObject {
