@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "common.hpp"
 #include "gmasim/io.hpp"
 #include "gmasim/model.hpp"
 #include "gmasim/simulate.hpp"
@@ -13,10 +14,7 @@ namespace {
 
 using namespace gmasim;
 
-const Model& mdma() {
-  static const Model m = load_model("");
-  return m;
-}
+using bench::mdma;
 
 void BM_FullModelStep(benchmark::State& bs) {
   const Model& m = mdma();

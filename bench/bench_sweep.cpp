@@ -5,16 +5,14 @@
 #include <benchmark/benchmark.h>
 
 #include "gmasim/experiments.hpp"
+#include "common.hpp"
 #include "gmasim/io.hpp"
 
 namespace {
 
 using namespace gmasim;
 
-const Model& mdma() {
-  static const Model m = load_model("");
-  return m;
-}
+using bench::mdma;
 
 void BM_SweepDefaultGrid(benchmark::State& bs) {
   const Model& m = mdma();

@@ -45,6 +45,20 @@ const Model& mdma() {
   return m;
 }
 
+// A random operating point of the circuit: three rod reluctances, log-uniform in
+// 10^5..10^9.5 1/H, and a coil current in the paper's range -3..9 A.
+struct CircuitDraw {
+  std::vector<double> rod_reluctance;
+  double current_A;
+};
+CircuitDraw draw_circuit_point(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> logR(5.0, 9.5), cur(-3.0, 9.0);
+  CircuitDraw d;
+  for (int i = 0; i < 3; ++i) d.rod_reluctance.push_back(std::pow(10.0, logR(rng)));
+  d.current_A = cur(rng);
+  return d;
+}
+
 int branch(const Model& m, const std::string& name) {
   for (int b = 0; b < m.circuit.branch_count(); ++b)
     if (m.circuit.branches[static_cast<std::size_t>(b)].name == name) return b;
@@ -71,12 +85,9 @@ TEST(Circuit, SolvedFluxesSatisfyAll15RowsOfEq23) {
   CircuitWorkspace ws;
   ws.resize(m.circuit);
   std::mt19937_64 rng(12345);
-  std::uniform_real_distribution<double> logR(5.0, 9.5), cur(-3.0, 9.0);
   double worst = 0.0;
   for (int trial = 0; trial < 200; ++trial) {
-    const std::vector<double> Rr{std::pow(10.0, logR(rng)), std::pow(10.0, logR(rng)),
-                                 std::pow(10.0, logR(rng))};
-    const double I = cur(rng);
+    const auto [Rr, I] = draw_circuit_point(rng);
     ASSERT_TRUE(solve_circuit(m.circuit, Rr, I, 1.0, ws));
     std::map<int, double> p;
     for (int k = 1; k <= 15; ++k)
@@ -115,12 +126,9 @@ TEST(Circuit, LowRankSolveEqualsFullFactorisation) {
   a.resize(m.circuit);
   b.resize(m.circuit);
   std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> logR(5.0, 9.5), cur(-3.0, 9.0);
   double worst = 0.0;
   for (int trial = 0; trial < 200; ++trial) {
-    const std::vector<double> Rr{std::pow(10.0, logR(rng)), std::pow(10.0, logR(rng)),
-                                 std::pow(10.0, logR(rng))};
-    const double I = cur(rng);
+    const auto [Rr, I] = draw_circuit_point(rng);
     ASSERT_TRUE(solve_circuit(m.circuit, Rr, I, 0.97, a));
     ASSERT_TRUE(solve_circuit_full(m.circuit, Rr, I, 0.97, b));
     double scale = 0.0;

@@ -59,6 +59,13 @@ def _temperature_colors(temps):
     return temps, norm, cmap
 
 
+def _plot_vs_temperature(ax, cols: Columns, y: str, groups, **style):
+    """One line of cols[y] against temperature per (row mask, label) group."""
+    for sel, label in groups:
+        order = np.argsort(cols["temperature_C"][sel])
+        ax.plot(cols["temperature_C"][sel][order], cols[y][sel][order], "o-", label=label, **style)
+
+
 def hysteresis_loops(loops: Columns, title="Hysteresis loops coloured by temperature"):
     """y(I) loops; columns temperature_C, current_A, y_um."""
     temps, norm, cmap = _temperature_colors(loops["temperature_C"])
@@ -85,12 +92,10 @@ def sweep_vs_temperature(sweep: Columns, frequency_Hz: float | None = None,
         frequency_Hz = float(np.min(f))
     sel_f = np.isclose(f, frequency_Hz)
     fig, axes = plt.subplots(1, 3, figsize=(13, 3.9))
-    for I in sorted(set(sweep["current_pp_A"][sel_f])):
-        sel = sel_f & np.isclose(sweep["current_pp_A"], I)
-        order = np.argsort(sweep["temperature_C"][sel])
-        T = sweep["temperature_C"][sel][order]
-        for ax, key in zip(axes, ("stroke_um", "hysteresis_um", "B_pp_T")):
-            ax.plot(T, sweep[key][sel][order], "o-", label=f"{I:g} A")
+    groups = [(sel_f & np.isclose(sweep["current_pp_A"], I), f"{I:g} A")
+              for I in sorted(set(sweep["current_pp_A"][sel_f]))]
+    for ax, key in zip(axes, ("stroke_um", "hysteresis_um", "B_pp_T")):
+        _plot_vs_temperature(ax, sweep, key, groups)
     for ax, lab in zip(axes, ("stroke (µm)", "hysteresis (µm)", "flux density B, peak-to-peak (T)")):
         ax.set_xlabel("temperature (°C)")
         ax.set_ylabel(lab)
@@ -135,11 +140,9 @@ def tracking_error(track: Columns, title="Closed-loop tracking error against tem
     """Columns temperature_C, amplitude_um, frequency_Hz, error_rms_um."""
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     refs = sorted(set(zip(track["amplitude_um"], track["frequency_Hz"])), key=lambda r: (r[1], r[0]))
-    for A, f in refs:
-        sel = np.isclose(track["amplitude_um"], A) & np.isclose(track["frequency_Hz"], f)
-        order = np.argsort(track["temperature_C"][sel])
-        ax.plot(track["temperature_C"][sel][order], track["error_rms_um"][sel][order], "o-",
-                label=f"{A:g} µm, {f:g} Hz")
+    _plot_vs_temperature(ax, track, "error_rms_um",
+                         [(np.isclose(track["amplitude_um"], A) & np.isclose(track["frequency_Hz"], f),
+                           f"{A:g} µm, {f:g} Hz") for A, f in refs])
     ax.set_xlabel("temperature (°C)")
     ax.set_ylabel("RMS tracking error (µm)")
     ax.set_title(title)
@@ -151,10 +154,8 @@ def tracking_error(track: Columns, title="Closed-loop tracking error against tem
 def retention(ret: Columns, title="Stroke retention against temperature (10 Hz)"):
     """Columns current_pp_A, temperature_C, stroke_retention_pct."""
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    for I in sorted(set(ret["current_pp_A"])):
-        sel = np.isclose(ret["current_pp_A"], I)
-        order = np.argsort(ret["temperature_C"][sel])
-        ax.plot(ret["temperature_C"][sel][order], ret["stroke_retention_pct"][sel][order], "o-", label=f"{I:g} A")
+    _plot_vs_temperature(ax, ret, "stroke_retention_pct",
+                         [(np.isclose(ret["current_pp_A"], I), f"{I:g} A") for I in sorted(set(ret["current_pp_A"]))])
     ax.axhline(70, color="gray", ls=":", lw=1)
     ax.text(ax.get_xlim()[0], 70, " paper: ≈70 % at 150 °C", color="gray", fontsize=7, va="bottom")
     ax.set_xlabel("temperature (°C)")
@@ -172,10 +173,7 @@ def params_vs_temperature(p: Columns, title="Model parameters against temperatur
               ("E_t_GPa", "E_t (GPa)")]
     fig, axes = plt.subplots(1, 5, figsize=(17, 3.6))
     for ax, (key, lab) in zip(axes, panels):
-        for rod in sorted(set(p["rod"])):
-            sel = p["rod"] == rod
-            order = np.argsort(p["temperature_C"][sel])
-            ax.plot(p["temperature_C"][sel][order], p[key][sel][order], "o-", ms=3, label=str(rod))
+        _plot_vs_temperature(ax, p, key, [(p["rod"] == rod, str(rod)) for rod in sorted(set(p["rod"]))], ms=3)
         ax.set_xlabel("temperature (°C)")
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3)
