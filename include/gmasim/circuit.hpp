@@ -64,16 +64,13 @@ struct Circuit {
 void finalize_circuit(Circuit& c, int rod_count, const std::string& where);
 
 // Buffers of the nodal solve, sized once.
-using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 8, 8>;
 using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 8, 1>;
 
 struct CircuitWorkspace {
   Eigen::MatrixXd G;
   Eigen::VectorXd rhs;  // holds the node potentials psi after a solve
   Eigen::LLT<Eigen::MatrixXd> llt;
-  SmallMatrix K;  // low-rank path: D^-1 + S
-  SmallVector v, z, F_rod;
-  Eigen::LLT<SmallMatrix> small_llt;
+  SmallVector v, z;                // low-rank path: rod potential drops B^T psi, and D F + z
   std::vector<double> reluctance;  // per branch, this step [1/H]
   std::vector<double> mmf;         // per branch, this step [A-turns]
   std::vector<double> phi;         // per branch, solved flux [Wb]

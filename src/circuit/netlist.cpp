@@ -1,5 +1,6 @@
 #include <fmt/format.h>
 
+#include <array>
 #include <vector>
 
 #include "gmasim/circuit.hpp"
@@ -115,12 +116,8 @@ void CircuitWorkspace::resize(const Circuit& c) {
   rhs = Eigen::VectorXd::Zero(n);
   llt = Eigen::LLT<Eigen::MatrixXd>(n);
   const int k = static_cast<int>(c.rod_branch.size());
-  K = SmallMatrix::Zero(k, k);
   v = SmallVector::Zero(k);
   z = SmallVector::Zero(k);
-  F_rod = SmallVector::Zero(k);
-  K.setIdentity();
-  small_llt.compute(K);  // sizes its buffers (fixed capacity: no heap)
   reluctance.assign(c.branches.size(), 0.0);
   mmf.assign(c.branches.size(), 0.0);
   phi.assign(c.branches.size(), 0.0);
@@ -146,35 +143,31 @@ double potential_drop(const CircuitBranch& br, const Eigen::VectorXd& psi) {
   return (br.from >= 0 ? psi(br.from) : 0.0) - (br.to >= 0 ? psi(br.to) : 0.0);
 }
 
-// (D^-1 + S) z = v for the k rods; fixed-size Eigen factorisations for the common small k.
+// The k x k part of the low-rank solve, with D = diag(1/R_rod), F the rods' own MMFs and
+// u = I psi_coil + pm psi_pm:
+//   v = B^T u - S D F,  (D^-1 + S) z' = v,  z = z' + D F,  B^T psi = B^T u - S z.
+// Leaves z in ws.z and the rod potential drops B^T psi in ws.v. Fixed-size Eigen types for
+// small k (the hot path of the step); capacity-8 storage otherwise. Allocation-free.
 template <int K>
-void solve_small_fixed(const SmallMatrix& A, const SmallVector& b, SmallVector& x) {
-  const Eigen::Matrix<double, K, K> Af = A.topLeftCorner<K, K>();
-  const Eigen::Matrix<double, K, 1> bf = b.head<K>();
-  x.head<K>() = Af.llt().solve(bf);
-}
-
-bool solve_small(CircuitWorkspace& ws) {
-  switch (ws.K.rows()) {
-    case 1:
-      ws.z(0) = ws.v(0) / ws.K(0, 0);
-      return ws.K(0, 0) > 0.0;
-    case 2:
-      solve_small_fixed<2>(ws.K, ws.v, ws.z);
-      break;
-    case 3:
-      solve_small_fixed<3>(ws.K, ws.v, ws.z);
-      break;
-    case 4:
-      solve_small_fixed<4>(ws.K, ws.v, ws.z);
-      break;
-    default:
-      ws.small_llt.compute(ws.K);
-      if (ws.small_llt.info() != Eigen::Success) return false;
-      ws.z = ws.v;
-      ws.small_llt.solveInPlace(ws.z);
-  }
-  return ws.z.allFinite();
+bool rod_solve(const LowRank& L, std::span<const double> R, const double* mmf, double current_A,
+               double pm_scale, CircuitWorkspace& ws) {
+  constexpr int kMax = K == Eigen::Dynamic ? 8 : K;
+  using Vec = Eigen::Matrix<double, K, 1, 0, kMax, 1>;
+  using Mat = Eigen::Matrix<double, K, K, 0, kMax, kMax>;
+  const int k = static_cast<int>(R.size());
+  const Mat S = L.S;
+  Vec DF(k);
+  for (int r = 0; r < k; ++r) DF(r) = mmf[r] / R[static_cast<std::size_t>(r)];
+  const Vec Btu = current_A * L.Bt_psi_coil + pm_scale * L.Bt_psi_pm;
+  Mat A = S;
+  for (int r = 0; r < k; ++r) A(r, r) += R[static_cast<std::size_t>(r)];
+  const Eigen::LLT<Mat> llt(A);
+  if (llt.info() != Eigen::Success) return false;
+  const Vec z = llt.solve(Vec(Btu - S * DF)) + DF;
+  if (!z.allFinite()) return false;
+  ws.z.head(k) = z;
+  ws.v.head(k) = Btu - S * z;
+  return true;
 }
 
 }  // namespace
@@ -183,35 +176,41 @@ bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_
                    double pm_scale, CircuitWorkspace& ws, bool all_branches) {
   const LowRank& L = c.lowrank;
   if (!L.enabled) return solve_circuit_full(c, rod_reluctance_per_H, current_A, pm_scale, ws);
-  // With g = diag(1/R_rod), F the rods' own MMFs, u = I psi_coil + pm psi_pm:
-  //   v = B^T u - S D F,  (D^-1 + S) z = v,  psi = u - W (D F + z).
   const int k = static_cast<int>(c.rod_branch.size());
-  for (int r = 0; r < k; ++r) {
-    const auto& br =
-        c.branches[static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)])];
-    ws.F_rod(r) = branch_mmf(br, current_A, pm_scale) /
-                  rod_reluctance_per_H[static_cast<std::size_t>(r)];  // D F
+  std::array<double, 8> mmf{};
+  for (int r = 0; r < k; ++r)
+    mmf[static_cast<std::size_t>(r)] =
+        branch_mmf(c.branches[static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)])],
+                   current_A, pm_scale);
+  bool ok = false;
+  switch (k) {
+    case 1:
+      ok = rod_solve<1>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, ws);
+      break;
+    case 2:
+      ok = rod_solve<2>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, ws);
+      break;
+    case 3:
+      ok = rod_solve<3>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, ws);
+      break;
+    case 4:
+      ok = rod_solve<4>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, ws);
+      break;
+    default:
+      ok = rod_solve<Eigen::Dynamic>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, ws);
   }
-  ws.v.noalias() = current_A * L.Bt_psi_coil + pm_scale * L.Bt_psi_pm;
-  ws.v.noalias() -= L.S * ws.F_rod;
-  ws.K = L.S;
-  for (int r = 0; r < k; ++r) ws.K(r, r) += rod_reluctance_per_H[static_cast<std::size_t>(r)];
-  if (!solve_small(ws)) return false;
-  ws.z += ws.F_rod;  // D F + z
-  if (!all_branches) {
-    // Rod fluxes need only the potential drops across the rods:
-    //   B^T psi = B^T u - S (D F + z),  phi_r = (drop_r + F_r) / R_r.
-    ws.v.noalias() = current_A * L.Bt_psi_coil + pm_scale * L.Bt_psi_pm;
-    ws.v.noalias() -= L.S * ws.z;
+  if (!ok) return false;
+  if (!all_branches) {  // the step needs only the rod fluxes: phi_r = (drop_r + F_r) / R_r
     for (int r = 0; r < k; ++r)
-      set_flux(c, static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)]), rod_reluctance_per_H,
-               current_A, pm_scale, ws.v(r), ws);
+      set_flux(c, static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)]),
+               rod_reluctance_per_H, current_A, pm_scale, ws.v(r), ws);
     return true;
   }
   ws.rhs.noalias() = current_A * L.psi_coil + pm_scale * L.psi_pm;
   ws.rhs.noalias() -= L.W * ws.z;
   for (std::size_t b = 0; b < c.branches.size(); ++b)
-    set_flux(c, b, rod_reluctance_per_H, current_A, pm_scale, potential_drop(c.branches[b], ws.rhs), ws);
+    set_flux(c, b, rod_reluctance_per_H, current_A, pm_scale, potential_drop(c.branches[b], ws.rhs),
+             ws);
   return true;
 }
 
@@ -231,7 +230,8 @@ bool solve_circuit_full(const Circuit& c, std::span<const double> rod_reluctance
   if (ws.llt.info() != Eigen::Success) return false;
   ws.llt.solveInPlace(ws.rhs);  // rhs now holds psi
   for (std::size_t b = 0; b < c.branches.size(); ++b)
-    set_flux(c, b, rod_reluctance_per_H, current_A, pm_scale, potential_drop(c.branches[b], ws.rhs), ws);
+    set_flux(c, b, rod_reluctance_per_H, current_A, pm_scale, potential_drop(c.branches[b], ws.rhs),
+             ws);
   return true;
 }
 
