@@ -9,6 +9,7 @@
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
+#include "model/rod_update.hpp"
 
 namespace gmasim {
 namespace {
@@ -25,38 +26,29 @@ void rhs(const Model& m, const Conditions& c, State& s, Y& y, double I, Y& dy) {
   for (std::size_t i = 0; i < n; ++i) {
     const auto& rc = c.rods[i];
     y.M[i] = ja_total_magnetisation(y.H[i], y.Mirr[i], y.M[i], rc.MsT_ja, rc.ja);
-    const double inv_chi =
-        inverse_susceptibility(y.M[i] / rc.MsT_mu, m.material.chi_m, rc.S_mu_J_per_m3, rc.MsT_mu);
-    const double mu = permeability(inv_chi);
-    s.rods[i].mu_r = mu / kMu0;
-    s.rod_reluctance[i] = rod_reluctance(rc.length_m, mu, rc.area_m2);
+    s.rod_reluctance[i] = detail::set_rod_permeability(m, i, rc, s.rods[i], y.M[i], s.t_s);
   }
   if (!solve_circuit(m.circuit, s.rod_reluctance, I, c.pm_scale, s.circuit))
     throw DivergenceError(s.t_s, "", "nodal matrix of the circuit", 0.0, "not positive definite");
-  std::array<double, kMax> krod{}, F{};
+  std::array<RodState, kMax> stage{};  // force and stiffness of this stage, per rod
   for (std::size_t i = 0; i < n; ++i) {
     const auto& rc = c.rods[i];
-    const double mu = s.rods[i].mu_r * kMu0;
-    const double phi = s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
-    const double Hc = static_field(phi, rc.k_f, mu, rc.area_m2);
-    const double tau = mu * rc.eddy_geometry_s_m_per_H;
+    const double Hc = detail::rod_static_field(m, i, rc, s.rods[i], s.circuit);
+    const double tau = s.rods[i].mu_r * kMu0 * rc.eddy_geometry_s_m_per_H;
     dy.H[i] = (Hc - y.H[i]) / tau;
     const double delta = dy.H[i] >= 0.0 ? 1.0 : -1.0;
     dy.Mirr[i] =
         ja_irreversible_slope(y.H[i], y.M[i], y.Mirr[i], delta, rc.MsT_ja, rc.ja) * dy.H[i];
-    const double E = delta_e_modulus(y.M[i] / rc.MsT_E, rc.dE);
-    const double lam = magnetostriction(y.M[i] / rc.MsT_ja, m.material.lambda_s, rc.sigma_p_Pa, E);
-    F[i] = rod_force(lam, E, rc.area_m2);
-    krod[i] = axial_stiffness(E, rc.area_m2, rc.length_m);
+    stage[i].M_A_per_m = y.M[i];
+    detail::update_rod_mechanics(m.material, rc, stage[i]);
   }
   for (std::size_t i = 0; i < n; ++i) {
     const auto& rc = c.rods[i];
-    double inv_k = rc.fixed_compliance_m_per_N;
-    for (int j = 0; j < rc.chain_rod_count; ++j)
-      inv_k += 1.0 / krod[static_cast<std::size_t>(rc.chain_rods[static_cast<std::size_t>(j)])];
-    const double K = krod[i] + 1.0 / inv_k;
+    const double K = stage[i].k_rod_N_per_m + detail::load_stiffness(rc, [&](int j) {
+                       return stage[static_cast<std::size_t>(j)].k_rod_N_per_m;
+                     });
     dy.x[i] = y.v[i];
-    dy.v[i] = (F[i] - rc.damping_osc_N_s_per_m * y.v[i] - K * y.x[i]) / rc.mass_osc_kg;
+    dy.v[i] = (stage[i].F_N - rc.damping_osc_N_s_per_m * y.v[i] - K * y.x[i]) / rc.mass_osc_kg;
   }
 }
 
@@ -99,11 +91,7 @@ void rk4_reference_step(const Model& m, const Conditions& c, State& s, double I0
     r.M_prev_A_per_m = r.M_A_per_m;
     r.M_A_per_m = ja_total_magnetisation(r.H_A_per_m, r.Mirr_A_per_m, yt.M[i], c.rods[i].MsT_ja,
                                          c.rods[i].ja);
-    r.E_Pa = delta_e_modulus(r.M_A_per_m / c.rods[i].MsT_E, c.rods[i].dE);
-    r.lambda = magnetostriction(r.M_A_per_m / c.rods[i].MsT_ja, m.material.lambda_s,
-                                c.rods[i].sigma_p_Pa, r.E_Pa);
-    r.F_N = rod_force(r.lambda, r.E_Pa, c.rods[i].area_m2);
-    r.k_rod_N_per_m = axial_stiffness(r.E_Pa, c.rods[i].area_m2, c.rods[i].length_m);
+    detail::update_rod_mechanics(m.material, c.rods[i], r);
     if (!std::isfinite(r.x_m) || std::fabs(r.x_m) > 1.0)
       throw DivergenceError(s.t_s + h, m.rods[i].name, "x [m] (RK4)", r.x_m,
                             "explicit RK4 unstable");

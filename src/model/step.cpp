@@ -11,39 +11,14 @@
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
+#include "model/rod_update.hpp"
 
 namespace gmasim {
 namespace {
 
 using namespace physics;
-
-// Permeability of rod i at magnetisation M (eq. 3); throws on a non-physical value.
-double rod_permeability(const RodConditions& rc, double chi_m, double M, double t,
-                        const std::string& rod) {
-  const double inv_chi = inverse_susceptibility(M / rc.MsT_mu, chi_m, rc.S_mu_J_per_m3, rc.MsT_mu);
-  if (!(inv_chi > 0.0) || !std::isfinite(inv_chi))
-    throw DivergenceError(t, rod, "1/chi of eq. (3)", inv_chi, "permeability not positive");
-  return permeability(inv_chi);
-}
-
-// Load stiffness of rod i (eq. 18): its fixed members plus the rods in its chain.
-double load_stiffness(const RodConditions& rc, const State& s) {
-  double inv_k = rc.fixed_compliance_m_per_N;
-  for (int j = 0; j < rc.chain_rod_count; ++j)
-    inv_k +=
-        1.0 /
-        s.rods[static_cast<std::size_t>(rc.chain_rods[static_cast<std::size_t>(j)])].k_rod_N_per_m;
-  return 1.0 / inv_k;
-}
-
-// Magnetostriction, Delta-E modulus and force of rod i at its present M (eq. 11-14, 17).
-void update_rod_mechanics(const Material& mat, const RodConditions& rc, RodState& r) {
-  r.E_Pa = delta_e_modulus(r.M_A_per_m / rc.MsT_E, rc.dE);  // eq. (13)
-  r.lambda = magnetostriction(r.M_A_per_m / rc.MsT_ja, mat.lambda_s, rc.sigma_p_Pa,
-                              r.E_Pa);                                 // eq. (11)-(12)
-  r.F_N = rod_force(r.lambda, r.E_Pa, rc.area_m2);                     // eq. (14)
-  r.k_rod_N_per_m = axial_stiffness(r.E_Pa, rc.area_m2, rc.length_m);  // eq. (17)
-}
+using detail::load_stiffness;
+using detail::update_rod_mechanics;
 
 inline void check(double value, double t, const std::string& rod, const char* quantity,
                   double limit) {
@@ -87,20 +62,15 @@ State make_state(const Model& m, const Conditions& c, double current_A) {
   const int ramp_steps = 400;
   for (int k = 1; k <= ramp_steps; ++k) {
     const double f = static_cast<double>(k) / ramp_steps;
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto& rc = c.rods[i];
-      const double mu =
-          rod_permeability(rc, m.material.chi_m, s.rods[i].M_A_per_m, 0.0, m.rods[i].name);
-      s.rod_reluctance[i] = rod_reluctance(rc.length_m, mu, rc.area_m2);
-      s.rods[i].mu_r = mu / kMu0;
-    }
+    for (std::size_t i = 0; i < n; ++i)
+      s.rod_reluctance[i] =
+          detail::set_rod_permeability(m, i, c.rods[i], s.rods[i], s.rods[i].M_A_per_m, 0.0);
     if (!solve_circuit(m.circuit, s.rod_reluctance, f * current_A, f * c.pm_scale, s.circuit))
       throw DivergenceError(0.0, "", "nodal matrix of the circuit", 0.0, "not positive definite");
     for (std::size_t i = 0; i < n; ++i) {
       const auto& rc = c.rods[i];
       auto& r = s.rods[i];
-      r.phi_Wb = s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
-      const double Hc = static_field(r.phi_Wb, rc.k_f, r.mu_r * kMu0, rc.area_m2);
+      const double Hc = detail::rod_static_field(m, i, rc, r, s.circuit);
       ja_step(r.H_A_per_m, Hc, rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m);
       r.H_A_per_m = Hc;
       r.Hc_A_per_m = Hc;
@@ -126,7 +96,6 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
   const double h = in.dt_s;
   const double t1 = s.t_s + h;
   const std::size_t n = s.rods.size();
-  const double chi_m = m.material.chi_m;
 
   // 1. Rod reluctances (eq. 2-3) at the magnetisation extrapolated to the end of the
   //    step (M* = 2 M_n - M_{n-1}, second order), then the nodal solve (eq. 23).
@@ -136,9 +105,7 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
     double Mx = 2.0 * r.M_A_per_m - r.M_prev_A_per_m;
     const double lim = 0.999 * rc.MsT_mu;
     Mx = Mx > lim ? lim : (Mx < -lim ? -lim : Mx);
-    const double mu = rod_permeability(rc, chi_m, Mx, t1, m.rods[i].name);
-    r.mu_r = mu / kMu0;
-    s.rod_reluctance[i] = rod_reluctance(rc.length_m, mu, rc.area_m2);
+    s.rod_reluctance[i] = detail::set_rod_permeability(m, i, rc, r, Mx, t1);
   }
   if (!solve_circuit(m.circuit, s.rod_reluctance, in.current_A, c.pm_scale, s.circuit, false))
     throw DivergenceError(t1, "", "nodal matrix of the circuit", 0.0, "not positive definite");
@@ -147,10 +114,8 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
   for (std::size_t i = 0; i < n; ++i) {
     const auto& rc = c.rods[i];
     auto& r = s.rods[i];
-    const double mu = r.mu_r * kMu0;
-    r.phi_Wb = s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
-    const double Hc1 = static_field(r.phi_Wb, rc.k_f, mu, rc.area_m2);
-    r.tau_s = mu * rc.eddy_geometry_s_m_per_H;
+    const double Hc1 = detail::rod_static_field(m, i, rc, r, s.circuit);
+    r.tau_s = r.mu_r * kMu0 * rc.eddy_geometry_s_m_per_H;
     const double H1 = first_order_lag_step(r.H_A_per_m, r.Hc_A_per_m, Hc1, h, r.tau_s);
     const double M_guess = 2.0 * r.M_A_per_m - r.M_prev_A_per_m;  // linear extrapolation
     r.M_prev_A_per_m = r.M_A_per_m;
