@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
+#include <utility>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/simulate.hpp"
@@ -95,31 +97,43 @@ double hysteresis_width(const std::vector<double>& current_A, const std::vector<
   return gap;
 }
 
+namespace {
+
+// Rows with t0 <= t < t1 (one whole period when t1 - t0 is the period), with a tolerance of
+// 1e-9 of the window for the times accumulated in floating point.
+std::pair<std::size_t, std::size_t> window_rows(const std::vector<double>& t, double t0,
+                                                double t1) {
+  const double eps = 1e-9 * (t1 - t0);
+  const auto row = [&](double x) {
+    return static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), x - eps) - t.begin());
+  };
+  return {row(t0), row(t1)};
+}
+
+// Peak-to-peak and mean of v over rows [b, e), e > b.
+std::pair<double, double> pp_and_mean(const std::vector<double>& v, std::size_t b, std::size_t e) {
+  const auto [lo, hi] =
+      std::minmax_element(v.begin() + static_cast<long>(b), v.begin() + static_cast<long>(e));
+  double s = 0.0;
+  for (std::size_t i = b; i < e; ++i) s += v[i];
+  return {*hi - *lo, s / static_cast<double>(e - b)};
+}
+
+}  // namespace
+
 Metrics compute_metrics(const TimeSeries& ts, double t0, double t1) {
   const auto& t = ts.column("t_s");
   const auto& I = ts.column("current_A");
   const auto& y = ts.column("y_um");
   const auto& B = ts.column("B_T");
-  // Samples with t0 <= t < t1 (one whole period when t1 - t0 is the period).
-  const double eps = 1e-9 * (t1 - t0);
-  const auto b =
-      static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), t0 - eps) - t.begin());
-  const auto e =
-      static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), t1 - eps) - t.begin());
+  const auto [b, e] = window_rows(t, t0, t1);
   Metrics m;
   m.window_start_s = t0;
   m.window_end_s = t1;
   if (e <= b + 2)
     throw InputError(fmt::format("metrics window [{}, {}] s holds fewer than 3 samples", t0, t1));
-  const auto [ymin, ymax] =
-      std::minmax_element(y.begin() + static_cast<long>(b), y.begin() + static_cast<long>(e));
-  const auto [Bmin, Bmax] =
-      std::minmax_element(B.begin() + static_cast<long>(b), B.begin() + static_cast<long>(e));
-  m.stroke_um = *ymax - *ymin;
-  m.B_pp_T = *Bmax - *Bmin;
-  double s = 0.0;
-  for (std::size_t i = b; i < e; ++i) s += y[i];
-  m.y_mean_um = s / static_cast<double>(e - b);
+  std::tie(m.stroke_um, m.y_mean_um) = pp_and_mean(y, b, e);
+  m.B_pp_T = pp_and_mean(B, b, e).first;
   m.hysteresis_um = hysteresis_width(I, y, b, e);
   return m;
 }
@@ -131,13 +145,8 @@ namespace gmasim {
 void add_quantity_stats(Result& r, const std::vector<std::string>& names) {
   const auto& t = r.series.column("t_s");
   std::size_t b = 0, e = t.size();
-  if (r.has_metrics) {
-    const double eps = 1e-9 * (r.metrics.window_end_s - r.metrics.window_start_s);
-    b = static_cast<std::size_t>(
-        std::lower_bound(t.begin(), t.end(), r.metrics.window_start_s - eps) - t.begin());
-    e = static_cast<std::size_t>(
-        std::lower_bound(t.begin(), t.end(), r.metrics.window_end_s - eps) - t.begin());
-  }
+  if (r.has_metrics)
+    std::tie(b, e) = window_rows(t, r.metrics.window_start_s, r.metrics.window_end_s);
   for (const auto& name : names) {
     const auto& v = r.series.column(name);
     QuantityStats q;
@@ -145,14 +154,7 @@ void add_quantity_stats(Result& r, const std::vector<std::string>& names) {
     const RmsPeak rp = rms_and_peak(v, b, e);
     q.rms = rp.rms;
     q.peak = rp.peak;
-    if (e > b) {
-      const auto [lo, hi] =
-          std::minmax_element(v.begin() + static_cast<long>(b), v.begin() + static_cast<long>(e));
-      q.pp = *hi - *lo;
-      double s = 0.0;
-      for (std::size_t i = b; i < e; ++i) s += v[i];
-      q.mean = s / static_cast<double>(e - b);
-    }
+    if (e > b) std::tie(q.pp, q.mean) = pp_and_mean(v, b, e);
     r.quantities.push_back(q);
   }
 }
