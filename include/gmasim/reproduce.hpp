@@ -11,16 +11,16 @@
 namespace gmasim {
 
 struct Claim {
-  std::string id;          // short stable key, e.g. "stroke_drop_8A"
-  std::string claim;       // what the paper says, in words
-  std::string source;      // "section 4.4.4, Fig. 13"
-  double paper = 0.0;      // the paper's value (NaN when the claim is not a number)
-  double ours = 0.0;       // our value (NaN when we cannot compute it)
-  std::string unit;        // "%", "um", "Hz", ...
-  std::string tolerance;   // the rule, in words ("|ours - paper| <= 3 pp")
+  std::string id;         // short stable key, e.g. "stroke_drop_8A"
+  std::string claim;      // what the paper says, in words
+  std::string source;     // "section 4.4.4, Fig. 13"
+  double paper = 0.0;     // the paper's value (NaN when the claim is not a number)
+  double ours = 0.0;      // our value (NaN when we cannot compute it)
+  std::string unit;       // "%", "um", "Hz", ...
+  std::string tolerance;  // the rule, in words ("|ours - paper| <= 3 pp")
   bool pass = false;
-  bool applicable = true;  // false: needs measurements we do not have
-  std::string note;        // why it passes/fails, or why it is not applicable
+  bool applicable = true;   // false: needs measurements we do not have
+  std::string note;         // why it passes/fails, or why it is not applicable
   double rel_diff() const;  // (ours - paper)/|paper|, NaN if not applicable
 };
 
@@ -37,8 +37,8 @@ struct ReproduceResult {
   AblateRequest ablate_request;
   ParamsVsTemperatureRequest params_request;
 
-  SweepResult sweep_10Hz;        // the paper's grid, 20-70 degC x 6/8/10/12 A x 10 Hz
-  SweepResult sweep_dynamic;     // 20-70 degC x 6/8 A x 100/200/400 Hz (Fig. 17 conditions)
+  SweepResult sweep_10Hz;     // the paper's grid, 20-70 degC x 6/8/10/12 A x 10 Hz
+  SweepResult sweep_dynamic;  // 20-70 degC x 6/8 A x 100/200/400 Hz (Fig. 17 conditions)
   FrfResult frf;
   TrackResult track;
   AblateResult ablate;
@@ -50,14 +50,28 @@ struct ReproduceResult {
   std::vector<Claim> claims;
   double wall_time_s = 0.0;
   std::string model_source;
-  std::string model_readings;    // the options in force, e.g. "eq10: mean_field, kelvin"
+  std::string model_readings;  // the options in force, e.g. "eq10: mean_field, kelvin"
 };
 
 ReproduceResult run_reproduce(const Model& m, const ReproduceOptions& o,
                               const ProgressFn& progress = {});
 
+// How many claims pass, of how many applicable.
+struct ClaimCount {
+  int pass = 0, applicable = 0;
+};
+ClaimCount count_claims(const std::vector<Claim>& claims);
+
 // The claims table as markdown (one row per claim) and the summary line "N of M pass".
 std::string claims_markdown(const std::vector<Claim>& claims);
+
+// Another model (e.g. one calibrated reading) scored on the same claims.
+struct ComparedModel {
+  std::string name, readings;
+  std::vector<Claim> claims;
+};
+// One row per applicable claim, one column per compared model ("" if none).
+std::string comparison_markdown(const std::vector<ComparedModel>& models);
 
 // The claims as a report table (columns id, claim, source, paper, ours, unit, rel_diff,
 // tolerance, result, note).
@@ -70,5 +84,10 @@ Report claims_report(const std::vector<Claim>& claims);
 std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
                                     const std::string& dir, const std::string& python_exe,
                                     const std::string& python_path);
+
+// The committed page (docs/reproduction.md): the claims table, the compared readings, and
+// the figures of out_dir (copied next to the page). Written atomically.
+void write_reproduction_doc(const ReproduceResult& r, const std::vector<ComparedModel>& compared,
+                            const std::string& doc_path, const std::string& out_dir);
 
 }  // namespace gmasim
