@@ -29,7 +29,8 @@ echo "reading,claims_pass,claims_applicable,fit_rms_pct" >calibration/scores.csv
 for reading in "${list[@]}"; do
   IFS=, read -r law scale sign <<<"$reading"
   name="${law}__${scale}__${sign}"
-  start="$OUT/start_${name}.toml"
+  mkdir -p "$OUT/start"
+  start="$OUT/start/${name}.toml"
   sed -e "s/^eq10_shape_law = \"[a-z_]*\"/eq10_shape_law = \"$law\"/" \
       -e "s/^eq10_temperature_scale = \"[a-z_]*\"/eq10_temperature_scale = \"$scale\"/" \
       -e "s/^stress_sign = \"[a-z_]*\"/stress_sign = \"$sign\"/" models/mdma.toml >"$start"
