@@ -31,6 +31,12 @@ const Model& mdma() {
   return m;
 }
 
+// The paper-as-printed reading (models/mdma_printed.toml): eq. 2, 3, 7, 10, 11 as printed.
+const Model& mdma_printed() {
+  static const Model m = load_model(std::string(GMASIM_SOURCE_DIR) + "/models/mdma_printed.toml");
+  return m;
+}
+
 constexpr double kTwoPi = 2.0 * physics::kPi;
 
 template <class F>
@@ -202,7 +208,7 @@ TEST(Frf, ResonanceAndBandwidthOfAnalyticCurves) {
 // terms of D removed it must be exactly the analytic product of the eddy lag and the
 // oscillator of each rod, and the full model must stay close to that (G is small).
 TEST(Frf, LinearisationIsTheMechanicsTimesTheEddyLag) {
-  const Model& m = mdma();
+  const Model& m = mdma_printed();
   const Conditions c = make_conditions(m, 20.0);
   const State s = settle_at_bias(m, c, 1.0, BiasState::Anhysteretic);
   const SmallSignalModel L = linearise(m, c, s);
@@ -266,8 +272,9 @@ TEST(Frf, ModesOfEq15AreTheDiagonalOscillators) {
 // agree in the linear regime. Two residuals remain (docs/experiments.md): the JA
 // irreversible magnetisation, proportional to the amplitude (+0.045 % in |Y/I| at 20 uA,
 // +0.18 % at 80 uA), and an O(dt) phase lag of the time stepping (<= 0.08 deg here).
-TEST(Frf, SteppedSineMatchesTheLinearisationInTheLinearRegime) {
-  const Model& m = mdma();
+// Both readings: the printed one (eq. 7's lag of H behind H_c) and the consistent one (the
+// rods' port equations with the eddy field kappa dB/dt, and the output stage).
+void expect_stepped_sine_matches_linearisation(const Model& m) {
   FrfRequest r;
   r.temperatures_C = {20, 70};
   r.f_min_Hz = 5.0;
@@ -280,9 +287,6 @@ TEST(Frf, SteppedSineMatchesTheLinearisationInTheLinearRegime) {
     EXPECT_LT(cv.max_mismatch_pct, 1.5) << cv.temperature_C << " degC";  // observed 0.15 %
     for (std::size_t k = 0; k < cv.f_Hz.size(); ++k)
       EXPECT_NEAR(cv.stepped_phase_deg[k], cv.linear_phase_deg[k], 0.8) << cv.f_Hz[k] << " Hz";
-    EXPECT_GT(cv.bandwidth_3dB_Hz, 100.0);   // eddy-lag roll-off: ~460 Hz here
-    EXPECT_LT(cv.bandwidth_3dB_Hz, 2000.0);  // below the paper's "> 2000 Hz"
-    EXPECT_EQ(cv.first_resonance_Hz, 0.0);   // no peak below 5 kHz: the modes are higher
   }
   // Four times the amplitude: four times the magnitude excess at low frequency.
   r.temperatures_C = {20};
@@ -293,6 +297,38 @@ TEST(Frf, SteppedSineMatchesTheLinearisationInTheLinearRegime) {
   };
   EXPECT_GT(excess(small.curves[0]), 0.0);
   EXPECT_NEAR(excess(larger.curves[0]) / excess(small.curves[0]), 4.0, 0.4);  // observed 4.00
+}
+
+TEST(Frf, SteppedSineMatchesTheLinearisationInTheLinearRegime) {
+  expect_stepped_sine_matches_linearisation(mdma());
+}
+
+TEST(Frf, PrintedReadingSteppedSineMatchesTheLinearisation) {
+  expect_stepped_sine_matches_linearisation(mdma_printed());
+}
+
+// The printed reading cannot carry Fig. 15: its eddy lag sets a bandwidth of a few hundred
+// Hz and nothing rings below 5 kHz (READING-NOTES). The built-in model's output stage
+// carries the measured 1270 Hz, temperature-independent, with the bandwidth above 2000 Hz.
+TEST(Frf, ResonanceAndBandwidthOfBothReadings) {
+  FrfRequest r;
+  r.temperatures_C = {20, 70};
+  r.stepped_sine = false;
+  const FrfResult printed = run_frf(mdma_printed(), r);
+  for (const auto& cv : printed.curves) {
+    EXPECT_GT(cv.bandwidth_3dB_Hz, 100.0);
+    EXPECT_LT(cv.bandwidth_3dB_Hz, 2000.0);
+    EXPECT_EQ(cv.first_resonance_Hz, 0.0);
+  }
+  const FrfResult built_in = run_frf(mdma(), r);
+  for (const auto& cv : built_in.curves) {
+    EXPECT_NEAR(cv.first_resonance_Hz, 1270.0, 0.02 * 1270.0) << cv.temperature_C << " degC";
+    EXPECT_GT(cv.bandwidth_3dB_Hz, 2000.0);
+  }
+  const double shift = std::fabs(built_in.curves[1].first_resonance_Hz /
+                                     built_in.curves[0].first_resonance_Hz -
+                                 1.0);
+  EXPECT_LT(shift, 0.002);  // the paper: < 0.17 %
 }
 
 // Starting from the virgin curve instead, the JA minor loop creeps (M_irr keeps moving on

@@ -1,6 +1,7 @@
 // Model-level tests: eq. (23) residuals, analytic limits of the assembled model,
 // convergence in dt, determinism, allocation-free stepping, bad conditions, divergence.
 #include <gtest/gtest.h>
+#include <gmock/gmock.h>
 
 #include <atomic>
 #include <cmath>
@@ -12,6 +13,7 @@
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
 #include "gmasim/model.hpp"
+#include "gmasim/physics/jiles_atherton.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/simulate.hpp"
 
@@ -37,11 +39,18 @@ extern "C" void* realloc(void* p, std::size_t n) {
 }
 
 using namespace gmasim;
+using ::testing::HasSubstr;
 
 namespace {
 
 const Model& mdma() {
   static const Model m = load_model("");
+  return m;
+}
+
+// The paper-as-printed reading (models/mdma_printed.toml): eq. 2, 3, 7, 10, 11 as printed.
+const Model& mdma_printed() {
+  static const Model m = load_model(std::string(GMASIM_SOURCE_DIR) + "/models/mdma_printed.toml");
   return m;
 }
 
@@ -212,13 +221,14 @@ TEST(Conditions, FrozenLawsEqualTheReferenceTemperature) {
     EXPECT_DOUBLE_EQ(hot.rods[i].area_m2, ref.rods[i].area_m2);
   }
   EXPECT_DOUBLE_EQ(hot.Et_Pa, ref.Et_Pa);
-  // The mean-field a^T law is referenced to T_ref: a(T_ref) = a0.
+  // One reference temperature (room_referenced): every eq. (10) law gives Table 4 at T_ref.
   EXPECT_NEAR(ref.rods[0].ja.a_A_per_m, m.rods[0].ja.a0_A_per_m, 1e-9);
-  // Eq. (10) in kelvin: k^T = k0 exp(-(T/T_c)/beta2) with T, T_c in K.
-  EXPECT_NEAR(ref.rods[0].ja.k_A_per_m,
-              m.rods[0].ja.k0_A_per_m *
-                  std::exp(-((m.T_ref_C + 273.15) / (m.material.Tc_C + 273.15)) / m.rods[0].ja.beta2),
-              1e-9);
+  EXPECT_NEAR(ref.rods[0].ja.k_A_per_m, m.rods[0].ja.k0_A_per_m, 1e-9);
+  EXPECT_NEAR(ref.rods[0].ja.c, m.rods[0].ja.c0, 1e-15);
+  // Consistent state: eq. (3)'s stress terms join alpha (magnetoelastic_coupling).
+  EXPECT_NEAR(ref.rods[0].ja.alpha, m.rods[0].ja.alpha0 + ref.rods[0].alpha_sigma, 1e-15);
+  EXPECT_DOUBLE_EQ(ref.rods[0].alpha_sigma,
+                   physics::magnetoelastic_coupling(ref.rods[0].S_mu_J_per_m3, ref.rods[0].MsT_mu));
 }
 
 // ---- analytic limits of the assembled model ---------------------------------------------
@@ -237,7 +247,7 @@ TEST(Model, StaticDeflectionEqualsForceOverStiffness) {
 }
 
 TEST(Model, EddyTimeConstantIsEq7) {
-  const Model& m = mdma();
+  const Model& m = mdma_printed();
   const Conditions c = make_conditions(m, 70.0);
   State s = make_state(m, c, 1.0);
   step(m, c, s, {1.0, 10e-6});
@@ -291,7 +301,7 @@ TEST(Numerics, HalvingDtChangesStrokeAndHysteresisByLessThan0p1Percent) {
 TEST(Numerics, ExactStepAgreesWithAFineExplicitRk4Reference) {
   // The production step (exact eddy/JA/oscillator updates, auto dt = 1.25 us at 400 Hz)
   // against a plain RK4 of the same ODE at 1 us: observed stroke difference 6.9e-5.
-  const Model& m = mdma();
+  const Model& m = mdma_printed();
   const SimulationSettings s = sine(8.0, 400.0, 70.0);
   const Result a = simulate(m, s);
   const Conditions c = make_conditions(m, 70.0);
@@ -376,4 +386,125 @@ TEST(Metrics, HysteresisOfAKnownEllipse) {
     y.push_back(-std::cos(wt - ph));
   }
   EXPECT_NEAR(hysteresis_width(I, y, 0, I.size()), 2 * std::sin(ph), 1e-5);
+}
+
+// ---- the consistent magnetic state (docs/model.md, "Magnetic state") ---------------------
+namespace {
+
+// The built-in model with one option changed (parsed from its text, so the line numbers
+// of the messages stay those of the file).
+ModelSpec builtin_with_option(const std::string& key, const std::string& from,
+                              const std::string& to) {
+  std::string text = kBuiltinModelToml;
+  const std::string a = key + " = \"" + from + "\"";
+  const auto p = text.find(a);
+  EXPECT_NE(p, std::string::npos) << a;
+  text.replace(p, a.size(), key + " = \"" + to + "\"");
+  return parse_model_spec(text, "variant.toml");
+}
+
+}  // namespace
+
+// Every rod carries the flux of its own material state, B = mu0 (H + M), and no flux
+// density exceeds 1.3 T anywhere on the standard grid (20-150 degC, 6-12 A, 10-400 Hz).
+// The printed reading violates both (rod 2's phi/A is several tesla).
+TEST(Consistent, FluxIsMu0HPlusMAndNeverBeyond1p3Tesla) {
+  const MagneticStateCheck k = check_magnetic_state(mdma());
+  EXPECT_EQ(k.runs, 12);
+  EXPECT_TRUE(k.divergence.empty()) << k.divergence;
+  EXPECT_LT(k.max_inconsistency_rel, 1e-8) << k.where_inconsistency;  // observed ~1e-10
+  EXPECT_LE(k.max_B_rod_T, 1.3) << k.where_B_rod;
+  EXPECT_LE(k.max_B_sensor_T, 1.3);
+  EXPECT_GT(k.max_B_rod_T, 0.3);  // and the rods are well magnetised
+  const MagneticStateCheck p = check_magnetic_state(mdma_printed());
+  EXPECT_GT(p.max_inconsistency_rel, 0.5) << p.where_inconsistency;
+  EXPECT_GT(p.max_B_rod_T, 1.3) << p.where_B_rod;
+}
+
+// Finite-difference check of the derivative the consistent state's Newton solve uses:
+// dM/dH of ja_step along a step, on the initial curve, a descending branch and at rest.
+TEST(Consistent, JaStepSlopeIsTheFiniteDifferenceDerivative) {
+  const Model& m = mdma();
+  const Conditions c = make_conditions(m, 70.0);
+  const auto& rc = c.rods[0];
+  // Each case: a field history (walked in 200 small steps per leg from the demagnetised
+  // state), then one step H0 -> H1 whose slope dM1/dH1 is checked.
+  struct Case {
+    std::vector<double> history;
+    double H1;
+  } cases[] = {{{2000.0}, 6000.0},                 // initial curve
+               {{20000.0}, 35000.0},               // initial curve, high field
+               {{40000.0}, 25000.0},               // descending branch
+               {{30000.0, 10000.0}, 14000.0},      // ascending minor loop
+               {{-15000.0}, -5000.0}};             // negative side, ascending
+  for (const auto& cs : cases) {
+    double Mirr0 = 0.0, M0 = 0.0, H = 0.0;
+    for (double target : cs.history)
+      for (int k = 1; k <= 200; ++k) {
+        const double Hn = H + (target - H) / (201 - k);
+        physics::ja_step(H, Hn, rc.MsT_ja, rc.ja, Mirr0, M0);
+        H = Hn;
+      }
+    auto M_at = [&](double H1, double* slope) {
+      double Mirr = Mirr0, M = M0;
+      physics::ja_step(H, H1, rc.MsT_ja, rc.ja, Mirr, M, M, slope);
+      return M;
+    };
+    double slope = 0.0;
+    (void)M_at(cs.H1, &slope);
+    const double dH = 1e-4 * std::fabs(cs.H1 - H);
+    const double fd = (M_at(cs.H1 + dH, nullptr) - M_at(cs.H1 - dH, nullptr)) / (2 * dH);
+    EXPECT_NEAR(slope, fd, 1e-5 * std::fabs(fd)) << H << " -> " << cs.H1;
+  }
+}
+
+// Halving dt changes the stroke and hysteresis of the consistent state by less than
+// 0.1 % (the trapezoidal eddy field and Newton's exact end-of-step state).
+TEST(Consistent, HalvingDtConverges) {
+  const Model& m = mdma();
+  for (double f : {10.0, 400.0}) {
+    SimulationSettings s;
+    s.temperature_C = 70.0;
+    s.waveform = biased_sine(8.0, f);
+    s.periods = 2;
+    const double dt = auto_dt(s.waveform);
+    s.dt_s = dt;
+    const Result a = simulate(m, s);
+    s.dt_s = dt / 2;
+    const Result b = simulate(m, s);
+    ASSERT_FALSE(a.diverged || b.diverged) << a.error << b.error;
+    EXPECT_NEAR(a.metrics.stroke_um, b.metrics.stroke_um, 1e-3 * b.metrics.stroke_um) << f;
+    EXPECT_NEAR(a.metrics.hysteresis_um, b.metrics.hysteresis_um, 1e-3 * b.metrics.hysteresis_um)
+        << f;
+  }
+}
+
+// The output stage is a base-excited oscillator: at rest it sits on the stack, and its
+// steady response is the stack output times the transmissibility (c s + k)/(m s^2 + c s + k).
+TEST(Consistent, OutputStageFollowsTheStackAtRestAndRingsAt1270Hz) {
+  const Model& m = mdma();
+  ASSERT_TRUE(m.output_stage.enabled);
+  const Conditions c = make_conditions(m, 20.0);
+  const State s = make_state(m, c, 2.0);
+  EXPECT_DOUBLE_EQ(s.z_m, s.y_stack_m);
+  EXPECT_DOUBLE_EQ(s.y_m, s.y_stack_m);
+  const auto& o = m.output_stage;
+  const double fn = std::sqrt(o.stiffness_N_per_m / o.mass_kg) / (2 * physics::kPi);
+  EXPECT_NEAR(fn, 1270.0, 0.1 * 1270.0);  // inferred from Fig. 15 (docs/model.md)
+}
+
+// One reference temperature per reading: the mean-field a^T law with Table 4 at 0 K (kelvin)
+// or at 0 degC (celsius) mixes reference points and is refused with the option's line.
+TEST(Consistent, MixedEq10ReferenceTemperaturesAreRefused) {
+  for (const char* scale : {"kelvin", "celsius"}) {
+    const ModelSpec spec =
+        builtin_with_option("eq10_temperature_scale", "room_referenced", scale);
+    try {
+      (void)compile(spec);
+      ADD_FAILURE() << scale << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("mixes reference temperatures")) << e.what();
+      EXPECT_THAT(e.what(), HasSubstr("variant.toml:")) << e.what();
+    }
+  }
 }

@@ -74,6 +74,9 @@ struct CircuitWorkspace {
   std::vector<double> reluctance;  // per branch, this step [1/H]
   std::vector<double> mmf;         // per branch, this step [A-turns]
   std::vector<double> phi;         // per branch, solved flux [Wb]
+  // Per rod: an MMF added to the rod branch's own source [A-turns], zero unless the caller
+  // sets it (the consistent magnetic state's linearised rods, model/step.cpp).
+  std::vector<double> rod_extra_mmf;
 
   void resize(const Circuit& c);
 };

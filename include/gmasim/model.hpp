@@ -58,11 +58,28 @@ struct ModelSpec {
 enum class StressSign { CompressionNegative, CompressionPositive };
 enum class Eq10Scale { RoomReferenced, Kelvin, Celsius };
 enum class ShapeLaw { Printed, MeanField };
+// How a rod's flux, field and magnetisation relate (docs/model.md, "Magnetic state").
+//   Printed:    eq. (2), (3), (7) as printed: the circuit passes phi = U mu_G A / l with mu_G of
+//               eq. (3), and the material sees H_c = phi / (k_f mu_G A). phi / A is not
+//               mu0 (H + M) of the JA state (it reaches 3.6 T in rod 2).
+//   Consistent: the rod branch carries the flux of its own material state, phi = A mu0 (H + M),
+//               over the magnetic length k_f l (U = k_f l H_c, so H_c is eq. 7's first line);
+//               the eddy field of eq. (7) is H_c - H = kappa dB/dt; eq. (3)'s stress terms enter
+//               the JA effective field as a magnetoelastic coupling. B never exceeds
+//               mu0 (H + M_s^T).
+enum class MagneticState { Printed, Consistent };
+// The saturation magnetisation that normalises M in eq. (11), lambda = f lambda_s (M/M_s)^2:
+//   Temperature: M_s^T of eq. (4), as printed (the strain at saturation is the same at any T);
+//   Reference:   M_s at T_r, i.e. lambda_s^T = lambda_s (M_s^T/M_s)^2: the strain is a function
+//                of the magnetisation alone (classical magnetoelastic scaling, docs/model.md).
+enum class Eq11Saturation { Temperature, Reference };
 
 struct Options {
   StressSign stress_sign = StressSign::CompressionNegative;
   Eq10Scale eq10_scale = Eq10Scale::RoomReferenced;
   ShapeLaw shape_law = ShapeLaw::Printed;
+  MagneticState magnetic_state = MagneticState::Printed;
+  Eq11Saturation eq11_saturation = Eq11Saturation::Temperature;
   bool thermal_expansion_in_output = false;
   bool geometry_thermal_expansion = true;
 };
@@ -111,6 +128,15 @@ struct SleeveModel {  // eq. (19)
   double alpha_thermal_per_K;
 };
 
+// Optional output stage (`[mechanics.output_stage]`): the output head and displacement
+// sensor on a compliant, temperature-independent mount, driven at its base by the stack
+// output y_stack:  m z'' + c (z' - y_stack') + k (z - y_stack) = 0. The sensor reads z. Its
+// reaction on the stack is neglected (k is far below the rods' stiffness). docs/model.md.
+struct OutputStageModel {
+  bool enabled = false;
+  double mass_kg = 0, stiffness_N_per_m = 0, damping_N_s_per_m = 0;
+};
+
 struct ChainLink {  // one member of a rod's load chain
   enum Kind { Element, Sleeve, Rod } kind;
   int index;
@@ -131,6 +157,7 @@ struct Model {
   std::vector<ChainElementModel> elements;
   std::vector<SleeveModel> sleeves;
   std::vector<std::vector<ChainLink>> chains;  // per rod
+  OutputStageModel output_stage;
   // eq. (21) alpha*l products of the stack [m/K]
   double xT_rod_m_per_K = 0, xT_magnetizer_m_per_K = 0, xT_output_rod_m_per_K = 0,
          xT_sleeve_m_per_K = 0;
@@ -147,11 +174,13 @@ Model compile(const ModelSpec& spec);
 struct RodConditions {
   double length_m, area_m2, r_outer_m, r_inner_m;
   double MsT_mu, MsT_ja, MsT_E;    // M_s^T of eq. (4) as seen by eq. (3), (9)/(11), (13)
+  double Ms_strain_A_per_m;        // the M_s that normalises M in eq. (11) (Eq11Saturation)
   double S_mu_J_per_m3;            // stress term of eq. (3)
   physics::DeltaETerms dE;         // eq. (13) constants
   physics::JaCoefficients ja;      // eq. (10) at T
   double rho_ohm_m;                // eq. (8)
-  double eddy_geometry_s_m_per_H;  // tau = mu * this  (eq. 7)
+  double eddy_geometry_s_m_per_H;  // kappa of eq. (7): tau = mu kappa; H_c - H = kappa dB/dt
+  double alpha_sigma;              // eq. (3) stress terms as a JA coupling S / (mu0 Ms^2) [-]
   double sigma_Pa;                 // signed prestress used in eq. (3), (6), (13)
   double sigma_p_Pa;               // compressive prestress magnitude of eq. (11)
   double k_f, k_j;
@@ -185,19 +214,25 @@ struct RodState {
   double x_m = 0, v_m_per_s = 0;
   // kept for the next step (hold values, warm starts)
   double Hc_A_per_m = 0;  // static field of eq. (7) at the end of the last step
+  double H_prev_A_per_m = 0;  // H one step earlier (consistent state: Newton's first guess)
   double M_A_per_m = 0;   // total magnetisation consistent with (H, M_irr)
   double M_prev_A_per_m = 0;
   double F_N = 0;  // force at the end of the last step
   // reported
+  // mu_r: eq. (3) (printed) or the JA differential permeability 1 + dM/dH (consistent);
+  // B_T: the flux density the circuit assigns to the rod, phi / A (stored in step()).
   double mu_r = 1, E_Pa = 0, lambda = 0, tau_s = 0, phi_Wb = 0, k_rod_N_per_m = 0,
-         k_load_N_per_m = 0;
+         k_load_N_per_m = 0, B_T = 0;
 };
 
 struct State {
   double t_s = 0;
   double current_A = 0;
-  double y_m = 0;  // total output x1 + x2 + x3 (+ x_T if the option says so)
-  double B_T = 0;  // flux density seen by the induction coil
+  double y_m = 0;        // the output the sensor reads: z with an output stage, else y_stack (+ x_T
+                         // if the option says so)
+  double y_stack_m = 0;  // x1 + x2 + x3 (eq. 20)
+  double z_m = 0, z_v_m_per_s = 0;  // output stage (if any): displacement and velocity
+  double B_T = 0;                   // flux density seen by the induction coil
   std::vector<RodState> rods;
   CircuitWorkspace circuit;
   std::vector<double> rod_reluctance;

@@ -17,8 +17,10 @@ def test_simulate_returns_numpy_series_and_metrics(mdma):
     t = s["t_s"]
     last = (t >= r["metrics"]["window_start_s"] - 1e-12) & (t < r["metrics"]["window_end_s"] - 1e-12)
     assert np.ptp(s["y_um"][last]) == pytest.approx(r["metrics"]["stroke_um"], rel=1e-12)
-    # y is the sum of the rods' displacements (eq. 20)
-    np.testing.assert_allclose(s["y_um"], s["rod1_x_um"] + s["rod2_x_um"] + s["rod3_x_um"], rtol=1e-12, atol=1e-12)
+    # the stack output is the sum of the rods' displacements (eq. 20); the sensor reads the
+    # output stage, which follows it within a micrometre at 10 Hz
+    np.testing.assert_allclose(s["y_stack_um"], s["rod1_x_um"] + s["rod2_x_um"] + s["rod3_x_um"], rtol=1e-12, atol=1e-12)
+    assert np.max(np.abs(s["y_um"] - s["y_stack_um"])) < 1.0
 
 
 def test_python_equals_cli_to_1e12(mdma, gmasim_bin, tmp_path):

@@ -121,6 +121,7 @@ void CircuitWorkspace::resize(const Circuit& c) {
   reluctance.assign(c.branches.size(), 0.0);
   mmf.assign(c.branches.size(), 0.0);
   phi.assign(c.branches.size(), 0.0);
+  rod_extra_mmf.assign(c.rod_branch.size(), 0.0);
 }
 
 namespace {
@@ -128,15 +129,17 @@ namespace {
 double branch_reluctance(const CircuitBranch& br, std::span<const double> rod_R) {
   return br.rod >= 0 ? rod_R[static_cast<std::size_t>(br.rod)] : br.fixed_reluctance_per_H;
 }
-double branch_mmf(const CircuitBranch& br, double current_A, double pm_scale) {
-  return br.coil_turns * current_A + br.pm_mmf_At * pm_scale;
+double branch_mmf(const CircuitBranch& br, double current_A, double pm_scale,
+                  const CircuitWorkspace& ws) {
+  const double extra = br.rod >= 0 ? ws.rod_extra_mmf[static_cast<std::size_t>(br.rod)] : 0.0;
+  return br.coil_turns * current_A + br.pm_mmf_At * pm_scale + extra;
 }
 // phi_b = (psi_from - psi_to + F) / R, with the potential drop psi_from - psi_to given.
 void set_flux(const Circuit& c, std::size_t b, std::span<const double> rod_R, double current_A,
               double pm_scale, double drop, CircuitWorkspace& ws) {
   const auto& br = c.branches[b];
   ws.reluctance[b] = branch_reluctance(br, rod_R);
-  ws.mmf[b] = branch_mmf(br, current_A, pm_scale);
+  ws.mmf[b] = branch_mmf(br, current_A, pm_scale, ws);
   ws.phi[b] = (drop + ws.mmf[b]) / ws.reluctance[b];
 }
 double potential_drop(const CircuitBranch& br, const Eigen::VectorXd& psi) {
@@ -181,7 +184,7 @@ bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_
   for (int r = 0; r < k; ++r)
     mmf[static_cast<std::size_t>(r)] =
         branch_mmf(c.branches[static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)])],
-                   current_A, pm_scale);
+                   current_A, pm_scale, ws);
   bool ok = false;
   switch (k) {
     case 1:
@@ -220,7 +223,7 @@ bool solve_circuit_full(const Circuit& c, std::span<const double> rod_reluctance
   ws.rhs.setZero();
   for (const auto& br : c.branches) {
     const double g = 1.0 / branch_reluctance(br, rod_reluctance_per_H);
-    const double F = branch_mmf(br, current_A, pm_scale);
+    const double F = branch_mmf(br, current_A, pm_scale, ws);
     if (br.rod >= 0) stamp_conductance(ws.G, br, g);
     // phi_b = (psi_from - psi_to + F)/R; KCL at `from` (outflow) and `to` (inflow).
     if (br.from >= 0) ws.rhs(br.from) -= F * g;

@@ -57,7 +57,7 @@ struct ForceStiffness {
 };
 ForceStiffness force_at(const Model& m, const RodConditions& rc, double M) {
   const double E = delta_e_modulus(M / rc.MsT_E, rc.dE);
-  const double lambda = magnetostriction(M / rc.MsT_ja, m.material.lambda_s, rc.sigma_p_Pa, E);
+  const double lambda = magnetostriction(M / rc.Ms_strain_A_per_m, m.material.lambda_s, rc.sigma_p_Pa, E);
   return {rod_force(lambda, E, rc.area_m2), axial_stiffness(E, rc.area_m2, rc.length_m)};
 }
 
@@ -138,15 +138,63 @@ SmallSignalModel linearise(const Model& m, const Conditions& c, const State& s) 
   ws.resize(m.circuit);
   const double I0 = s.current_A;
 
+  if (m.output_stage.enabled) {
+    L.output_stage = true;
+    L.os_mass_kg = m.output_stage.mass_kg;
+    L.os_stiffness_N_per_m = m.output_stage.stiffness_N_per_m;
+    L.os_damping_N_s_per_m = m.output_stage.damping_N_s_per_m;
+  }
+  if (m.options.magnetic_state == MagneticState::Consistent) {
+    // The circuit seen from the rod branches: with rod reluctances R_p and extra rod MMFs e,
+    // the rod fluxes solve (R_p + S) phi = b I + e (netlist.cpp), whatever R_p; probe it.
+    L.consistent = true;
+    const auto N = static_cast<Eigen::Index>(n);
+    std::vector<double> Rp(n);
+    for (std::size_t i = 0; i < n; ++i)
+      Rp[i] = c.rods[i].length_m / (kMu0 * s.rods[i].mu_r * c.rods[i].area_m2);
+    auto rod_flux = [&](double I) {
+      if (!solve_circuit(m.circuit, Rp, I, 0.0, ws, false))
+        throw DivergenceError(0.0, "", "nodal matrix of the circuit", 0.0, "not positive definite");
+      Eigen::VectorXd phi(N);
+      for (std::size_t i = 0; i < n; ++i)
+        phi(static_cast<Eigen::Index>(i)) = ws.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
+      return phi;
+    };
+    Eigen::MatrixXd P(N, N);
+    for (std::size_t j = 0; j < n; ++j) {
+      std::fill(ws.rod_extra_mmf.begin(), ws.rod_extra_mmf.end(), 0.0);
+      ws.rod_extra_mmf[j] = 1.0;
+      P.col(static_cast<Eigen::Index>(j)) = rod_flux(0.0);
+    }
+    std::fill(ws.rod_extra_mmf.begin(), ws.rod_extra_mmf.end(), 0.0);
+    const Eigen::MatrixXd RS = P.inverse();  // R_p + S
+    const Eigen::VectorXd b = RS * rod_flux(1.0);
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& rc = c.rods[i];
+      const auto& r = s.rods[i];
+      for (std::size_t j = 0; j < n; ++j)
+        L.port_S_per_H.push_back(RS(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) -
+                                 (i == j ? Rp[i] : 0.0));
+      L.port_b_At_per_A.push_back(b(static_cast<Eigen::Index>(i)));
+      L.kfl_m.push_back(rc.k_f * rc.length_m);
+      L.kappa_s_m_per_H.push_back(rc.eddy_geometry_s_m_per_H);
+      L.area_m2.push_back(rc.area_m2);
+      const double He = r.H_A_per_m + rc.ja.alpha * r.M_A_per_m;
+      const double dMan = anhysteretic_slope(He, rc.MsT_ja, rc.ja.a_A_per_m);
+      const double chi = rc.ja.c * dMan / (1.0 - rc.ja.alpha * rc.ja.c * dMan);
+      L.chi.push_back(chi);
+      L.tau_s.push_back(kMu0 * (1.0 + chi) * rc.eddy_geometry_s_m_per_H);
+    }
+  }
   // Circuit: dHc/dI at fixed M (linear in I, so any step is exact), dHc/dM_j at fixed I.
-  {
+  if (!L.consistent) {
     const double dI = 1e-2;
     const auto Hp = static_fields(m, c, ws, I0 + dI, M0);
     const auto Hm = static_fields(m, c, ws, I0 - dI, M0);
     for (std::size_t i = 0; i < n; ++i) L.g_A_per_m_per_A.push_back((Hp[i] - Hm[i]) / (2 * dI));
   }
   L.G.assign(n * n, 0.0);
-  for (std::size_t j = 0; j < n; ++j) {
+  for (std::size_t j = 0; j < n && !L.consistent; ++j) {
     const double dM = 1e-5 * c.rods[j].MsT_mu;
     auto Mp = M0, Mm = M0;
     Mp[j] += dM;
@@ -156,7 +204,7 @@ SmallSignalModel linearise(const Model& m, const Conditions& c, const State& s) 
     for (std::size_t i = 0; i < n; ++i) L.G[i * n + j] = (Hp[i] - Hm[i]) / (2 * dM);
   }
   // Eddy lag (eq. 7) and JA with M_irr pinned (eq. 9): M = (1-c) M_irr + c M_an(H + alpha M).
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < n && !L.consistent; ++i) {
     const auto& rc = c.rods[i];
     const auto& r = s.rods[i];
     L.tau_s.push_back(mu_at(m, rc, r.M_A_per_m) * rc.eddy_geometry_s_m_per_H);
@@ -195,14 +243,30 @@ std::complex<double> SmallSignalModel::response(double f_Hz) const {
   const cd sj(0.0, kTwoPi * f_Hz);
   Eigen::MatrixXcd A = Eigen::MatrixXcd::Identity(N, N);
   Eigen::VectorXcd b(N);
-  for (Eigen::Index i = 0; i < N; ++i) {
-    const auto ui = static_cast<std::size_t>(i);
-    const cd lag_chi = chi[ui] / (1.0 + tau_s[ui] * sj);  // dM_i / dHc_i
-    b(i) = lag_chi * g_A_per_m_per_A[ui];
-    for (Eigen::Index j = 0; j < N; ++j)
-      A(i, j) -= lag_chi * G[ui * static_cast<std::size_t>(n) + static_cast<std::size_t>(j)];
+  Eigen::VectorXcd dM(N);
+  if (consistent) {  // port equations of the rods (see the struct), solved for dH
+    for (Eigen::Index i = 0; i < N; ++i) {
+      const auto ui = static_cast<std::size_t>(i);
+      b(i) = port_b_At_per_A[ui];
+      for (Eigen::Index j = 0; j < N; ++j) {
+        const auto uj = static_cast<std::size_t>(j);
+        A(i, j) = port_S_per_H[ui * static_cast<std::size_t>(n) + uj] * area_m2[uj] * kMu0 *
+                  (1.0 + chi[uj]);
+      }
+      A(i, i) += kfl_m[ui] * (1.0 + kappa_s_m_per_H[ui] * sj * kMu0 * (1.0 + chi[ui]));
+    }
+    const Eigen::VectorXcd dH = A.partialPivLu().solve(b);
+    for (Eigen::Index i = 0; i < N; ++i) dM(i) = chi[static_cast<std::size_t>(i)] * dH(i);
+  } else {
+    for (Eigen::Index i = 0; i < N; ++i) {
+      const auto ui = static_cast<std::size_t>(i);
+      const cd lag_chi = chi[ui] / (1.0 + tau_s[ui] * sj);  // dM_i / dHc_i
+      b(i) = lag_chi * g_A_per_m_per_A[ui];
+      for (Eigen::Index j = 0; j < N; ++j)
+        A(i, j) -= lag_chi * G[ui * static_cast<std::size_t>(n) + static_cast<std::size_t>(j)];
+    }
+    dM = A.partialPivLu().solve(b);
   }
-  const Eigen::VectorXcd dM = A.partialPivLu().solve(b);
   cd Y = 0.0;
   for (Eigen::Index i = 0; i < N; ++i) {
     const auto ui = static_cast<std::size_t>(i);
@@ -211,6 +275,9 @@ std::complex<double> SmallSignalModel::response(double f_Hz) const {
       dF += D_N_per_A_per_m[ui * static_cast<std::size_t>(n) + static_cast<std::size_t>(j)] * dM(j);
     Y += dF / (mass_kg[ui] * sj * sj + damping_N_s_per_m[ui] * sj + stiffness_N_per_m[ui]);
   }
+  if (output_stage)
+    Y *= (os_damping_N_s_per_m * sj + os_stiffness_N_per_m) /
+         (os_mass_kg * sj * sj + os_damping_N_s_per_m * sj + os_stiffness_N_per_m);
   return Y;
 }
 
@@ -365,6 +432,9 @@ FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progres
             const double zw = lin[ti].damping_N_s_per_m[i] / (2.0 * lin[ti].mass_kg[i]);
             t_settle = std::max({t_settle, 10.0 * lin[ti].tau_s[i], 10.0 / zw});
           }
+          if (lin[ti].output_stage && lin[ti].os_damping_N_s_per_m > 0)
+            t_settle = std::max(t_settle, 10.0 * 2.0 * lin[ti].os_mass_kg /
+                                              lin[ti].os_damping_N_s_per_m);
           const long settle =
               std::max<long>(r.settle_periods, static_cast<long>(std::ceil(t_settle * fr - 1e-9)));
           const long measure = r.measure_periods;

@@ -70,6 +70,13 @@ constexpr Field kElement[] = {
     {"damping_N_s_per_m", R::Positive},
 };
 
+// [mechanics.output_stage] (optional): the output head and sensor on a compliant mount.
+constexpr Field kOutputStage[] = {
+    {"mass_kg", R::Positive},
+    {"stiffness_N_per_m", R::Positive},
+    {"damping_N_s_per_m", R::NonNegative},
+};
+
 constexpr Field kSleeveModulus[] = {{"Et_Pa", R::Positive}, {"dEt_dT_Pa_per_C", R::Any}};
 
 constexpr Field kSleeve[] = {
@@ -152,6 +159,7 @@ std::span<const Field> rod_fields() { return kRod; }
 std::span<const Field> ja_fields() { return kJa; }
 std::span<const Field> element_fields() { return kElement; }
 std::span<const Field> sleeve_modulus_fields() { return kSleeveModulus; }
+std::span<const Field> output_stage_fields() { return kOutputStage; }
 std::span<const Field> sleeve_fields() { return kSleeve; }
 std::span<const Field> thermal_expansion_fields() { return kThermal; }
 std::span<const Field> branch_number_fields() { return kBranchNumbers; }
@@ -178,6 +186,7 @@ std::optional<Field> field_of(const ModelSpec& spec, const std::string& dotted) 
     if (is_rod(spec, p[0])) return find_field(kRod, p[1]);
   } else if (p.size() == 3) {
     if (p[0] == "mechanics" && p[1] == "sleeve_modulus") return find_field(kSleeveModulus, p[2]);
+    if (p[0] == "mechanics" && p[1] == "output_stage") return find_field(kOutputStage, p[2]);
     if (p[0] == "circuit" && p[1] == "reluctances_per_H") return kReluctanceField;
     if (p[1] == "ja" && is_rod(spec, p[0])) return find_field(kJa, p[2]);
   } else if (p.size() == 4) {
@@ -595,6 +604,8 @@ class Loader {
         {"stress_sign", {"compression_negative", "compression_positive"}},
         {"eq10_temperature_scale", {"room_referenced", "kelvin", "celsius"}},
         {"eq10_shape_law", {"printed", "mean_field"}},
+        {"magnetic_state", {"printed", "consistent"}},
+        {"eq11_saturation", {"temperature", "reference"}},
         {"thermal_expansion_in_output", {}},
         {"geometry_thermal_expansion", {}},
     };
@@ -865,7 +876,11 @@ class Loader {
     const auto* t = table_at(root, "mechanics", "mechanics", 1);
     if (!t) return;
     const long tl = node_line(*t);
-    check_keys(*t, "[mechanics]", {"elements", "sleeve_modulus", "sleeves", "chains"});
+    check_keys(*t, "[mechanics]",
+               {"elements", "sleeve_modulus", "sleeves", "chains", "output_stage"});
+    if (t->get("output_stage"))  // optional: absent means the sensor reads the stack output
+      read_table_fields(*t, "output_stage", "mechanics.output_stage", tl,
+                        schema::output_stage_fields());
     std::set<std::string> rods(spec_.rods.begin(), spec_.rods.end());
     bool members_ok = rods_ok_;
     if (const auto* et = table_at(*t, "elements", "mechanics.elements", tl)) {

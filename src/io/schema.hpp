@@ -38,6 +38,7 @@ std::span<const Field> rod_fields();
 std::span<const Field> ja_fields();
 std::span<const Field> element_fields();
 std::span<const Field> sleeve_modulus_fields();
+std::span<const Field> output_stage_fields();
 std::span<const Field> sleeve_fields();
 std::span<const Field> thermal_expansion_fields();
 std::span<const Field> branch_number_fields();

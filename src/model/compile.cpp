@@ -70,6 +70,31 @@ Options read_options(const Reader& r) {
   else
     r.fail(r.opt_line("eq10_shape_law"),
            fmt::format("options.eq10_shape_law = '{}': must be printed or mean_field", sl));
+  // One reference temperature per reading (issue 7): a^T proportional to T vanishes at 0 K,
+  // so Table 4's a0 can only be the T_ref value, and then k, alpha and c must be too.
+  if (o.shape_law == ShapeLaw::MeanField && o.eq10_scale != Eq10Scale::RoomReferenced)
+    r.fail(r.opt_line("eq10_shape_law"),
+           fmt::format("options.eq10_shape_law = 'mean_field' with eq10_temperature_scale = "
+                       "'{}': mixes reference temperatures (a^T = a0 T/T_ref takes Table 4 at "
+                       "T_ref, '{}' takes k0, alpha0, c0 at {}); use eq10_temperature_scale = "
+                       "'room_referenced' (docs/model.md)",
+                       sc, sc, sc == "kelvin" ? "0 K" : "0 degC"));
+  const std::string ms = r.opt("magnetic_state");
+  if (ms == "printed")
+    o.magnetic_state = MagneticState::Printed;
+  else if (ms == "consistent")
+    o.magnetic_state = MagneticState::Consistent;
+  else
+    r.fail(r.opt_line("magnetic_state"),
+           fmt::format("options.magnetic_state = '{}': must be printed or consistent", ms));
+  const std::string e11 = r.opt("eq11_saturation");
+  if (e11 == "temperature")
+    o.eq11_saturation = Eq11Saturation::Temperature;
+  else if (e11 == "reference")
+    o.eq11_saturation = Eq11Saturation::Reference;
+  else
+    r.fail(r.opt_line("eq11_saturation"),
+           fmt::format("options.eq11_saturation = '{}': must be temperature or reference", e11));
   o.thermal_expansion_in_output = r.boolean("thermal_expansion_in_output");
   o.geometry_thermal_expansion = r.boolean("geometry_thermal_expansion");
   return o;
@@ -189,6 +214,13 @@ Model compile(const ModelSpec& spec) {
     const std::string p = "mechanics.elements." + e + ".";
     m.elements.push_back(
         {e, r.num(p + "mass_kg"), r.num(p + "stiffness_N_per_m"), r.num(p + "damping_N_s_per_m")});
+  }
+  if (spec.params.count("mechanics.output_stage.mass_kg")) {
+    auto& os = m.output_stage;
+    os.enabled = true;
+    os.mass_kg = r.num("mechanics.output_stage.mass_kg");
+    os.stiffness_N_per_m = r.num("mechanics.output_stage.stiffness_N_per_m");
+    os.damping_N_s_per_m = r.num("mechanics.output_stage.damping_N_s_per_m");
   }
   m.Et_Pa = r.num("mechanics.sleeve_modulus.Et_Pa");
   m.dEt_dT_Pa_per_C = r.num("mechanics.sleeve_modulus.dEt_dT_Pa_per_C");

@@ -109,6 +109,8 @@ Conditions make_conditions(const Model& m, double temperature_C, const Freeze& f
     rc.MsT_mu = MsT(fz.permeability);
     rc.MsT_ja = MsT(fz.magnetisation);
     rc.MsT_E = MsT(fz.modulus);
+    rc.Ms_strain_A_per_m =
+        m.options.eq11_saturation == Eq11Saturation::Temperature ? rc.MsT_ja : mat.Ms_A_per_m;
     const double L0 = Lambda0(rc.sigma_Pa, mat.lambda_s, mat.sigma_lambda_Pa);  // eq. (6)
     rc.S_mu_J_per_m3 =
         stress_energy_term(rc.sigma_Pa, mat.lambda_s, L0, mat.beta_per_K, dT_if(fz.permeability));
@@ -126,6 +128,10 @@ Conditions make_conditions(const Model& m, double temperature_C, const Freeze& f
                       src, temperature_C, rod.name, inv_chi0));
     const double Tja = fz.magnetisation ? Tr : temperature_C;
     rc.ja = ja_at(m, rod.ja, Tja);  // eq. (10)
+    // Consistent magnetic state: eq. (3)'s stress and temperature terms act in the JA
+    // effective field (magnetic.hpp, magnetoelastic_coupling); frozen with mu_G.
+    rc.alpha_sigma = magnetoelastic_coupling(rc.S_mu_J_per_m3, rc.MsT_mu);
+    if (m.options.magnetic_state == MagneticState::Consistent) rc.ja.alpha += rc.alpha_sigma;
     if (!(rc.ja.a_A_per_m > 0 && rc.ja.k_A_per_m > 0 && rc.ja.c >= 0 && rc.ja.c < 1 &&
           std::isfinite(rc.ja.alpha)))
       throw InputError(fmt::format(

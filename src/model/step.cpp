@@ -32,6 +32,8 @@ inline void check(double value, double t, const std::string& rod, const char* qu
 void finish_outputs(const Model& m, const Conditions& c, State& s) {
   double y = 0.0;
   for (const auto& r : s.rods) y += r.x_m;
+  s.y_stack_m = y;  // eq. (20)
+  if (m.output_stage.enabled) y = s.z_m;
   if (m.options.thermal_expansion_in_output) y += c.thermal_expansion_m;
   s.y_m = y;
   double phi = 0.0, area = 0.0;
@@ -41,6 +43,99 @@ void finish_outputs(const Model& m, const Conditions& c, State& s) {
     area += c.rods[static_cast<std::size_t>(rod)].area_m2;
   }
   s.B_T = phi / area;
+  for (std::size_t i = 0; i < s.rods.size(); ++i)
+    s.rods[i].B_T = s.rods[i].phi_Wb / c.rods[i].area_m2;
+}
+
+// The output stage (model.hpp, OutputStageModel): m z'' + c z' + k z = c y' + k y with the
+// stack output y linear over the step, so the forcing is linear too and oscillator_step is
+// exact.
+void advance_output_stage(const OutputStageModel& o, double y0_m, double y1_m, double h_s,
+                          State& s) {
+  const double ydot = (y1_m - y0_m) / h_s;
+  const double c = o.damping_N_s_per_m, k = o.stiffness_N_per_m;
+  oscillator_step(o.mass_kg, c, k, c * ydot + k * y0_m, c * ydot + k * y1_m, h_s, s.z_m,
+                  s.z_v_m_per_s);
+}
+
+// Consistent magnetic state (docs/model.md, "Magnetic state"). At the end of the step every
+// rod i satisfies, with its own JA state (eq. 9) and the circuit (eq. 23):
+//   phi_i = A_i B_i,  B_i = mu0 (H_i + M_i(H_i)),  U_i = k_f l_i H_c,i  (eq. 7, first line)
+//   H_c,i = H_i + kappa_i dB_i/dt  (eq. 7's eddy field, trapezoidal over the step)
+// Newton's method on the rods' fields: each rod is linearised at the iterate H* (slope
+// dM/dH of ja_step) into a branch  U = R_eff phi + U_off, the circuit is solved with
+// R_eff and the MMF -U_off, and H* moves to the field that flux implies. Quadratic; damped
+// after 8 iterations (the JA slope jumps where M_irr starts or stops moving).
+// quasi_static drops the eddy term (the at-rest ramp of make_state).
+void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, double current_A,
+                                double pm_scale, double h_s, bool quasi_static, double t1) {
+  const std::size_t n = s.rods.size();
+  std::array<double, 8> H{}, M{}, Bs{}, mud{}, B0{}, e0{}, g{};
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& r = s.rods[i];
+    B0[i] = flux_density(r.H_A_per_m, r.M_A_per_m);
+    e0[i] = quasi_static ? 0.0 : r.Hc_A_per_m - r.H_A_per_m;
+    g[i] = quasi_static ? 0.0 : 2.0 * c.rods[i].eddy_geometry_s_m_per_H / h_s;
+    H[i] = quasi_static ? r.H_A_per_m : 2.0 * r.H_A_per_m - r.H_prev_A_per_m;
+    M[i] = r.M_A_per_m + (r.mu_r - 1.0) * (H[i] - r.H_A_per_m);
+  }
+  constexpr int kMaxIterations = 60;
+  double worst = 0.0;
+  int worst_rod = 0;
+  for (int it = 0;; ++it) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& rc = c.rods[i];
+      const auto& r = s.rods[i];
+      double Mirr = r.Mirr_A_per_m, Mi = r.M_A_per_m, chi = 0.0;
+      ja_step(r.H_A_per_m, H[i], rc.MsT_ja, rc.ja, Mirr, Mi, M[i], &chi);
+      M[i] = Mi;
+      Bs[i] = flux_density(H[i], Mi);
+      mud[i] = kMu0 * (1.0 + chi);
+      const double kfl = rc.k_f * rc.length_m;
+      s.rod_reluctance[i] = kfl / rc.area_m2 * (1.0 / mud[i] + g[i]);
+      s.circuit.rod_extra_mmf[i] = -kfl * (H[i] - Bs[i] / mud[i] - g[i] * B0[i] - e0[i]);
+    }
+    if (!solve_circuit(m.circuit, s.rod_reluctance, current_A, pm_scale, s.circuit, false))
+      throw DivergenceError(t1, "", "nodal matrix of the circuit", 0.0, "not positive definite");
+    worst = 0.0;
+    bool converged = true;
+    const double damping = it < 8 ? 1.0 : 0.5;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double phi = s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
+      const double dH = (phi / c.rods[i].area_m2 - Bs[i]) / mud[i];
+      if (std::fabs(dH) > worst) {
+        worst = std::fabs(dH);
+        worst_rod = static_cast<int>(i);
+      }
+      if (!(std::fabs(dH) <= 1e-7 + 1e-11 * std::fabs(H[i]))) converged = false;
+      H[i] += damping * dH;
+    }
+    if (converged) break;
+    if (it == kMaxIterations || !std::isfinite(worst)) {
+      if (worst <= 1e-3) break;  // 1 mA/m: far below anything the outputs resolve
+      throw DivergenceError(t1, m.rods[static_cast<std::size_t>(worst_rod)].name,
+                            "field H [A/m] of the consistent magnetic state", worst,
+                            "Newton's method did not converge");
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {  // commit the end-of-step state
+    const auto& rc = c.rods[i];
+    auto& r = s.rods[i];
+    double chi = 0.0;
+    ja_step(r.H_A_per_m, H[i], rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m, M[i], &chi);
+    const double B1 = flux_density(H[i], r.M_A_per_m);
+    r.Hc_A_per_m = quasi_static ? H[i]
+                                : eddy_static_field_trapezoid(r.H_A_per_m, H[i], r.Hc_A_per_m,
+                                                              B0[i], B1, rc.eddy_geometry_s_m_per_H,
+                                                              h_s);
+    r.H_prev_A_per_m = r.H_A_per_m;
+    r.H_A_per_m = H[i];
+    r.M_prev_A_per_m = r.M_A_per_m;
+    r.mu_r = 1.0 + chi;
+    r.tau_s = kMu0 * r.mu_r * rc.eddy_geometry_s_m_per_H;
+    r.phi_Wb = B1 * rc.area_m2;
+    s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])] = r.phi_Wb;
+  }
 }
 
 }  // namespace
@@ -57,11 +152,16 @@ State make_state(const Model& m, const Conditions& c, double current_A) {
   s.rod_reluctance.assign(n, 0.0);
   s.circuit.resize(m.circuit);
   s.current_A = current_A;
+  const bool consistent = m.options.magnetic_state == MagneticState::Consistent;
   // Quasi-static ramp of the total MMF from zero (demagnetised rods, no field) to its
   // value at t = 0, along the initial magnetisation curve; no eddy lag (at rest).
   const int ramp_steps = 400;
   for (int k = 1; k <= ramp_steps; ++k) {
     const double f = static_cast<double>(k) / ramp_steps;
+    if (consistent) {
+      consistent_magnetic_update(m, c, s, f * current_A, f * c.pm_scale, 1.0, true, 0.0);
+      continue;
+    }
     for (std::size_t i = 0; i < n; ++i)
       s.rod_reluctance[i] =
           detail::set_rod_permeability(m, i, c.rods[i], s.rods[i], s.rods[i].M_A_per_m, 0.0);
@@ -79,7 +179,8 @@ State make_state(const Model& m, const Conditions& c, double current_A) {
   for (std::size_t i = 0; i < n; ++i) {
     auto& r = s.rods[i];
     r.M_prev_A_per_m = r.M_A_per_m;
-    r.tau_s = r.mu_r * kMu0 * c.rods[i].eddy_geometry_s_m_per_H;
+    r.H_prev_A_per_m = r.H_A_per_m;
+    if (!consistent) r.tau_s = r.mu_r * kMu0 * c.rods[i].eddy_geometry_s_m_per_H;
     update_rod_mechanics(m.material, c.rods[i], r);
   }
   for (std::size_t i = 0; i < n; ++i) {  // static equilibrium x = F / K (eq. 15 at rest)
@@ -88,6 +189,10 @@ State make_state(const Model& m, const Conditions& c, double current_A) {
     r.x_m = r.F_N / (r.k_rod_N_per_m + r.k_load_N_per_m);
     r.v_m_per_s = 0.0;
   }
+  double y_stack = 0.0;
+  for (const auto& r : s.rods) y_stack += r.x_m;
+  s.z_m = y_stack;  // the output stage at rest on the stack
+  s.z_v_m_per_s = 0.0;
   finish_outputs(m, c, s);
   return s;
 }
@@ -97,33 +202,42 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
   const double t1 = s.t_s + h;
   const std::size_t n = s.rods.size();
 
-  // 1. Rod reluctances (eq. 2-3) at the magnetisation extrapolated to the end of the
-  //    step (M* = 2 M_n - M_{n-1}, second order), then the nodal solve (eq. 23).
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto& rc = c.rods[i];
-    auto& r = s.rods[i];
-    double Mx = 2.0 * r.M_A_per_m - r.M_prev_A_per_m;
-    const double lim = 0.999 * rc.MsT_mu;
-    Mx = Mx > lim ? lim : (Mx < -lim ? -lim : Mx);
-    s.rod_reluctance[i] = detail::set_rod_permeability(m, i, rc, r, Mx, t1);
-  }
-  if (!solve_circuit(m.circuit, s.rod_reluctance, in.current_A, c.pm_scale, s.circuit, false))
-    throw DivergenceError(t1, "", "nodal matrix of the circuit", 0.0, "not positive definite");
+  if (m.options.magnetic_state == MagneticState::Consistent) {
+    // 1-2. Circuit, eddy field and JA solved together (consistent_magnetic_update).
+    consistent_magnetic_update(m, c, s, in.current_A, c.pm_scale, h, false, t1);
+    for (std::size_t i = 0; i < n; ++i) {
+      check(s.rods[i].H_A_per_m, t1, m.rods[i].name, "H [A/m]", 1e9);
+      check(s.rods[i].M_A_per_m, t1, m.rods[i].name, "M [A/m]", 1.5 * c.rods[i].MsT_ja);
+    }
+  } else {
+    // 1. Rod reluctances (eq. 2-3) at the magnetisation extrapolated to the end of the
+    //    step (M* = 2 M_n - M_{n-1}, second order), then the nodal solve (eq. 23).
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& rc = c.rods[i];
+      auto& r = s.rods[i];
+      double Mx = 2.0 * r.M_A_per_m - r.M_prev_A_per_m;
+      const double lim = 0.999 * rc.MsT_mu;
+      Mx = Mx > lim ? lim : (Mx < -lim ? -lim : Mx);
+      s.rod_reluctance[i] = detail::set_rod_permeability(m, i, rc, r, Mx, t1);
+    }
+    if (!solve_circuit(m.circuit, s.rod_reluctance, in.current_A, c.pm_scale, s.circuit, false))
+      throw DivergenceError(t1, "", "nodal matrix of the circuit", 0.0, "not positive definite");
 
-  // 2. Per rod: static field (eq. 7), eddy lag (eq. 7), JA (eq. 9), force (eq. 11-14).
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto& rc = c.rods[i];
-    auto& r = s.rods[i];
-    const double Hc1 = detail::rod_static_field(m, i, rc, r, s.circuit);
-    r.tau_s = r.mu_r * kMu0 * rc.eddy_geometry_s_m_per_H;
-    const double H1 = first_order_lag_step(r.H_A_per_m, r.Hc_A_per_m, Hc1, h, r.tau_s);
-    const double M_guess = 2.0 * r.M_A_per_m - r.M_prev_A_per_m;  // linear extrapolation
-    r.M_prev_A_per_m = r.M_A_per_m;
-    ja_step(r.H_A_per_m, H1, rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m, M_guess);
-    r.H_A_per_m = H1;
-    r.Hc_A_per_m = Hc1;
-    check(H1, t1, m.rods[i].name, "H [A/m]", 1e9);
-    check(r.M_A_per_m, t1, m.rods[i].name, "M [A/m]", 1.5 * rc.MsT_ja);
+    // 2. Per rod: static field (eq. 7), eddy lag (eq. 7), JA (eq. 9), force (eq. 11-14).
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& rc = c.rods[i];
+      auto& r = s.rods[i];
+      const double Hc1 = detail::rod_static_field(m, i, rc, r, s.circuit);
+      r.tau_s = r.mu_r * kMu0 * rc.eddy_geometry_s_m_per_H;
+      const double H1 = first_order_lag_step(r.H_A_per_m, r.Hc_A_per_m, Hc1, h, r.tau_s);
+      const double M_guess = 2.0 * r.M_A_per_m - r.M_prev_A_per_m;  // linear extrapolation
+      r.M_prev_A_per_m = r.M_A_per_m;
+      ja_step(r.H_A_per_m, H1, rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m, M_guess);
+      r.H_A_per_m = H1;
+      r.Hc_A_per_m = Hc1;
+      check(H1, t1, m.rods[i].name, "H [A/m]", 1e9);
+      check(r.M_A_per_m, t1, m.rods[i].name, "M [A/m]", 1.5 * rc.MsT_ja);
+    }
   }
   // 3. Mechanics (eq. 15-18): each rod's oscillator, exact over the step with the force
   //    linear from F_n to F_{n+1} and the stiffness at the end of the step (which needs
@@ -141,6 +255,12 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
     oscillator_step(rc.mass_osc_kg, rc.damping_osc_N_s_per_m, K, F0[i], r.F_N, h, r.x_m,
                     r.v_m_per_s);
     check(r.x_m, t1, m.rods[i].name, "x [m]", 1.0);
+  }
+  if (m.output_stage.enabled) {
+    double y1 = 0.0;
+    for (const auto& r : s.rods) y1 += r.x_m;
+    advance_output_stage(m.output_stage, s.y_stack_m, y1, h, s);
+    check(s.z_m, t1, "output stage", "z [m]", 1.0);
   }
   s.t_s = t1;
   s.current_A = in.current_A;

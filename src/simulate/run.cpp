@@ -10,14 +10,14 @@ namespace gmasim {
 namespace {
 
 // Column layout of the recorded series: global columns, then per rod.
-constexpr int kGlobal = 5;  // t_s, current_A, y_um, B_T, xT_um
-constexpr int kPerRod = 8;  // H, M, mu_r, E_G, lambda, F, x, tau
+constexpr int kGlobal = 6;  // t_s, current_A, y_um, B_T, xT_um, y_stack_um
+constexpr int kPerRod = 9;  // H, M, mu_r, E_G, lambda, F, x, tau, B
 
 void make_columns(const Model& m, TimeSeries& ts, std::size_t reserve) {
-  ts.names = {"t_s", "current_A", "y_um", "B_T", "xT_um"};
+  ts.names = {"t_s", "current_A", "y_um", "B_T", "xT_um", "y_stack_um"};
   for (const auto& r : m.rods) {
     for (const char* q : {"_H_A_per_m", "_M_A_per_m", "_mu_r", "_E_GPa", "_lambda_ppm", "_F_N",
-                          "_x_um", "_tau_eddy_ms"})
+                          "_x_um", "_tau_eddy_ms", "_B_T"})
       ts.names.push_back(r.name + q);
   }
   ts.columns.assign(ts.names.size(), {});
@@ -31,6 +31,7 @@ void record(const Conditions& c, const State& s, TimeSeries& ts) {
   col[2].push_back(s.y_m * 1e6);
   col[3].push_back(s.B_T);
   col[4].push_back(c.thermal_expansion_m * 1e6);
+  col[5].push_back(s.y_stack_m * 1e6);
   for (std::size_t i = 0; i < s.rods.size(); ++i) {
     const auto& r = s.rods[i];
     const std::size_t b = kGlobal + i * kPerRod;
@@ -42,6 +43,7 @@ void record(const Conditions& c, const State& s, TimeSeries& ts) {
     col[b + 5].push_back(r.F_N);
     col[b + 6].push_back(r.x_m * 1e6);
     col[b + 7].push_back(r.tau_s * 1e3);
+    col[b + 8].push_back(r.B_T);
   }
 }
 

@@ -23,7 +23,7 @@ check() {  # name, expected exit code, expected text (grep -E) in stdout+stderr,
 }
 check "simulate default" 0 "stroke +[0-9.]+ um" "$B" simulate --out "$T/a"
 [[ -s "$T/a/timeseries.csv" && -s "$T/a/metrics.json" ]] && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: outputs missing"; }
-head -1 "$T/a/timeseries.csv" | grep -q '^t_s,current_A,y_um,B_T,xT_um,rod1_H_A_per_m' && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: csv header"; }
+head -1 "$T/a/timeseries.csv" | grep -q '^t_s,current_A,y_um,B_T,xT_um,y_stack_um,rod1_H_A_per_m' && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: csv header"; }
 grep -q '"stroke_um"' "$T/a/metrics.json" && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: metrics.json"; }
 ls "$T/a" | grep -q tmp && { fail=$((fail + 1)); echo "FAIL: temp files left"; } || pass=$((pass + 1))
 check "quantity stats" 0 "rod2_F_N +rms" "$B" simulate --periods 2 --quantity rod2_F_N --out "$T/q"

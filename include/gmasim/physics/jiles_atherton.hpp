@@ -121,16 +121,20 @@ inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, dou
   const double d0 = (Man0 - Mirr0) * delta, d1 = (Man1 - Mirr0) * delta;
   if (d0 <= 0.0 && d1 <= 0.0) return Mirr0;  // pinned for the whole step
   double s = std::fabs(dHe), u0 = Man0;
+  double ds_dHe1 = delta;  // d|He1 - He0| / dHe1
   if (d0 <= 0.0) {  // M_an crosses M_irr inside the step: relax over the remainder only
-    s *= d1 / (d1 - d0);
+    const double frac = d1 / (d1 - d0);
+    // d frac / dHe1 = -d0 (dd1/dHe1) / (d1 - d0)^2 with dd1/dHe1 = delta dMan1.
+    ds_dHe1 = delta * frac - s * d0 * delta * dMan1 / ((d1 - d0) * (d1 - d0));
+    s *= frac;
     u0 = Mirr0;
   }
   const double r = s / k_A_per_m;
   const LagWeights w = lag_weights(r);
   // d/dHe1 through M_an1 (weight 1 - q) and through r = s/k (dq/dr = (E - q)/r).
   const double dq_dr = r > 1e-12 ? (w.E - w.q) / r : -0.5;
-  dMirr_dHe1 =
-      (1.0 - w.q) * dMan1 + delta / k_A_per_m * (-(Mirr0 - u0) * w.E - (Man1 - u0) * dq_dr);
+  dMirr_dHe1 = (1.0 - w.q) * dMan1 +
+               ds_dHe1 / k_A_per_m * (-(Mirr0 - u0) * w.E - (Man1 - u0) * dq_dr);
   return Man1 + (Mirr0 - u0) * w.E - (Man1 - u0) * w.q;
 }
 
@@ -139,10 +143,23 @@ inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, dou
 // Newton's method with its exact derivative (H_e depends on M through alpha), M_irr1 from
 // ja_irreversible_update. M_guess is the starting point (e.g. linear extrapolation).
 // On entry M must be consistent with (H0, Mirr); on exit Mirr and M hold the values at H1.
+// If dM_dH is given it receives the differential susceptibility along the step at H1,
+//   dM1/dH1 = chi_e / (1 - alpha chi_e),  chi_e = (1-c) dM_irr1/dH_e + c dM_an/dH_e
+// (the implicit-function derivative of g; the consistent magnetic state's Newton solve
+// uses it). At H1 == H0 it is the reversible slope (M_irr pinned).
 inline void ja_step(double H0, double H1, double MsT_A_per_m, const JaCoefficients& p, double& Mirr,
-                    double& M, double M_guess) {
-  if (H1 == H0) return;
+                    double& M, double M_guess, double* dM_dH = nullptr) {
   const double inv_a = 1.0 / p.a_A_per_m;
+  auto slope = [&](double chi_e) {
+    if (dM_dH) *dM_dH = chi_e / (1.0 - p.alpha * chi_e);
+  };
+  if (H1 == H0) {
+    if (dM_dH) {
+      const LangevinValue lv = langevin_pair((H0 + p.alpha * M) * inv_a);
+      slope(p.c * MsT_A_per_m * inv_a * lv.dL);
+    }
+    return;
+  }
   const double He0 = H0 + p.alpha * M;
   const double Man0 = MsT_A_per_m * langevin(He0 * inv_a);
   const double tol = 1e-12 * MsT_A_per_m;
@@ -157,12 +174,14 @@ inline void ja_step(double H0, double H1, double MsT_A_per_m, const JaCoefficien
         ja_irreversible_update(Mirr, Man0, Man1, dMan, He1 - He0, p.k_A_per_m, dMirr);
     const double Mnew = (1.0 - p.c) * Mirr1 + p.c * Man1;
     const double g = M1 - Mnew;
+    const double chi_e = (1.0 - p.c) * dMirr + p.c * dMan;
     if (std::fabs(g) <= tol || it == 59) {
       Mirr = Mirr1;
       M = Mnew;
+      slope(chi_e);
       return;
     }
-    double dg = 1.0 - p.alpha * ((1.0 - p.c) * dMirr + p.c * dMan);
+    double dg = 1.0 - p.alpha * chi_e;
     if (dg < 0.2) dg = 0.2;  // alpha > 0 (positive feedback): damp the Newton step
     M1 -= g / dg;
   }

@@ -67,6 +67,21 @@ inline double inverse_susceptibility(double m, double chi_m, double S_J_per_m3,
   return 1.0 / (chi_m * c * c) - S_J_per_m3 / (kMu0 * MsT_A_per_m * MsT_A_per_m);
 }
 
+// Eq. (3), consistent reading (docs/model.md, "Magnetic state"): eq. (3) is the
+// differential permeability of the anhysteretic H(M) = (2 M_s/(pi chi_m)) tan(pi M/2M_s)
+// - S M/(mu0 M_s^2). Its stress and temperature terms are therefore a field alpha_sigma M
+// that adds to the JA effective field of eq. (9): H_e = H + (alpha^T + alpha_sigma) M, with
+//   alpha_sigma = S / (mu0 (M_s^T)^2)     [-]
+// (the magnetoelastic coupling of Jiles' H_sigma = (3 sigma/2 mu0) dlambda/dM has this form).
+inline double magnetoelastic_coupling(double S_J_per_m3, double MsT_A_per_m) {
+  return S_J_per_m3 / (kMu0 * MsT_A_per_m * MsT_A_per_m);
+}
+
+// Flux density of a magnetised material [T]:  B = mu0 (H + M).
+inline double flux_density(double H_A_per_m, double M_A_per_m) {
+  return kMu0 * (H_A_per_m + M_A_per_m);
+}
+
 // Eq. (3): magneto-thermo-elastic permeability mu_G^{M,T,sigma} [H/m].
 //   mu = mu0 (1 + chi)
 inline double permeability(double inverse_chi) { return kMu0 * (1.0 + 1.0 / inverse_chi); }
@@ -83,6 +98,17 @@ inline double static_field(double phi_Wb, double k_f, double mu_H_per_m, double 
 inline double eddy_time_constant(double mu_H_per_m, double r_outer_m, double r_inner_m, double k_j,
                                  double rho_ohm_m) {
   return mu_H_per_m * (r_outer_m * r_outer_m - r_inner_m * r_inner_m) / (4.0 * k_j * rho_ohm_m);
+}
+
+// Eq. (7), consistent reading: the field the circuit applies to a rod, H_c = U/(k_f l), is
+// the material's field H plus the eddy-current field, which opposes the change of flux:
+//   H_c = H + kappa dB/dt,   kappa = (r1^2 - r2^2)/(4 k_j rho)   [s m/H]
+// (kappa = eddy_time_constant(1, ...); for a linear material dB = mu dH this is eq. 7's
+// H(s) = H_c(s)/(1 + tau s) with tau = mu kappa). Trapezoidal average over a step h:
+//   (H_c0 + H_c1)/2 = (H0 + H1)/2 + kappa (B1 - B0)/h.
+inline double eddy_static_field_trapezoid(double H0, double H1, double Hc0, double B0_T,
+                                          double B1_T, double kappa_s_m_per_H, double h_s) {
+  return H1 + 2.0 * kappa_s_m_per_H * (B1_T - B0_T) / h_s - (Hc0 - H0);
 }
 
 // Eq. (8): temperature-dependent resistivity of Terfenol-D [ohm m].
