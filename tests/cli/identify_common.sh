@@ -8,8 +8,9 @@ PY=/usr/bin/python3
 rm -rf "$WORK"
 mkdir -p "$WORK"
 cd "$WORK"
-"$GMASIM" identify synthesize --out data --steps-per-period 200 --samples-per-period 100 \
+TRUTH="$SRC/tests/data/identify_fixture.toml"  # the calibrated printed reading (tests/test_identify.cpp)
+"$GMASIM" identify synthesize --model "$TRUTH" --out data --steps-per-period 200 --samples-per-period 100 \
   --noise 1 --seed 2 >/dev/null
 FIT="$SRC/examples/identify_synthetic/fit.toml"
-COMMON=(identify --data data/manifest.toml --fit "$FIT" --steps-per-period 200 --islands 2
+COMMON=(identify --model "$TRUTH" --data data/manifest.toml --fit "$FIT" --steps-per-period 200 --islands 2
         --population 12 --no-plots)

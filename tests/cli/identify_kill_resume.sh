@@ -26,7 +26,7 @@ echo "killed after the checkpoint of generation $GEN (best $BEST %)"
 # (--no-profile: the intervals are tested elsewhere; this test is about the resume.)
 "$GMASIM" "${COMMON[@]}" --generations $((GEN + 10)) --checkpoint ck.txt --checkpoint-every 5 \
   --out resumed/model.toml --resume ck.txt --quiet --no-profile
-"$PY" "$SRC/tests/cli/check_identify.py" resumed/model_report/fit_report.json --gmasim "$GMASIM" \
+"$PY" "$SRC/tests/cli/check_identify.py" resumed/model_report/fit_report.json --gmasim "$GMASIM" --truth-model "$TRUTH" \
   --resumed --not-worse-than "$BEST" --skip-params
 "$GMASIM" model check resumed/model.toml
 grep -q '^# command: gmasim identify .*--resume ck.txt' resumed/model.toml

@@ -10,7 +10,7 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 "$MPIEXEC" -np 2 --oversubscribe "$GMASIM" "${COMMON[@]}" --generations 10 \
   --out mpi/model.toml >stdout.txt 2>stderr.txt || { cat stdout.txt stderr.txt; exit 1; }
 cat stdout.txt
-"$PY" "$SRC/tests/cli/check_identify.py" mpi/model_report/fit_report.json --gmasim "$GMASIM" \
+"$PY" "$SRC/tests/cli/check_identify.py" mpi/model_report/fit_report.json --gmasim "$GMASIM" --truth-model "$TRUTH" \
   --ranks 2
 "$GMASIM" model check mpi/model.toml
 for f in fit_report.md fit_report.json convergence.csv overlay_T70_I8_f100.csv plot_fit.py; do

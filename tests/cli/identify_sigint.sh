@@ -19,12 +19,12 @@ set -e
 grep -q "interrupted: wrote the best model so far" stderr.txt
 grep -q "gmasim identify: generation" stderr.txt  # progress on stderr
 "$GMASIM" model check stopped/model.toml
-"$PY" "$SRC/tests/cli/check_identify.py" stopped/model_report/fit_report.json --gmasim "$GMASIM" \
+"$PY" "$SRC/tests/cli/check_identify.py" stopped/model_report/fit_report.json --gmasim "$GMASIM" --truth-model "$TRUTH" \
   --interrupted --max-rms 100
 BEST=$(awk '$1 == "best_f" {print $2}' ck.txt)
 GEN=$(awk '$1 == "generation" {print $2}' ck.txt)
 "$GMASIM" "${COMMON[@]}" --generations $((GEN + 5)) --checkpoint ck.txt --out resumed/model.toml \
   --resume ck.txt --no-refine --no-profile --quiet
-"$PY" "$SRC/tests/cli/check_identify.py" resumed/model_report/fit_report.json --gmasim "$GMASIM" \
+"$PY" "$SRC/tests/cli/check_identify.py" resumed/model_report/fit_report.json --gmasim "$GMASIM" --truth-model "$TRUTH" \
   --resumed --not-worse-than "$BEST" --max-rms 100 --skip-params
 echo "PASS"
