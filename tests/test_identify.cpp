@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments.hpp"
 #include "gmasim/identify.hpp"
 #include "gmasim/io.hpp"
 
@@ -428,6 +429,35 @@ TEST(Objective, WeightsAndFluxEnterTheWeightedRms) {
 }
 
 // ---- scalar targets (how the paper's claims are calibrated, issue item 7) -------------
+TEST(Identify, FrequencyResponseTargetsAreTheFrfCommandsNumbers) {
+  // frf_peak_Hz and bandwidth_Hz are gmasim frf's first resonance and -3 dB point.
+  const FitSpec fit = parse_fit_spec(R"(
+[[parameter]]
+name = "mechanics.output_stage.stiffness_N_per_m"
+lower = 3e5
+upper = 9e5
+[[target]]
+kind = "frf_peak_Hz"
+temperature_C = 20.0
+value = 1270.0
+[[target]]
+kind = "bandwidth_Hz"
+temperature_C = 70.0
+value = 2000.0
+)",
+                                     "frf.toml");
+  const Objective obj(builtin_model_spec(), MeasurementSet{}, fit, ci_objective());
+  const auto tf = obj.target_fits(obj.start_unit());
+  ASSERT_EQ(tf.size(), 2u);
+  FrfRequest r;
+  r.temperatures_C = {20, 70};
+  r.stepped_sine = false;
+  const FrfResult frf = run_frf(load_model(""), r);
+  EXPECT_DOUBLE_EQ(tf[0].simulated, frf.curves[0].first_resonance_Hz);
+  EXPECT_DOUBLE_EQ(tf[1].simulated, frf.curves[1].bandwidth_3dB_Hz);
+  EXPECT_NEAR(tf[0].simulated, 1270.0, 0.01 * 1270.0);
+}
+
 TEST(Identify, ScalarTargetsAloneCalibrateAParameter) {
   // Target: the stroke the built-in model gives at 70 degC; start chi_m 30 % off.
   ModelSpec spec = printed_spec();

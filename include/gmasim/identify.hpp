@@ -87,7 +87,9 @@ enum class TargetKind {
   HysteresisChangePct,  // the same for the hysteresis width [%]
   BppChangePct,         // the same for B p-p [%]
   RetentionPct,         // 100 stroke(T) / stroke(T_ref) [%]
-  ResonanceHz           // lowest natural frequency of eq. (15) at (T, bias current) [Hz]
+  ResonanceHz,          // lowest natural frequency of eq. (15) at (T, bias current) [Hz]
+  FrfPeakHz,            // peak of the small-signal |Y/I| at (T, bias) (FrfCurve::first_resonance_Hz) [Hz]
+  BandwidthHz           // -3 dB point of the small-signal |Y/I| at (T, bias) [Hz]
 };
 std::string target_kind_name(TargetKind k);
 

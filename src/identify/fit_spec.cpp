@@ -31,6 +31,8 @@ constexpr KindName kKinds[] = {
     {TargetKind::BppChangePct, "B_pp_change_pct", true, true},
     {TargetKind::RetentionPct, "retention_pct", true, true},
     {TargetKind::ResonanceHz, "resonance_Hz", false, false},
+    {TargetKind::FrfPeakHz, "frf_peak_Hz", false, false},
+    {TargetKind::BandwidthHz, "bandwidth_Hz", false, false},
 };
 
 std::string kind_list() {

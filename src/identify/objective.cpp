@@ -12,6 +12,7 @@
 #include <set>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments.hpp"
 #include "gmasim/identify.hpp"
 #include "gmasim/io.hpp"
 #include "gmasim/physics/magnetic.hpp"
@@ -42,6 +43,7 @@ struct SineRun {
 };
 struct ResonanceRun {
   double T, bias;
+  TargetKind kind;  // ResonanceHz, FrfPeakHz or BandwidthHz
   bool operator==(const ResonanceRun&) const = default;
 };
 
@@ -163,6 +165,15 @@ SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings
 }
 
 double lowest_resonance_Hz(const Model& m, const ResonanceRun& run) {
+  if (run.kind != TargetKind::ResonanceHz) {  // the small-signal frequency response (Fig. 15)
+    FrfRequest r;
+    r.temperatures_C = {run.T};
+    r.bias_A = run.bias;
+    r.stepped_sine = false;
+    r.threads = 1;
+    const FrfCurve& cv = run_frf(m, r).curves.at(0);
+    return run.kind == TargetKind::FrfPeakHz ? cv.first_resonance_Hz : cv.bandwidth_3dB_Hz;
+  }
   const Conditions c = make_conditions(m, run.T);
   const State st = make_state(m, c, run.bias);
   double f = std::numeric_limits<double>::infinity();
@@ -335,6 +346,8 @@ struct Objective::Impl {
       case TargetKind::RetentionPct:
         return 100.0 + change(stroke);
       case TargetKind::ResonanceHz:
+      case TargetKind::FrfPeakHz:
+      case TargetKind::BandwidthHz:
         return res[static_cast<std::size_t>(td.res_run)];
     }
     return 0.0;
@@ -481,8 +494,9 @@ Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const F
         throw InputError(located(fit.source, t.line, e.what()));
       }
     }
-    if (t.kind == TargetKind::ResonanceHz) {
-      const ResonanceRun rr{t.temperature_C, t.bias_A};
+    if (t.kind == TargetKind::ResonanceHz || t.kind == TargetKind::FrfPeakHz ||
+        t.kind == TargetKind::BandwidthHz) {
+      const ResonanceRun rr{t.temperature_C, t.bias_A, t.kind};
       const auto it = std::find(I.res_runs.begin(), I.res_runs.end(), rr);
       td.res_run = static_cast<int>(it - I.res_runs.begin());
       if (it == I.res_runs.end()) I.res_runs.push_back(rr);
