@@ -20,6 +20,7 @@ namespace {
 
 struct ReproduceArgs {
   std::string model, out = "out/reproduce", doc, python = "/usr/bin/python3";
+  std::string claims;  // claims file (data/claims.toml format); "" = the built-in claims
   std::vector<std::string> compare;  // other model files (readings) scored on the same claims
   std::string python_path = GMASIM_PYTHON_PACKAGE_DIR;
   int threads = 0;
@@ -28,9 +29,11 @@ struct ReproduceArgs {
 
 int run_reproduce_cmd(const ReproduceArgs& a) {
   const Model model = load_model(a.model);
+  const ClaimsData claims = a.claims.empty() ? builtin_claims() : load_claims(a.claims);
   ReproduceOptions o;
   o.threads = a.threads;
   o.quick = a.quick;
+  o.claims = &claims;
   ensure_output_dir(a.out);
   const bool tty = isatty(fileno(stderr)) != 0;
   const ReproduceResult r = run_reproduce(model, o, [tty](std::size_t done, std::size_t total) {
@@ -48,11 +51,12 @@ int run_reproduce_cmd(const ReproduceArgs& a) {
   }
   if (!a.doc.empty()) write_reproduction_doc(r, compared, a.doc, a.out);
   const ClaimCount n = count_claims(r.claims);
-  fmt::print("gmasim reproduce  model: {}\n  {}\n", model_label(a.model), r.model_readings);
+  fmt::print("gmasim reproduce  model: {}\n  {}\n  claims: {}\n", model_label(a.model),
+             r.model_readings, claims.source);
   fmt::print("  {} of {} applicable claims pass ({} claims); study took {:.1f} s\n", n.pass,
              n.applicable, r.claims.size(), r.wall_time_s);
-  fmt::print("  wrote {}/report.md, {}/claims.csv, {}/data/*.csv|json{}\n", a.out, a.out, a.out,
-             a.doc.empty() ? "" : ", " + a.doc);
+  fmt::print("  wrote {}/report.md, {}/claims.csv|json, {}/data/*.csv|json{}\n", a.out, a.out,
+             a.out, a.doc.empty() ? "" : ", " + a.doc);
   return 0;
 }
 
@@ -77,6 +81,9 @@ Runner add_reproduce(CLI::App& app) {
       "--compare", a->compare,
       "Also score these model files (e.g. each calibrated reading) on the claims; with --doc, "
       "adds a table of which claims each meets");
+  sub->add_option("--claims", a->claims,
+                  "Score these claims (TOML, the format of data/claims.toml: docs/claims.md) "
+                  "instead of the built-in ones");
   sub->add_flag("--no-figures", a->no_figures, "Do not render figures (no Python)");
   sub->add_option("--python", a->python, "Python interpreter that renders the figures")
       ->capture_default_str();

@@ -112,8 +112,13 @@ struct FitSpec {
 
 // A TOML file ([[parameter]] and [[target]] tables), or inline
 // "name:lower:upper[:log][,name:lower:upper...]". Throws InputError.
+// A [[target]] with `claim = "<id>"` takes its kind, value and condition from that claim
+// (gmasim/claims.hpp): of the spec's top-level `claims = "file"` (relative to the spec) if
+// it names one, else of `claims` if given, else of the built-in data/claims.toml.
+struct ClaimsData;
 FitSpec load_fit_spec(const std::string& file_or_inline);
-FitSpec parse_fit_spec(const std::string& toml_text, const std::string& source_name);
+FitSpec parse_fit_spec(const std::string& toml_text, const std::string& source_name,
+                       const ClaimsData* claims = nullptr);
 
 // =======================================================================================
 // Objective

@@ -1,10 +1,13 @@
 // `gmasim reproduce`: the whole study of the paper on one model, and the claims table
 // (READING-NOTES' list of the paper's numbers, each beside ours with a stated tolerance).
+// The claims themselves are data (data/claims.toml, gmasim/claims.hpp); score_claims
+// computes ours for each with the extractor its kind names.
 #pragma once
 
 #include <string>
 #include <vector>
 
+#include "gmasim/claims.hpp"
 #include "gmasim/experiments.hpp"
 #include "gmasim/model.hpp"
 
@@ -21,12 +24,16 @@ struct Claim {
   bool pass = false;
   bool applicable = true;   // false: needs measurements we do not have
   std::string note;         // why it passes/fails, or why it is not applicable
+  std::string kind;         // the extractor (ClaimSpec::kind)
+  ClaimCondition condition;  // where it holds (NaN fields: not part of the claim)
   double rel_diff() const;  // (ours - paper)/|paper|, NaN if not applicable
 };
 
 struct ReproduceOptions {
   int threads = 0;
   bool quick = false;  // smaller grids (tests)
+  // The claims to score; nullptr: the built-in data/claims.toml. Not owned.
+  const ClaimsData* claims = nullptr;
 };
 
 struct ReproduceResult {
@@ -56,6 +63,11 @@ struct ReproduceResult {
 ReproduceResult run_reproduce(const Model& m, const ReproduceOptions& o,
                               const ProgressFn& progress = {});
 
+// One Claim per ClaimSpec of `data`, in its order: ours from the study by the extractor of
+// the claim's kind, pass/fail by its tolerance. A condition the study did not run gives
+// ours = NaN (fail) with a note saying so.
+std::vector<Claim> score_claims(const ReproduceResult& r, const ClaimsData& data);
+
 // How many claims pass, of how many applicable.
 struct ClaimCount {
   int pass = 0, applicable = 0;
@@ -73,8 +85,9 @@ struct ComparedModel {
 // One row per applicable claim, one column per compared model ("" if none).
 std::string comparison_markdown(const std::vector<ComparedModel>& models);
 
-// The claims as a report table (columns id, claim, source, paper, ours, unit, rel_diff,
-// tolerance, result, note).
+// The claims as a report table (columns id, claim, source, kind, paper, ours, unit,
+// rel_diff, tolerance, result, pass, the condition: temperature_C, reference_temperature_C,
+// current_pp_A, frequency_Hz, amplitude_um (empty/null where not part of the claim), note).
 Report claims_report(const std::vector<Claim>& claims);
 
 // Writes DIR/report.md, DIR/claims.{csv,json}, and every experiment's data as CSV and JSON

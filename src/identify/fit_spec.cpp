@@ -7,9 +7,12 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
+#include <optional>
 #include <set>
 #include <string_view>
 
+#include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/identify.hpp"
 
@@ -124,34 +127,107 @@ FitParameter read_parameter(const toml::table& t, const std::string& src) {
   return p;
 }
 
-FitTarget read_target(const toml::table& t, const std::string& src) {
+const KindName* find_kind(std::string_view name) {
+  for (const auto& k : kKinds)
+    if (k.name == name) return &k;
+  return nullptr;
+}
+
+// A target `claim = "<id>"`: the claim's fit target (kind, value, condition) from the claims
+// data (data/claims.toml, or the spec's `claims = "file"`).
+ClaimFitTarget resolve_claim(const toml::table& t, const std::string& src,
+                             const ClaimsData& claims) {
+  const toml::node* n = t.get("claim");
+  const auto id = n->value<std::string>();
+  if (!id || id->empty())
+    throw InputError(located(src, line_of(*n), "[[target]]: claim must be a claim id (string)"));
+  const ClaimSpec* c = claims.find(*id);
+  if (!c)
+    throw InputError(located(src, line_of(*n),
+                             fmt::format("[[target]]: no claim '{}' in {}", *id, claims.source)));
+  const auto ft = claim_fit_target(*c);
+  if (!ft)
+    throw InputError(
+        located(src, line_of(*n),
+                fmt::format("[[target]]: claim '{}' (kind {}, {}:{}) has no fit target "
+                            "counterpart; claims of kind {} can be targets",
+                            *id, c->kind, claims.source, c->line, [] {
+                              std::string s;
+                              for (const auto& k : claim_kinds())
+                                if (!k.fit_target.empty()) s += (s.empty() ? "" : ", ") + k.name;
+                              return s;
+                            }())));
+  if (const toml::node* k = t.get("kind")) {
+    const auto kind = k->value<std::string>();
+    if (!kind || *kind != ft->kind)
+      throw InputError(located(
+          src, line_of(*k),
+          fmt::format("[[target]]: kind '{}' contradicts claim '{}', a {} target; leave kind out",
+                      kind ? *kind : "?", *id, ft->kind)));
+  }
+  return *ft;
+}
+
+FitTarget read_target(const toml::table& t, const std::string& src, const ClaimsData* claims) {
   check_keys(t,
-             {"kind", "label", "temperature_C", "reference_temperature_C", "current_pp_A",
+             {"kind", "claim", "label", "temperature_C", "reference_temperature_C", "current_pp_A",
               "current_min_A", "frequency_Hz", "bias_A", "value", "weight", "scale"},
              "[[target]]", src);
   FitTarget g;
   g.line = line_of(t);
-  const auto kind = t["kind"].value<std::string>();
-  const KindName* kn = nullptr;
-  for (const auto& k : kKinds)
-    if (kind && k.name == *kind) kn = &k;
+  std::optional<ClaimFitTarget> from;
+  std::string claim_id;
+  if (t.get("claim")) {
+    from = resolve_claim(t, src, claims ? *claims : builtin_claims());
+    claim_id = *t["claim"].value<std::string>();
+  }
+  const auto kind = from ? std::optional<std::string>(from->kind) : t["kind"].value<std::string>();
+  const KindName* kn = kind ? find_kind(*kind) : nullptr;
   if (!kn) {
     throw InputError(located(src, g.line,
                              fmt::format("[[target]]: kind must be one of {}{}", kind_list(),
                                          kind ? fmt::format(" (got '{}')", *kind) : "")));
   }
   g.kind = kn->kind;
+  // What a claim gives: its value and condition (NaN: the claim does not give it).
+  auto from_claim = [&](std::string_view key) {
+    if (!from) return std::numeric_limits<double>::quiet_NaN();
+    const ClaimCondition& c = from->condition;
+    if (key == "value") return from->value;
+    if (key == "temperature_C") return c.temperature_C;
+    if (key == "reference_temperature_C") return c.reference_temperature_C;
+    if (key == "current_pp_A") return c.current_pp_A;
+    if (key == "frequency_Hz") return c.frequency_Hz;
+    return std::numeric_limits<double>::quiet_NaN();
+  };
   bool f = false;
+  auto given = [&](std::string_view key, bool& found) {
+    const double c = from_claim(key);
+    const double v = number(t, key, src, found);
+    if (!std::isnan(c)) {
+      if (found) {
+        throw InputError(located(src, line_of(*t.get(key)),
+                                 fmt::format("[[target]] {}: {} comes from claim '{}' ({:g}); "
+                                             "leave it out",
+                                             kn->name, key, claim_id, c)));
+      }
+      found = true;
+      return c;
+    }
+    return v;
+  };
   auto req = [&](std::string_view key) {
-    const double v = number(t, key, src, f);
+    const double v = given(key, f);
     if (!f) {
-      throw InputError(
-          located(src, g.line, fmt::format("[[target]] {}: missing {}", kn->name, key)));
+      throw InputError(located(
+          src, g.line,
+          fmt::format("[[target]] {}: missing {}{}", kn->name, key,
+                      from ? fmt::format(" (claim '{}' does not give it)", claim_id) : "")));
     }
     return v;
   };
   auto opt = [&](std::string_view key, double def) {
-    const double v = number(t, key, src, f);
+    const double v = given(key, f);
     return f ? v : def;
   };
   g.value = req("value");
@@ -191,6 +267,7 @@ FitTarget read_target(const toml::table& t, const std::string& src) {
                   : (kn->sine ? fmt::format("{} {:g}C {:g}A {:g}Hz", kn->name, g.temperature_C,
                                             g.current_pp_A, g.frequency_Hz)
                               : fmt::format("{} {:g}C {:g}A", kn->name, g.temperature_C, g.bias_A));
+  if (from && !label) g.label = fmt::format("{} ({})", claim_id, g.label);
   return g;
 }
 
@@ -247,7 +324,8 @@ std::string target_kind_name(TargetKind k) {
   return "?";
 }
 
-FitSpec parse_fit_spec(const std::string& toml_text, const std::string& source_name) {
+FitSpec parse_fit_spec(const std::string& toml_text, const std::string& source_name,
+                       const ClaimsData* claims) {
   toml::table root;
   try {
     root = toml::parse(toml_text, std::string_view(source_name));
@@ -257,7 +335,19 @@ FitSpec parse_fit_spec(const std::string& toml_text, const std::string& source_n
   }
   FitSpec spec;
   spec.source = source_name;
-  check_keys(root, {"parameter", "target"}, "the fit spec", source_name);
+  check_keys(root, {"claims", "parameter", "target"}, "the fit spec", source_name);
+  // `claims = "file"` (relative to the spec): the claims `[[target]] claim = "<id>"` refers
+  // to, instead of the built-in data/claims.toml.
+  std::optional<ClaimsData> own_claims;
+  if (const toml::node* n = root.get("claims")) {
+    const auto path = n->value<std::string>();
+    if (!path || path->empty())
+      throw InputError(located(source_name, line_of(*n), "claims: expected a file name"));
+    std::filesystem::path p(*path);
+    if (p.is_relative()) p = std::filesystem::path(source_name).parent_path() / p;
+    own_claims = load_claims(p.string());
+    claims = &*own_claims;
+  }
   auto tables = [&](std::string_view key) {
     std::vector<const toml::table*> out;
     if (const toml::node* n = root.get(key)) {
@@ -277,7 +367,8 @@ FitSpec parse_fit_spec(const std::string& toml_text, const std::string& source_n
   };
   for (const auto* t : tables("parameter"))
     spec.parameters.push_back(read_parameter(*t, source_name));
-  for (const auto* t : tables("target")) spec.targets.push_back(read_target(*t, source_name));
+  for (const auto* t : tables("target"))
+    spec.targets.push_back(read_target(*t, source_name, claims));
   if (spec.parameters.empty())
     throw InputError(located(source_name, 1, "no [[parameter]] to fit: name at least one"));
   return spec;
