@@ -20,6 +20,7 @@
 #include "gmasim/io.hpp"
 #include "gmasim/model.hpp"
 #include "gmasim/physics/magnetic.hpp"
+#include "gmasim/reproduce.hpp"
 #include "gmasim/simulate.hpp"
 
 using namespace gmasim;
@@ -683,4 +684,61 @@ TEST(ExperimentsCli, BadRequestsExitWithCode2AndSayWhy) {
       header.rfind("temperature_C,current_pp_A,frequency_Hz,stroke_um,hysteresis_um,B_pp_T", 0),
       0u);
   std::filesystem::remove_all(dir);
+}
+
+// docs/reproduction.md explains every failing claim (issue 7, item 4): the notes file's
+// "### <id>" sections reach the page under their claim; failures without one are named.
+TEST(ReproductionDoc, FailingClaimsCarryTheirExplanations) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(::testing::TempDir()) /
+                       ("gmasim_notes_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path notes_path = dir / "notes.md";
+  std::ofstream(notes_path) << "# Why\n\nintro text, ignored\n\n### b_fails\n\nBecause eq. 8 "
+                               "rises.\nSecond line.\n\n### a_passes\n\nnot shown\n";
+  const auto notes = gmasim::load_claim_notes(notes_path.string());
+  ASSERT_EQ(notes.size(), 2u);
+  EXPECT_EQ(notes[0].first, "b_fails");
+  EXPECT_EQ(notes[0].second, "Because eq. 8 rises.\nSecond line.");
+
+  gmasim::ReproduceResult r;
+  auto claim = [](const char* id, bool pass, bool applicable) {
+    gmasim::Claim c;
+    c.id = id;
+    c.claim = std::string("claim ") + id;
+    c.pass = pass;
+    c.applicable = applicable;
+    return c;
+  };
+  r.claims = {claim("a_passes", true, true), claim("b_fails", false, true),
+              claim("c_fails", false, true), claim("d_na", false, false)};
+  EXPECT_EQ(gmasim::unexplained_failures(r.claims, notes), std::vector<std::string>{"c_fails"});
+
+  const fs::path doc = dir / "reproduction.md";
+  gmasim::write_reproduction_doc(r, {}, doc.string(), (dir / "no_out").string(), notes);
+  std::stringstream ss;
+  ss << std::ifstream(doc).rdbuf();
+  const std::string md = ss.str();
+  const auto why = md.find("## Why the failing claims fail");
+  ASSERT_NE(why, std::string::npos);
+  EXPECT_NE(md.find("### b_fails (claim b_fails)\n\nBecause eq. 8 rises.\nSecond line.", why),
+            std::string::npos);
+  EXPECT_NE(md.find("### c_fails (claim c_fails)\n\n*No explanation recorded.*", why),
+            std::string::npos);
+  EXPECT_EQ(md.find("### a_passes", why), std::string::npos);  // passing: not explained
+  EXPECT_EQ(md.find("### d_na", why), std::string::npos);      // not applicable: not a failure
+
+  // A heading without an id, or an id twice, is an error naming file:line.
+  std::ofstream(notes_path) << "### x\n\ntext\n\n### x\n";
+  try {
+    (void)gmasim::load_claim_notes(notes_path.string());
+    ADD_FAILURE() << "duplicate id accepted";
+  } catch (const gmasim::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("notes.md:5: claim 'x' is explained twice"),
+              std::string::npos)
+        << e.what();
+  }
+  std::ofstream(notes_path) << "### \n";
+  EXPECT_THROW((void)gmasim::load_claim_notes(notes_path.string()), gmasim::InputError);
+  fs::remove_all(dir);
 }

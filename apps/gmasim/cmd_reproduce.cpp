@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
 #include "gmasim/reproduce.hpp"
 
@@ -20,6 +21,7 @@ namespace {
 
 struct ReproduceArgs {
   std::string model, out = "out/reproduce", doc, python = "/usr/bin/python3";
+  std::string doc_notes;  // markdown "### <claim id>" explanations of failing claims, for --doc
   std::string claims;  // claims file (data/claims.toml format); "" = the built-in claims
   std::vector<std::string> compare;  // other model files (readings) scored on the same claims
   std::string python_path = GMASIM_PYTHON_PACKAGE_DIR;
@@ -30,6 +32,10 @@ struct ReproduceArgs {
 int run_reproduce_cmd(const ReproduceArgs& a) {
   const Model model = load_model(a.model);
   const ClaimsData claims = a.claims.empty() ? builtin_claims() : load_claims(a.claims);
+  if (!a.doc_notes.empty() && a.doc.empty())
+    throw InputError("--doc-notes " + a.doc_notes + ": explains the claims of --doc; give --doc too");
+  const auto notes = a.doc_notes.empty() ? std::vector<std::pair<std::string, std::string>>{}
+                                         : load_claim_notes(a.doc_notes);
   ReproduceOptions o;
   o.threads = a.threads;
   o.quick = a.quick;
@@ -49,12 +55,16 @@ int run_reproduce_cmd(const ReproduceArgs& a) {
     const ReproduceResult o2 = run_reproduce(other, o);
     compared.push_back({std::filesystem::path(path).stem().string(), o2.model_readings, o2.claims});
   }
-  if (!a.doc.empty()) write_reproduction_doc(r, compared, a.doc, a.out);
+  if (!a.doc.empty()) write_reproduction_doc(r, compared, a.doc, a.out, notes);
   const ClaimCount n = count_claims(r.claims);
   fmt::print("gmasim reproduce  model: {}\n  {}\n  claims: {}\n", model_label(a.model),
              r.model_readings, claims.source);
   fmt::print("  {} of {} applicable claims pass ({} claims); study took {:.1f} s\n", n.pass,
              n.applicable, r.claims.size(), r.wall_time_s);
+  if (!a.doc.empty())
+    for (const auto& id : unexplained_failures(r.claims, notes))
+      fmt::print(stderr, "gmasim reproduce: warning: failing claim {} has no explanation{}\n", id,
+                 a.doc_notes.empty() ? " (--doc-notes)" : " in " + a.doc_notes);
   fmt::print("  wrote {}/report.md, {}/claims.csv|json, {}/data/*.csv|json{}\n", a.out, a.out,
              a.out, a.doc.empty() ? "" : ", " + a.doc);
   return 0;
@@ -74,6 +84,9 @@ Runner add_reproduce(CLI::App& app) {
   sub->add_option(
       "--doc", a->doc,
       "Also write this markdown page (e.g. docs/reproduction.md) with the claims table");
+  sub->add_option("--doc-notes", a->doc_notes,
+                  "With --doc: markdown whose '### <claim id>' sections explain failing claims "
+                  "(e.g. docs/failing_claims.md); each failing claim's explanation goes into the page");
   sub->add_option("--threads", a->threads, "Worker threads for the sweeps [-]; 0 = all cores")
       ->capture_default_str();
   sub->add_flag("--quick", a->quick, "Smaller grids (for tests)");

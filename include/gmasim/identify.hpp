@@ -355,6 +355,9 @@ struct FitProvenance {
 
 // The start model's text with each fitted value replaced and its provenance comment set;
 // a header names the data, the command and the fit. Re-parsed and checked before return.
+// The output describes this one run: when the start is itself an identify output, its
+// header and its 'identified:' comments are replaced, not nested (the original provenance
+// of each value is kept).
 std::string fitted_model_toml(const std::string& start_text, const ModelSpec& start,
                               const IdentifyResult& r, const FitProvenance& p);
 std::string fit_report_json(const IdentifyResult& r, const FitProvenance& p);

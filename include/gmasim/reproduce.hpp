@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "gmasim/claims.hpp"
@@ -100,7 +101,20 @@ std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
 
 // The committed page (docs/reproduction.md): the claims table, the compared readings, and
 // the figures of out_dir (copied next to the page). Written atomically.
+// Explanations of failing claims, keyed by claim id: a markdown file whose "### <id>"
+// headings each open one explanation (the text up to the next "### " heading or the end).
+// Text before the first heading is ignored. Throws InputError naming file:line for a
+// heading without an id or an id given twice.
+std::vector<std::pair<std::string, std::string>> load_claim_notes(const std::string& path);
+
+// The ids of the failing applicable claims that `notes` does not explain.
+std::vector<std::string> unexplained_failures(
+    const std::vector<Claim>& claims, const std::vector<std::pair<std::string, std::string>>& notes);
+
+// docs/reproduction.md: the claims table, the compared readings, the figures and, for every
+// failing claim, its explanation from `notes` (or "no explanation recorded").
 void write_reproduction_doc(const ReproduceResult& r, const std::vector<ComparedModel>& compared,
-                            const std::string& doc_path, const std::string& out_dir);
+                            const std::string& doc_path, const std::string& out_dir,
+                            const std::vector<std::pair<std::string, std::string>>& notes = {});
 
 }  // namespace gmasim

@@ -52,6 +52,63 @@ def save(fig, directory, stem: str) -> list[pathlib.Path]:
     return out
 
 
+# ---- the paper's numbers beside ours (issue 7, item 6) ------------------------------------
+# A claim row is one row of claims.json (`gmasim reproduce`): id, kind, paper, ours, pass,
+# result and the condition (temperature_C, reference_temperature_C, current_pp_A,
+# frequency_Hz, amplitude_um). Figures mark the paper's value as a diamond: green edge when
+# the claim passes, red edge and the claim id when it fails.
+
+PASS_COLOR, FAIL_COLOR = "#1a9641", "#d7191c"
+
+
+def read_claims(path) -> list[dict]:
+    """The claim rows of a claims.json written by `gmasim reproduce`."""
+    import json
+
+    with open(path) as f:
+        return json.load(f)["tables"]["claims"]["rows"]
+
+
+def _claims_of(claims, kind, **cond):
+    """Applicable claims of one kind whose condition matches every given value."""
+    out = []
+    for c in claims or ():
+        if c.get("kind") != kind or c.get("result") == "n/a" or c.get("paper") is None:
+            continue
+        if all(c.get(k) is not None and np.isclose(c[k], v) for k, v in cond.items() if v is not None):
+            out.append(c)
+    return out
+
+
+def _mark_paper(ax, x, y, claim, label_text=None):
+    """The paper's value of one claim at (x, y): a diamond, its edge the pass/fail colour."""
+    if not (np.isfinite(x) and np.isfinite(y)):
+        return
+    ok = bool(claim.get("pass"))
+    col = PASS_COLOR if ok else FAIL_COLOR
+    ax.plot([x], [y], "D", ms=7, mfc="white", mec=col, mew=1.8, zorder=5)
+    if not ok or label_text:
+        ax.annotate(label_text or f"✗ {claim['id']}", (x, y), xytext=(4, 4), textcoords="offset points",
+                    fontsize=6.5, color=col)
+
+
+def _paper_legend(ax):
+    from matplotlib.lines import Line2D
+
+    h, lab = ax.get_legend_handles_labels()
+    h += [Line2D([], [], ls="", marker="D", mfc="white", mec=PASS_COLOR, mew=1.8),
+          Line2D([], [], ls="", marker="D", mfc="white", mec=FAIL_COLOR, mew=1.8)]
+    lab += ["paper (claim passes)", "paper (claim fails)"]
+    return h, lab
+
+
+def _value_at(cols, y, **cond):
+    sel = np.ones(len(cols["temperature_C"]), dtype=bool)
+    for k, v in cond.items():
+        sel &= np.isclose(cols[k], v)
+    return float(np.mean(cols[y][sel])) if np.any(sel) else np.nan
+
+
 def _temperature_colors(temps):
     temps = np.asarray(sorted(set(np.round(temps, 9))))
     norm = matplotlib.colors.Normalize(vmin=temps.min(), vmax=max(temps.max(), temps.min() + 1e-9))
@@ -85,8 +142,11 @@ def hysteresis_loops(loops: Columns, title="Hysteresis loops coloured by tempera
 
 
 def sweep_vs_temperature(sweep: Columns, frequency_Hz: float | None = None,
-                         title="Stroke, hysteresis and flux density against temperature"):
-    """Columns temperature_C, current_pp_A, frequency_Hz, stroke_um, hysteresis_um, B_pp_T."""
+                         title="Stroke, hysteresis and flux density against temperature", claims=None):
+    """Columns temperature_C, current_pp_A, frequency_Hz, stroke_um, hysteresis_um, B_pp_T.
+
+    With `claims` (rows of claims.json), the paper's drops 20 -> 70 degC (Fig. 12-14) are
+    marked at our 20 degC value times (1 - paper drop)."""
     f = sweep["frequency_Hz"]
     if frequency_Hz is None:
         frequency_Hz = float(np.min(f))
@@ -96,19 +156,31 @@ def sweep_vs_temperature(sweep: Columns, frequency_Hz: float | None = None,
               for I in sorted(set(sweep["current_pp_A"][sel_f]))]
     for ax, key in zip(axes, ("stroke_um", "hysteresis_um", "B_pp_T")):
         _plot_vs_temperature(ax, sweep, key, groups)
+    for ax, key, kind in zip(axes, ("stroke_um", "hysteresis_um", "B_pp_T"),
+                             ("stroke_drop_pct", "hysteresis_drop_pct", "flux_drop_pct")):
+        for c in _claims_of(claims, kind, frequency_Hz=frequency_Hz):
+            ref = _value_at(sweep, key, temperature_C=c["reference_temperature_C"],
+                            current_pp_A=c["current_pp_A"], frequency_Hz=frequency_Hz)
+            _mark_paper(ax, c["temperature_C"], ref * (1.0 - c["paper"] / 100.0), c)
     for ax, lab in zip(axes, ("stroke (µm)", "hysteresis (µm)", "flux density B, peak-to-peak (T)")):
         ax.set_xlabel("temperature (°C)")
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3)
-        ax.legend(title="current p-p", fontsize=8)
+        if claims:
+            ax.legend(*_paper_legend(ax), title="current p-p", fontsize=7)
+        else:
+            ax.legend(title="current p-p", fontsize=8)
     fig.suptitle(f"{title} ({frequency_Hz:g} Hz)")
     fig.tight_layout()
     return fig
 
 
-def bode(frf: Columns, title="Frequency response, current to displacement"):
+def bode(frf: Columns, title="Frequency response, current to displacement", claims=None):
     """Columns temperature_C, frequency_Hz, stepped_mag_um_per_A, stepped_phase_deg,
-    linear_mag_um_per_A, linear_phase_deg (NaN where a method was not run)."""
+    linear_mag_um_per_A, linear_phase_deg (NaN where a method was not run).
+
+    With `claims`, the paper's first resonance (Fig. 15) is marked on our curve at its
+    temperature, and its bandwidth bounds as vertical lines coloured pass/fail."""
     temps, norm, cmap = _temperature_colors(frf["temperature_C"])
     freq = frf["frequency_Hz"] if "frequency_Hz" in frf else frf["f_Hz"]
     fig, (am, ap) = plt.subplots(2, 1, figsize=(6.8, 6), sharex=True)
@@ -123,8 +195,23 @@ def bode(frf: Columns, title="Frequency response, current to displacement"):
             am.loglog(f, frf["stepped_mag_um_per_A"][sel], "o", ms=3.5, mfc="none", color=c,
                       label=f"{T:g} °C, stepped sine")
             ap.semilogx(f, frf["stepped_phase_deg"][sel], "o", ms=3.5, mfc="none", color=c)
-    am.axvline(1270, color="gray", ls=":", lw=1)
-    am.text(1270, am.get_ylim()[0], " paper: 1270 Hz", color="gray", fontsize=7, va="bottom")
+    if claims:
+        mag = np.where(np.isfinite(frf["linear_mag_um_per_A"]), frf["linear_mag_um_per_A"],
+                       frf["stepped_mag_um_per_A"])
+        for c in _claims_of(claims, "first_resonance_Hz"):
+            sel = np.isclose(frf["temperature_C"], c["temperature_C"])
+            if np.any(sel):
+                order = np.argsort(freq[sel])
+                y = float(np.interp(c["paper"], freq[sel][order], mag[sel][order]))
+                _mark_paper(am, c["paper"], y, c, None if not c.get("pass") else f"paper: {c['paper']:g} Hz")
+        for c in _claims_of(claims, "bandwidth_Hz"):
+            col = PASS_COLOR if c.get("pass") else FAIL_COLOR
+            am.axvline(c["paper"], color=col, ls=":", lw=1)
+            am.text(c["paper"], am.get_ylim()[0], f" {c['id']}: > {c['paper']:g} Hz" +
+                    ("" if c.get("pass") else " ✗"), color=col, fontsize=6.5, va="bottom", rotation=90)
+    else:
+        am.axvline(1270, color="gray", ls=":", lw=1)
+        am.text(1270, am.get_ylim()[0], " paper: 1270 Hz", color="gray", fontsize=7, va="bottom")
     am.set_ylabel("|Y/I| (µm/A)")
     ap.set_ylabel("phase (°)")
     ap.set_xlabel("frequency (Hz)")
@@ -136,38 +223,56 @@ def bode(frf: Columns, title="Frequency response, current to displacement"):
     return fig
 
 
-def tracking_error(track: Columns, title="Closed-loop tracking error against temperature"):
-    """Columns temperature_C, amplitude_um, frequency_Hz, error_rms_um."""
+def tracking_error(track: Columns, title="Closed-loop tracking error against temperature", claims=None):
+    """Columns temperature_C, amplitude_um, frequency_Hz, error_rms_um.
+
+    With `claims`, the paper's error growth 20 -> 70 degC (Fig. 16) is marked at our 20 degC
+    error times (1 + paper growth)."""
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     refs = sorted(set(zip(track["amplitude_um"], track["frequency_Hz"])), key=lambda r: (r[1], r[0]))
     _plot_vs_temperature(ax, track, "error_rms_um",
                          [(np.isclose(track["amplitude_um"], A) & np.isclose(track["frequency_Hz"], f),
                            f"{A:g} µm, {f:g} Hz") for A, f in refs])
     ax.set_xlabel("temperature (°C)")
+    for c in _claims_of(claims, "track_error_growth_pct"):
+        ref = _value_at(track, "error_rms_um", temperature_C=c["reference_temperature_C"],
+                        amplitude_um=c["amplitude_um"], frequency_Hz=c["frequency_Hz"])
+        _mark_paper(ax, c["temperature_C"], ref * (1.0 + c["paper"] / 100.0), c)
     ax.set_ylabel("RMS tracking error (µm)")
     ax.set_title(title)
     ax.grid(alpha=0.3)
-    ax.legend(title="reference", fontsize=8)
+    if claims:
+        ax.legend(*_paper_legend(ax), title="reference", fontsize=7)
+    else:
+        ax.legend(title="reference", fontsize=8)
     return fig
 
 
-def retention(ret: Columns, title="Stroke retention against temperature (10 Hz)"):
-    """Columns current_pp_A, temperature_C, stroke_retention_pct."""
+def retention(ret: Columns, title="Stroke retention against temperature (10 Hz)", claims=None):
+    """Columns current_pp_A, temperature_C, stroke_retention_pct. With `claims`, the
+    paper's retention (section 4.4.4) is marked per current."""
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     _plot_vs_temperature(ax, ret, "stroke_retention_pct",
                          [(np.isclose(ret["current_pp_A"], I), f"{I:g} A") for I in sorted(set(ret["current_pp_A"]))])
     ax.axhline(70, color="gray", ls=":", lw=1)
     ax.text(ax.get_xlim()[0], 70, " paper: ≈70 % at 150 °C", color="gray", fontsize=7, va="bottom")
+    for c in _claims_of(claims, "stroke_retention_pct"):
+        _mark_paper(ax, c["temperature_C"], c["paper"], c)
     ax.set_xlabel("temperature (°C)")
     ax.set_ylabel("stroke / stroke at 20 °C (%)")
     ax.set_title(title)
     ax.grid(alpha=0.3)
-    ax.legend(title="current p-p", fontsize=8)
+    if claims:
+        ax.legend(*_paper_legend(ax), title="current p-p", fontsize=7)
+    else:
+        ax.legend(title="current p-p", fontsize=8)
     return fig
 
 
-def params_vs_temperature(p: Columns, title="Model parameters against temperature (8 A, 10 Hz)"):
-    """Columns temperature_C, rod (name), mu_r_mean, rho_ohm_m, M_peak_A_per_m, E_G_mean_GPa, E_t_GPa."""
+def params_vs_temperature(p: Columns, title="Model parameters against temperature (8 A, 10 Hz)", claims=None):
+    """Columns temperature_C, rod (name), mu_r_mean, rho_ohm_m, M_peak_A_per_m, E_G_mean_GPa, E_t_GPa.
+    With `claims`, the paper's E_G rise (section 4.4.4) is marked at the rods' mean E_G at
+    20 degC times (1 + rise)."""
     panels = [("mu_r_mean", "μ_G/μ0, mean (-)"), ("rho_ohm_m", "ρ_G (Ω m)"),
               ("M_peak_A_per_m", "M_G, peak (A/m)"), ("E_G_mean_GPa", "E_G, mean (GPa)"),
               ("E_t_GPa", "E_t (GPa)")]
@@ -177,6 +282,11 @@ def params_vs_temperature(p: Columns, title="Model parameters against temperatur
         ax.set_xlabel("temperature (°C)")
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3)
+    for c in _claims_of(claims, "EG_rise_pct"):
+        ref = _value_at(p, "E_G_mean_GPa", temperature_C=c["reference_temperature_C"])
+        _mark_paper(axes[3], c["temperature_C"], ref * (1.0 + c["paper"] / 100.0), c)
+    if claims:
+        axes[3].legend(*_paper_legend(axes[3]), fontsize=7)
     axes[0].legend(fontsize=8)
     fig.suptitle(title)
     fig.tight_layout()
@@ -205,4 +315,40 @@ def ablation(ab: Columns, laws: Sequence[str] | None = None,
     ax.set_title(title)
     ax.grid(alpha=0.3, axis="y")
     ax.legend(title="excitation (6 A, 70 °C)", fontsize=8)
+    return fig
+
+
+def claims_overview(claims: Sequence[dict], title="The paper's claims: ours against the paper"):
+    """One row per applicable claim of claims.json: ours / paper on a log axis (1 = the
+    paper), green when the claim passes, red when it fails; rankings and bounds without a
+    number are listed with their result."""
+    rows = [c for c in claims if c.get("result") != "n/a"]
+    fig, ax = plt.subplots(figsize=(7.4, 0.26 * len(rows) + 1.4))
+    y = np.arange(len(rows))[::-1]
+    for yi, c in zip(y, rows):
+        col = PASS_COLOR if c.get("pass") else FAIL_COLOR
+        paper, ours = c.get("paper"), c.get("ours")
+        if paper is not None and ours is not None and np.isfinite(paper) and paper != 0 and np.isfinite(ours):
+            r = ours / paper
+            r = r if r > 0 else np.nan
+            if np.isfinite(r):
+                rc = min(max(r, 0.1), 10.0)  # off the axis: an arrow at its edge and the ratio
+                ax.plot([1.0, rc], [yi, yi], "-", color=col, lw=1.2)
+                ax.plot([rc], [yi], "o" if rc == r else (">" if r > 1 else "<"), color=col, ms=5)
+                if rc != r:
+                    ax.text(rc, yi + 0.25, f"×{r:.3g} ", color=col, fontsize=6.5, ha="right" if r > 1 else "left")
+                continue
+        ax.text(1.0, yi, f" {c.get('result')}: {c.get('tolerance', '')}", color=col, fontsize=6.5,
+                va="center")
+    ax.axvline(1.0, color="black", lw=0.8)
+    ax.set_xscale("log")
+    ax.set_xlim(0.1, 10.0)
+    ax.set_yticks(y, [f"{'✓' if c.get('pass') else '✗'} {c['id']}" for c in rows], fontsize=7)
+    for t, c in zip(ax.get_yticklabels(), rows):
+        t.set_color(PASS_COLOR if c.get("pass") else FAIL_COLOR)
+    npass = sum(1 for c in rows if c.get("pass"))
+    ax.set_xlabel("ours / paper (log; 1 = the paper's number)")
+    ax.set_title(f"{title}: {npass} of {len(rows)} pass")
+    ax.grid(alpha=0.3, axis="x", which="both")
+    fig.tight_layout()
     return fig

@@ -1,5 +1,6 @@
 """Figures are readable without explanation: units on axes, legends, titles; PNG and SVG."""
 import numpy as np
+import pytest
 
 import gmasim
 from gmasim import plots
@@ -64,3 +65,73 @@ def test_sweep_bode_tracking_retention_params_ablation_figures(tmp_path):
     _check_axes(fig)
     plots.save(fig, tmp_path, "ablate")
     assert (tmp_path / "ablate.svg").read_text().startswith("<?xml")
+
+
+def _claim(id_, kind, paper, passed, **cond):
+    row = {"id": id_, "kind": kind, "paper": paper, "ours": None, "pass": passed,
+           "result": "pass" if passed else "fail", "tolerance": "within 3 pp of the paper",
+           "temperature_C": None, "reference_temperature_C": None, "current_pp_A": None,
+           "frequency_Hz": None, "amplitude_um": None}
+    row.update(cond)
+    return row
+
+
+def _diamonds(ax):
+    """(x, y, edge colour) of every paper marker on an axes."""
+    out = []
+    for line in ax.get_lines():
+        if line.get_marker() == "D" and len(line.get_xdata()) == 1:
+            out.append((float(line.get_xdata()[0]), float(line.get_ydata()[0]), line.get_markeredgecolor()))
+    return out
+
+
+def test_paper_markers_sit_at_the_papers_number_and_flag_failures():
+    # Our 20 degC values: stroke 50 um at 6 A, 80 um at 8 A. The paper's drop 20 -> 70 degC
+    # (11.3 %, 12.6 %) puts its 70 degC stroke at 50 (1 - 0.113) and 80 (1 - 0.126).
+    sweep = {"temperature_C": np.array([20.0, 70.0, 20.0, 70.0]),
+             "current_pp_A": np.array([6.0, 6.0, 8.0, 8.0]),
+             "frequency_Hz": np.full(4, 10.0),
+             "stroke_um": np.array([50.0, 44.0, 80.0, 60.0]),
+             "hysteresis_um": np.array([10.0, 7.5, 12.0, 9.0]),
+             "B_pp_T": np.array([0.3, 0.29, 0.4, 0.38])}
+    cond = dict(temperature_C=70.0, reference_temperature_C=20.0, frequency_Hz=10.0)
+    claims = [_claim("stroke_drop_6A", "stroke_drop_pct", 11.3, True, current_pp_A=6.0, **cond),
+              _claim("stroke_drop_8A", "stroke_drop_pct", 12.6, False, current_pp_A=8.0, **cond),
+              _claim("flux_drop_6A", "flux_drop_pct", 5.6, True, current_pp_A=6.0, **cond),
+              _claim("na", "stroke_drop_pct", 1.0, False, current_pp_A=6.0, **cond) | {"result": "n/a"}]
+    fig = plots.sweep_vs_temperature(sweep, 10.0, claims=claims)
+    stroke, hyst, flux = fig.axes
+    got = sorted(_diamonds(stroke))
+    assert len(got) == 2  # the n/a claim is not drawn
+    assert got[0][:2] == pytest.approx((70.0, 50.0 * (1 - 0.113)), rel=1e-12)
+    assert got[1][:2] == pytest.approx((70.0, 80.0 * (1 - 0.126)), rel=1e-12)
+    assert got[0][2] == plots.PASS_COLOR and got[1][2] == plots.FAIL_COLOR
+    assert any("stroke_drop_8A" in t.get_text() for t in stroke.texts)  # the failure is named
+    assert not any("stroke_drop_6A" in t.get_text() for t in stroke.texts)
+    assert _diamonds(hyst) == []
+    assert _diamonds(flux)[0][:2] == pytest.approx((70.0, 0.3 * (1 - 0.056)), rel=1e-12)
+    _check_axes(fig)
+
+    # Tracking: the paper's growth 30 % over our 20 degC error of 2 um -> 2.6 um at 70 degC.
+    track = {"temperature_C": np.array([20.0, 70.0]), "amplitude_um": np.array([10.0, 10.0]),
+             "frequency_Hz": np.array([10.0, 10.0]), "error_rms_um": np.array([2.0, 2.1])}
+    fig = plots.tracking_error(track, claims=[
+        _claim("track_growth_10um_10Hz", "track_error_growth_pct", 30.0, False, temperature_C=70.0,
+               reference_temperature_C=20.0, amplitude_um=10.0, frequency_Hz=10.0)])
+    assert _diamonds(fig.axes[0]) == [(70.0, pytest.approx(2.6, rel=1e-12), plots.FAIL_COLOR)]
+
+
+def test_claims_overview_counts_and_colours_every_applicable_claim():
+    claims = [_claim("a", "stroke_drop_pct", 10.0, True) | {"ours": 11.0},
+              _claim("b", "first_resonance_Hz", 1270.0, False) | {"ours": 500.0},
+              _claim("c", "param_change_pct", float("nan"), False) | {"ours": float("nan")},
+              _claim("d", "resonance_shift_pct", 0.17, False) | {"ours": 3.4},  # off the axis
+              _claim("e", "stroke_um", 1.0, False) | {"result": "n/a"}]
+    fig = plots.claims_overview(claims)
+    ax = fig.axes[0]
+    assert "2 of 4 pass" not in ax.get_title() and "1 of 4 pass" in ax.get_title()
+    labels = [t.get_text() for t in ax.get_yticklabels()]
+    assert labels == ["✓ a", "✗ b", "✗ c", "✗ d"]
+    dots = {round(float(l.get_xdata()[0]), 9) for l in ax.get_lines() if len(l.get_xdata()) == 1}
+    assert 1.1 in dots and round(500.0 / 1270.0, 9) in dots and 10.0 in dots  # d clipped at 10
+    assert any("×20" in t.get_text() for t in ax.texts)  # 3.4 / 0.17 = 20, written out

@@ -7,7 +7,8 @@ def test_reproduce_quick_writes_report_figures_and_claims(gmasim_bin, tmp_path):
     out = tmp_path / "rep"
     subprocess.run([gmasim_bin, "reproduce", "--quick", "--out", str(out)], check=True, capture_output=True)
     report = (out / "report.md").read_text()
-    for stem in ("loops_8A_10Hz", "sweep_10Hz", "frf", "track", "retention", "params_vs_temperature", "ablate"):
+    for stem in ("claims", "loops_8A_10Hz", "sweep_10Hz", "frf", "track", "retention", "params_vs_temperature",
+                 "ablate"):
         assert (out / "figures" / f"{stem}.png").stat().st_size > 5000, stem
         assert (out / "figures" / f"{stem}.svg").exists(), stem
         assert f"figures/{stem}.png" in report, stem

@@ -84,6 +84,38 @@ std::string wald_text(const FittedParameter& p) {
   return fmt::format("[{:.4g}, {:.4g}]", p.wald_low, p.wald_high);
 }
 
+// The provenance of a value before any identify run: a comment "identified: ...; was V (P)"
+// written by an earlier run gives P (recursively), "identified: ..." alone gives "". One run
+// then describes itself and the parameter's original source, never earlier runs.
+std::string original_provenance(std::string c) {
+  while (c.starts_with("identified:")) {
+    const auto was = c.find("; was ");
+    if (was == std::string::npos) return "";
+    const auto open = c.find(" (", was + 6);
+    if (open == std::string::npos || c.back() != ')') return "";
+    c = c.substr(open + 2, c.size() - open - 3);
+  }
+  return c;
+}
+
+// How many leading lines of a model file are the header an earlier identify run wrote
+// ("# Calibrated by `gmasim identify` ..." through the "#" line after "# Fitted values carry
+// ..."), repeated headers included.
+std::size_t earlier_run_header_lines(const std::vector<std::string>& lines) {
+  std::size_t n = 0;
+  while (n < lines.size() && lines[n].starts_with("# Calibrated by `gmasim identify`")) {
+    std::size_t k = n;
+    while (k < lines.size() && lines[k].starts_with("#") &&
+           !lines[k].starts_with("# Fitted values carry an 'identified:'"))
+      ++k;
+    if (k == lines.size() || !lines[k].starts_with("# Fitted values carry")) break;
+    ++k;
+    if (k < lines.size() && lines[k] == "#") ++k;
+    n = k;
+  }
+  return n;
+}
+
 std::string data_label(const IdentifyResult& r, const FitProvenance& p) {
   if (!p.data.empty()) return fmt::format("{} ({} files)", p.data, r.conditions.size());
   return "scalar targets only";
@@ -125,7 +157,7 @@ std::string fitted_model_toml(const std::string& start_text, const ModelSpec& st
     while (vend < line.size() &&
            std::string_view(" \t,}#").find(line[vend]) == std::string_view::npos)
       ++vend;
-    const std::string old_comment = schema::trailing_comment(line);
+    const std::string old_comment = original_provenance(schema::trailing_comment(line));
     const bool simple = line.find('{') == std::string::npos;
     std::string ci = ci_text(fp);
     if (ci.front() == '[') ci = "95 % CI " + ci;
@@ -156,7 +188,8 @@ std::string fitted_model_toml(const std::string& start_text, const ModelSpec& st
                       p.report_dir.empty() ? "" : fmt::format("; report: {}", p.report_dir));
   head += "# Fitted values carry an 'identified:' provenance comment.\n#\n";
   std::string text = head;
-  for (const auto& l : lines) text += l + "\n";
+  for (std::size_t i = earlier_run_header_lines(lines); i < lines.size(); ++i)
+    text += lines[i] + "\n";
 
   // The file must load and carry exactly the fitted values.
   const ModelSpec check = parse_model_spec(text, "fitted model");

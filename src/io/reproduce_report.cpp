@@ -9,6 +9,7 @@
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
 #include "gmasim/reproduce.hpp"
+#include "text_io.hpp"
 
 namespace gmasim {
 namespace {
@@ -67,6 +68,7 @@ std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
       "## Claims\n\nOne row per number of the paper that READING-NOTES lists, beside ours "
       "(`claims.csv`, `claims.json`).\n\n";
   md += claims_markdown(r.claims);
+  md += fig("claims", "Every applicable claim: ours / paper, green when it passes, red when it fails");
   md += "\n## Temperature sweep at 10 Hz (Fig. 12-14)\n\n";
   md += fig("loops_8A_10Hz", "Hysteresis loops y(I) at 8 A, 10 Hz, coloured by temperature");
   md += fig("sweep_10Hz", "Stroke, hysteresis and flux density against temperature, 10 Hz");
@@ -108,8 +110,57 @@ std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
   return md;
 }
 
+std::vector<std::pair<std::string, std::string>> load_claim_notes(const std::string& path) {
+  const std::string text = io_detail::read_text_file(path, "claim notes");
+  std::vector<std::pair<std::string, std::string>> notes;
+  std::size_t pos = 0;
+  int line_no = 0;
+  bool in_note = false;
+  while (pos < text.size()) {
+    const std::size_t end = std::min(text.find('\n', pos), text.size());
+    const std::string_view line(text.data() + pos, end - pos);
+    pos = end + 1;
+    ++line_no;
+    if (line.starts_with("### ")) {
+      const std::string id(io_detail::trim(line.substr(4)));
+      if (id.empty() || id.find_first_of(" \t") != std::string::npos)
+        throw InputError(fmt::format("{}:{}: a '### ' heading must name one claim id, got '{}'",
+                                     path, line_no, id));
+      for (const auto& n : notes)
+        if (n.first == id)
+          throw InputError(
+              fmt::format("{}:{}: claim '{}' is explained twice", path, line_no, id));
+      notes.emplace_back(id, std::string());
+      in_note = true;
+    } else if (in_note) {
+      notes.back().second += std::string(line) + "\n";
+    }
+  }
+  for (auto& n : notes) {
+    const auto last = n.second.find_last_not_of(" \t\r\n");
+    n.second.erase(last == std::string::npos ? 0 : last + 1);
+    const auto first = n.second.find_first_not_of(" \t\r\n");
+    n.second.erase(0, first == std::string::npos ? n.second.size() : first);
+  }
+  return notes;
+}
+
+std::vector<std::string> unexplained_failures(
+    const std::vector<Claim>& claims,
+    const std::vector<std::pair<std::string, std::string>>& notes) {
+  std::vector<std::string> out;
+  for (const auto& c : claims) {
+    if (!c.applicable || c.pass) continue;
+    bool found = false;
+    for (const auto& n : notes) found = found || (n.first == c.id && !n.second.empty());
+    if (!found) out.push_back(c.id);
+  }
+  return out;
+}
+
 void write_reproduction_doc(const ReproduceResult& r, const std::vector<ComparedModel>& compared,
-                            const std::string& doc_path, const std::string& out_dir) {
+                            const std::string& doc_path, const std::string& out_dir,
+                            const std::vector<std::pair<std::string, std::string>>& notes) {
   namespace fs = std::filesystem;
   const fs::path doc(doc_path);
   const fs::path doc_dir = doc.parent_path().empty() ? fs::path(".") : doc.parent_path();
@@ -131,10 +182,21 @@ void write_reproduction_doc(const ReproduceResult& r, const std::vector<Compared
       "that decides "
       "pass or fail. Claims that need the paper's measurements are marked n/a.\n\n";
   md += claims_markdown(r.claims);
+  // Every failing claim with its physical explanation (--doc-notes).
+  std::string why;
+  for (const auto& c : r.claims) {
+    if (!c.applicable || c.pass) continue;
+    std::string text = "*No explanation recorded.*";
+    for (const auto& n : notes)
+      if (n.first == c.id && !n.second.empty()) text = n.second;
+    why += fmt::format("### {} ({})\n\n{}\n\n", c.id, c.claim, text);
+  }
+  if (!why.empty()) md += "\n## Why the failing claims fail\n\n" + why;
   md += comparison_markdown(compared);
   if (figures) {
-    md += "\n## Figures\n\n";
-    for (const char* f : {"loops_8A_10Hz", "sweep_10Hz", "frf", "track", "retention",
+    md += "\n## Figures\n\nThe paper's numbers are the diamonds (green: the claim passes, red: it "
+          "fails).\n\n";
+    for (const char* f : {"claims", "loops_8A_10Hz", "sweep_10Hz", "frf", "track", "retention",
                           "params_vs_temperature", "ablate"})
       md += fmt::format("![{0}](figures/{0}.png)\n\n", f);
   }

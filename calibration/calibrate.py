@@ -1,0 +1,283 @@
+#!/usr/bin/python3
+"""Calibrate the MDMA model's readings to the paper's claims (docs/calibration.md).
+
+    /usr/bin/python3 calibration/calibrate.py                 # every reading of readings.toml
+    /usr/bin/python3 calibration/calibrate.py NAME [NAME...]  # some readings
+    /usr/bin/python3 calibration/calibrate.py --list
+    /usr/bin/python3 calibration/calibrate.py --smoke         # one reading, small budget, vs reference
+    /usr/bin/python3 calibration/calibrate.py --smoke --write-reference
+
+The calibration is a pure function of committed inputs: calibration/readings.toml (the readings,
+the search settings), each reading's fixed start model (calibration/start/) and fit spec, and
+the claims (data/claims.toml, compiled into gmasim). For each reading it runs
+
+    gmasim identify --model <start> --fit <fit> --out models/<name>.toml --report models/<name>_report ...
+    gmasim reproduce --model models/<name>.toml --out models/<name>_reproduce --no-figures
+
+rewriting (never appending to) those outputs, then rewrites scores.csv from each reading's
+models/<name>_reproduce/claims.json (claims passed) and models/<name>_report/fit_report.json
+(fit RMS). Standard library only.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import io
+import json
+import math
+import os
+import pathlib
+import shutil
+import subprocess
+import sys
+import tempfile
+import tomllib
+
+HERE = pathlib.Path(__file__).resolve().parent
+ROOT = HERE.parent
+
+
+class CalibrationError(Exception):
+    pass
+
+
+def rel(p: pathlib.Path) -> str:
+    """A path as the commands and headers show it: relative to the repository when inside."""
+    p = pathlib.Path(p).resolve()
+    try:
+        return str(p.relative_to(ROOT))
+    except ValueError:
+        return str(p)
+
+
+def load_readings(path: pathlib.Path) -> dict:
+    with open(path, "rb") as f:
+        cfg = tomllib.load(f)
+    unknown = set(cfg) - {"search", "smoke", "reading"}
+    if unknown:
+        raise CalibrationError(f"{path}: unknown table(s) {sorted(unknown)}; expected search, smoke, reading")
+    names = set()
+    for r in cfg.get("reading", []):
+        for key in ("name", "start", "fit"):
+            if key not in r:
+                raise CalibrationError(f"{path}: a [[reading]] has no {key}")
+        if r["name"] in names:
+            raise CalibrationError(f"{path}: reading {r['name']} listed twice")
+        names.add(r["name"])
+        for key in ("start", "fit"):
+            if not (HERE / r[key]).is_file():
+                raise CalibrationError(f"{path}: reading {r['name']}: {key} {HERE / r[key]} does not exist")
+    if not names:
+        raise CalibrationError(f"{path}: no [[reading]]")
+    return cfg
+
+
+def identify_flags(settings: dict) -> list[str]:
+    """readings.toml settings -> gmasim identify flags (key_name = v -> --key-name v; true -> flag)."""
+    flags = []
+    for key, value in settings.items():
+        flag = "--" + key.replace("_", "-")
+        if isinstance(value, bool):
+            if value:
+                flags.append(flag)
+        else:
+            flags += [flag, str(value)]
+    return flags
+
+
+def run(cmd: list[str], quiet: bool = False) -> None:
+    print("$ " + " ".join(cmd), file=sys.stderr)
+    res = subprocess.run(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if res.returncode != 0:
+        raise CalibrationError(f"{cmd[1]} failed (exit {res.returncode}):\n{res.stderr.strip()}")
+    if not quiet and res.stdout.strip():
+        print(res.stdout.rstrip(), file=sys.stderr)
+
+
+def fresh_dir(d: pathlib.Path) -> None:
+    if d.exists():
+        shutil.rmtree(d)
+
+
+def read_claims(path: pathlib.Path) -> dict:
+    """claims.json of `gmasim reproduce` -> counts and the rows."""
+    with open(path) as f:
+        doc = json.load(f)
+    rows = doc["tables"]["claims"]["rows"]
+    applicable = [r for r in rows if r["result"] != "n/a"]
+    return {"pass": sum(1 for r in applicable if r["pass"] is True),
+            "applicable": len(applicable), "total": len(rows), "rows": rows}
+
+
+def read_fit(path: pathlib.Path) -> dict:
+    with open(path) as f:
+        doc = json.load(f)
+    return {"rms_pct": doc["rms_pct"],
+            "parameters": {p["name"]: p["value"] for p in doc["parameters"]}}
+
+
+def calibrate(bin_: str, reading: dict, search: dict, out: pathlib.Path, quick: bool = False) -> dict:
+    """identify + reproduce for one reading into out/<name>*; returns its scores."""
+    name = reading["name"]
+    settings = dict(search)
+    settings.update({k: v for k, v in reading.items() if k not in ("name", "start", "fit")})
+    model = out / f"{name}.toml"
+    report = out / f"{name}_report"
+    scored = out / f"{name}_reproduce"
+    for d in (report, scored):
+        fresh_dir(d)
+    out.mkdir(parents=True, exist_ok=True)
+    print(f"== {name}", file=sys.stderr)
+    run([bin_, "identify", "--model", rel(HERE / reading["start"]), "--fit", rel(HERE / reading["fit"]),
+         "--out", rel(model), "--report", rel(report), *identify_flags(settings), "--no-plots", "--quiet"])
+    run([bin_, "reproduce", "--model", rel(model), "--out", rel(scored), "--no-figures",
+         *(["--quick", "--threads", "1"] if quick else [])], quiet=True)
+    return scores_of(out, name)
+
+
+def scores_of(out: pathlib.Path, name: str) -> dict | None:
+    claims = out / f"{name}_reproduce" / "claims.json"
+    fit = out / f"{name}_report" / "fit_report.json"
+    if not (claims.is_file() and fit.is_file()):
+        return None
+    c, f = read_claims(claims), read_fit(fit)
+    return {"reading": name, "claims_pass": c["pass"], "claims_applicable": c["applicable"],
+            "claims_total": c["total"], "fit_rms_pct": f["rms_pct"], "parameters": f["parameters"]}
+
+
+def write_scores(cfg: dict, out: pathlib.Path, path: pathlib.Path) -> list[dict]:
+    """scores.csv, rewritten: one row per reading (readings.toml order) that has outputs."""
+    rows = [s for s in (scores_of(out, r["name"]) for r in cfg["reading"]) if s]
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["reading", "claims_pass", "claims_applicable", "fit_rms_pct"])
+    for s in rows:
+        w.writerow([s["reading"], s["claims_pass"], s["claims_applicable"], f"{s['fit_rms_pct']:.4g}"])
+    tmp = path.with_suffix(".csv.tmp")
+    tmp.write_text(buf.getvalue())
+    os.replace(tmp, path)
+    return rows
+
+
+def close(a: float, b: float, rel_tol: float) -> bool:
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    return abs(a - b) <= rel_tol * max(abs(a), abs(b), 1e-300)
+
+
+def smoke(bin_: str, cfg: dict, work: pathlib.Path | None, write_reference: bool) -> int:
+    sm = dict(cfg.get("smoke", {}))
+    if "reading" not in sm:
+        raise CalibrationError("readings.toml: [smoke] needs reading = \"<name>\"")
+    name = sm.pop("reading")
+    rel_tol = float(sm.pop("rel_tol", 1e-6))
+    reading = next((r for r in cfg["reading"] if r["name"] == name), None)
+    if reading is None:
+        raise CalibrationError(f"readings.toml: [smoke] reading {name} is not a [[reading]]")
+    # The smoke budget replaces the search settings and the reading's own overrides.
+    reading = {k: reading[k] for k in ("name", "start", "fit")}
+    tmp = None
+    if work is None:
+        tmp = tempfile.mkdtemp(prefix="gmasim_calibration_smoke_")
+        work = pathlib.Path(tmp)
+    try:
+        got = calibrate(bin_, reading, sm, work, quick=True)
+    finally:
+        if tmp:
+            shutil.rmtree(tmp, ignore_errors=True)
+    result = {
+        "reading": name,
+        "inputs": {"start": f"calibration/{reading['start']}", "fit": f"calibration/{reading['fit']}",
+                   "claims": "data/claims.toml (built into gmasim)"},
+        "settings": sm,
+        "scored_with": "gmasim reproduce --quick",
+        "rel_tol": rel_tol,
+        "parameters": got["parameters"],
+        "fit_rms_pct": got["fit_rms_pct"],
+        "claims": {"pass": got["claims_pass"], "applicable": got["claims_applicable"],
+                   "total": got["claims_total"]},
+    }
+    ref_path = HERE / "reference" / f"{name}.json"
+    if write_reference:
+        ref_path.parent.mkdir(parents=True, exist_ok=True)
+        ref_path.write_text(json.dumps(result, indent=2) + "\n")
+        print(f"calibrate.py --smoke: wrote {rel(ref_path)}")
+        return 0
+    if not ref_path.is_file():
+        raise CalibrationError(f"{rel(ref_path)} does not exist: run calibrate.py --smoke --write-reference")
+    ref = json.loads(ref_path.read_text())
+    problems = []
+    if ref.get("settings") != sm or ref.get("inputs", {}).get("start") != result["inputs"]["start"]:
+        problems.append(f"the reference was made with other settings/inputs ({ref.get('settings')}); "
+                        "regenerate it with --smoke --write-reference")
+    tol = float(ref.get("rel_tol", rel_tol))
+    if set(ref["parameters"]) != set(result["parameters"]):
+        problems.append(f"fitted parameters {sorted(result['parameters'])} != reference {sorted(ref['parameters'])}")
+    for p, v in ref["parameters"].items():
+        if p in result["parameters"] and not close(result["parameters"][p], v, tol):
+            problems.append(f"{p} = {result['parameters'][p]!r}, reference {v!r} (rel. tol {tol:g})")
+    if not close(result["fit_rms_pct"], ref["fit_rms_pct"], tol):
+        problems.append(f"fit RMS {result['fit_rms_pct']!r} %, reference {ref['fit_rms_pct']!r} %")
+    if result["claims"] != ref["claims"]:
+        problems.append(f"claims {result['claims']} != reference {ref['claims']}")
+    if problems:
+        print(f"calibrate.py --smoke: {name} does not reproduce {rel(ref_path)}:", file=sys.stderr)
+        for p in problems:
+            print("  " + p, file=sys.stderr)
+        return 1
+    print(f"calibrate.py --smoke: {name} reproduces {rel(ref_path)}: {len(ref['parameters'])} parameters "
+          f"within {tol:g}, fit RMS {result['fit_rms_pct']:.4g} %, {result['claims']['pass']} of "
+          f"{result['claims']['applicable']} applicable claims pass")
+    return 0
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("readings", nargs="*", help="readings to calibrate (default: all of readings.toml)")
+    ap.add_argument("--bin", default=os.environ.get("GMASIM_BIN", str(ROOT / "build/ci/bin/gmasim")),
+                    help="the gmasim executable (default: $GMASIM_BIN or build/ci/bin/gmasim)")
+    ap.add_argument("--config", default=str(HERE / "readings.toml"), help="the readings list")
+    ap.add_argument("--list", action="store_true", help="list the readings and exit")
+    ap.add_argument("--smoke", action="store_true",
+                    help="rerun the [smoke] reading on its small budget and compare with reference/<reading>.json")
+    ap.add_argument("--write-reference", action="store_true", help="with --smoke: rewrite the reference")
+    ap.add_argument("--work", help="with --smoke: keep the run's outputs in this directory")
+    a = ap.parse_args(argv)
+    try:
+        cfg = load_readings(pathlib.Path(a.config))
+        if a.list:
+            for r in cfg["reading"]:
+                print(f"{r['name']}: start {r['start']}, fit {r['fit']}")
+            return 0
+        if a.write_reference and not a.smoke:
+            raise CalibrationError("--write-reference goes with --smoke")
+        if not pathlib.Path(a.bin).is_file():
+            raise CalibrationError(f"gmasim not found at {a.bin} (build it, or pass --bin / set GMASIM_BIN)")
+        if a.smoke:
+            if a.readings:
+                raise CalibrationError("--smoke runs the [smoke] reading of readings.toml; name no readings")
+            return smoke(a.bin, cfg, pathlib.Path(a.work) if a.work else None, a.write_reference)
+        known = {r["name"]: r for r in cfg["reading"]}
+        for n in a.readings:
+            if n not in known:
+                raise CalibrationError(f"unknown reading {n}; readings.toml lists: {', '.join(known)}")
+        todo = [known[n] for n in a.readings] if a.readings else cfg["reading"]
+        out = HERE / "models"
+        for r in todo:
+            s = calibrate(a.bin, r, cfg.get("search", {}), out)
+            print(f"   {s['claims_pass']} of {s['claims_applicable']} applicable claims pass; "
+                  f"fit RMS {s['fit_rms_pct']:.4g} %", file=sys.stderr)
+        rows = write_scores(cfg, out, HERE / "scores.csv")
+        print("ranking (most claims passed, then lowest fit RMS):")
+        for s in sorted(rows, key=lambda s: (-s["claims_pass"], s["fit_rms_pct"])):
+            print(f"  {s['reading']}: {s['claims_pass']} of {s['claims_applicable']}, "
+                  f"fit RMS {s['fit_rms_pct']:.4g} %")
+        return 0
+    except (CalibrationError, OSError, KeyError, tomllib.TOMLDecodeError) as e:
+        print(f"calibrate.py: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
