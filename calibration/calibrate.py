@@ -120,7 +120,7 @@ def calibrate(bin_: str, reading: dict, search: dict, out: pathlib.Path, quick: 
     """identify + reproduce for one reading into out/<name>*; returns its scores."""
     name = reading["name"]
     settings = dict(search)
-    settings.update({k: v for k, v in reading.items() if k not in ("name", "start", "fit")})
+    settings.update({k: v for k, v in reading.items() if k not in ("name", "start", "fit", "install")})
     model = out / f"{name}.toml"
     report = out / f"{name}_report"
     scored = out / f"{name}_reproduce"
@@ -132,7 +132,23 @@ def calibrate(bin_: str, reading: dict, search: dict, out: pathlib.Path, quick: 
          "--out", rel(model), "--report", rel(report), *identify_flags(settings), "--no-plots", "--quiet"])
     run([bin_, "reproduce", "--model", rel(model), "--out", rel(scored), "--no-figures",
          *(["--quick", "--threads", "1"] if quick else [])], quiet=True)
+    if "install" in reading:
+        install(model, HERE / reading["install"], name)
     return scores_of(out, name)
+
+
+INSTALL_HEADER = ("# The built-in model: calibration/models/{name}.toml, installed by calibration/calibrate.py\n"
+                  "# (readings.toml `install`). Do not edit here: edit the start model or the fit spec and\n"
+                  "# rerun `calibration/calibrate.py {name}` (docs/calibration.md).\n")
+
+
+def install(model: pathlib.Path, dest: pathlib.Path, name: str) -> None:
+    """Writes the fitted model to dest verbatim under a header, atomically (temp file, rename)."""
+    text = INSTALL_HEADER.format(name=name) + model.read_text()
+    tmp = dest.with_name(dest.name + ".tmp")
+    tmp.write_text(text)
+    os.replace(tmp, dest)
+    print(f"   installed as {rel(dest)}", file=sys.stderr)
 
 
 def scores_of(out: pathlib.Path, name: str) -> dict | None:

@@ -263,9 +263,11 @@ TEST(Frf, ModesOfEq15AreTheDiagonalOscillators) {
     EXPECT_NEAR(modes[k].frequency_Hz, fn[k], 1e-9 * fn[k]);
     EXPECT_GT(modes[k].damping_ratio, 0.0);
   }
-  // READING-NOTES: the oscillators of eq. (15) ring at several kHz, far above the 1270 Hz
-  // of Fig. 15 (5.97 / 7.82 / 10.2 kHz at this bias point).
-  EXPECT_GT(modes[0].frequency_Hz, 4.0 * 1270.0);
+  // READING-NOTES: the oscillators of eq. (15) ring at several kHz, above the 1270 Hz of
+  // Fig. 15, which is the output stage's (3.52 / 4.26 / 5.94 kHz at this bias point for the
+  // built-in model; 5.97 / 7.82 / 10.2 kHz with Table 5's E_s): the first resonance is not
+  // a rod's.
+  EXPECT_GT(modes[0].frequency_Hz, 2.5 * 1270.0);
   EXPECT_LT(modes[2].frequency_Hz, 15000.0);
 }
 
@@ -331,9 +333,9 @@ TEST(Frf, ResonanceAndBandwidthOfBothReadings) {
     return std::fabs(res.curves[1].first_resonance_Hz / res.curves[0].first_resonance_Hz - 1.0);
   };
   const FrfResult built_in = run_frf(mdma(), r);
-  EXPECT_NEAR(built_in.curves[0].first_resonance_Hz, 1270.0, 0.01 * 1270.0);  // 1271 Hz
+  EXPECT_NEAR(built_in.curves[0].first_resonance_Hz, 1270.0, 0.01 * 1270.0);      // 1271 Hz
   for (const auto& cv : built_in.curves) EXPECT_GT(cv.bandwidth_3dB_Hz, 2000.0);  // 2092, 2292
-  EXPECT_GT(shift_of(built_in), 0.01);  // observed 3.4 %
+  EXPECT_GT(shift_of(built_in), 0.01);                                            // observed 3.4 %
   EXPECT_LT(shift_of(built_in), 0.06);
 
   ModelSpec light = builtin_model_spec();
@@ -540,20 +542,26 @@ TEST(Ablate, MagnetisationMattersMostAtLowFrequencyAndResistivityGrowsWithFreque
     ADD_FAILURE() << law;
     return 0.0;
   };
-  // Section 5: M first, then E_G and mu_G (observed 3.06 / 1.08 / 0.80 um at 10 Hz).
+  // Section 5: M first, then E_G and mu_G (observed M 2.93, E_G 0.69, mu_G 0.79 um at 10 Hz: E_G
+  // and mu_G swap, a failing claim, docs/failing_claims.md).
   for (const char* law : {"mu_G", "rho_G", "E_G", "E_t", "F_pm", "geometry"})
     EXPECT_GT(err("M", 10), err(law, 10)) << law;
   EXPECT_GT(err("E_G", 10), err("rho_G", 10));
   EXPECT_GT(err("mu_G", 10), err("rho_G", 10));
-  // Eddy currents: rho_G matters far more at 200 Hz (observed 0.084 -> 1.26 um).
+  // Eddy currents: rho_G matters far more at 200 Hz (observed 0.045 -> 0.67 um).
   EXPECT_GT(err("rho_G", 200), 5.0 * err("rho_G", 10));
-  // The PM drift (alpha_pm1 identified -1.1e-4 /K, section 4.4.1) is small but not zero;
+  // The PM drift (eq. 1; section 4.4.1 ignores it): freezing it changes nothing when the
+  // model's alpha_pm1 is 0 (the built-in model's identified value), and little otherwise.
   // E_t acts through the sleeves in series with the soft disk spring: negligible.
-  EXPECT_GT(err("F_pm", 10), 0.0);
+  const Model& m = mdma();
+  if (m.alpha_pm1_per_K == 0.0 && m.alpha_pm2_per_K2 == 0.0)
+    EXPECT_EQ(err("F_pm", 10), 0.0);
+  else
+    EXPECT_GT(err("F_pm", 10), 0.0);
   EXPECT_LT(err("F_pm", 10), 0.2 * err("M", 10));
   EXPECT_LT(err("E_t", 10), 1e-3 * err("mu_G", 10));
   // Freezing every law restores the 20 degC output: the error is of the order of M's
-  // (observed 2.56 vs 2.83 um: the laws partly cancel, the PM drift against M_s^T).
+  // (observed 2.73 vs 2.93 um: the laws partly cancel).
   EXPECT_GT(err("all", 10), 0.5 * err("M", 10));
 }
 
@@ -690,8 +698,8 @@ TEST(ExperimentsCli, BadRequestsExitWithCode2AndSayWhy) {
 // "### <id>" sections reach the page under their claim; failures without one are named.
 TEST(ReproductionDoc, FailingClaimsCarryTheirExplanations) {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::path(::testing::TempDir()) /
-                       ("gmasim_notes_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::path(::testing::TempDir()) / ("gmasim_notes_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const fs::path notes_path = dir / "notes.md";
   std::ofstream(notes_path) << "# Why\n\nintro text, ignored\n\n### b_fails\n\nBecause eq. 8 "

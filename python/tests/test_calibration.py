@@ -1,0 +1,78 @@
+"""calibration/calibrate.py: the built-in model is the output of the committed calibration,
+and the pipeline's pure functions behave (docs/calibration.md)."""
+import re
+import sys
+import tomllib
+
+import pytest
+
+from conftest import SOURCE_DIR
+
+sys.path.insert(0, str(SOURCE_DIR / "calibration"))
+import calibrate  # noqa: E402
+
+
+def _load(path):
+    with open(path, "rb") as f:
+        return tomllib.load(f)
+
+
+def test_builtin_model_is_the_installed_calibration_output():
+    cfg = calibrate.load_readings(SOURCE_DIR / "calibration" / "readings.toml")
+    installs = [r for r in cfg["reading"] if "install" in r]
+    assert [r["name"] for r in installs] == ["consistent"]
+    r = installs[0]
+    dest = (SOURCE_DIR / "calibration" / r["install"]).resolve()
+    assert dest == (SOURCE_DIR / "models" / "mdma.toml").resolve()
+    fitted = SOURCE_DIR / "calibration" / "models" / f"{r['name']}.toml"
+    # Same data (every value, bit for bit) and the same text under the header.
+    assert _load(dest) == _load(fitted)
+    header = calibrate.INSTALL_HEADER.format(name=r["name"])
+    assert dest.read_text() == header + fitted.read_text()
+
+
+def test_install_is_atomic_and_verbatim(tmp_path):
+    model = tmp_path / "fit.toml"
+    model.write_text('[material]\nMs_A_per_m = 7e5  # identified\n')
+    dest = tmp_path / "mdma.toml"
+    dest.write_text("old")
+    calibrate.install(model, dest, "x")
+    assert _load(dest) == {"material": {"Ms_A_per_m": 7e5}}
+    assert dest.read_text().startswith("# The built-in model: calibration/models/x.toml")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fit.toml", "mdma.toml"]
+
+
+def test_identify_flags_translate_settings():
+    flags = calibrate.identify_flags({"population": 24, "no_profile": True, "quick": False, "seed": 7})
+    assert flags == ["--population", "24", "--no-profile", "--seed", "7"]
+
+
+@pytest.mark.parametrize("text, message", [
+    ('[bogus]\n', "unknown table"),
+    ('[[reading]]\nname = "a"\nfit = "consistent.toml"\n', "has no start"),
+    ('[[reading]]\nname = "a"\nstart = "nope.toml"\nfit = "consistent.toml"\n', "does not exist"),
+    ('', "no [[reading]]"),
+])
+def test_readings_config_errors_are_clear(tmp_path, text, message):
+    p = tmp_path / "readings.toml"
+    p.write_text(text)
+    with pytest.raises(calibrate.CalibrationError, match=re.escape(message)):
+        calibrate.load_readings(p)
+
+
+def test_committed_scores_agree_with_the_committed_outputs():
+    cfg = calibrate.load_readings(SOURCE_DIR / "calibration" / "readings.toml")
+    out = SOURCE_DIR / "calibration" / "models"
+    rows = {}
+    with open(SOURCE_DIR / "calibration" / "scores.csv") as f:
+        next(f)
+        for line in f:
+            name, npass, napp, rms = line.strip().split(",")
+            rows[name] = (int(npass), int(napp), float(rms))
+    assert rows, "scores.csv is empty"
+    for name, (npass, napp, rms) in rows.items():
+        s = calibrate.scores_of(out, name)
+        assert s is not None, f"{name}: scores.csv lists it but its outputs are missing"
+        assert (s["claims_pass"], s["claims_applicable"]) == (npass, napp)
+        assert s["fit_rms_pct"] == pytest.approx(rms, rel=1e-3)
+    assert set(rows) <= {r["name"] for r in cfg["reading"]}
