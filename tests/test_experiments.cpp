@@ -128,10 +128,15 @@ TEST(Sweep, DeterministicWhateverTheThreadCount) {
 TEST(Sweep, ADivergedPointIsRecordedAndTheSweepContinues) {
   SweepRequest r;
   r.temperatures_C = {20};
-  r.currents_pp_A = {6, 1e9};  // 1e9 A: the field leaves the physical range
+  // A coil of 7.2e6 turns: 6 mA peak-to-peak drive it as 60 A would the MDMA's; 1000 A
+  // (kMaxCurrent_A) takes the field out of the physical range.
+  ModelSpec spec = builtin_model_spec();
+  spec.set("circuit.branches.phi4.coil_turns", 7.2e6);
+  r.current_min_A = -3e-3;
+  r.currents_pp_A = {6e-3, 1000.0};
   r.frequencies_Hz = {50};
   r.periods = 1;
-  const SweepResult res = run_sweep(mdma(), r);
+  const SweepResult res = run_sweep(compile(spec), r);
   ASSERT_EQ(res.points.size(), 2u);
   EXPECT_FALSE(res.points[0].diverged);
   EXPECT_GT(res.points[0].metrics.stroke_um, 1.0);
@@ -672,7 +677,7 @@ TEST(ExperimentsCli, BadRequestsExitWithCode2AndSayWhy) {
   EXPECT_EQ(run_cli("sweep --temperatures ''" + out, text), 2);
   EXPECT_NE(text.find("empty grid"), std::string::npos) << text;
   EXPECT_EQ(run_cli("sweep --temperatures 20,abc" + out, text), 2);
-  EXPECT_NE(text.find("'abc' is not a number [degC]"), std::string::npos) << text;
+  EXPECT_NE(text.find("'abc' is not a finite number [degC]"), std::string::npos) << text;
   EXPECT_EQ(run_cli("frf --temperatures 400" + out, text), 2);
   EXPECT_NE(text.find("Curie"), std::string::npos) << text;
   EXPECT_EQ(run_cli("track --sample-rate 150 --frequencies 100" + out, text), 2);

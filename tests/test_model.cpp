@@ -355,12 +355,16 @@ TEST(Numerics, StepAllocatesNothing) {
 }
 
 TEST(Numerics, DivergenceNamesTimeRodAndQuantityAndKeepsThePartialRun) {
-  const Model& m = mdma();
+  // An absurd coil (7.2e9 turns) and a 1000 A step, the largest current a request may
+  // hold (kMaxCurrent_A): the field leaves every bound.
+  ModelSpec spec = builtin_model_spec();
+  spec.set("circuit.branches.phi4.coil_turns", 7.2e9);
+  const Model m = compile(spec);
   SimulationSettings s;
   s.temperature_C = 20.0;
   s.waveform.kind = WaveformKind::Step;
-  s.waveform.level_A = 1.0;
-  s.waveform.step_to_A = 1e9;  // an absurd coil current: the field leaves every bound
+  s.waveform.level_A = 1e-6;
+  s.waveform.step_to_A = kMaxCurrent_A;
   s.waveform.step_time_s = 1e-3;
   s.duration_s = 2e-3;
   const Result r = simulate(m, s);

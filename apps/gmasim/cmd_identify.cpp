@@ -150,11 +150,7 @@ std::string command_line() {
 }
 
 std::string read_file_text(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw InputError(located(path, 0, "cannot open the model file"));
-  std::ostringstream ss;
-  ss << f.rdbuf();
-  return ss.str();
+  return read_input_file(path, "model file");
 }
 
 int env_int(const char* name, int fallback) {

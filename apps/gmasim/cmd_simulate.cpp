@@ -61,8 +61,11 @@ int run_simulate(const SimulateArgs& a) {
   Result r = simulate(model, s);
   if (!r.diverged && !a.quantities.empty()) add_quantity_stats(r, a.quantities);
   const std::filesystem::path dir(a.out);
-  write_file_atomic((dir / "timeseries.csv").string(), timeseries_csv(r.series));
-  write_file_atomic((dir / "metrics.json").string(), metrics_json(r, s, model));
+  // One set: both temporaries are complete before either is renamed, and metrics.json
+  // (renamed last) names the hash of its timeseries.csv.
+  const std::string csv = timeseries_csv(r.series);
+  write_files_atomic({{(dir / "timeseries.csv").string(), csv},
+                      {(dir / "metrics.json").string(), metrics_json(r, s, model, csv)}});
 
   fmt::print("gmasim simulate  model: {}\n", model_label(a.model));
   fmt::print("  temperature {:.1f} degC, dt {:.4g} us, {} steps, wall time {:.3f} s\n",

@@ -24,5 +24,7 @@ Runner add_thermal(CLI::App& app);  // cmd_params.cpp: thermal
 // Shared helpers.
 std::string model_label(const std::string& path);  // "models/mdma.toml (built-in)" or path
 void print_error(const std::string& what);
+// Throws InputError if a floating-point flag of the parsed command is NaN or infinite.
+void require_finite_numbers(const CLI::App& app);
 
 }  // namespace gmasim::cli

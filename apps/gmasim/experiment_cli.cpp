@@ -12,6 +12,7 @@
 
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
+#include "gmasim/validate.hpp"
 
 namespace gmasim::cli {
 namespace {
@@ -29,7 +30,8 @@ double parse_number(const std::string& item, const std::string& flag, const std:
   char* end = nullptr;
   const double v = t.empty() ? 0.0 : std::strtod(t.c_str(), &end);
   if (t.empty() || end != t.c_str() + t.size() || !std::isfinite(v))
-    throw InputError(fmt::format("{} '{}': '{}' is not a number [{}]", flag, text, t, unit));
+    throw InputError(fmt::format("{} '{}': '{}' is not a finite number [{}]", flag,
+                                 clip_for_message(text), clip_for_message(t), unit));
   return v;
 }
 
@@ -57,12 +59,15 @@ std::vector<double> parse_list(const std::string& text, const std::string& flag,
       if (!(step > 0.0) || b < a)
         throw InputError(fmt::format("{} '{}': range {}: needs step > 0 and stop >= start [{}]",
                                      flag, text, trim(item), unit));
-      const long n = std::lround(std::floor((b - a) / step + 1e-9));
-      if (n > 100000)
-        throw InputError(
-            fmt::format("{} '{}': range {} has too many values", flag, text, trim(item)));
+      const double span = std::floor((b - a) / step + 1e-9);
+      if (!(span < kMaxListValues))
+        throw InputError(fmt::format("{} '{}': range {} has {:.4g} values (limit {:g})", flag,
+                                     text, trim(item), span + 1.0, kMaxListValues));
+      const long n = checked_count(span, kMaxListValues, flag);
       for (long k = 0; k <= n; ++k) out.push_back(a + static_cast<double>(k) * step);
     }
+    if (static_cast<double>(out.size()) > kMaxListValues)
+      throw InputError(fmt::format("{}: more than {:g} values", flag, kMaxListValues));
     if (comma == std::string::npos) break;
     pos = comma + 1;
   }

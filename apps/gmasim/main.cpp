@@ -1,9 +1,12 @@
 // gmasim: command-line front end. Exit codes: 0 ok, 1 usage, 2 bad input,
-// 3 numerical divergence (partial output written), 4 internal error.
+// 3 numerical divergence (partial output written), 4 internal error. A parse error (an
+// unknown flag, a value that is not a number, a non-finite number) is a usage error, 1.
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <vector>
 
@@ -15,6 +18,27 @@ namespace gmasim::cli {
 void print_error(const std::string& what) {
   std::fprintf(stderr, "gmasim: error: %s\n", what.c_str());
 }
+
+// Every floating-point flag of the parsed command must be a finite number: "nan" and "inf"
+// parse as doubles, and an unused flag (--step-time nan without a step waveform) would
+// otherwise pass silently (issue 8). CLI11 names such options' type "FLOAT".
+namespace {
+void check_options(const CLI::App& app) {
+  for (const CLI::Option* o : app.get_options()) {
+    if (o->get_type_name().find("FLOAT") == std::string::npos) continue;
+    for (const std::string& v : o->results()) {
+      char* end = nullptr;
+      const double d = std::strtod(v.c_str(), &end);
+      if (end != v.c_str() && !std::isfinite(d))
+        throw InputError(fmt::format("{} {}: must be a finite number", o->get_name(),
+                                     clip_error_message(v)));
+    }
+  }
+  for (const CLI::App* sub : app.get_subcommands()) check_options(*sub);
+}
+}  // namespace
+
+void require_finite_numbers(const CLI::App& app) { check_options(app); }
 
 std::string model_label(const std::string& path) {
   return path.empty() ? std::string("models/mdma.toml (built-in)") : path;
@@ -41,8 +65,22 @@ int main(int argc, char** argv) {
   runners.push_back(gmasim::cli::add_thermal(app));
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
+    gmasim::cli::require_finite_numbers(app);
+  } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // Every parse error is a usage error, exit 1 (CLI11's own codes are 100+), with the
+    // message clipped so that a hostile value is not echoed whole.
+    gmasim::cli::print_error(gmasim::clip_error_message(e.what()));
+    std::fprintf(stderr, "Run with --help for more information.\n");
+    return 1;
+  } catch (const gmasim::InputError& e) {
+    gmasim::cli::print_error(e.what());
+    return 1;
   }
   try {
     // Each runner checks whether its subcommand was parsed and returns -1 if not.

@@ -2,14 +2,22 @@
 // numerical divergence is a DivergenceError naming time, rod and quantity.
 #pragma once
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 
 namespace gmasim {
 
+// The message is clipped to kMaxErrorChars (in the middle, saying how much was left out), so
+// an error never echoes a whole hostile input line (issue 8).
+inline constexpr std::size_t kMaxErrorChars = 2000;
+std::string clip_error_message(const std::string& message);
+
 class InputError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  explicit InputError(const std::string& message)
+      : std::runtime_error(clip_error_message(message)) {}
+  explicit InputError(const char* message) : InputError(std::string(message)) {}
 };
 
 // "file:line: message" (line omitted when 0).

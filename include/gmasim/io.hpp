@@ -2,6 +2,8 @@
 #pragma once
 
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "gmasim/experiments.hpp"
@@ -39,8 +41,20 @@ std::vector<ParamRow> describe_model(const ModelSpec& spec);
 Waveform load_waveform_csv(const std::string& path);
 
 // Writes `content` to `path` atomically: a temporary file in the same directory, flushed,
-// then renamed over the target. Throws InputError if the directory cannot be written.
+// then renamed over the target. Throws InputError if the directory cannot be written, or if
+// something other than a regular file (a device, a FIFO, a directory) sits at `path`: an
+// output never replaces it (issue 8).
 void write_file_atomic(const std::string& path, const std::string& content);
+
+// Writes several files as one: every temporary file is written and flushed first, then all
+// are renamed, so a run killed before the renames leaves the previous set untouched and one
+// killed between them leaves each file complete (a reader pairs them by the run stamp they
+// carry, e.g. metrics.json's "steps"). Same checks as write_file_atomic.
+void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& path_content);
+
+// Reads a user's input file whole: at most kMaxInputBytes (gmasim/validate.hpp), else an
+// InputError "<path>: <what> is larger than ..."; `what` names the file in messages.
+std::string read_input_file(const std::string& path, const std::string& what);
 
 // Creates the directory (and parents) if needed and checks it is writable.
 void ensure_output_dir(const std::string& dir);
@@ -53,6 +67,12 @@ std::string timeseries_csv(const TimeSeries& ts);
 std::vector<std::string> write_report_files(const std::string& dir, const std::string& stem,
                                             const Report& r);
 // metrics.json: settings, metrics, status; `extra` holds more "key": value lines.
-std::string metrics_json(const Result& r, const SimulationSettings& s, const Model& m);
+// With the text of the timeseries.csv written beside it, the file records that text's size
+// and FNV-1a 64-bit hash ("timeseries_csv": {"bytes", "fnv1a64"}), so a reader can check
+// that the two files belong to the same run.
+std::string metrics_json(const Result& r, const SimulationSettings& s, const Model& m,
+                         std::string_view timeseries_csv_text = {});
+// FNV-1a 64-bit hash of data, as 16 hex digits.
+std::string fnv1a64_hex(std::string_view data);
 
 }  // namespace gmasim

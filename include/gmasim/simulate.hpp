@@ -91,6 +91,16 @@ struct Result {
   double thermal_expansion_um = 0;
 };
 
+// The validation layer (gmasim/validate.hpp): throws InputError naming the field, its value
+// and the rule for a non-finite or out-of-range number (currents |I| <= kMaxCurrent_A,
+// frequencies in (0, kMaxFrequency_Hz], a table that starts before t = 0 or later than 0,
+// run lengths whose step count exceeds kMaxSteps or whose record exceeds kMaxRecordedRows).
+// simulate() calls it first; callers that derive settings call it before any work.
+inline constexpr double kMaxCurrent_A = 1000.0;
+inline constexpr double kMaxFrequency_Hz = 1e6;
+void validate(const Waveform& w);
+void validate(const SimulationSettings& s);
+
 // Runs the model. Never throws on divergence: the partial result is returned with
 // diverged = true and error set. Throws InputError on bad settings.
 Result simulate(const Model& m, const SimulationSettings& s);

@@ -9,6 +9,7 @@
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
+#include "gmasim/validate.hpp"
 
 namespace gmasim {
 
@@ -49,6 +50,15 @@ AblateResult run_ablate(const Model& m, const AblateRequest& r) {
   if (!(r.periods >= 1.0) || !std::isfinite(r.periods))
     throw InputError(fmt::format("periods {}: must be >= 1", r.periods));
   (void)make_conditions(m, r.temperature_C);  // T < T_c
+  if (static_cast<double>(r.frequencies_Hz.size()) > kMaxListValues)
+    throw InputError(fmt::format("ablate: {} frequencies: too many (limit {:g})",
+                                 r.frequencies_Hz.size(), kMaxListValues));
+  for (double f : r.frequencies_Hz) {  // every run's settings, before any run
+    SimulationSettings s;
+    s.waveform = biased_sine(r.current_pp_A, f, r.current_min_A);
+    s.periods = r.periods;
+    validate(s);
+  }
 
   const auto laws = ablation_laws();
   const std::size_t per_f = laws.size() + 1;  // the full model, then each law

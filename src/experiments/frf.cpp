@@ -12,6 +12,7 @@
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
+#include "gmasim/validate.hpp"
 #include "gmasim/physics/jiles_atherton.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
@@ -381,6 +382,24 @@ FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progres
                                  r.settle_periods, r.measure_periods));
   if (!r.stepped_sine && !r.small_signal)
     throw InputError("frf: neither the stepped sine nor the small-signal method is selected");
+  for (double T : r.temperatures_C) require_finite(T, "temperature", "degC");
+  if (static_cast<double>(r.temperatures_C.size()) > kMaxListValues)
+    throw InputError(fmt::format("frf: {} temperatures: too many (limit {:g})",
+                                 r.temperatures_C.size(), kMaxListValues));
+  require_in(r.f_max_Hz, 0.0, kMaxFrequency_Hz, "maximum frequency", "Hz");
+  (void)checked_count(r.points, kMaxFrfPoints, "frequency points");
+  require_in(r.amplitude_A, 0.0, kMaxCurrent_A, "amplitude", "A");
+  require_in(r.bias_A, -kMaxCurrent_A, kMaxCurrent_A, "bias current", "A");
+  require_int_in(r.settle_periods, 1, 1000000, "settle periods");
+  require_int_in(r.measure_periods, 1, 1000000, "measure periods");
+  if (r.stepped_sine) {
+    // The longest stepped-sine run (at f_min) before settling for the model's time
+    // constants; the settling is checked again per frequency once those are known.
+    const double per = std::max(static_cast<double>(r.min_steps_per_period),
+                                std::ceil(1.0 / (r.f_min_Hz * kMaxDt_s) - 1e-9));
+    (void)checked_count(per * (r.settle_periods + r.measure_periods), kMaxSteps,
+                        fmt::format("stepped-sine steps at {:g} Hz", r.f_min_Hz));
+  }
   std::vector<Conditions> conds;
   for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
 
@@ -421,7 +440,8 @@ FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progres
           State s = bias[ti];
           // >= min_steps_per_period steps per period, dt <= 10 us; whole steps per period.
           const long per = std::max<long>(
-              r.min_steps_per_period, static_cast<long>(std::ceil(1.0 / (fr * kMaxDt_s) - 1e-9)));
+              r.min_steps_per_period,
+              checked_ceil_count(1.0 / (fr * kMaxDt_s), kMaxSteps, "steps per period"));
           const double dt = 1.0 / (fr * static_cast<double>(per));
           // Settling: the transient of switching the sine on decays with the slowest of the
           // eddy lags and the mechanical modes. Settle for 10 of those time constants (the
@@ -435,9 +455,11 @@ FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progres
           if (lin[ti].output_stage && lin[ti].os_damping_N_s_per_m > 0)
             t_settle = std::max(t_settle, 10.0 * 2.0 * lin[ti].os_mass_kg /
                                               lin[ti].os_damping_N_s_per_m);
-          const long settle =
-              std::max<long>(r.settle_periods, static_cast<long>(std::ceil(t_settle * fr - 1e-9)));
+          const long settle = std::max<long>(
+              r.settle_periods, checked_ceil_count(t_settle * fr, kMaxSteps, "settle periods"));
           const long measure = r.measure_periods;
+          (void)checked_count(static_cast<double>(settle + measure) * static_cast<double>(per),
+                              kMaxSteps, fmt::format("stepped-sine steps at {:g} Hz", fr));
           const double w = kTwoPi * fr;
           std::vector<double> ts, ys, is;
           ts.reserve(static_cast<std::size_t>(measure * per));

@@ -8,6 +8,7 @@
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
+#include "gmasim/validate.hpp"
 
 namespace gmasim {
 namespace {
@@ -42,6 +43,22 @@ ParamsVsTemperatureResult run_params_vs_temperature(const Model& m,
   if (!(r.current_pp_A >= 0.0) || !std::isfinite(r.current_pp_A))
     throw InputError(fmt::format("current peak-to-peak {} A: must be >= 0", r.current_pp_A));
   if (!(r.periods >= 1.0)) throw InputError(fmt::format("periods {}: must be >= 1", r.periods));
+  if (static_cast<double>(r.temperatures_C.size()) > kMaxListValues ||
+      static_cast<double>(r.retention_currents_pp_A.size()) > kMaxListValues)
+    throw InputError(fmt::format("params-vs-temperature: more than {:g} values in a list",
+                                 kMaxListValues));
+  for (double pp : r.retention_currents_pp_A) {  // every run's settings, before any run
+    SimulationSettings s;
+    s.waveform = biased_sine(pp, r.frequency_Hz, r.current_min_A);
+    s.periods = r.periods;
+    validate(s);
+  }
+  {
+    SimulationSettings s;
+    s.waveform = biased_sine(r.current_pp_A, r.frequency_Hz, r.current_min_A);
+    s.periods = r.periods;
+    validate(s);
+  }
   std::vector<Conditions> conds;
   for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
 

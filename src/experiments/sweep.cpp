@@ -8,6 +8,7 @@
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
+#include "gmasim/validate.hpp"
 
 namespace gmasim {
 namespace {
@@ -19,6 +20,9 @@ void check_list(const std::vector<double>& v, const char* what, const char* unit
   for (double x : v)
     if (!std::isfinite(x))
       throw InputError(fmt::format("{} {} {}: not a finite number", what, x, unit));
+  if (static_cast<double>(v.size()) > kMaxListValues)
+    throw InputError(fmt::format("{} {} values: too many (limit {:g})", v.size(), what,
+                                 kMaxListValues));
 }
 
 struct Job {
@@ -37,11 +41,28 @@ SweepResult run_sweep(const Model& m, const SweepRequest& r, const ProgressFn& p
     if (!(pp >= 0.0)) throw InputError(fmt::format("current peak-to-peak {} A: must be >= 0", pp));
   if (!(r.periods >= 1.0) || !std::isfinite(r.periods))
     throw InputError(fmt::format("periods {}: must be >= 1", r.periods));
+  require_finite(r.reference_temperature_C, "reference temperature", "degC");
+  const double runs = static_cast<double>(r.temperatures_C.size() + 1) *
+                      static_cast<double>(r.currents_pp_A.size()) *
+                      static_cast<double>(r.frequencies_Hz.size());
+  if (runs > kMaxGridRuns)
+    throw InputError(fmt::format("sweep grid of {:.4g} runs: too many (limit {:g})", runs,
+                                 kMaxGridRuns));
   if (!(r.dt_s >= 0.0) || !std::isfinite(r.dt_s))
     throw InputError(fmt::format("dt {} s: must be > 0 (or 0 for the automatic rule)", r.dt_s));
   if (!std::isfinite(r.current_min_A))
     throw InputError(fmt::format("current minimum {} A: not a finite number", r.current_min_A));
-  // Every temperature must give valid conditions (T < T_c, ...): fail before any run.
+  // Every point's settings must be valid (currents, frequency, run length: simulate's
+  // validate()) and every temperature must give valid conditions (T < T_c, ...): fail before
+  // any run, not in the middle of the grid.
+  for (double pp : r.currents_pp_A)
+    for (double f : r.frequencies_Hz) {
+      SimulationSettings s;
+      s.waveform = biased_sine(pp, f, r.current_min_A);
+      s.periods = r.periods;
+      s.dt_s = r.dt_s;
+      validate(s);
+    }
   for (double T : r.temperatures_C) (void)make_conditions(m, T, r.freeze);
   (void)make_conditions(m, r.reference_temperature_C, r.freeze);
 

@@ -14,6 +14,7 @@
 
 #include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/io.hpp"
 #include "gmasim/identify.hpp"
 
 namespace gmasim {
@@ -379,14 +380,7 @@ FitSpec load_fit_spec(const std::string& file_or_inline) {
   const bool looks_like_file =
       file_or_inline.ends_with(".toml") || std::filesystem::is_regular_file(file_or_inline, ec);
   if (!looks_like_file) return parse_inline(file_or_inline);
-  std::FILE* f = std::fopen(file_or_inline.c_str(), "rb");
-  if (!f) throw InputError(located(file_or_inline, 0, "cannot open the fit spec"));
-  std::string text;
-  char buf[1 << 14];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
-  std::fclose(f);
-  return parse_fit_spec(text, file_or_inline);
+  return parse_fit_spec(read_input_file(file_or_inline, "fit spec"), file_or_inline);
 }
 
 }  // namespace gmasim

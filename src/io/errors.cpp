@@ -5,7 +5,13 @@
 
 #include <utility>
 
+#include "gmasim/validate.hpp"
+
 namespace gmasim {
+
+std::string clip_error_message(const std::string& message) {
+  return message.size() <= kMaxErrorChars ? message : clip_for_message(message, kMaxErrorChars);
+}
 
 std::string located(const std::string& file, long line, const std::string& message) {
   if (line > 0) return fmt::format("{}:{}: {}", file, line, message);

@@ -211,6 +211,12 @@ std::optional<std::string> check_value(const ModelSpec& spec, const std::string&
   };
   if (std::isnan(value)) return bad("NaN is not allowed: every number must be finite");
   if (std::isinf(value)) return bad("Inf is not allowed: every number must be finite");
+  // No SI value of the model is below 1e-30 or above 1e30 in magnitude (the smallest, eq. 1's
+  // alpha_pm2, is ~1e-7 /K^2; the largest, a modulus, ~1e11 Pa): such a number is a typo or
+  // a hostile input, and a subnormal one turns into inf/NaN downstream (issue 8).
+  if (value != 0.0 && !(std::fabs(value) >= 1e-30 && std::fabs(value) <= 1e30))
+    return bad("outside the range of any physical value of the model (1e-30 <= |v| <= 1e30, "
+               "or 0)");
   if (!field) return std::nullopt;
   switch (field->rule) {
     case R::Any:

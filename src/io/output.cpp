@@ -1,10 +1,12 @@
 // Output files: atomic writes, the output directory, timeseries.csv and metrics.json.
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <fmt/format.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -19,29 +21,57 @@
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
 #include "io/json.hpp"
+#include "io/text_io.hpp"
 
 namespace gmasim {
 
 // ---------------------------------------------------------------------------------------
 // Files
 // ---------------------------------------------------------------------------------------
-void write_file_atomic(const std::string& path, const std::string& content) {
+namespace {
+
+// The destination must be absent or a regular file: never replace a device, a FIFO, a
+// socket or a directory with an output (`--out /dev/null` would become a regular file).
+void require_regular_destination(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return;  // absent (or a dangling link): fine
+  if (S_ISREG(st.st_mode)) return;
+  const char* kind = S_ISDIR(st.st_mode)   ? "a directory"
+                     : S_ISCHR(st.st_mode) ? "a character device"
+                     : S_ISBLK(st.st_mode) ? "a block device"
+                     : S_ISFIFO(st.st_mode) ? "a FIFO"
+                     : S_ISSOCK(st.st_mode) ? "a socket"
+                                            : "not a regular file";
+  throw InputError(located(path, 0,
+                           fmt::format("cannot write output: the destination is {}; gmasim "
+                                       "writes only regular files (choose another --out)",
+                                       kind)));
+}
+
+// Writes content to a fresh temporary next to path, flushed and synced; returns its name.
+std::string write_temporary(const std::string& path, const std::string& content) {
   const std::string tmp = fmt::format("{}.tmp.{}", path, static_cast<long>(::getpid()));
   auto fail = [&](int err, std::FILE* f) {
     if (f) std::fclose(f);
     std::remove(tmp.c_str());
     throw InputError(located(path, 0, fmt::format("cannot write output ({})", std::strerror(err))));
   };
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  std::FILE* f = std::fopen(tmp.c_str(), "wbx");  // x: never follow or reuse an existing name
+  if (!f && errno == EEXIST) {
+    std::remove(tmp.c_str());  // a stale temporary of a killed run with our pid
+    f = std::fopen(tmp.c_str(), "wbx");
+  }
   if (!f) fail(errno, nullptr);
   if (!content.empty() && std::fwrite(content.data(), 1, content.size(), f) != content.size())
     fail(errno, f);
   if (std::fflush(f) != 0) fail(errno, f);
   if (::fsync(::fileno(f)) != 0) fail(errno, f);
   if (std::fclose(f) != 0) fail(errno, nullptr);
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) fail(errno, nullptr);
-  // Make the rename itself durable; a failure here leaves a complete file, so it is not
-  // reported.
+  return tmp;
+}
+
+void sync_directory_of(const std::string& path) {
+  // Make the renames durable; a failure here leaves complete files, so it is not reported.
   std::filesystem::path dir = std::filesystem::path(path).parent_path();
   if (dir.empty()) dir = ".";
   const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
@@ -49,6 +79,36 @@ void write_file_atomic(const std::string& path, const std::string& content) {
     (void)::fsync(dfd);
     ::close(dfd);
   }
+}
+
+}  // namespace
+
+void write_file_atomic(const std::string& path, const std::string& content) {
+  write_files_atomic({{path, content}});
+}
+
+void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files) {
+  for (const auto& [path, content] : files) require_regular_destination(path);
+  std::vector<std::string> tmps;
+  try {
+    for (const auto& [path, content] : files) tmps.push_back(write_temporary(path, content));
+  } catch (...) {
+    for (const auto& t : tmps) std::remove(t.c_str());
+    throw;
+  }
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    if (std::rename(tmps[i].c_str(), files[i].first.c_str()) != 0) {
+      const int err = errno;
+      for (std::size_t j = i; j < tmps.size(); ++j) std::remove(tmps[j].c_str());
+      throw InputError(
+          located(files[i].first, 0, fmt::format("cannot write output ({})", std::strerror(err))));
+    }
+  }
+  for (const auto& f : files) sync_directory_of(f.first);
+}
+
+std::string read_input_file(const std::string& path, const std::string& what) {
+  return io_detail::read_text_file(path, what);
 }
 
 void ensure_output_dir(const std::string& dir) {
@@ -191,7 +251,17 @@ std::string frozen_json(const Freeze& f) {
 
 }  // namespace
 
-std::string metrics_json(const Result& r, const SimulationSettings& s, const Model& m) {
+std::string fnv1a64_hex(std::string_view data) {
+  std::uint64_t h = 14695981039346656037ull;
+  for (const unsigned char c : data) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return fmt::format("{:016x}", h);
+}
+
+std::string metrics_json(const Result& r, const SimulationSettings& s, const Model& m,
+                         std::string_view timeseries_csv_text) {
   JsonObject o(0);
   o.string("status", r.diverged ? "diverged" : "ok");
   o.raw("error", r.error.empty() ? std::string("null") : json_string(r.error));
@@ -233,6 +303,13 @@ std::string metrics_json(const Result& r, const SimulationSettings& s, const Mod
     o.raw("quantities", qo.str());
   }
   o.number("thermal_expansion_um", r.thermal_expansion_um);
+  if (!timeseries_csv_text.empty()) {
+    // Pairs this file with the timeseries.csv written with it (write_files_atomic).
+    JsonObject to(2);
+    to.integer("bytes", static_cast<long>(timeseries_csv_text.size()));
+    to.string("fnv1a64", fnv1a64_hex(timeseries_csv_text));
+    o.raw("timeseries_csv", to.str());
+  }
   return o.str() + "\n";
 }
 

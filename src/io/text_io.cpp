@@ -9,6 +9,7 @@
 #include <cstring>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/validate.hpp"
 
 namespace gmasim::io_detail {
 
@@ -22,7 +23,16 @@ std::string read_text_file(const std::string& path, std::string_view what,
   std::string text;
   char buf[1 << 14];
   std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) {
+    text.append(buf, n);
+    if (text.size() > kMaxInputBytes) {  // /dev/zero, a runaway pipe, a wrong file
+      std::fclose(f);
+      throw InputError(located(path, 0,
+                               fmt::format("{} is larger than {} MiB: not a gmasim input (limit "
+                                           "kMaxInputBytes, docs/reliability.md)",
+                                           what, kMaxInputBytes >> 20)));
+    }
+  }
   const bool failed = std::ferror(f) != 0;
   const int err = errno;
   std::fclose(f);

@@ -5,6 +5,7 @@
 
 #include "gmasim/errors.hpp"
 #include "gmasim/simulate.hpp"
+#include "gmasim/validate.hpp"
 
 namespace gmasim {
 namespace {
@@ -47,38 +48,118 @@ void record(const Conditions& c, const State& s, TimeSeries& ts) {
   }
 }
 
+// The run's fixed time step and length (docs/model.md, "Time step"), after validate().
+struct RunLength {
+  double dt_s = 0, duration_s = 0;
+  long steps = 0;
+};
+
+RunLength run_length(const SimulationSettings& s) {
+  const auto& w = s.waveform;
+  RunLength L;
+  double dt = s.dt_s > 0.0 ? s.dt_s : auto_dt(w);
+  if (w.periodic()) {
+    // Whole steps per period, so the last period's window is sampled exactly.
+    const double per = w.period_s();
+    const double steps_per_period =
+        static_cast<double>(checked_ceil_count(per / dt, kMaxSteps, "steps per period"));
+    dt = per / steps_per_period;
+    L.duration_s = s.periods * per;
+  } else {
+    L.duration_s = s.duration_s;
+    if (L.duration_s == 0.0 && w.kind == WaveformKind::Table) L.duration_s = w.table_t_s.back();
+    if (L.duration_s == 0.0 && w.kind == WaveformKind::Chirp) L.duration_s = w.duration_s;
+    if (!(L.duration_s > 0.0))
+      throw InputError(fmt::format("duration {} s: must be > 0", L.duration_s));
+  }
+  L.dt_s = dt;
+  L.steps = checked_step_count(L.duration_s, dt, "simulation");
+  const double rows = static_cast<double>(L.steps) / s.record_every + 2.0;
+  if (rows > kMaxRecordedRows)
+    throw InputError(fmt::format(
+        "simulation: {} steps recorded every {} give {:.4g} rows (limit {:g}); record less often "
+        "(record_every, --record-every) or shorten the run",
+        L.steps, s.record_every, rows, kMaxRecordedRows));
+  return L;
+}
+
 }  // namespace
 
-Result simulate(const Model& m, const SimulationSettings& s) {
-  const auto& w = s.waveform;
-  if (w.periodic() && !(w.frequency_Hz > 0.0 && std::isfinite(w.frequency_Hz)))
-    throw InputError(fmt::format("frequency {} Hz: must be > 0", w.frequency_Hz));
-  if (w.kind == WaveformKind::BiasedSine && !(w.pp_A >= 0.0 && std::isfinite(w.pp_A)))
-    throw InputError(fmt::format("current peak-to-peak {} A: must be >= 0", w.pp_A));
+void validate(const Waveform& w) {
+  auto current = [](double v, const char* what) {
+    require_in(v, -kMaxCurrent_A, kMaxCurrent_A, what, "A");
+  };
+  auto frequency = [](double v, const char* what) {
+    require_positive(v, what, "Hz");
+    require_in(v, 0.0, kMaxFrequency_Hz, what, "Hz");
+  };
+  switch (w.kind) {
+    case WaveformKind::BiasedSine:
+      frequency(w.frequency_Hz, "frequency");
+      current(w.min_A, "current minimum");
+      require_in(w.pp_A, 0.0, 2.0 * kMaxCurrent_A, "current peak-to-peak", "A");
+      current(w.min_A + w.pp_A, "current maximum");
+      break;
+    case WaveformKind::DC:
+      current(w.level_A, "current level");
+      break;
+    case WaveformKind::Step:
+      current(w.level_A, "current level");
+      current(w.step_to_A, "step current");
+      require_finite(w.step_time_s, "step time", "s");
+      break;
+    case WaveformKind::Chirp:
+      current(w.offset_A, "chirp offset");
+      require_in(w.amplitude_A, 0.0, kMaxCurrent_A, "chirp amplitude", "A");
+      frequency(w.f0_Hz, "chirp start frequency");
+      frequency(w.f1_Hz, "chirp end frequency");
+      require_positive(w.duration_s, "chirp duration", "s");
+      break;
+    case WaveformKind::Table: {
+      const std::string src = w.table_source.empty() ? "waveform table" : w.table_source;
+      if (w.table_t_s.empty() || w.table_t_s.size() != w.table_current_A.size())
+        throw InputError(fmt::format("{}: needs equally long, non-empty t_s and current_A", src));
+      for (std::size_t k = 0; k < w.table_t_s.size(); ++k) {
+        require_finite(w.table_t_s[k], src + ": t_s", "s");
+        current(w.table_current_A[k], "waveform current");
+        if (k > 0 && !(w.table_t_s[k] > w.table_t_s[k - 1]))
+          throw InputError(fmt::format("{}: time {:g} s does not increase (previous {:g} s)", src,
+                                       w.table_t_s[k], w.table_t_s[k - 1]));
+      }
+      // The run starts at t = 0: a table that starts later would be held at its first value
+      // for that long, a silent prefix nobody asked for; one that starts earlier is cut.
+      if (w.table_t_s.front() != 0.0)
+        throw InputError(fmt::format(
+            "{}: starts at t = {:g} s; a waveform table must start at t = 0 (the run starts "
+            "there): subtract {:g} s from t_s",
+            src, w.table_t_s.front(), w.table_t_s.front()));
+      break;
+    }
+  }
+}
+
+void validate(const SimulationSettings& s) {
+  require_finite(s.temperature_C, "temperature", "degC");
+  validate(s.waveform);
   if (!(s.dt_s >= 0.0) || !std::isfinite(s.dt_s))
     throw InputError(fmt::format("dt {} s: must be > 0 (or 0 for the automatic rule)", s.dt_s));
   if (s.record_every < 1)
     throw InputError(fmt::format("record_every {}: must be >= 1", s.record_every));
-
-  double duration = 0.0;
-  double dt = s.dt_s > 0.0 ? s.dt_s : auto_dt(w);
-  if (w.periodic()) {
+  if (s.waveform.periodic()) {
+    require_finite(s.periods, "periods");
     if (!(s.periods >= 1.0)) throw InputError(fmt::format("periods {}: must be >= 1", s.periods));
-    // Whole steps per period, so the last period's window is sampled exactly.
-    const double per = w.period_s();
-    const double steps_per_period = std::ceil(per / dt - 1e-9);
-    dt = per / steps_per_period;
-    duration = s.periods * per;
-  } else {
-    duration = s.duration_s;
-    if (duration == 0.0 && w.kind == WaveformKind::Table) duration = w.table_t_s.back();
-    if (duration == 0.0 && w.kind == WaveformKind::Chirp) duration = w.duration_s;
-    if (!(duration > 0.0)) throw InputError(fmt::format("duration {} s: must be > 0", duration));
+    require_in(s.periods, 1.0, kMaxPeriods, "periods");
   }
-  const long nsteps = std::lround(duration / dt);
-  if (nsteps > 200'000'000L)
-    throw InputError(fmt::format(
-        "{} steps of {} s: too many (limit 2e8); raise dt or shorten the run", nsteps, dt));
+  require_nonnegative(s.duration_s, "duration", "s");
+  (void)run_length(s);
+}
+
+Result simulate(const Model& m, const SimulationSettings& s) {
+  const auto& w = s.waveform;
+  validate(s);
+  const RunLength L = run_length(s);
+  const double duration = L.duration_s, dt = L.dt_s;
+  const long nsteps = L.steps;
 
   const Conditions c = make_conditions(m, s.temperature_C, s.freeze);
   Result r;

@@ -30,7 +30,7 @@ check "quantity stats" 0 "rod2_F_N +rms" "$B" simulate --periods 2 --quantity ro
 check "unknown quantity" 2 "unknown quantity 'nope'" "$B" simulate --periods 2 --quantity nope --out "$T/q2"
 check "curie" 2 "at or above the Curie temperature" "$B" simulate --temperature 400 --out "$T/b"
 check "below absolute zero" 2 "below absolute zero" "$B" simulate --temperature -300 --out "$T/b"
-check "frequency" 2 "frequency 0 Hz: must be > 0" "$B" simulate --frequency 0 --out "$T/b"
+check "frequency" 2 "frequency = 0 Hz: must be > 0" "$B" simulate --frequency 0 --out "$T/b"
 printf 't_s,current_A\n0,1\n0.001,abc\n' >"$T/w1.csv"
 check "csv non-numeric" 2 "w1.csv:3: non-numeric cell 'abc'" "$B" simulate --waveform "$T/w1.csv" --out "$T/b"
 printf 't_s,current_A\n0,1\n0.002,1\n0.001,2\n' >"$T/w2.csv"
@@ -47,7 +47,10 @@ sed 's/^length_m = 0.030  # derived: k_1/length_m = -0.030  # derived: k_1/' "$(
 check "negative length" 2 "bad.toml:[0-9]+: rod1.length_m = -0.03 m: must be > 0" "$B" model check "$T/bad.toml"
 printf '[meta\nname = 1\n' >"$T/syntax.toml"
 check "malformed toml" 2 "syntax.toml:1" "$B" model check "$T/syntax.toml"
-check "divergence" 3 "diverged at t = 0.001000000 s in rod1: H" "$B" simulate --waveform-kind step --level 1 --step-to 1e9 --step-time 0.001 --duration 0.002 --out "$T/d"
+# An absurd coil (7.2e9 turns) and a 1000 A step (the largest current allowed): the field
+# leaves every bound.
+sed 's/^coil_turns = 720.0 /coil_turns = 7.2e9 /' "$(dirname "$0")/../../models/mdma.toml" >"$T/coil.toml"
+check "divergence" 3 "diverged at t = 0.001000000 s in rod1: H" "$B" simulate --model "$T/coil.toml" --waveform-kind step --level 1e-6 --step-to 1000 --step-time 0.001 --duration 0.002 --out "$T/d"
 grep -q '"status": "diverged"' "$T/d/metrics.json" && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: diverged metrics"; }
 check "reproduce quick" 0 "applicable claims pass" "$B" reproduce --quick --no-figures --out "$T/r"
 [[ -s "$T/r/report.md" && $(grep -c '^stroke_drop_\|^hysteresis_drop_\|^flux_drop_' "$T/r/claims.csv") -eq 12 ]] && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: reproduce outputs"; }
