@@ -186,6 +186,8 @@ class Objective {
   bool residuals(const double* u, double* r) const;
   // sqrt(sum r^2): the weighted RMS error [%]; kPenalty when residuals() fails.
   double rms_pct(const std::vector<double>& u) const;
+  // Why residuals() fails at u (the InputError or DivergenceError message), "" if it does not.
+  std::string failure_reason(const std::vector<double>& u) const;
   static constexpr double kPenalty = 1e6;
 
   ModelSpec spec_at(const std::vector<double>& u) const;  // the start spec with u applied

@@ -117,6 +117,52 @@ void update_best(const pagmo::archipelago& archi, Communicator& comm, GaOutcome&
   }
 }
 
+// A checkpoint is not trusted (issue 8): its counts must match this run's layout, and every
+// stored fitness (each island's individuals on this rank, and best_f) must be what the model
+// gives at the stored point. One batch of evaluations, about one generation's cost; the
+// verdict is collective, so that no rank is left waiting in a collective call.
+void verify_restored(const Checkpoint& c, const pagmo::problem& prob, const IdentifyOptions& o,
+                     Communicator& comm, int ranks, std::size_t n) {
+  auto fail = [&](const std::string& what) {
+    throw InputError(located(o.resume_path, 0, fmt::format("cannot resume: {}", what)));
+  };
+  if (c.ranks != ranks || c.islands != o.islands || c.population != o.population ||
+      c.dim != static_cast<int>(n) ||
+      c.rank_islands.size() != static_cast<std::size_t>(ranks))
+    fail(fmt::format("the checkpoint holds {} rank(s) x {} island(s) x {} individuals of "
+                     "dimension {}; this run has {} x {} x {} of dimension {}",
+                     c.ranks, c.islands, c.population, c.dim, ranks, o.islands, o.population, n));
+  const auto& mine = c.rank_islands[static_cast<std::size_t>(comm.rank())];
+  pagmo::vector_double dvs(c.best_u.begin(), c.best_u.end());
+  std::vector<double> stored{c.best_f};
+  for (const auto& ip : mine)
+    for (std::size_t k = 0; k < ip.x.size(); ++k) {
+      dvs.insert(dvs.end(), ip.x[k].begin(), ip.x[k].end());
+      stored.push_back(ip.f[k]);
+    }
+  const pagmo::vector_double fv = pagmo::bfe{pagmo::thread_bfe{}}(prob, dvs);
+  long bad = 0;
+  std::size_t first_bad = 0;
+  for (std::size_t k = 0; k < stored.size(); ++k) {
+    const double tol = 1e-9 * std::max(1.0, std::fabs(fv[k]));
+    if (!(std::fabs(fv[k] - stored[k]) <= tol)) {
+      if (bad++ == 0) first_bad = k;
+    }
+  }
+  const long bad_all = sum_ranks(comm, bad);
+  if (bad_all > 0) {
+    const std::string where =
+        bad == 0 ? std::string("on another rank")
+                 : fmt::format("{}: stored {:.9g}, the model gives {:.9g}",
+                               first_bad == 0 ? std::string("best_f")
+                                              : fmt::format("individual {}", first_bad - 1),
+                               stored[first_bad], fv[first_bad]);
+    fail(fmt::format("{} stored fitness value(s) are not what the model gives ({}); the file "
+                     "was altered, or written by another build of gmasim",
+                     bad_all, where));
+  }
+}
+
 }  // namespace
 
 GaOutcome run_ga(const Objective& obj, const IdentifyOptions& o, Communicator& comm,
@@ -139,6 +185,7 @@ GaOutcome run_ga(const Objective& obj, const IdentifyOptions& o, Communicator& c
   if (!o.resume_path.empty()) {
     Checkpoint c = read_checkpoint(o.resume_path);
     check_compatible(c, fp, o.resume_path);
+    verify_restored(c, prob, o, comm, ranks, n);
     out.resumed = true;
     out.generation = c.generation;
     out.evaluations = c.evaluations;

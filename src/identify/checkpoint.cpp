@@ -87,9 +87,22 @@ struct LineReader {
       fail(fmt::format("expected {} numbers, got {}", expected, v.size()));
     return v;
   }
-  long integer(const std::string& key) {
+  // An integer field in [lo, hi] (a forged or damaged value never becomes a count).
+  long integer(const std::string& key, double lo, double hi) {
     const auto v = nums(expect(key), 1);
+    if (!(v[0] >= lo && v[0] <= hi && v[0] == std::floor(v[0])))
+      fail(fmt::format("{} {:g}: must be an integer in [{:g}, {:g}]", key, v[0], lo, hi));
     return static_cast<long>(v[0]);
+  }
+  double finite(const std::string& key, double lo) {
+    const double v = nums(expect(key), 1)[0];
+    if (!(std::isfinite(v) && v >= lo)) fail(fmt::format("{} {:g}: must be finite and >= {:g}", key, v, lo));
+    return v;
+  }
+  // A point of the unit cube of the search space, as the GA writes it.
+  void unit_vector(const std::vector<double>& u, const char* what) {
+    for (double x : u)
+      if (!(x >= 0.0 && x <= 1.0)) fail(fmt::format("{}: coordinate {:g} is outside [0, 1]", what, x));
   }
 };
 
@@ -186,27 +199,33 @@ Checkpoint read_checkpoint(const std::string& path) {
   c.fp_settings = in.expect("fp_settings");
   c.fp_layout = in.expect("fp_layout");
   c.algorithm = in.expect("algorithm");
-  c.ranks = static_cast<int>(in.integer("ranks"));
-  c.islands = static_cast<int>(in.integer("islands"));
-  c.population = static_cast<int>(in.integer("population"));
-  c.dim = static_cast<int>(in.integer("dim"));
-  c.seed = static_cast<unsigned>(in.integer("seed"));
-  c.generation = static_cast<int>(in.integer("generation"));
-  c.evaluations = in.integer("evaluations");
-  c.wall_s = in.nums(in.expect("wall_s"), 1)[0];
-  c.best_f = in.nums(in.expect("best_f"), 1)[0];
+  // Limits: far above any run (the CLI's own limits), far below a forged count.
+  c.ranks = static_cast<int>(in.integer("ranks", 1, 4096));
+  c.islands = static_cast<int>(in.integer("islands", 1, 4096));
+  c.population = static_cast<int>(in.integer("population", 1, 1e6));
+  c.dim = static_cast<int>(in.integer("dim", 1, 10000));
+  c.seed = static_cast<unsigned>(in.integer("seed", 0, 4294967295.0));
+  c.generation = static_cast<int>(in.integer("generation", 0, 1e9));
+  c.evaluations = in.integer("evaluations", 0, 1e15);
+  c.wall_s = in.finite("wall_s", 0.0);
+  c.best_f = in.finite("best_f", 0.0);  // a weighted RMS [%]: finite, >= 0
   c.best_u = in.nums(in.expect("best_u"), static_cast<std::size_t>(c.dim));
-  const long nh = in.integer("history");
+  in.unit_vector(c.best_u, "best_u");
+  const long nh = in.integer("history", 0, 1e7);
   for (long k = 0; k < nh; ++k) {
     const std::string l = in.next();
     const auto sp = l.find(' ');
     if (sp == std::string::npos) in.fail("bad history line");
     const auto v = in.nums(l.substr(sp + 1), 5);
+    for (double x : v)
+      if (!(std::isfinite(x) && x >= 0.0)) in.fail(fmt::format("history: {:g} is not a finite value >= 0", x));
+    const std::string phase = l.substr(0, sp);
+    if (phase != "ga" && phase != "refine") in.fail(fmt::format("history: unknown phase '{}'", phase));
     c.history.push_back(
-        {l.substr(0, sp), static_cast<int>(v[0]), static_cast<long>(v[1]), v[2], v[3], v[4]});
+        {phase, static_cast<int>(v[0]), static_cast<long>(v[1]), v[2], v[3], v[4]});
   }
   for (int r = 0; r < c.ranks; ++r) {
-    if (in.integer("rank") != r) in.fail(fmt::format("expected rank {}", r));
+    if (in.integer("rank", 0, 4096) != r) in.fail(fmt::format("expected rank {}", r));
     std::vector<IslandPopulation> isl;
     for (int i = 0; i < c.islands; ++i) {
       const std::string il = in.next();
@@ -214,13 +233,23 @@ Checkpoint read_checkpoint(const std::string& path) {
       if (std::sscanf(il.c_str(), "island %ld seed %ld size %ld", &v[0], &v[1], &v[2]) != 3)
         in.fail(fmt::format("expected 'island N seed S size P', got '{}'", il));
       if (static_cast<int>(v[0]) != i) in.fail(fmt::format("expected island {}", i));
+      // Every island holds the whole population: an empty or short island cannot be
+      // restored (pagmo's algorithms need the population they were configured for).
+      if (v[2] != c.population)
+        in.fail(fmt::format("island {} has {} individuals; the population is {}", i, v[2],
+                            c.population));
+      if (v[1] < 0 || v[1] > 4294967295L) in.fail(fmt::format("island {}: seed {} out of range", i, v[1]));
       IslandPopulation ip;
       ip.seed = static_cast<unsigned>(v[1]);
       const auto size = static_cast<std::size_t>(v[2]);
       for (std::size_t k = 0; k < size; ++k) {
         const auto row = in.nums(in.next(), static_cast<std::size_t>(c.dim) + 1);
+        if (!(std::isfinite(row[0]) && row[0] >= 0.0))
+          in.fail(fmt::format("island {} individual {}: fitness {:g} is not a finite value >= 0",
+                              i, k, row[0]));
         ip.f.push_back(row[0]);
         ip.x.emplace_back(row.begin() + 1, row.end());
+        in.unit_vector(ip.x.back(), "individual");
       }
       isl.push_back(std::move(ip));
     }

@@ -243,14 +243,33 @@ FitTarget read_target(const toml::table& t, const std::string& src, const Claims
                                            "frequency_Hz must be > 0",
                                            kn->name)));
     }
+    auto range = [&](const char* key, double v, double lo, double hi, const char* unit) {
+      if (!(std::isfinite(v) && v >= lo && v <= hi))
+        throw InputError(located(src, g.line,
+                                 fmt::format("[[target]] {}: {} = {:g} {}: must be in [{:g}, {:g}]",
+                                             kn->name, key, v, unit, lo, hi)));
+    };
+    range("current_pp_A", g.current_pp_A, 0.0, 2.0 * kMaxCurrent_A, "A");
+    range("frequency_Hz", g.frequency_Hz, 0.0, kMaxFrequency_Hz, "Hz");
+    range("current_min_A", g.current_min_A, -kMaxCurrent_A, kMaxCurrent_A, "A");
   } else {
     g.bias_A = opt("bias_A", 1.0);
+    if (!(std::fabs(g.bias_A) <= kMaxCurrent_A))
+      throw InputError(located(src, g.line,
+                               fmt::format("[[target]] {}: bias_A = {:g} A: must be in [-{:g}, "
+                                           "{:g}]",
+                                           kn->name, g.bias_A, kMaxCurrent_A, kMaxCurrent_A)));
   }
   if (kn->needs_reference) g.reference_temperature_C = opt("reference_temperature_C", 20.0);
   g.weight = opt("weight", 1.0);
   if (!(g.weight > 0.0))
     throw InputError(
         located(src, g.line, fmt::format("[[target]] {}: weight must be > 0", kn->name)));
+  // Relative weights: an extreme one scales every other residual to nothing (issue 8).
+  if (!(g.weight >= 1e-6 && g.weight <= 1e6))
+    throw InputError(located(src, g.line,
+                             fmt::format("[[target]] {}: weight = {:g}: must be in [1e-6, 1e6]",
+                                         kn->name, g.weight)));
   g.scale = opt("scale", 0.0);
   if (g.scale < 0.0)
     throw InputError(

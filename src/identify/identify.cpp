@@ -56,8 +56,15 @@ IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, cons
   const std::vector<double> u_start = obj.start_unit();
   const double f_start = obj.rms_pct(u_start);
   res.start_rms_pct = f_start;
-  if (f_start >= Objective::kPenalty)
-    res.notes.push_back("the start model cannot be evaluated (invalid or diverges)");
+  // The start model must evaluate: a search from a model that cannot be simulated under
+  // these settings would penalise every candidate alike and end "successfully" with nothing
+  // determined (issue 8). A candidate that fails later is penalised; the start is not.
+  if (f_start >= Objective::kPenalty) {
+    const std::string why = obj.failure_reason(u_start);
+    throw InputError(fmt::format("the start model cannot be evaluated: {}{}",
+                                 why.empty() ? "its error is not finite" : why,
+                                 "; fix the start model or the settings before searching"));
+  }
 
   // ---- global search ------------------------------------------------------------------
   GaOutcome ga = run_ga(obj, o, comm, u_start, f_start);

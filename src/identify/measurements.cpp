@@ -13,6 +13,7 @@
 #include <string_view>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/validate.hpp"
 #include "gmasim/identify.hpp"
 #include "gmasim/io.hpp"
 #include "io/text_io.hpp"
@@ -203,15 +204,25 @@ MeasurementCondition make_condition(const KeyMap& keys, const Measurement& m,
                      side));
   }
   c.temperature_C = keys.at("temperature_C").number;
-  if (!(c.temperature_C > -273.15))
+  if (!(c.temperature_C > -273.15 && c.temperature_C < 1e4))
     fail("temperature_C",
          fmt::format("temperature_C = {:g}: must be > -273.15 degC", c.temperature_C));
+  const double t0_rec = m.t_s.front(), t1_rec = m.t_s.back();
   const bool has_f = keys.count("frequency_Hz") > 0;
   const bool has_pp = keys.count("current_pp_A") > 0;
   if (has_f) {
     c.frequency_Hz = keys.at("frequency_Hz").number;
-    if (!(c.frequency_Hz > 0.0))
-      fail("frequency_Hz", fmt::format("frequency_Hz = {:g}: must be > 0", c.frequency_Hz));
+    if (!(c.frequency_Hz > 0.0 && c.frequency_Hz <= kMaxFrequency_Hz))
+      fail("frequency_Hz", fmt::format("frequency_Hz = {:g}: must be in (0, {:g}] Hz",
+                                       c.frequency_Hz, kMaxFrequency_Hz));
+    // The record must span a whole number of steps the simulator can take: at least the
+    // 8-step floor per period, at most kMaxSteps over the record.
+    if (!((t1_rec - t0_rec) * c.frequency_Hz * 8.0 <= kMaxSteps))
+      fail("frequency_Hz",
+           fmt::format("frequency_Hz = {:g}: {:.4g} periods over the record's {:g} s: too many "
+                       "to simulate (limit {:g} steps)",
+                       c.frequency_Hz, (t1_rec - t0_rec) * c.frequency_Hz, t1_rec - t0_rec,
+                       kMaxSteps));
     if (!has_pp) {
       fail("frequency_Hz",
            "condition missing: current_pp_A (a periodic condition, with frequency_Hz, also "
@@ -224,10 +235,16 @@ MeasurementCondition make_condition(const KeyMap& keys, const Measurement& m,
            "condition missing: frequency_Hz (current_pp_A describes a periodic excitation)");
     }
     c.current_pp_A = keys.at("current_pp_A").number;
-    if (!(c.current_pp_A > 0.0))
-      fail("current_pp_A", fmt::format("current_pp_A = {:g}: must be > 0", c.current_pp_A));
+    if (!(c.current_pp_A > 0.0 && c.current_pp_A <= 2.0 * kMaxCurrent_A))
+      fail("current_pp_A", fmt::format("current_pp_A = {:g}: must be in (0, {:g}] A",
+                                       c.current_pp_A, 2.0 * kMaxCurrent_A));
   }
-  if (keys.count("current_min_A")) c.current_min_A = keys.at("current_min_A").number;
+  if (keys.count("current_min_A")) {
+    c.current_min_A = keys.at("current_min_A").number;
+    if (!(std::fabs(c.current_min_A) <= kMaxCurrent_A))
+      fail("current_min_A", fmt::format("current_min_A = {:g}: must be in [-{:g}, {:g}] A",
+                                        c.current_min_A, kMaxCurrent_A, kMaxCurrent_A));
+  }
   if (keys.count("current_source")) {
     c.current_source = keys.at("current_source").text;
     if (c.current_source != "measured" && c.current_source != "sine")
@@ -406,6 +423,11 @@ MeasurementSet load_manifest(const std::string& path) {
       if (!wv) throw InputError(located(path, wl, "weight: expected a number"));
       if (!(*wv > 0.0) || !std::isfinite(*wv))
         throw InputError(located(path, wl, fmt::format("weight = {:g}: must be > 0", *wv)));
+      // Weights are relative: a range of 1e-6..1e6 covers any use, and an extreme one
+      // would scale every other residual to nothing ("RMS 0 %", issue 8).
+      if (!(*wv >= 1e-6 && *wv <= 1e6))
+        throw InputError(
+            located(path, wl, fmt::format("weight = {:g}: must be in [1e-6, 1e6]", *wv)));
       weight = *wv;
     }
     const fs::path fp = fs::path(*file).is_absolute() ? fs::path(*file) : base / *file;

@@ -12,6 +12,7 @@
 #include <set>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/validate.hpp"
 #include "gmasim/experiments.hpp"
 #include "gmasim/identify.hpp"
 #include "gmasim/io.hpp"
@@ -131,9 +132,10 @@ SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings
                      StartCache& starts) {
   const Waveform w = biased_sine(run.pp, run.f, run.min);
   const double per = w.period_s();
-  const long n_per = std::max(8L, static_cast<long>(std::ceil(per / step_for(s, per) - 1e-9)));
+  const long n_per = std::max(8L, checked_ceil_count(per / step_for(s, per), kMaxSteps,
+                                                     "steps per period"));
   const double dt = per / static_cast<double>(n_per);
-  const long periods = std::max(1L, std::lround(s.target_periods));
+  const long periods = std::max(1L, checked_count(s.target_periods, 1e4, "target periods"));
   const long total = periods * n_per;
   const auto& [c, st0] = starts.get(run.T, w.current_at(0.0));
   State st = st0;
@@ -204,10 +206,8 @@ void run_measurement(const Model& m, const Conditions& c, State st, const Measur
   auto current = [&](double t) { return sine ? w.current_at(t) : table(t); };
 
   const double dt_target = step_for(s, meas.periodic() ? 1.0 / cond.frequency_Hz : 0.0);
-  const long nsteps = std::max(1L, static_cast<long>(std::ceil((t1 - t0) / dt_target - 1e-9)));
-  if (nsteps > 50'000'000L)
-    throw InputError(
-        fmt::format("{}: {} steps: the time step is too small for the record", meas.path, nsteps));
+  const long nsteps = std::max(1L, checked_ceil_count((t1 - t0) / dt_target, kMaxSteps,
+                                                      meas.path + ": steps over the record"));
   const double dt = (t1 - t0) / static_cast<double>(nsteps);
 
   st.t_s = t0;
@@ -282,7 +282,7 @@ struct Objective::Impl {
     return compile(spec);
   }
 
-  bool residuals(const double* u, double* r) const {
+  bool residuals(const double* u, double* r, std::string* why = nullptr) const {
     try {
       const Model model = model_at(u);
       StartCache starts(model);
@@ -311,13 +311,18 @@ struct Objective::Impl {
           r[td.r_index] = td.r_scale * (sim - td.t.value);
         }
       }
-    } catch (const InputError&) {
+    } catch (const InputError& e) {
+      if (why) *why = e.what();
       return false;
-    } catch (const DivergenceError&) {
+    } catch (const DivergenceError& e) {
+      if (why) *why = e.what();
       return false;
     }
     for (std::size_t i = 0; i < m; ++i)
-      if (!std::isfinite(r[i])) return false;
+      if (!std::isfinite(r[i])) {
+        if (why) *why = fmt::format("residual {} is not finite", i);
+        return false;
+      }
     return true;
   }
 
@@ -370,6 +375,9 @@ Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const F
     throw InputError(fmt::format("flux weight {:g}: must be >= 0", settings.flux_weight));
   if (!(settings.target_periods >= 1.0))
     throw InputError(fmt::format("target periods {:g}: must be >= 1", settings.target_periods));
+  require_in(settings.steps_per_period, 8.0, 1e6, "steps per period");
+  require_in(settings.target_periods, 1.0, 1e4, "target periods");
+  require_in(settings.flux_weight, 0.0, 1e6, "flux weight");
   if (fit.parameters.empty()) throw InputError(located(fit.source, 0, "no parameter to fit"));
   if (data.items.empty() && fit.targets.empty()) {
     throw InputError(
@@ -513,6 +521,27 @@ Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const F
     W += t.weight;
     I.targets.push_back(td);
   }
+  // ---- run lengths: every simulation an evaluation will run is checked here, so that an
+  // evaluation fails only for its parameter values, never for the settings (issue 8) ----
+  for (const SineRun& run : I.sine_runs) {
+    const double per = 1.0 / run.f;
+    const double n_per = std::max(8.0, std::ceil(per / step_for(settings, per) - 1e-9));
+    (void)checked_count(n_per * std::round(settings.target_periods), kMaxSteps,
+                        fmt::format("steps of the {:g} Hz target simulation", run.f));
+  }
+  for (const auto& cd : I.conds) {
+    const Measurement& meas = data.items[cd.index];
+    const double span = meas.t_s.back() - meas.t_s.front();
+    const double dt_target =
+        step_for(settings, meas.periodic() ? 1.0 / meas.condition.frequency_Hz : 0.0);
+    const double n = std::ceil(span / dt_target - 1e-9);
+    if (!(n <= kMaxSteps))
+      throw InputError(located(
+          meas.path, 0,
+          fmt::format("{:.4g} steps of {:g} s over the record's {:g} s: too many (limit {:g}); "
+                      "give --dt, or a frequency_Hz condition for a periodic record",
+                      n, dt_target, span, kMaxSteps)));
+  }
   // ---- residual layout and scales ----
   std::size_t off = 0;
   for (auto& cd : I.conds) {
@@ -540,6 +569,12 @@ Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const F
                     I.m, I.params.size()));
   }
   impl_ = std::move(impl);
+}
+
+std::string Objective::failure_reason(const std::vector<double>& u) const {
+  std::vector<double> r(impl_->m);
+  std::string why;
+  return impl_->residuals(u.data(), r.data(), &why) ? std::string() : why;
 }
 
 std::size_t Objective::dim() const { return impl_->params.size(); }
@@ -702,6 +737,21 @@ std::vector<TargetFit> Objective::target_fits(const std::vector<double>& u) cons
 MeasurementSet synthesize_measurements(const Model& truth, const SyntheticRequest& r) {
   if (r.samples_per_period < 8) throw InputError("samples per period: must be >= 8");
   if (!(r.periods >= 1.5)) throw InputError("periods: must be >= 1.5 (the first is not compared)");
+  require_in(r.periods, 1.5, kMaxPeriods, "periods");
+  require_in(r.current_min_A, -kMaxCurrent_A, kMaxCurrent_A, "current minimum", "A");
+  require_in(r.noise_pct, 0.0, 100.0, "noise", "%");
+  require_in(r.flux_noise_pct, 0.0, 100.0, "flux noise", "%");
+  for (double T : r.temperatures_C) require_finite(T, "temperature", "degC");
+  for (double pp : r.currents_pp_A) require_in(pp, 0.0, 2.0 * kMaxCurrent_A, "current peak-to-peak", "A");
+  for (double f : r.frequencies_Hz) {
+    require_positive(f, "frequency", "Hz");
+    require_in(f, 0.0, kMaxFrequency_Hz, "frequency", "Hz");
+  }
+  (void)checked_count(r.periods * r.samples_per_period, kMaxRecordedRows, "samples per record");
+  (void)checked_count(static_cast<double>(r.temperatures_C.size()) *
+                          static_cast<double>(r.currents_pp_A.size()) *
+                          static_cast<double>(r.frequencies_Hz.size()),
+                      kMaxListValues, "synthetic records");
   MeasurementSet set;
   std::uint64_t state = 0x9E3779B97F4A7C15ULL ^ r.seed;
   auto next_u01 = [&]() {  // splitmix64: the same numbers on every platform
