@@ -1,0 +1,199 @@
+#!/usr/bin/env bash
+# Regression tests of issue 8 (hostile input): each defect found by the mutation campaign is
+# a check here, numbered as in the issue. Every hostile input must give a clear error and
+# the documented exit code (1 usage, 2 bad input), never a crash (>= 128), a hang (timeout
+# 124), or exit 0 with nonsense. Usage: hostile_cli.sh <path to gmasim>.
+set -u
+B="$(cd "$(dirname "$1")" && pwd)/$(basename "$1")"
+SRC="$(cd "$(dirname "$0")/../.." && pwd)"
+T="$(mktemp -d)"
+trap 'rm -rf "$T"' EXIT
+cd "$T"
+pass=0
+fail=0
+check() {  # name, expected exit code, expected text (grep -E) in stdout+stderr, command...
+  local name="$1" code="$2" text="$3"
+  shift 3
+  local out rc
+  out="$(timeout 120 "$@" 2>&1)"
+  rc=$?
+  if [[ $rc -eq $code ]] && grep -qE -- "$text" <<<"$out"; then
+    pass=$((pass + 1))
+  else
+    fail=$((fail + 1))
+    echo "FAIL: $name (exit $rc, expected $code; wanted /$text/)"
+    echo "$out" | head -c 600
+    echo
+  fi
+}
+ok() {  # name, condition already evaluated as a command
+  local name="$1"
+  shift
+  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $name"; fi
+}
+
+# ---- 1. checkpoints are not trusted --------------------------------------------------
+cat >fit.toml <<'EOF'
+[[parameter]]
+name = "material.lambda_s"
+lower = 0.8e-3
+upper = 1.2e-3
+
+[[target]]
+kind = "stroke_change_pct"
+temperature_C = 70.0
+current_pp_A = 8.0
+frequency_Hz = 10.0
+value = -12.6
+
+[[target]]
+kind = "hysteresis_change_pct"
+temperature_C = 70.0
+current_pp_A = 8.0
+frequency_Hz = 10.0
+value = -27.6
+EOF
+ID=(identify --fit fit.toml --islands 1 --population 8 --migrate-every 1 --no-refine --no-plots
+    --quiet --steps-per-period 100 --threads 1)
+check "identify writes a checkpoint" 0 "" "$B" "${ID[@]}" --out m.toml --generations 2 \
+  --checkpoint ck.txt --checkpoint-every 1
+R=("$B" "${ID[@]}" --out m2.toml --generations 3 --resume)
+check "resume an honest checkpoint" 0 "" "${R[@]}" ck.txt
+sed 's/ size 8$/ size 0/' ck.txt >c_size0.txt
+check "1 island of size 0" 2 "island 0 has 0 individuals; the population is 8" "${R[@]}" c_size0.txt
+# Forge the last individual's fitness: it would become the champion.
+awk 'BEGIN{n=0} /^island /{isl=1} {if (isl && $0 ~ /^[0-9.e+-]+ [0-9.e+-]+$/) {n++; if (n==8) {$1="0.005"}} print}' ck.txt >c_forged.txt
+check "1 forged fitness" 2 "stored fitness value\(s\) are not what the model gives" "${R[@]}" c_forged.txt
+sed 's/^best_f .*/best_f -1/' ck.txt >c_neg.txt
+check "1 best_f -1" 2 "best_f -1: must be finite and >= 0" "${R[@]}" c_neg.txt
+sed 's/^best_f .*/best_f -inf/' ck.txt >c_inf.txt
+check "1 best_f -inf" 2 "best_f -inf: must be finite" "${R[@]}" c_inf.txt
+sed 's/^best_u .*/best_u 7.5/' ck.txt >c_out.txt
+check "1 point outside the bounds" 2 "coordinate 7.5 is outside \[0, 1\]" "${R[@]}" c_out.txt
+sed 's/^population 8$/population 0/' ck.txt >c_pop0.txt
+check "1 population 0" 2 "population 0: must be an integer in" "${R[@]}" c_pop0.txt
+sed 's/^islands 1$/islands 1e18/' ck.txt >c_isl.txt
+check "1 islands 1e18" 2 "islands 1e\+18: must be an integer" "${R[@]}" c_isl.txt
+
+# ---- 2, 3. identify counts -----------------------------------------------------------
+check "2 --target-periods 1e18" 2 "target periods = 1e\+18: must be in \[1, 10000\]" \
+  "$B" "${ID[@]}" --out m3.toml --generations 1 --target-periods 1e18
+check "3 --steps-per-period 1e20" 2 "steps per period = 1e\+20: must be in \[8, 1e\+06\]" \
+  "$B" identify --fit fit.toml --out m3.toml --population 8 --generations 1 --no-plots --quiet \
+  --steps-per-period 1e20
+mkdir -p d
+{
+  echo "# temperature_C = 20"
+  echo "# frequency_Hz = 1e300"
+  echo "# current_pp_A = 8"
+  echo "t_s,current_A,displacement_um"
+  for k in 0 1 2 3 4 5 6 7 8 9; do echo "0.0$k,$k,$k"; done
+} >d/huge_f.csv
+printf '[[measurement]]\nfile = "huge_f.csv"\n' >d/manifest.toml
+check "3 frequency_Hz 1e300 in data" 2 "frequency_Hz = 1e\+300: must be in \(0, 1e\+06\] Hz" \
+  "$B" identify --data d/manifest.toml --fit 'material.lambda_s:0.8e-3:1.2e-3' --out m4.toml \
+  --population 8 --generations 1 --no-plots --quiet
+
+# ---- 4. extreme weights -----------------------------------------------------------------
+{
+  echo "# temperature_C = 20"
+  echo "t_s,current_A,displacement_um"
+  for k in 0 1 2 3 4 5 6 7 8 9; do echo "0.00$k,$k,$k"; done
+} >d/dc.csv
+printf '[[measurement]]\nfile = "dc.csv"\nweight = 1e308\n' >d/heavy.toml
+check "4 manifest weight 1e308" 2 "weight = 1e\+308: must be in \[1e-6, 1e6\]" \
+  "$B" identify --data d/heavy.toml --fit 'material.lambda_s:0.8e-3:1.2e-3' --out m5.toml \
+  --population 8 --generations 1 --no-plots --quiet
+
+# ---- 5. simulate step counts ---------------------------------------------------------------
+check "5 --periods 1e300" 2 "periods = 1e\+300: must be in \[1, 1e\+06\]" "$B" simulate --periods 1e300 --out s
+check "5 --periods inf" 1 "--periods inf: must be a finite number" "$B" simulate --periods inf --out s
+check "5 --frequency 1e-300" 2 "steps per period = .*too many" "$B" simulate --frequency 1e-300 --out s
+check "5 --dt 1e-300" 2 "too many \(limit 2e\+08\)" "$B" simulate --dt 1e-300 --out s
+check "5 --duration inf" 1 "--duration inf: must be a finite number" "$B" simulate --duration inf --out s
+check "5 chirp --f1 inf" 1 "--f1 inf: must be a finite number" "$B" simulate --waveform-kind chirp --f1 inf --out s
+check "5 chirp --f1 1e300" 2 "chirp end frequency = 1e\+300 Hz: must be in" "$B" simulate --waveform-kind chirp --f1 1e300 --duration 1 --out s
+printf 't_s,current_A\n0,1\n1e300,2\n' >w_long.csv
+check "5 waveform ending at 1e300 s" 2 "steps of 1e-05 s over 1e\+300 s: too many" "$B" simulate --waveform w_long.csv --out s
+check "5 record too long" 2 "rows \(limit 2e\+07\); record less often" "$B" simulate --periods 3000 --out s
+ok "5 no output after a refused run" test ! -e s/timeseries.csv
+
+# ---- 6, 7. lists -------------------------------------------------------------------------
+check "6 range step 1e-300" 2 "range 30:1e-300:70 has .* values \(limit 100000\)" \
+  "$B" sweep --temperatures 20,30:1e-300:70 --periods 1 --out sw
+check "7 track --amplitudes 1e300" 2 "reference amplitude = 1e\+300 um: must be in \[0 um, 10000 um\]" \
+  "$B" track --amplitudes 1e300 --temperatures 20 --out tr
+ok "7 no track.csv after a refused run" test ! -e tr/track.csv
+
+# ---- 8. non-finite flags and model values --------------------------------------------------
+check "8 --step-time nan" 1 "--step-time nan: must be a finite number" "$B" simulate --step-time nan --out s
+check "8 --temperature nan" 1 "--temperature nan: must be a finite number" "$B" simulate --temperature nan --out s
+sed 's/^k_j = 0.473294403942 /k_j = 1e-320 /' "$SRC/models/mdma.toml" >kj.toml
+check "8 k_j = 1e-320" 2 "kj.toml:[0-9]+: rod1.k_j = .*: outside the range of any physical value" "$B" model check kj.toml
+
+# ---- 9. size limits ---------------------------------------------------------------------
+check "9 model check /dev/zero" 2 "larger than 256 MiB" "$B" model check /dev/zero
+check "9 --resume /dev/zero" 2 "checkpoint is larger than 256 MiB" "${R[@]}" /dev/zero
+check "9 frf --points 2e9" 2 "frequency points = 2e\+09: too many \(limit 100000\)" "$B" frf --points 2000000000 --out f
+printf 't_s,current_A\n100,1\n100.01,2\n' >w_late.csv
+check "9 waveform starting at t = 100 s" 2 "starts at t = 100 s; a waveform table must start at t = 0" \
+  "$B" simulate --waveform w_late.csv --out s
+
+# ---- 10. non-regular destinations ---------------------------------------------------------
+mkdir -p dev
+ln -s /dev/null dev/metrics.json
+check "10 a device at the destination" 2 "the destination is a character device" "$B" simulate --periods 1 --out dev
+ok "10 /dev/null is still a device" test -c /dev/null
+ok "10 nothing written beside it" test ! -e dev/timeseries.csv
+
+# ---- 11. evaluation errors stop the run -------------------------------------------------
+{
+  echo "# temperature_C = 20"
+  echo "t_s,current_A,displacement_um"
+  echo "0,0,0"
+  echo "1000,1,1"
+  echo "2000,2,2"
+  echo "3000,1,3"
+  echo "4000,0,2"
+} >d/undated.csv
+printf '[[measurement]]\nfile = "undated.csv"\n' >d/m_undated.toml
+check "11 undated record without --dt" 2 "steps of 1e-05 s over the record's 4000 s: too many .* give --dt" \
+  "$B" identify --data d/m_undated.toml --fit 'material.lambda_s:0.8e-3:1.2e-3' --out m6.toml \
+  --population 8 --generations 1 --no-plots --quiet
+sed 's/^coil_turns = 720.0 /coil_turns = 7.2e9 /' "$SRC/models/mdma.toml" >start_div.toml
+check "11 a start model that diverges stops the run" 2 "the start model cannot be evaluated: diverged" \
+  "$B" "${ID[@]}" --model start_div.toml --out m7.toml --generations 1
+
+# ---- 12. simulate writes one set ---------------------------------------------------------
+check "12 simulate" 0 "wrote" "$B" simulate --periods 1 --out pair
+ok "12 metrics.json names its timeseries.csv" /usr/bin/python3 - pair <<'EOF'
+import json, sys, pathlib
+d = pathlib.Path(sys.argv[1])
+data = (d / "timeseries.csv").read_bytes()
+h = 14695981039346656037
+for c in data:
+    h = ((h ^ c) * 1099511628211) & 0xFFFFFFFFFFFFFFFF
+m = json.loads((d / "metrics.json").read_text())["timeseries_csv"]
+sys.exit(0 if m == {"bytes": len(data), "fnv1a64": f"{h:016x}"} else 1)
+EOF
+ok "12 no temporary left" test -z "$(ls pair | grep tmp)"
+
+# ---- 13. parse errors ---------------------------------------------------------------------
+check "13 unknown flag is a usage error" 1 "not expected: --bogus" "$B" simulate --bogus
+check "13 bad number is a usage error" 1 "Could not convert" "$B" simulate --periods abc
+check "13 +-1" 1 "Could not convert" "$B" simulate --periods +-1
+# One argument may hold at most 128 KiB (Linux MAX_ARG_STRLEN): 100 kB.
+long="$(head -c 100000 /dev/zero | tr '\0' '7')x"
+out="$("$B" simulate --periods "$long" 2>&1)"
+rc=$?
+ok "13 a 100 kB value: usage error" test "$rc" -eq 1
+ok "13 a 100 kB value is not echoed whole (${#out} characters)" test "${#out}" -lt 5000
+big="$(head -c 1000000 /dev/zero | tr '\0' '7')x"
+printf 't_s,current_A\n0,1\n0.001,%s\n' "$big" >w_big.csv
+out="$("$B" simulate --waveform w_big.csv --out s 2>&1)"
+rc=$?
+ok "13 a 1 MB cell: bad input" test "$rc" -eq 2
+ok "13 a 1 MB cell is not echoed whole (${#out} characters)" test "${#out}" -lt 5000
+
+echo "$pass passed, $fail failed"
+[[ $fail -eq 0 ]]
