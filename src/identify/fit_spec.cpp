@@ -14,6 +14,7 @@
 
 #include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
+#include "io/text_io.hpp"
 #include "gmasim/io.hpp"
 #include "gmasim/identify.hpp"
 
@@ -347,6 +348,7 @@ std::string target_kind_name(TargetKind k) {
 FitSpec parse_fit_spec(const std::string& toml_text, const std::string& source_name,
                        const ClaimsData* claims) {
   toml::table root;
+  io_detail::guard_toml_text(toml_text, source_name);
   try {
     root = toml::parse(toml_text, std::string_view(source_name));
   } catch (const toml::parse_error& e) {

@@ -30,6 +30,7 @@ using io_detail::trim;
 // The TOML file at `path` (`what` names it in the open/read error).
 toml::table read_toml(const std::string& path, std::string_view what) {
   const std::string text = read_text_file(path, what);
+  io_detail::guard_toml_text(text, path);
   try {
     return toml::parse(text, std::string_view(path));
   } catch (const toml::parse_error& e) {

@@ -265,6 +265,7 @@ ClaimSpec read_claim(const Reader& rd, const toml::table& t,
 
 ClaimsData parse_claims(const std::string& toml_text, const std::string& source_name) {
   toml::table root;
+  io_detail::guard_toml_text(toml_text, source_name);
   try {
     root = toml::parse(toml_text, std::string_view(source_name));
   } catch (const toml::parse_error& e) {

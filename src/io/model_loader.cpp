@@ -366,6 +366,7 @@ class Loader {
 
   ModelSpec run() {
     toml::table root;
+    io_detail::guard_toml_text(text_, spec_.source);
     try {
       root = toml::parse(text_, std::string_view(spec_.source));
     } catch (const toml::parse_error& e) {

@@ -73,4 +73,115 @@ CellError parse_finite(std::string_view cell, double& v) {
   return CellError::None;
 }
 
+namespace {
+
+bool is_bare_key_char(char c) {
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
+         c == '_' || c == '-';
+}
+
+std::string shown(char c) {
+  const auto u = static_cast<unsigned char>(c);
+  if (u >= 0x21 && u < 0x7f) return fmt::format("'{}'", c);
+  return fmt::format("byte 0x{:02x}", static_cast<unsigned>(u));
+}
+
+}  // namespace
+
+void guard_toml_text(std::string_view text, const std::string& source) {
+  enum class Str { None, Basic, Literal, MlBasic, MlLiteral };
+  Str str = Str::None;
+  int depth = 0;  // [ and { nesting inside values
+  long line = 1;
+  bool line_start = true;
+  auto fail = [&](const std::string& why) { throw InputError(located(source, line, why)); };
+  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);  // UTF-8 byte-order mark
+  const std::size_t n = text.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const char c = text[i];
+    if (c == '\0') fail("NUL byte: not a text file");
+    if (c == '\n') {
+      ++line;
+      line_start = true;
+      if (str == Str::Basic || str == Str::Literal) str = Str::None;  // toml++ reports it
+      continue;
+    }
+    if (str == Str::Basic || str == Str::MlBasic) {
+      if (c == '\\') {
+        if (i + 1 < n && text[i + 1] != '\n') ++i;  // skip the escaped character
+        continue;
+      }
+      if (c == '"') {
+        if (str == Str::Basic) str = Str::None;
+        else if (text.substr(i, 3) == "\"\"\"") {
+          str = Str::None;
+          i += 2;
+        }
+      }
+      continue;
+    }
+    if (str == Str::Literal || str == Str::MlLiteral) {
+      if (c == '\'') {
+        if (str == Str::Literal) str = Str::None;
+        else if (text.substr(i, 3) == "'''") {
+          str = Str::None;
+          i += 2;
+        }
+      }
+      continue;
+    }
+    if (line_start && depth == 0) {
+      if (c == ' ' || c == '\t' || c == '\r') continue;
+      line_start = false;
+      if (c == '[') {  // a table header: [key] or [[key]]
+        std::size_t j = i + 1;
+        if (j < n && text[j] == '[') ++j;
+        while (j < n && (text[j] == ' ' || text[j] == '\t')) ++j;
+        if (j >= n || !(is_bare_key_char(text[j]) || text[j] == '"' || text[j] == '\''))
+          fail(fmt::format("malformed table header: a key cannot start with {}",
+                           j >= n || text[j] == '\n' ? std::string("the end of the line")
+                                                      : shown(text[j])));
+        // The rest of the header (quoted keys may hold brackets) is toml++'s to check.
+        while (i + 1 < n && text[i + 1] != '\n') ++i;
+        continue;
+      }
+      if (!(is_bare_key_char(c) || c == '"' || c == '\'' || c == '#'))
+        fail(fmt::format("expected a key, a [table] or a comment; a key cannot start with {}",
+                         shown(c)));
+    }
+    line_start = false;
+    switch (c) {
+      case '#':
+        while (i + 1 < n && text[i + 1] != '\n') ++i;
+        break;
+      case '"':
+        if (text.substr(i, 3) == "\"\"\"") {
+          str = Str::MlBasic;
+          i += 2;
+        } else {
+          str = Str::Basic;
+        }
+        break;
+      case '\'':
+        if (text.substr(i, 3) == "'''") {
+          str = Str::MlLiteral;
+          i += 2;
+        } else {
+          str = Str::Literal;
+        }
+        break;
+      case '[':
+      case '{':
+        ++depth;
+        break;
+      case ']':
+      case '}':
+        if (depth > 0) --depth;
+        break;
+      default:
+        break;
+    }
+  }
+}
+
 }  // namespace gmasim::io_detail

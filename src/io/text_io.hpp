@@ -32,4 +32,12 @@ enum class CellError { None, Empty, NonNumeric, OutOfRange, NaN, Inf };
 // would). Anything but CellError::None leaves `v` unspecified.
 CellError parse_finite(std::string_view cell, double& v);
 
+// Guards toml++ 3.3 (Debian 12) against inputs it mishandles (issue 8): a table header whose
+// first key character is not a key character (`[[[1]]]`, `[&`, `[[=`, `[Π]`: assertion
+// failures and undefined behaviour upstream, marzer/tomlplusplus#294, #301), a line at the
+// top level that starts with a character no key starts with, and NUL bytes. Scans strings,
+// comments and multi-line arrays as TOML does; throws InputError "<source>:<line>: ...".
+// Call before toml::parse on any user text.
+void guard_toml_text(std::string_view text, const std::string& source);
+
 }  // namespace gmasim::io_detail

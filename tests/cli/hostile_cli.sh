@@ -195,5 +195,17 @@ rc=$?
 ok "13 a 1 MB cell: bad input" test "$rc" -eq 2
 ok "13 a 1 MB cell is not echoed whole (${#out} characters)" test "${#out}" -lt 5000
 
+# ---- 14. inputs toml++ 3.3 mishandles (asserts / UB upstream) -----------------------------
+for hdr in '[[[1]]]' '[[[a]]' '[[[]]' '[[=' '[&' '[Π]'; do
+  printf '%s\nx = 1\n' "$hdr" >bad_header.toml
+  check "14 header $hdr (model)" 2 "bad_header.toml:1: malformed table header" "$B" model check bad_header.toml
+  check "14 header $hdr (fit spec)" 2 "bad_header.toml:1: malformed table header" \
+    "$B" identify --fit bad_header.toml --out m8.toml --population 8 --generations 1 --no-plots --quiet
+done
+printf 'Π = 1\n' >bad_key.toml
+check "14 U+03A0 key" 2 "bad_key.toml:1: expected a key" "$B" model check bad_key.toml
+printf '[meta]\nname = "a\0b"\n' >nul.toml
+check "14 NUL byte" 2 "nul.toml:2: NUL byte" "$B" model check nul.toml
+
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]
