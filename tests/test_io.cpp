@@ -16,6 +16,7 @@
 
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
+#include "gmasim/validate.hpp"
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
@@ -34,7 +35,8 @@ std::string builtin_text() {
   return ss.str();
 }
 gmasim::ModelSpec fixture_spec() {
-  return gmasim::parse_model_spec(builtin_text(), std::string(gmasim::kBuiltinModelName) + " (built-in)");
+  return gmasim::parse_model_spec(builtin_text(),
+                                  std::string(gmasim::kBuiltinModelName) + " (built-in)");
 }
 
 // Replaces the single occurrence of `from` (the test fails if it is not unique).
@@ -112,7 +114,8 @@ class TempDir {
 // The built-in model
 // =======================================================================================
 TEST(ModelFile, BuiltinParses) {
-  EXPECT_EQ(gmasim::builtin_model_spec().source, std::string(gmasim::kBuiltinModelName) + " (built-in)");
+  EXPECT_EQ(gmasim::builtin_model_spec().source,
+            std::string(gmasim::kBuiltinModelName) + " (built-in)");
   const auto spec = fixture_spec();
   EXPECT_EQ(spec.rods, (std::vector<std::string>{"rod1", "rod2", "rod3"}));
   EXPECT_EQ(spec.reference_node, "0");
@@ -181,7 +184,7 @@ TEST(ModelFile, IntegersAreNumbers) {
 TEST(ModelFile, DescribeGivesProvenanceForEveryParameter) {
   const auto spec = gmasim::builtin_model_spec();  // the real built-in file: its provenance
   const auto rows = gmasim::describe_model(spec);
-  const std::vector<std::string> prefixes = {"Table",     "eq.",     "derived",   "literature",
+  const std::vector<std::string> prefixes = {"Table",     "eq.",     "derived",    "literature",
                                              "judgement", "section", "identified", "inferred"};
   std::size_t numeric = 0;
   long previous_line = 0;
@@ -228,7 +231,8 @@ TEST(ModelFile, DescribeListsOptionsAndStructure) {
   EXPECT_THAT(chain->provenance, StartsWith("eq. 18"));
   const auto* ms = find("material.Ms_A_per_m");
   ASSERT_NE(ms, nullptr);
-  EXPECT_EQ(ms->value, fmt::format("{:g}", gmasim::builtin_model_spec().get("material.Ms_A_per_m")));
+  EXPECT_EQ(ms->value,
+            fmt::format("{:g}", gmasim::builtin_model_spec().get("material.Ms_A_per_m")));
   EXPECT_EQ(ms->unit, "A/m");
 }
 
@@ -786,4 +790,139 @@ TEST(Errors, DivergenceMessage) {
   const gmasim::DivergenceError f(1.5, "", "B_T", 7.0, "circuit matrix not positive definite");
   EXPECT_STREQ(f.what(),
                "diverged at t = 1.500000000 s: B_T = 7 (circuit matrix not positive definite)");
+}
+
+// ---------------------------------------------------------------------------------------
+// The validation layer (gmasim/validate.hpp, issue 8)
+// ---------------------------------------------------------------------------------------
+TEST(Validate, CountsAreCheckedBeforeConversion) {
+  using gmasim::checked_count;
+  EXPECT_EQ(checked_count(3.4, 10, "n"), 3);
+  EXPECT_EQ(checked_count(10.0, 10, "n"), 10);
+  EXPECT_EQ(gmasim::checked_ceil_count(2.0000000001, 10, "n"), 2);  // 1e-9 slack
+  EXPECT_EQ(gmasim::checked_ceil_count(2.01, 10, "n"), 3);
+  EXPECT_EQ(input_error([] { checked_count(1e300, 1e6, "steps"); }),
+            "steps = 1e+300: too many (limit 1e+06)");
+  EXPECT_EQ(input_error([] { checked_count(-1.0, 1e6, "steps"); }), "steps = -1: must be >= 0");
+  EXPECT_EQ(input_error([] { checked_count(std::nan(""), 1e6, "steps"); }),
+            "steps = nan: not a finite count");
+  EXPECT_EQ(input_error([] { checked_count(INFINITY, 1e6, "steps"); }),
+            "steps = inf: not a finite count");
+  EXPECT_EQ(input_error([] { gmasim::checked_ceil_count(INFINITY, 1e6, "n"); }),
+            "n = inf: not a finite count");
+  EXPECT_THAT(input_error([] { gmasim::checked_step_count(1e300, 1e-5, "run"); }),
+              HasSubstr("too many (limit 2e+08)"));
+  EXPECT_EQ(gmasim::checked_step_count(0.1, 1e-5, "run"), 10000);
+}
+
+TEST(Validate, RangesNameTheValueTheUnitAndTheRule) {
+  EXPECT_EQ(input_error([] { gmasim::require_in(5.0, 0.0, 1.0, "x", "A"); }),
+            "x = 5 A: must be in [0 A, 1 A]");
+  EXPECT_EQ(input_error([] { gmasim::require_positive(0.0, "f", "Hz"); }), "f = 0 Hz: must be > 0");
+  EXPECT_EQ(input_error([] { gmasim::require_finite(-INFINITY, "T", "degC"); }),
+            "T = -inf degC: must be a finite number");
+  EXPECT_EQ(input_error([] { gmasim::require_int_in(0, 1, 9, "islands"); }),
+            "islands = 0: must be in [1, 9]");
+}
+
+TEST(Validate, LongMessagesAreClipped) {
+  const std::string line(1'000'000, 'x');
+  const gmasim::InputError e("bad value '" + line + "'");
+  EXPECT_LE(std::string(e.what()).size(), gmasim::kMaxErrorChars + 100);
+  EXPECT_THAT(e.what(), HasSubstr("characters omitted"));
+  EXPECT_THAT(e.what(), StartsWith("bad value 'xxx"));
+  EXPECT_EQ(gmasim::clip_for_message("short"), "short");
+}
+
+TEST(Validate, SimulationSettingsAreRefusedBeforeAnyWork) {
+  const gmasim::Model m = gmasim::compile(fixture_spec());
+  auto err = [&](auto edit) {
+    gmasim::SimulationSettings s;
+    edit(s);
+    return input_error([&] { (void)gmasim::simulate(m, s); });
+  };
+  using S = gmasim::SimulationSettings;
+  EXPECT_EQ(err([](S& s) { s.periods = 1e300; }), "periods = 1e+300: must be in [1, 1e+06]");
+  EXPECT_THAT(err([](S& s) { s.waveform.frequency_Hz = 1e-300; }), HasSubstr("too many"));
+  EXPECT_THAT(err([](S& s) { s.dt_s = 1e-300; }), HasSubstr("too many"));
+  EXPECT_THAT(err([](S& s) { s.periods = 3000; }), HasSubstr("record less often"));
+  EXPECT_EQ(err([](S& s) { s.temperature_C = std::nan(""); }),
+            "temperature = nan degC: must be a finite number");
+  EXPECT_EQ(err([](S& s) { s.duration_s = INFINITY; }),
+            "duration = inf s: must be a finite number");
+  EXPECT_EQ(err([](S& s) {
+              s.waveform.kind = gmasim::WaveformKind::Step;
+              s.waveform.step_time_s = std::nan("");
+              s.duration_s = 0.01;
+            }),
+            "step time = nan s: must be a finite number");
+  EXPECT_EQ(err([](S& s) {
+              s.waveform.kind = gmasim::WaveformKind::Table;
+              s.waveform.table_t_s = {100.0, 100.01};
+              s.waveform.table_current_A = {1.0, 2.0};
+            }),
+            "waveform table: starts at t = 100 s; a waveform table must start at t = 0 (the "
+            "run starts there): subtract 100 s from t_s");
+  // 3000 periods recorded every 10th step are fine to validate (not run here).
+  gmasim::SimulationSettings ok;
+  ok.periods = 3000;
+  ok.record_every = 10;
+  EXPECT_NO_THROW(gmasim::validate(ok));
+}
+
+TEST(Output, NeverReplacesANonRegularFile) {
+  TempDir dir;
+  const auto link = dir.path() / "metrics.json";
+  fs::create_symlink("/dev/null", link);
+  EXPECT_THAT(input_error([&] { gmasim::write_file_atomic(link.string(), "x"); }),
+              HasSubstr("the destination is a character device"));
+  EXPECT_TRUE(fs::is_character_file("/dev/null"));
+  fs::create_directory(dir.path() / "sub");
+  EXPECT_THAT(input_error([&] { gmasim::write_file_atomic((dir.path() / "sub").string(), "x"); }),
+              HasSubstr("the destination is a directory"));
+}
+
+TEST(Output, WriteFilesAtomicWritesAllOrNothing) {
+  TempDir dir;
+  const auto a = (dir.path() / "a.csv").string(), b = (dir.path() / "b.json").string();
+  gmasim::write_files_atomic({{a, "A1"}, {b, "B1"}});
+  // The second destination is refused: neither file changes, no temporary is left.
+  fs::create_directory(dir.path() / "c");
+  const auto c = (dir.path() / "c").string();
+  EXPECT_THROW(gmasim::write_files_atomic({{a, "A2"}, {c, "C2"}}), gmasim::InputError);
+  std::ifstream in(a);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_EQ(ss.str(), "A1");
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"a.csv", "b.json", "c"}));
+}
+
+TEST(Input, FilesLargerThanTheLimitAreRefused) {
+  TempDir dir;
+  const auto big = (dir.path() / "big.toml").string();
+  {
+    std::ofstream out(big);  // a sparse file just over the limit
+  }
+  fs::resize_file(big, gmasim::kMaxInputBytes + 1);
+  EXPECT_THAT(input_error([&] { (void)gmasim::read_input_file(big, "model file"); }),
+              HasSubstr("model file is larger than 256 MiB"));
+}
+
+TEST(Input, TomlGuardRefusesWhatTomlPlusPlusMishandles) {
+  for (const char* text : {"[[[1]]]\n", "[[[a]]\n", "[[[]]\n", "[[=\n", "[&\n", "[\xCE\xA0]\n"})
+    EXPECT_THAT(input_error([&] { (void)gmasim::parse_model_spec(text, "t.toml"); }),
+                StartsWith("t.toml:1: malformed table header"))
+        << text;
+  EXPECT_THAT(input_error([] { (void)gmasim::parse_model_spec("\xCE\xA0 = 1\n", "t.toml"); }),
+              StartsWith("t.toml:1: expected a key"));
+  EXPECT_THAT(
+      input_error([] { (void)gmasim::parse_model_spec(std::string("a = 1\n\0", 7), "t.toml"); }),
+      StartsWith("t.toml:2: NUL byte"));
+  // Brackets inside strings, comments and multi-line arrays are values, not headers.
+  const std::string fine =
+      "\xEF\xBB\xBF# [&\n[meta]\nname = \"[[=\"  # ]\nlist = [\n  [1, 2],\n  [\n  3],\n]\n"
+      "s = '''\n[&\n'''\n";
+  const std::string err = input_error([&] { (void)gmasim::parse_model_spec(fine, "t.toml"); });
+  EXPECT_THAT(err, Not(HasSubstr("malformed")));
+  EXPECT_THAT(err, Not(HasSubstr("expected a key")));
 }

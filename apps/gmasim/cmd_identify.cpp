@@ -149,9 +149,7 @@ std::string command_line() {
   return cmd.empty() ? "gmasim identify" : cmd;
 }
 
-std::string read_file_text(const std::string& path) {
-  return read_input_file(path, "model file");
-}
+std::string read_file_text(const std::string& path) { return read_input_file(path, "model file"); }
 
 int env_int(const char* name, int fallback) {
   const char* v = std::getenv(name);

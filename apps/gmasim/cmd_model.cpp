@@ -40,12 +40,15 @@ Runner add_model(CLI::App& app) {
                    m.circuit.branch_count());
         const MagneticStateCheck k = check_magnetic_state(m);
         fmt::print(
-            "magnetic state over {} runs (20/70/150 degC x 6/12 A x 10/400 Hz), options.magnetic_state "
+            "magnetic state over {} runs (20/70/150 degC x 6/12 A x 10/400 Hz), "
+            "options.magnetic_state "
             "= {}:\n"
             "  max |B| of the induction coil          {:.4f} T\n"
             "  max |phi/A| of a rod                   {:.4f} T   ({})\n"
-            "  max |phi/A - mu0 (H + M)| of a rod     {:.3g} T   ({:.3g} of mu0 (|H| + M_s^T); {})\n",
-            k.runs, m.options.magnetic_state == MagneticState::Consistent ? "consistent" : "printed",
+            "  max |phi/A - mu0 (H + M)| of a rod     {:.3g} T   ({:.3g} of mu0 (|H| + M_s^T); "
+            "{})\n",
+            k.runs,
+            m.options.magnetic_state == MagneticState::Consistent ? "consistent" : "printed",
             k.max_B_sensor_T, k.max_B_rod_T, k.where_B_rod, k.max_inconsistency_T,
             k.max_inconsistency_rel, k.where_inconsistency);
         if (!k.divergence.empty()) {

@@ -22,7 +22,7 @@ namespace {
 struct ReproduceArgs {
   std::string model, out = "out/reproduce", doc, python = "/usr/bin/python3";
   std::string doc_notes;  // markdown "### <claim id>" explanations of failing claims, for --doc
-  std::string claims;  // claims file (data/claims.toml format); "" = the built-in claims
+  std::string claims;     // claims file (data/claims.toml format); "" = the built-in claims
   std::vector<std::string> compare;  // other model files (readings) scored on the same claims
   std::string python_path = GMASIM_PYTHON_PACKAGE_DIR;
   int threads = 0;
@@ -33,7 +33,8 @@ int run_reproduce_cmd(const ReproduceArgs& a) {
   const Model model = load_model(a.model);
   const ClaimsData claims = a.claims.empty() ? builtin_claims() : load_claims(a.claims);
   if (!a.doc_notes.empty() && a.doc.empty())
-    throw InputError("--doc-notes " + a.doc_notes + ": explains the claims of --doc; give --doc too");
+    throw InputError("--doc-notes " + a.doc_notes +
+                     ": explains the claims of --doc; give --doc too");
   const auto notes = a.doc_notes.empty() ? std::vector<std::pair<std::string, std::string>>{}
                                          : load_claim_notes(a.doc_notes);
   ReproduceOptions o;
@@ -84,9 +85,10 @@ Runner add_reproduce(CLI::App& app) {
   sub->add_option(
       "--doc", a->doc,
       "Also write this markdown page (e.g. docs/reproduction.md) with the claims table");
-  sub->add_option("--doc-notes", a->doc_notes,
-                  "With --doc: markdown whose '### <claim id>' sections explain failing claims "
-                  "(e.g. docs/failing_claims.md); each failing claim's explanation goes into the page");
+  sub->add_option(
+      "--doc-notes", a->doc_notes,
+      "With --doc: markdown whose '### <claim id>' sections explain failing claims "
+      "(e.g. docs/failing_claims.md); each failing claim's explanation goes into the page");
   sub->add_option("--threads", a->threads, "Worker threads for the sweeps [-]; 0 = all cores")
       ->capture_default_str();
   sub->add_flag("--quick", a->quick, "Smaller grids (for tests)");

@@ -61,8 +61,8 @@ std::vector<double> parse_list(const std::string& text, const std::string& flag,
                                      flag, text, trim(item), unit));
       const double span = std::floor((b - a) / step + 1e-9);
       if (!(span < kMaxListValues))
-        throw InputError(fmt::format("{} '{}': range {} has {:.4g} values (limit {:g})", flag,
-                                     text, trim(item), span + 1.0, kMaxListValues));
+        throw InputError(fmt::format("{} '{}': range {} has {:.4g} values (limit {:g})", flag, text,
+                                     trim(item), span + 1.0, kMaxListValues));
       const long n = checked_count(span, kMaxListValues, flag);
       for (long k = 0; k <= n; ++k) out.push_back(a + static_cast<double>(k) * step);
     }

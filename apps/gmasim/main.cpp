@@ -30,8 +30,8 @@ void check_options(const CLI::App& app) {
       char* end = nullptr;
       const double d = std::strtod(v.c_str(), &end);
       if (end != v.c_str() && !std::isfinite(d))
-        throw InputError(fmt::format("{} {}: must be a finite number", o->get_name(),
-                                     clip_error_message(v)));
+        throw InputError(
+            fmt::format("{} {}: must be a finite number", o->get_name(), clip_error_message(v)));
     }
   }
   for (const CLI::App* sub : app.get_subcommands()) check_options(*sub);

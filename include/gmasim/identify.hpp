@@ -88,8 +88,8 @@ enum class TargetKind {
   BppChangePct,         // the same for B p-p [%]
   RetentionPct,         // 100 stroke(T) / stroke(T_ref) [%]
   ResonanceHz,          // lowest natural frequency of eq. (15) at (T, bias current) [Hz]
-  FrfPeakHz,            // peak of the small-signal |Y/I| at (T, bias) (FrfCurve::first_resonance_Hz) [Hz]
-  BandwidthHz           // -3 dB point of the small-signal |Y/I| at (T, bias) [Hz]
+  FrfPeakHz,   // peak of the small-signal |Y/I| at (T, bias) (FrfCurve::first_resonance_Hz) [Hz]
+  BandwidthHz  // -3 dB point of the small-signal |Y/I| at (T, bias) [Hz]
 };
 std::string target_kind_name(TargetKind k);
 

@@ -213,9 +213,9 @@ struct RodState {
   double Mirr_A_per_m = 0;  // irreversible magnetisation (eq. 9)
   double x_m = 0, v_m_per_s = 0;
   // kept for the next step (hold values, warm starts)
-  double Hc_A_per_m = 0;  // static field of eq. (7) at the end of the last step
+  double Hc_A_per_m = 0;      // static field of eq. (7) at the end of the last step
   double H_prev_A_per_m = 0;  // H one step earlier (consistent state: Newton's first guess)
-  double M_A_per_m = 0;   // total magnetisation consistent with (H, M_irr)
+  double M_A_per_m = 0;       // total magnetisation consistent with (H, M_irr)
   double M_prev_A_per_m = 0;
   double F_N = 0;  // force at the end of the last step
   // reported

@@ -23,11 +23,11 @@ struct Claim {
   std::string unit;       // "%", "um", "Hz", ...
   std::string tolerance;  // the rule, in words ("|ours - paper| <= 3 pp")
   bool pass = false;
-  bool applicable = true;   // false: needs measurements we do not have
-  std::string note;         // why it passes/fails, or why it is not applicable
-  std::string kind;         // the extractor (ClaimSpec::kind)
+  bool applicable = true;    // false: needs measurements we do not have
+  std::string note;          // why it passes/fails, or why it is not applicable
+  std::string kind;          // the extractor (ClaimSpec::kind)
   ClaimCondition condition;  // where it holds (NaN fields: not part of the claim)
-  double rel_diff() const;  // (ours - paper)/|paper|, NaN if not applicable
+  double rel_diff() const;   // (ours - paper)/|paper|, NaN if not applicable
 };
 
 struct ReproduceOptions {
@@ -109,7 +109,8 @@ std::vector<std::pair<std::string, std::string>> load_claim_notes(const std::str
 
 // The ids of the failing applicable claims that `notes` does not explain.
 std::vector<std::string> unexplained_failures(
-    const std::vector<Claim>& claims, const std::vector<std::pair<std::string, std::string>>& notes);
+    const std::vector<Claim>& claims,
+    const std::vector<std::pair<std::string, std::string>>& notes);
 
 // docs/reproduction.md: the claims table, the compared readings, the figures and, for every
 // failing claim, its explanation from `notes` (or "no explanation recorded").

@@ -134,10 +134,10 @@ namespace gmasim {
 // flux density phi/A the circuit assigns to a rod, and the largest departure of phi/A
 // from the rod's own material state mu0 (H + M), with where each occurs.
 struct MagneticStateCheck {
-  double max_B_sensor_T = 0;      // max |B| of the induction coil (State::B_T)
-  double max_B_rod_T = 0;         // max |phi_i / A_i| over rods and steps
-  double max_inconsistency_T = 0; // max |phi_i / A_i - mu0 (H_i + M_i)|
-  double max_inconsistency_rel = 0;  // the same over mu0 (|H| + M_s^T) of that rod
+  double max_B_sensor_T = 0;                     // max |B| of the induction coil (State::B_T)
+  double max_B_rod_T = 0;                        // max |phi_i / A_i| over rods and steps
+  double max_inconsistency_T = 0;                // max |phi_i / A_i - mu0 (H_i + M_i)|
+  double max_inconsistency_rel = 0;              // the same over mu0 (|H| + M_s^T) of that rod
   std::string where_B_rod, where_inconsistency;  // "rod2, 150 degC, 12 A, 10 Hz, t = ... s"
   int runs = 0;
   std::string divergence;  // the first run that diverged, if any (its samples still count)

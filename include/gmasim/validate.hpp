@@ -13,12 +13,12 @@ namespace gmasim {
 // Limits on what one request may ask for. They are far above any use of the tool (a run of
 // 2e8 steps is 2000 s at the automatic 10 us step) and far below what would exhaust memory or
 // time silently; exceeding one is an InputError that names the limit.
-inline constexpr double kMaxSteps = 2e8;             // time steps of one simulation
-inline constexpr double kMaxRecordedRows = 2e7;      // rows of one recorded time series
-inline constexpr double kMaxListValues = 1e5;        // values of one list/range flag
-inline constexpr double kMaxGridRuns = 1e6;          // simulations of one sweep/track grid
-inline constexpr double kMaxFrfPoints = 1e5;         // frequencies of one response
-inline constexpr double kMaxPeriods = 1e6;           // periods of one periodic run
+inline constexpr double kMaxSteps = 2e8;                   // time steps of one simulation
+inline constexpr double kMaxRecordedRows = 2e7;            // rows of one recorded time series
+inline constexpr double kMaxListValues = 1e5;              // values of one list/range flag
+inline constexpr double kMaxGridRuns = 1e6;                // simulations of one sweep/track grid
+inline constexpr double kMaxFrfPoints = 1e5;               // frequencies of one response
+inline constexpr double kMaxPeriods = 1e6;                 // periods of one periodic run
 inline constexpr std::size_t kMaxInputBytes = 256u << 20;  // one input file (256 MiB)
 inline constexpr double kMaxTrackAmplitude_um = 1e4;       // a tracking reference (10 mm)
 

@@ -59,3 +59,27 @@ def test_bad_requests_raise_clear_errors(mdma):
         mdma.with_params({"no.such": 1.0})
     with pytest.raises(gmasim.InputError, match="must be > 0"):
         mdma.with_params({"rod1.length_m": -1.0})
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(periods=1e300), r"periods = 1e\+300: must be in \[1, 1e\+06\]"),
+    (dict(periods=float("nan")), "periods"),
+    (dict(frequency_Hz=1e-300), "too many"),
+    (dict(frequency_Hz=float("inf")), "frequency"),
+    (dict(dt_s=1e-300), "too many"),
+    (dict(temperature_C=float("nan")), "temperature"),
+    (dict(current_pp_A=1e300), "current peak-to-peak = 1e\\+300 A"),
+])
+def test_every_number_is_checked_before_it_becomes_a_count(mdma, kwargs, message):
+    # Issue 8: the library validates before any work, so Python gets the CLI's errors.
+    with pytest.raises(gmasim.InputError, match=message):
+        gmasim.simulate(mdma, **kwargs)
+
+
+def test_experiment_requests_are_validated(mdma):
+    with pytest.raises(gmasim.InputError, match=r"reference amplitude = 1e\+300 um"):
+        gmasim.track(mdma, temperatures_C=[20], amplitudes_um=[1e300])
+    with pytest.raises(gmasim.InputError, match="frequency points"):
+        gmasim.frf(mdma, temperatures_C=[20], points=2_000_000_000)
+    with pytest.raises(gmasim.InputError, match="too many"):
+        gmasim.sweep(mdma, temperatures_C=[20], currents_pp_A=[6], frequencies_Hz=[1e-300])

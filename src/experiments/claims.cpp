@@ -2,6 +2,8 @@
 // that computes our value from a `gmasim reproduce` study, and the scoring of a claim by its
 // tolerance rule. The claims themselves (numbers, tolerances, conditions) are data; the
 // loader is src/io/claims_loader.cpp.
+#include "gmasim/claims.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -10,7 +12,6 @@
 #include <string_view>
 #include <utility>
 
-#include "gmasim/claims.hpp"
 #include "gmasim/reproduce.hpp"
 
 namespace gmasim {
@@ -86,8 +87,7 @@ Extraction sweep_value(const ReproduceResult& r, const ClaimSpec& s) {
     return missing(fmt::format("the study has no sweep point at {}", condition_words(s.condition)));
   if (Change && !same(req->reference_temperature_C, s.condition.reference_temperature_C))
     return missing(fmt::format("the study's sweeps change against {:g} degC, not {:g} degC",
-                               req->reference_temperature_C,
-                               s.condition.reference_temperature_C));
+                               req->reference_temperature_C, s.condition.reference_temperature_C));
   Extraction e;
   e.ours = Get(*p);
   return e;
@@ -139,8 +139,7 @@ Extraction resonance_shift(const ReproduceResult& r, const ClaimSpec& s) {
   const double T = s.condition.temperature_C, T0 = s.condition.reference_temperature_C;
   const FrfCurve* c = find_curve(r.frf, T);
   const FrfCurve* c0 = find_curve(r.frf, T0);
-  if (!c || !c0)
-    return missing(fmt::format("the study has no FRF at {:g} degC", c ? T0 : T));
+  if (!c || !c0) return missing(fmt::format("the study has no FRF at {:g} degC", c ? T0 : T));
   const double f = peak(c), f0 = peak(c0);
   Extraction e;
   e.ours = (f0 > 0 && f > 0) ? 100.0 * std::fabs(f - f0) / f0 : kNaN;
@@ -202,8 +201,8 @@ Extraction EG_rise(const ReproduceResult& r, const ClaimSpec& s) {
   if (auto why = params_mismatch(r, s.condition, true); !why.empty()) return missing(why);
   const double E0 = mean_over_rods(r.params, s.condition.reference_temperature_C,
                                    &ParamsVsTemperatureRow::E_G_mean_GPa);
-  const double E = mean_over_rods(r.params, s.condition.temperature_C,
-                                  &ParamsVsTemperatureRow::E_G_mean_GPa);
+  const double E =
+      mean_over_rods(r.params, s.condition.temperature_C, &ParamsVsTemperatureRow::E_G_mean_GPa);
   Extraction e;
   e.ours = 100.0 * (E / E0 - 1.0);
   return e;
@@ -239,8 +238,8 @@ Extraction param_change(const ReproduceResult& r, const ClaimSpec& s) {
   e.ours = 100 * headline(s, e);
   e.note = fmt::format("relative changes {:g} -> {:g} degC:", T0, T);
   for (std::size_t i = 0; i < e.values.size(); ++i)
-    e.note += fmt::format("{} {} {:.1f} %", i ? "," : "", e.values[i].first,
-                          100 * e.values[i].second);
+    e.note +=
+        fmt::format("{} {} {:.1f} %", i ? "," : "", e.values[i].first, 100 * e.values[i].second);
   return e;
 }
 
@@ -459,9 +458,9 @@ std::string ClaimTolerance::describe(const std::string& unit) const {
     case ToleranceKind::Top: {
       static constexpr const char* kCount[] = {"", "", "two", "three", "four", "five"};
       if (names.size() == 1) return names.front() + " is the largest";
-      return fmt::format("{} are the {} largest", join(", ", " and "),
-                         names.size() < 6 ? std::string(kCount[names.size()])
-                                          : std::to_string(names.size()));
+      return fmt::format(
+          "{} are the {} largest", join(", ", " and "),
+          names.size() < 6 ? std::string(kCount[names.size()]) : std::to_string(names.size()));
     }
     case ToleranceKind::NotApplicable:
       return "-";
@@ -478,8 +477,8 @@ const ClaimSpec* ClaimsData::find(const std::string& id) const {
 std::vector<ClaimKindInfo> claim_kinds() {
   std::vector<ClaimKindInfo> out;
   for (const auto& k : kinds())
-    out.push_back({std::string(k.name), k.required, k.optional, k.values,
-                   std::string(k.fit_target), std::string(k.description)});
+    out.push_back({std::string(k.name), k.required, k.optional, k.values, std::string(k.fit_target),
+                   std::string(k.description)});
   return out;
 }
 

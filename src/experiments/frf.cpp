@@ -12,11 +12,11 @@
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
-#include "gmasim/validate.hpp"
 #include "gmasim/physics/jiles_atherton.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
+#include "gmasim/validate.hpp"
 
 namespace gmasim {
 namespace {
@@ -58,7 +58,8 @@ struct ForceStiffness {
 };
 ForceStiffness force_at(const Model& m, const RodConditions& rc, double M) {
   const double E = delta_e_modulus(M / rc.MsT_E, rc.dE);
-  const double lambda = magnetostriction(M / rc.Ms_strain_A_per_m, m.material.lambda_s, rc.sigma_p_Pa, E);
+  const double lambda =
+      magnetostriction(M / rc.Ms_strain_A_per_m, m.material.lambda_s, rc.sigma_p_Pa, E);
   return {rod_force(lambda, E, rc.area_m2), axial_stiffness(E, rc.area_m2, rc.length_m)};
 }
 
@@ -158,7 +159,8 @@ SmallSignalModel linearise(const Model& m, const Conditions& c, const State& s) 
         throw DivergenceError(0.0, "", "nodal matrix of the circuit", 0.0, "not positive definite");
       Eigen::VectorXd phi(N);
       for (std::size_t i = 0; i < n; ++i)
-        phi(static_cast<Eigen::Index>(i)) = ws.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
+        phi(static_cast<Eigen::Index>(i)) =
+            ws.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
       return phi;
     };
     Eigen::MatrixXd P(N, N);
@@ -453,8 +455,8 @@ FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progres
             t_settle = std::max({t_settle, 10.0 * lin[ti].tau_s[i], 10.0 / zw});
           }
           if (lin[ti].output_stage && lin[ti].os_damping_N_s_per_m > 0)
-            t_settle = std::max(t_settle, 10.0 * 2.0 * lin[ti].os_mass_kg /
-                                              lin[ti].os_damping_N_s_per_m);
+            t_settle =
+                std::max(t_settle, 10.0 * 2.0 * lin[ti].os_mass_kg / lin[ti].os_damping_N_s_per_m);
           const long settle = std::max<long>(
               r.settle_periods, checked_ceil_count(t_settle * fr, kMaxSteps, "settle periods"));
           const long measure = r.measure_periods;

@@ -45,8 +45,8 @@ ParamsVsTemperatureResult run_params_vs_temperature(const Model& m,
   if (!(r.periods >= 1.0)) throw InputError(fmt::format("periods {}: must be >= 1", r.periods));
   if (static_cast<double>(r.temperatures_C.size()) > kMaxListValues ||
       static_cast<double>(r.retention_currents_pp_A.size()) > kMaxListValues)
-    throw InputError(fmt::format("params-vs-temperature: more than {:g} values in a list",
-                                 kMaxListValues));
+    throw InputError(
+        fmt::format("params-vs-temperature: more than {:g} values in a list", kMaxListValues));
   for (double pp : r.retention_currents_pp_A) {  // every run's settings, before any run
     SimulationSettings s;
     s.waveform = biased_sine(pp, r.frequency_Hz, r.current_min_A);

@@ -116,23 +116,10 @@ Report claims_report(const std::vector<Claim>& claims) {
                "note"};
   for (const auto& c : claims) {
     const ClaimCondition& k = c.condition;
-    t.rows.push_back({c.id,
-                      c.claim,
-                      c.source,
-                      c.kind,
-                      c.paper,
-                      c.ours,
-                      c.unit,
-                      c.rel_diff(),
-                      c.tolerance,
-                      std::string(!c.applicable ? "n/a" : (c.pass ? "pass" : "fail")),
-                      c.pass,
-                      k.temperature_C,
-                      k.reference_temperature_C,
-                      k.current_pp_A,
-                      k.frequency_Hz,
-                      k.amplitude_um,
-                      c.note});
+    t.rows.push_back({c.id, c.claim, c.source, c.kind, c.paper, c.ours, c.unit, c.rel_diff(),
+                      c.tolerance, std::string(!c.applicable ? "n/a" : (c.pass ? "pass" : "fail")),
+                      c.pass, k.temperature_C, k.reference_temperature_C, k.current_pp_A,
+                      k.frequency_Hz, k.amplitude_um, c.note});
   }
   rep.tables.push_back(std::move(t));
   return rep;

@@ -21,8 +21,8 @@ void check_list(const std::vector<double>& v, const char* what, const char* unit
     if (!std::isfinite(x))
       throw InputError(fmt::format("{} {} {}: not a finite number", what, x, unit));
   if (static_cast<double>(v.size()) > kMaxListValues)
-    throw InputError(fmt::format("{} {} values: too many (limit {:g})", v.size(), what,
-                                 kMaxListValues));
+    throw InputError(
+        fmt::format("{} {} values: too many (limit {:g})", v.size(), what, kMaxListValues));
 }
 
 struct Job {
@@ -46,8 +46,8 @@ SweepResult run_sweep(const Model& m, const SweepRequest& r, const ProgressFn& p
                       static_cast<double>(r.currents_pp_A.size()) *
                       static_cast<double>(r.frequencies_Hz.size());
   if (runs > kMaxGridRuns)
-    throw InputError(fmt::format("sweep grid of {:.4g} runs: too many (limit {:g})", runs,
-                                 kMaxGridRuns));
+    throw InputError(
+        fmt::format("sweep grid of {:.4g} runs: too many (limit {:g})", runs, kMaxGridRuns));
   if (!(r.dt_s >= 0.0) || !std::isfinite(r.dt_s))
     throw InputError(fmt::format("dt {} s: must be > 0 (or 0 for the automatic rule)", r.dt_s));
   if (!std::isfinite(r.current_min_A))

@@ -11,8 +11,8 @@
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
-#include "gmasim/validate.hpp"
 #include "gmasim/physics/magnetic.hpp"
+#include "gmasim/validate.hpp"
 
 namespace gmasim {
 
@@ -69,8 +69,8 @@ void check_positive_list(const std::vector<double>& v, const char* what, const c
     if (!(x > 0.0) || !std::isfinite(x))
       throw InputError(fmt::format("{} {} {}: must be > 0", what, x, unit));
   if (static_cast<double>(v.size()) > kMaxListValues)
-    throw InputError(fmt::format("{} {} values: too many (limit {:g})", v.size(), what,
-                                 kMaxListValues));
+    throw InputError(
+        fmt::format("{} {} values: too many (limit {:g})", v.size(), what, kMaxListValues));
 }
 
 }  // namespace
@@ -82,8 +82,10 @@ TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& p
   check_positive_list(r.frequencies_Hz, "reference frequency", "Hz");
   // A reference beyond 10 mm is no actuator's stroke: refuse it rather than report a
   // saturated loop with astronomically large errors.
-  for (double A : r.amplitudes_um) require_in(A, 0.0, kMaxTrackAmplitude_um, "reference amplitude", "um");
-  for (double f : r.frequencies_Hz) require_in(f, 0.0, kMaxFrequency_Hz, "reference frequency", "Hz");
+  for (double A : r.amplitudes_um)
+    require_in(A, 0.0, kMaxTrackAmplitude_um, "reference amplitude", "um");
+  for (double f : r.frequencies_Hz)
+    require_in(f, 0.0, kMaxFrequency_Hz, "reference frequency", "Hz");
   require_in(r.sample_rate_Hz, 0.0, 1e3 * kMaxFrequency_Hz, "PID sample rate", "Hz");
   require_in(r.bias_A, -kMaxCurrent_A, kMaxCurrent_A, "bias current", "A");
   require_in(r.current_limit_A, 0.0, kMaxCurrent_A, "current limit", "A");
@@ -94,8 +96,8 @@ TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& p
                       static_cast<double>(r.amplitudes_um.size()) *
                       static_cast<double>(r.frequencies_Hz.size());
   if (runs > kMaxGridRuns)
-    throw InputError(fmt::format("track grid of {:.4g} runs: too many (limit {:g})", runs,
-                                 kMaxGridRuns));
+    throw InputError(
+        fmt::format("track grid of {:.4g} runs: too many (limit {:g})", runs, kMaxGridRuns));
   if (!(r.sample_rate_Hz > 0.0) || !std::isfinite(r.sample_rate_Hz))
     throw InputError(fmt::format("PID sample rate {} Hz: must be > 0", r.sample_rate_Hz));
   for (double f : r.frequencies_Hz)
@@ -134,14 +136,16 @@ TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& p
   for (double f : r.frequencies_Hz) f_max = std::max(f_max, f);
   const double dt_target =
       r.dt_s > 0.0 ? r.dt_s : std::min(kMaxDt_s, 1.0 / (kStepsPerPeriod * f_max));
-  const long sub = std::max(1L, checked_ceil_count(Ts / dt_target, kMaxSteps, "plant steps per PID sample"));
+  const long sub =
+      std::max(1L, checked_ceil_count(Ts / dt_target, kMaxSteps, "plant steps per PID sample"));
   const double dt = Ts / static_cast<double>(sub);
   // Every run's length: samples of the PID and plant steps, checked before any run.
   double f_min = f_max;
   for (double f : r.frequencies_Hz) f_min = std::min(f_min, f);
   const double samples_max = r.periods / f_min / Ts;
   (void)checked_count(samples_max, kMaxSteps, "PID samples of the longest run");
-  (void)checked_count(samples_max * static_cast<double>(sub), kMaxSteps, "plant steps of the longest run");
+  (void)checked_count(samples_max * static_cast<double>(sub), kMaxSteps,
+                      "plant steps of the longest run");
 
   TrackResult res;
   res.plant_dt_s = dt;

@@ -127,11 +127,11 @@ void verify_restored(const Checkpoint& c, const pagmo::problem& prob, const Iden
     throw InputError(located(o.resume_path, 0, fmt::format("cannot resume: {}", what)));
   };
   if (c.ranks != ranks || c.islands != o.islands || c.population != o.population ||
-      c.dim != static_cast<int>(n) ||
-      c.rank_islands.size() != static_cast<std::size_t>(ranks))
-    fail(fmt::format("the checkpoint holds {} rank(s) x {} island(s) x {} individuals of "
-                     "dimension {}; this run has {} x {} x {} of dimension {}",
-                     c.ranks, c.islands, c.population, c.dim, ranks, o.islands, o.population, n));
+      c.dim != static_cast<int>(n) || c.rank_islands.size() != static_cast<std::size_t>(ranks))
+    fail(
+        fmt::format("the checkpoint holds {} rank(s) x {} island(s) x {} individuals of "
+                    "dimension {}; this run has {} x {} x {} of dimension {}",
+                    c.ranks, c.islands, c.population, c.dim, ranks, o.islands, o.population, n));
   const auto& mine = c.rank_islands[static_cast<std::size_t>(comm.rank())];
   pagmo::vector_double dvs(c.best_u.begin(), c.best_u.end());
   std::vector<double> stored{c.best_f};
@@ -157,9 +157,10 @@ void verify_restored(const Checkpoint& c, const pagmo::problem& prob, const Iden
                                first_bad == 0 ? std::string("best_f")
                                               : fmt::format("individual {}", first_bad - 1),
                                stored[first_bad], fv[first_bad]);
-    fail(fmt::format("{} stored fitness value(s) are not what the model gives ({}); the file "
-                     "was altered, or written by another build of gmasim",
-                     bad_all, where));
+    fail(
+        fmt::format("{} stored fitness value(s) are not what the model gives ({}); the file "
+                    "was altered, or written by another build of gmasim",
+                    bad_all, where));
   }
 }
 

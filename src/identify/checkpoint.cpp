@@ -96,13 +96,15 @@ struct LineReader {
   }
   double finite(const std::string& key, double lo) {
     const double v = nums(expect(key), 1)[0];
-    if (!(std::isfinite(v) && v >= lo)) fail(fmt::format("{} {:g}: must be finite and >= {:g}", key, v, lo));
+    if (!(std::isfinite(v) && v >= lo))
+      fail(fmt::format("{} {:g}: must be finite and >= {:g}", key, v, lo));
     return v;
   }
   // A point of the unit cube of the search space, as the GA writes it.
   void unit_vector(const std::vector<double>& u, const char* what) {
     for (double x : u)
-      if (!(x >= 0.0 && x <= 1.0)) fail(fmt::format("{}: coordinate {:g} is outside [0, 1]", what, x));
+      if (!(x >= 0.0 && x <= 1.0))
+        fail(fmt::format("{}: coordinate {:g} is outside [0, 1]", what, x));
   }
 };
 
@@ -218,11 +220,12 @@ Checkpoint read_checkpoint(const std::string& path) {
     if (sp == std::string::npos) in.fail("bad history line");
     const auto v = in.nums(l.substr(sp + 1), 5);
     for (double x : v)
-      if (!(std::isfinite(x) && x >= 0.0)) in.fail(fmt::format("history: {:g} is not a finite value >= 0", x));
+      if (!(std::isfinite(x) && x >= 0.0))
+        in.fail(fmt::format("history: {:g} is not a finite value >= 0", x));
     const std::string phase = l.substr(0, sp);
-    if (phase != "ga" && phase != "refine") in.fail(fmt::format("history: unknown phase '{}'", phase));
-    c.history.push_back(
-        {phase, static_cast<int>(v[0]), static_cast<long>(v[1]), v[2], v[3], v[4]});
+    if (phase != "ga" && phase != "refine")
+      in.fail(fmt::format("history: unknown phase '{}'", phase));
+    c.history.push_back({phase, static_cast<int>(v[0]), static_cast<long>(v[1]), v[2], v[3], v[4]});
   }
   for (int r = 0; r < c.ranks; ++r) {
     if (in.integer("rank", 0, 4096) != r) in.fail(fmt::format("expected rank {}", r));
@@ -238,15 +241,16 @@ Checkpoint read_checkpoint(const std::string& path) {
       if (v[2] != c.population)
         in.fail(fmt::format("island {} has {} individuals; the population is {}", i, v[2],
                             c.population));
-      if (v[1] < 0 || v[1] > 4294967295L) in.fail(fmt::format("island {}: seed {} out of range", i, v[1]));
+      if (v[1] < 0 || v[1] > 4294967295L)
+        in.fail(fmt::format("island {}: seed {} out of range", i, v[1]));
       IslandPopulation ip;
       ip.seed = static_cast<unsigned>(v[1]);
       const auto size = static_cast<std::size_t>(v[2]);
       for (std::size_t k = 0; k < size; ++k) {
         const auto row = in.nums(in.next(), static_cast<std::size_t>(c.dim) + 1);
         if (!(std::isfinite(row[0]) && row[0] >= 0.0))
-          in.fail(fmt::format("island {} individual {}: fitness {:g} is not a finite value >= 0",
-                              i, k, row[0]));
+          in.fail(fmt::format("island {} individual {}: fitness {:g} is not a finite value >= 0", i,
+                              k, row[0]));
         ip.f.push_back(row[0]);
         ip.x.emplace_back(row.begin() + 1, row.end());
         in.unit_vector(ip.x.back(), "individual");

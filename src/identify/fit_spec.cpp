@@ -14,9 +14,9 @@
 
 #include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
-#include "io/text_io.hpp"
-#include "gmasim/io.hpp"
 #include "gmasim/identify.hpp"
+#include "gmasim/io.hpp"
+#include "io/text_io.hpp"
 
 namespace gmasim {
 namespace {
@@ -268,9 +268,9 @@ FitTarget read_target(const toml::table& t, const std::string& src, const Claims
         located(src, g.line, fmt::format("[[target]] {}: weight must be > 0", kn->name)));
   // Relative weights: an extreme one scales every other residual to nothing (issue 8).
   if (!(g.weight >= 1e-6 && g.weight <= 1e6))
-    throw InputError(located(src, g.line,
-                             fmt::format("[[target]] {}: weight = {:g}: must be in [1e-6, 1e6]",
-                                         kn->name, g.weight)));
+    throw InputError(located(
+        src, g.line,
+        fmt::format("[[target]] {}: weight = {:g}: must be in [1e-6, 1e6]", kn->name, g.weight)));
   g.scale = opt("scale", 0.0);
   if (g.scale < 0.0)
     throw InputError(

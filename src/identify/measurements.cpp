@@ -13,9 +13,9 @@
 #include <string_view>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/validate.hpp"
 #include "gmasim/identify.hpp"
 #include "gmasim/io.hpp"
+#include "gmasim/validate.hpp"
 #include "io/text_io.hpp"
 
 namespace gmasim {

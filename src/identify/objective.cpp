@@ -12,11 +12,11 @@
 #include <set>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/validate.hpp"
 #include "gmasim/experiments.hpp"
 #include "gmasim/identify.hpp"
 #include "gmasim/io.hpp"
 #include "gmasim/physics/magnetic.hpp"
+#include "gmasim/validate.hpp"
 
 namespace gmasim {
 namespace {
@@ -132,8 +132,8 @@ SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings
                      StartCache& starts) {
   const Waveform w = biased_sine(run.pp, run.f, run.min);
   const double per = w.period_s();
-  const long n_per = std::max(8L, checked_ceil_count(per / step_for(s, per), kMaxSteps,
-                                                     "steps per period"));
+  const long n_per =
+      std::max(8L, checked_ceil_count(per / step_for(s, per), kMaxSteps, "steps per period"));
   const double dt = per / static_cast<double>(n_per);
   const long periods = std::max(1L, checked_count(s.target_periods, 1e4, "target periods"));
   const long total = periods * n_per;
@@ -742,7 +742,8 @@ MeasurementSet synthesize_measurements(const Model& truth, const SyntheticReques
   require_in(r.noise_pct, 0.0, 100.0, "noise", "%");
   require_in(r.flux_noise_pct, 0.0, 100.0, "flux noise", "%");
   for (double T : r.temperatures_C) require_finite(T, "temperature", "degC");
-  for (double pp : r.currents_pp_A) require_in(pp, 0.0, 2.0 * kMaxCurrent_A, "current peak-to-peak", "A");
+  for (double pp : r.currents_pp_A)
+    require_in(pp, 0.0, 2.0 * kMaxCurrent_A, "current peak-to-peak", "A");
   for (double f : r.frequencies_Hz) {
     require_positive(f, "frequency", "Hz");
     require_in(f, 0.0, kMaxFrequency_Hz, "frequency", "Hz");

@@ -65,8 +65,7 @@ struct Reader {
 
   double number(const toml::node& n, std::string_view key, const std::string& where,
                 bool allow_nan = false) const {
-    if (!n.is_number())
-      fail(line_of(n), fmt::format("{}: {} must be a number", where, key));
+    if (!n.is_number()) fail(line_of(n), fmt::format("{}: {} must be a number", where, key));
     const double v = *n.value<double>();
     if (std::isinf(v) || (std::isnan(v) && !allow_nan))
       fail(line_of(n), fmt::format("{}: {} must be finite{}", where, key,
@@ -89,9 +88,12 @@ struct ToleranceName {
   std::string_view name;
 };
 constexpr ToleranceName kTolerances[] = {
-    {ToleranceKind::Absolute, "absolute"},   {ToleranceKind::Relative, "relative"},
-    {ToleranceKind::LessThan, "less_than"},  {ToleranceKind::GreaterThan, "greater_than"},
-    {ToleranceKind::Order, "order"},         {ToleranceKind::Top, "top"},
+    {ToleranceKind::Absolute, "absolute"},
+    {ToleranceKind::Relative, "relative"},
+    {ToleranceKind::LessThan, "less_than"},
+    {ToleranceKind::GreaterThan, "greater_than"},
+    {ToleranceKind::Order, "order"},
+    {ToleranceKind::Top, "top"},
     {ToleranceKind::NotApplicable, "not_applicable"},
 };
 
@@ -113,7 +115,8 @@ ClaimTolerance read_tolerance(const Reader& rd, const toml::table& t, const Clai
   tol.kind = tn->kind;
   tol.text = rd.text(t, "text", where, false);
   // The parameter each rule takes; any other is an error.
-  const bool want_value = tol.kind == ToleranceKind::Absolute || tol.kind == ToleranceKind::Relative;
+  const bool want_value =
+      tol.kind == ToleranceKind::Absolute || tol.kind == ToleranceKind::Relative;
   const bool want_bound =
       tol.kind == ToleranceKind::LessThan || tol.kind == ToleranceKind::GreaterThan;
   const bool want_names = tol.kind == ToleranceKind::Order || tol.kind == ToleranceKind::Top;
@@ -128,9 +131,9 @@ ClaimTolerance read_tolerance(const Reader& rd, const toml::table& t, const Clai
   if (const toml::node* n = param("value", want_value)) {
     tol.value = rd.number(*n, "value", where);
     if (tol.kind == ToleranceKind::Absolute ? tol.value < 0.0 : !(tol.value > 0.0))
-      rd.fail(line_of(*n), fmt::format("{}: value must be {} (got {:g})", where,
-                                       tol.kind == ToleranceKind::Absolute ? ">= 0" : "> 0",
-                                       tol.value));
+      rd.fail(line_of(*n),
+              fmt::format("{}: value must be {} (got {:g})", where,
+                          tol.kind == ToleranceKind::Absolute ? ">= 0" : "> 0", tol.value));
   }
   if (const toml::node* n = param("bound", want_bound)) tol.bound = rd.number(*n, "bound", where);
   if (const toml::node* n = param("names", want_names)) {
@@ -150,8 +153,8 @@ ClaimTolerance read_tolerance(const Reader& rd, const toml::table& t, const Clai
       rd.fail(line_of(*n), fmt::format("{}: an order needs at least two names", where));
     if (tol.kind == ToleranceKind::Top &&
         (tol.names.empty() || tol.names.size() >= kind.values.size()))
-      rd.fail(line_of(*n), fmt::format("{}: top needs 1 to {} names", where,
-                                       kind.values.size() - 1));
+      rd.fail(line_of(*n),
+              fmt::format("{}: top needs 1 to {} names", where, kind.values.size() - 1));
   }
   // The rule must fit the kind: rankings compare named values, the others one number.
   const long kline = line_of(*t.get("kind"));
@@ -200,8 +203,8 @@ ClaimCondition read_condition(const Reader& rd, const toml::table* t, long claim
       if (!key) {
         std::string list;
         for (const auto& kk : kKeys) list += (list.empty() ? "" : ", ") + std::string(kk.name);
-        rd.fail(line_of(v), fmt::format("{}: unknown key '{}'; expected one of: {}", where,
-                                        k.str(), list));
+        rd.fail(line_of(v),
+                fmt::format("{}: unknown key '{}'; expected one of: {}", where, k.str(), list));
       }
       if (!listed(kind.required, k.str()) && !listed(kind.optional, k.str()))
         rd.fail(line_of(v), fmt::format("{}: {} does not apply to kind {} (it uses: {})", where,
@@ -211,9 +214,8 @@ ClaimCondition read_condition(const Reader& rd, const toml::table* t, long claim
   }
   for (const auto& k : kind.required) {
     if (!t || !t->get(k))
-      rd.fail(t ? line_of(*t) : claim_line,
-              fmt::format("{}: kind {} needs {} (it uses: {})", where, kind.name, k,
-                          join(kind.required)));
+      rd.fail(t ? line_of(*t) : claim_line, fmt::format("{}: kind {} needs {} (it uses: {})", where,
+                                                        kind.name, k, join(kind.required)));
   }
   return cond;
 }
@@ -222,16 +224,14 @@ ClaimSpec read_claim(const Reader& rd, const toml::table& t,
                      const std::map<std::string, ClaimKindInfo>& kinds) {
   ClaimSpec c;
   c.line = line_of(t);
-  rd.check_keys(t,
-                {"id", "claim", "source", "kind", "paper", "unit", "tolerance", "condition",
-                 "note"},
-                "[[claim]]");
+  rd.check_keys(
+      t, {"id", "claim", "source", "kind", "paper", "unit", "tolerance", "condition", "note"},
+      "[[claim]]");
   c.id = rd.text(t, "id", "[[claim]]");
   for (char ch : c.id)
     if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-' || ch == '.'))
       rd.fail(line_of(*t.get("id")),
-              fmt::format("[[claim]]: id '{}' may hold only letters, digits, '_', '-', '.'",
-                          c.id));
+              fmt::format("[[claim]]: id '{}' may hold only letters, digits, '_', '-', '.'", c.id));
   const std::string where = "claim " + c.id;
   c.claim = rd.text(t, "claim", where);
   c.source = rd.text(t, "source", where);

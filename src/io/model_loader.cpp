@@ -215,8 +215,9 @@ std::optional<std::string> check_value(const ModelSpec& spec, const std::string&
   // alpha_pm2, is ~1e-7 /K^2; the largest, a modulus, ~1e11 Pa): such a number is a typo or
   // a hostile input, and a subnormal one turns into inf/NaN downstream (issue 8).
   if (value != 0.0 && !(std::fabs(value) >= 1e-30 && std::fabs(value) <= 1e30))
-    return bad("outside the range of any physical value of the model (1e-30 <= |v| <= 1e30, "
-               "or 0)");
+    return bad(
+        "outside the range of any physical value of the model (1e-30 <= |v| <= 1e30, "
+        "or 0)");
   if (!field) return std::nullopt;
   switch (field->rule) {
     case R::Any:

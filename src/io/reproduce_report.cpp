@@ -68,7 +68,8 @@ std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
       "## Claims\n\nOne row per number of the paper that READING-NOTES lists, beside ours "
       "(`claims.csv`, `claims.json`).\n\n";
   md += claims_markdown(r.claims);
-  md += fig("claims", "Every applicable claim: ours / paper, green when it passes, red when it fails");
+  md += fig("claims",
+            "Every applicable claim: ours / paper, green when it passes, red when it fails");
   md += "\n## Temperature sweep at 10 Hz (Fig. 12-14)\n\n";
   md += fig("loops_8A_10Hz", "Hysteresis loops y(I) at 8 A, 10 Hz, coloured by temperature");
   md += fig("sweep_10Hz", "Stroke, hysteresis and flux density against temperature, 10 Hz");
@@ -128,8 +129,7 @@ std::vector<std::pair<std::string, std::string>> load_claim_notes(const std::str
                                      path, line_no, id));
       for (const auto& n : notes)
         if (n.first == id)
-          throw InputError(
-              fmt::format("{}:{}: claim '{}' is explained twice", path, line_no, id));
+          throw InputError(fmt::format("{}:{}: claim '{}' is explained twice", path, line_no, id));
       notes.emplace_back(id, std::string());
       in_note = true;
     } else if (in_note) {
@@ -194,8 +194,9 @@ void write_reproduction_doc(const ReproduceResult& r, const std::vector<Compared
   if (!why.empty()) md += "\n## Why the failing claims fail\n\n" + why;
   md += comparison_markdown(compared);
   if (figures) {
-    md += "\n## Figures\n\nThe paper's numbers are the diamonds (green: the claim passes, red: it "
-          "fails).\n\n";
+    md +=
+        "\n## Figures\n\nThe paper's numbers are the diamonds (green: the claim passes, red: it "
+        "fails).\n\n";
     for (const char* f : {"claims", "loops_8A_10Hz", "sweep_10Hz", "frf", "track", "retention",
                           "params_vs_temperature", "ablate"})
       md += fmt::format("![{0}](figures/{0}.png)\n\n", f);

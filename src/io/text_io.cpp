@@ -76,8 +76,8 @@ CellError parse_finite(std::string_view cell, double& v) {
 namespace {
 
 bool is_bare_key_char(char c) {
-  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') ||
-         c == '_' || c == '-';
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' ||
+         c == '-';
 }
 
 std::string shown(char c) {
@@ -112,7 +112,8 @@ void guard_toml_text(std::string_view text, const std::string& source) {
         continue;
       }
       if (c == '"') {
-        if (str == Str::Basic) str = Str::None;
+        if (str == Str::Basic)
+          str = Str::None;
         else if (text.substr(i, 3) == "\"\"\"") {
           str = Str::None;
           i += 2;
@@ -122,7 +123,8 @@ void guard_toml_text(std::string_view text, const std::string& source) {
     }
     if (str == Str::Literal || str == Str::MlLiteral) {
       if (c == '\'') {
-        if (str == Str::Literal) str = Str::None;
+        if (str == Str::Literal)
+          str = Str::None;
         else if (text.substr(i, 3) == "'''") {
           str = Str::None;
           i += 2;
@@ -138,9 +140,9 @@ void guard_toml_text(std::string_view text, const std::string& source) {
         if (j < n && text[j] == '[') ++j;
         while (j < n && (text[j] == ' ' || text[j] == '\t')) ++j;
         if (j >= n || !(is_bare_key_char(text[j]) || text[j] == '"' || text[j] == '\''))
-          fail(fmt::format("malformed table header: a key cannot start with {}",
-                           j >= n || text[j] == '\n' ? std::string("the end of the line")
-                                                      : shown(text[j])));
+          fail(fmt::format(
+              "malformed table header: a key cannot start with {}",
+              j >= n || text[j] == '\n' ? std::string("the end of the line") : shown(text[j])));
         // The rest of the header (quoted keys may hold brackets) is toml++'s to check.
         while (i + 1 < n && text[i + 1] != '\n') ++i;
         continue;

@@ -43,7 +43,8 @@ double require_nonnegative(double v, std::string_view what, std::string_view uni
 double require_in(double v, double lo, double hi, std::string_view what, std::string_view unit) {
   require_finite(v, what, unit);
   if (!(v >= lo && v <= hi))
-    fail(v, what, unit, fmt::format("must be in [{}, {}]", with_unit(lo, unit), with_unit(hi, unit)));
+    fail(v, what, unit,
+         fmt::format("must be in [{}, {}]", with_unit(lo, unit), with_unit(hi, unit)));
   return v;
 }
 

@@ -60,11 +60,11 @@ Waveform load_waveform_csv(const std::string& path) {
               located(path, line_no, fmt::format("empty cell in column {}", kColumns[c])));
         case CellError::NonNumeric:
         case CellError::OutOfRange:
-          throw InputError(located(
-              path, line_no,
-              fmt::format("{} cell '{}' in column {}",
-                          err == CellError::OutOfRange ? "out-of-range" : "non-numeric", cell,
-                          kColumns[c])));
+          throw InputError(
+              located(path, line_no,
+                      fmt::format("{} cell '{}' in column {}",
+                                  err == CellError::OutOfRange ? "out-of-range" : "non-numeric",
+                                  cell, kColumns[c])));
         case CellError::NaN:
           throw InputError(
               located(path, line_no, fmt::format("NaN in column {} ('{}')", kColumns[c], cell)));
