@@ -278,8 +278,8 @@ TEST(Frf, ModesOfEq15AreTheDiagonalOscillators) {
 
 // The stepped sine (time-domain runs of the full nonlinear step) and the linearisation
 // agree in the linear regime. Two residuals remain (docs/experiments.md): the JA
-// irreversible magnetisation, proportional to the amplitude (+0.045 % in |Y/I| at 20 uA,
-// +0.18 % at 80 uA), and an O(dt) phase lag of the time stepping (<= 0.08 deg here).
+// irreversible magnetisation, proportional to the amplitude (+0.004 % in |Y/I| at 20 uA,
+// +0.018 % at 80 uA for the built-in model; 0.002 / 0.010 % for the printed reading), and an O(dt) phase lag of the time stepping (<= 0.08 deg here).
 // Both readings: the printed one (eq. 7's lag of H behind H_c) and the consistent one (the
 // rods' port equations with the eddy field kappa dB/dt, and the output stage).
 void expect_stepped_sine_matches_linearisation(const Model& m) {
@@ -317,7 +317,7 @@ TEST(Frf, PrintedReadingSteppedSineMatchesTheLinearisation) {
 
 // The printed reading cannot carry Fig. 15: its eddy lag sets a bandwidth of a few hundred
 // Hz and nothing rings below 5 kHz (READING-NOTES). The built-in model's output stage
-// carries the measured 1270 Hz with the bandwidth above 2000 Hz. Its peak shifts 3.4 %
+// carries the measured 1270 Hz with the bandwidth above 2000 Hz. Its peak shifts 1.4 %
 // from 20 to 70 degC (paper < 0.17 %): with damping ratio 0.37 the peak is shaped by the
 // eddy lag, whose time constant falls as rho rises (eq. 8). A lightly damped stage (ratio
 // 0.09) keeps the shift < 0.2 %, so the mechanics alone are temperature-independent, but it
