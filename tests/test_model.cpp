@@ -17,14 +17,26 @@
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/simulate.hpp"
 
-// ---- allocation counter: interposes glibc's malloc family for this test binary --------
-extern "C" void* __libc_malloc(std::size_t);
-extern "C" void* __libc_calloc(std::size_t, std::size_t);
-extern "C" void* __libc_realloc(void*, std::size_t);
+// ---- allocation counter ----------------------------------------------------------------
+// Normal builds interpose glibc's malloc family for this test binary; under AddressSanitizer
+// (which owns malloc) the sanitizer's allocation hooks count instead.
 namespace {
 std::atomic<bool> g_counting{false};
 std::atomic<long> g_allocations{0};
 }  // namespace
+#if defined(GMASIM_SANITIZE)
+#include <sanitizer/allocator_interface.h>
+namespace {
+void count_malloc(const volatile void*, std::size_t) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
+}
+void ignore_free(const volatile void*) {}
+const int g_hooks_installed = __sanitizer_install_malloc_and_free_hooks(count_malloc, ignore_free);
+}  // namespace
+#else
+extern "C" void* __libc_malloc(std::size_t);
+extern "C" void* __libc_calloc(std::size_t, std::size_t);
+extern "C" void* __libc_realloc(void*, std::size_t);
 extern "C" void* malloc(std::size_t n) {
   if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
   return __libc_malloc(n);
@@ -37,6 +49,7 @@ extern "C" void* realloc(void* p, std::size_t n) {
   if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
   return __libc_realloc(p, n);
 }
+#endif
 
 using namespace gmasim;
 using ::testing::HasSubstr;

@@ -7,6 +7,7 @@ Every function takes a mapping of column name -> 1-D array, as returned by the P
 """
 from __future__ import annotations
 
+import os
 import pathlib
 from typing import Mapping, Sequence
 
@@ -46,7 +47,15 @@ def save(fig, directory, stem: str) -> list[pathlib.Path]:
     out = []
     for ext in ("png", "svg"):
         p = directory / f"{stem}.{ext}"
-        fig.savefig(p, dpi=130, bbox_inches="tight")
+        # Atomic, like every gmasim output (docs/reliability.md): a temporary file beside the
+        # target, then a rename; a killed run never leaves a truncated figure under its name.
+        tmp = p.with_name(f".{p.name}.tmp.{os.getpid()}")
+        try:
+            fig.savefig(tmp, dpi=130, bbox_inches="tight", format=ext)
+            os.replace(tmp, p)
+        finally:
+            if tmp.exists():
+                tmp.unlink()
         out.append(p)
     plt.close(fig)
     return out

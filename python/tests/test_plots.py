@@ -135,3 +135,25 @@ def test_claims_overview_counts_and_colours_every_applicable_claim():
     dots = {round(float(l.get_xdata()[0]), 9) for l in ax.get_lines() if len(l.get_xdata()) == 1}
     assert 1.1 in dots and round(500.0 / 1270.0, 9) in dots and 10.0 in dots  # d clipped at 10
     assert any("×20" in t.get_text() for t in ax.texts)  # 3.4 / 0.17 = 20, written out
+
+
+def test_figures_are_written_atomically(tmp_path, monkeypatch):
+    import matplotlib.pyplot as plt
+    from gmasim import plots
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [0, 1])
+    paths = plots.save(fig, tmp_path, "f")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f.png", "f.svg"]
+    old = (tmp_path / "f.png").read_bytes()
+    assert old.startswith(b"\x89PNG")
+    # A failure while rendering leaves the previous figure and no temporary file.
+    fig2, _ = plt.subplots()
+
+    def boom(*a, **k):
+        raise RuntimeError("killed")
+    monkeypatch.setattr(fig2, "savefig", boom)
+    with pytest.raises(RuntimeError):
+        plots.save(fig2, tmp_path, "f")
+    assert (tmp_path / "f.png").read_bytes() == old
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f.png", "f.svg"]
+    assert [p.name for p in paths] == ["f.png", "f.svg"]
