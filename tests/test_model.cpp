@@ -1,7 +1,7 @@
 // Model-level tests: eq. (23) residuals, analytic limits of the assembled model,
 // convergence in dt, determinism, allocation-free stepping, bad conditions, divergence.
-#include <gtest/gtest.h>
 #include <gmock/gmock.h>
+#include <gtest/gtest.h>
 
 #include <atomic>
 #include <cmath>
@@ -449,11 +449,11 @@ TEST(Consistent, JaStepSlopeIsTheFiniteDifferenceDerivative) {
   struct Case {
     std::vector<double> history;
     double H1;
-  } cases[] = {{{2000.0}, 6000.0},                 // initial curve
-               {{20000.0}, 35000.0},               // initial curve, high field
-               {{40000.0}, 25000.0},               // descending branch
-               {{30000.0, 10000.0}, 14000.0},      // ascending minor loop
-               {{-15000.0}, -5000.0}};             // negative side, ascending
+  } cases[] = {{{2000.0}, 6000.0},             // initial curve
+               {{20000.0}, 35000.0},           // initial curve, high field
+               {{40000.0}, 25000.0},           // descending branch
+               {{30000.0, 10000.0}, 14000.0},  // ascending minor loop
+               {{-15000.0}, -5000.0}};         // negative side, ascending
   for (const auto& cs : cases) {
     double Mirr0 = 0.0, M0 = 0.0, H = 0.0;
     for (double target : cs.history)
@@ -518,8 +518,7 @@ TEST(Consistent, OutputStageFollowsTheStackAtRestAndRingsAt1270Hz) {
 // or at 0 degC (celsius) mixes reference points and is refused with the option's line.
 TEST(Consistent, MixedEq10ReferenceTemperaturesAreRefused) {
   for (const char* scale : {"kelvin", "celsius"}) {
-    const ModelSpec spec =
-        builtin_with_option("eq10_temperature_scale", "room_referenced", scale);
+    const ModelSpec spec = builtin_with_option("eq10_temperature_scale", "room_referenced", scale);
     try {
       (void)compile(spec);
       ADD_FAILURE() << scale << " accepted";

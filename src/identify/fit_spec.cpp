@@ -17,6 +17,7 @@
 #include "gmasim/identify.hpp"
 #include "gmasim/io.hpp"
 #include "io/text_io.hpp"
+#include "io/toml_io.hpp"
 
 namespace gmasim {
 namespace {
@@ -347,14 +348,7 @@ std::string target_kind_name(TargetKind k) {
 
 FitSpec parse_fit_spec(const std::string& toml_text, const std::string& source_name,
                        const ClaimsData* claims) {
-  toml::table root;
-  io_detail::guard_toml_text(toml_text, source_name);
-  try {
-    root = toml::parse(toml_text, std::string_view(source_name));
-  } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("{}:{}:{}: TOML syntax error: {}", source_name,
-                                 e.source().begin.line, e.source().begin.column, e.description()));
-  }
+  const toml::table root = io_detail::parse_toml(toml_text, source_name);
   FitSpec spec;
   spec.source = source_name;
   check_keys(root, {"claims", "parameter", "target"}, "the fit spec", source_name);

@@ -17,6 +17,7 @@
 #include "gmasim/io.hpp"
 #include "gmasim/validate.hpp"
 #include "io/text_io.hpp"
+#include "io/toml_io.hpp"
 
 namespace gmasim {
 namespace {
@@ -29,14 +30,7 @@ using io_detail::trim;
 
 // The TOML file at `path` (`what` names it in the open/read error).
 toml::table read_toml(const std::string& path, std::string_view what) {
-  const std::string text = read_text_file(path, what);
-  io_detail::guard_toml_text(text, path);
-  try {
-    return toml::parse(text, std::string_view(path));
-  } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("{}:{}:{}: TOML syntax error: {}", path, e.source().begin.line,
-                                 e.source().begin.column, e.description()));
-  }
+  return io_detail::parse_toml(read_text_file(path, what), path);
 }
 
 // A finite number, or the reason it is not one.

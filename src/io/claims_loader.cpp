@@ -13,6 +13,7 @@
 #include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
 #include "io/text_io.hpp"
+#include "io/toml_io.hpp"
 
 namespace gmasim {
 
@@ -264,14 +265,7 @@ ClaimSpec read_claim(const Reader& rd, const toml::table& t,
 }  // namespace
 
 ClaimsData parse_claims(const std::string& toml_text, const std::string& source_name) {
-  toml::table root;
-  io_detail::guard_toml_text(toml_text, source_name);
-  try {
-    root = toml::parse(toml_text, std::string_view(source_name));
-  } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("{}:{}:{}: TOML syntax error: {}", source_name,
-                                 e.source().begin.line, e.source().begin.column, e.description()));
-  }
+  const toml::table root = io_detail::parse_toml(toml_text, source_name);
   const Reader rd{source_name};
   rd.check_keys(root, {"claim"}, "the claims file");
   std::map<std::string, ClaimKindInfo> kinds;

@@ -12,6 +12,7 @@
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
 #include "io/text_io.hpp"
+#include "io/toml_io.hpp"
 #include "schema.hpp"
 
 namespace gmasim {
@@ -366,15 +367,7 @@ class Loader {
   }
 
   ModelSpec run() {
-    toml::table root;
-    io_detail::guard_toml_text(text_, spec_.source);
-    try {
-      root = toml::parse(text_, std::string_view(spec_.source));
-    } catch (const toml::parse_error& e) {
-      throw InputError(fmt::format("{}:{}:{}: TOML syntax error: {}", spec_.source,
-                                   e.source().begin.line, e.source().begin.column,
-                                   e.description()));
-    }
+    const toml::table root = io_detail::parse_toml(text_, spec_.source);
     read_root(root);
     for (const auto& [name, pv] : spec_.params)
       if (auto p = schema::check_value(spec_, name, pv.value)) problem(pv.line, *p);

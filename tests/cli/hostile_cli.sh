@@ -9,28 +9,7 @@ SRC="$(cd "$(dirname "$0")/../.." && pwd)"
 T="$(mktemp -d)"
 trap 'rm -rf "$T"' EXIT
 cd "$T"
-pass=0
-fail=0
-check() {  # name, expected exit code, expected text (grep -E) in stdout+stderr, command...
-  local name="$1" code="$2" text="$3"
-  shift 3
-  local out rc
-  out="$(timeout 120 "$@" 2>&1)"
-  rc=$?
-  if [[ $rc -eq $code ]] && grep -qE -- "$text" <<<"$out"; then
-    pass=$((pass + 1))
-  else
-    fail=$((fail + 1))
-    echo "FAIL: $name (exit $rc, expected $code; wanted /$text/)"
-    echo "$out" | head -c 600
-    echo
-  fi
-}
-ok() {  # name, condition already evaluated as a command
-  local name="$1"
-  shift
-  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAIL: $name"; fi
-}
+source "$SRC/tests/cli/check_lib.sh"
 
 # ---- 1. checkpoints are not trusted --------------------------------------------------
 cat >fit.toml <<'EOF'

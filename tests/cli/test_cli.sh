@@ -5,22 +5,7 @@ set -u
 B="$1"
 T="$(mktemp -d)"
 trap 'rm -rf "$T"' EXIT
-pass=0
-fail=0
-check() {  # name, expected exit code, expected text (grep -E) in stdout+stderr, command...
-  local name="$1" code="$2" text="$3"
-  shift 3
-  local out rc
-  out="$("$@" 2>&1)"
-  rc=$?
-  if [[ $rc -eq $code ]] && grep -qE -- "$text" <<<"$out"; then
-    pass=$((pass + 1))
-  else
-    fail=$((fail + 1))
-    echo "FAIL: $name (exit $rc, expected $code; wanted /$text/)"
-    echo "$out" | head -5
-  fi
-}
+source "$(dirname "$0")/check_lib.sh"
 check "simulate default" 0 "stroke +[0-9.]+ um" "$B" simulate --out "$T/a"
 [[ -s "$T/a/timeseries.csv" && -s "$T/a/metrics.json" ]] && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: outputs missing"; }
 head -1 "$T/a/timeseries.csv" | grep -q '^t_s,current_A,y_um,B_T,xT_um,y_stack_um,rod1_H_A_per_m' && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: csv header"; }
