@@ -114,7 +114,10 @@ void CircuitWorkspace::resize(const Circuit& c) {
   const int n = c.node_count();
   G = Eigen::MatrixXd::Zero(n, n);
   rhs = Eigen::VectorXd::Zero(n);
-  llt = Eigen::LLT<Eigen::MatrixXd>(n);
+  // Sized by a factorisation of the identity, not by LLT(n): LLT(n) leaves its status and
+  // norm uninitialised, and copying such a workspace (a State copy) loads an indeterminate
+  // enum (UBSan, issue 8). compute() sets both; step() refactorises in place, no allocation.
+  llt.compute(Eigen::MatrixXd::Identity(n, n));
   const int k = static_cast<int>(c.rod_branch.size());
   v = SmallVector::Zero(k);
   z = SmallVector::Zero(k);
