@@ -65,6 +65,9 @@ std::vector<std::string_view> split_cells(std::string_view line) {
 CellError parse_finite(std::string_view cell, double& v) {
   if (cell.empty()) return CellError::Empty;
   const std::string_view digits = cell.starts_with('+') ? cell.substr(1) : cell;
+  // One sign only: "+-1" is not a number (from_chars after the '+' would read -1).
+  if (digits.size() != cell.size() && (digits.starts_with('-') || digits.starts_with('+')))
+    return CellError::NonNumeric;
   const auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), v);
   if (ec != std::errc() || ptr != digits.data() + digits.size())
     return ec == std::errc::result_out_of_range ? CellError::OutOfRange : CellError::NonNumeric;

@@ -161,6 +161,9 @@ ok "12 no temporary left" test -z "$(ls pair | grep tmp)"
 check "13 unknown flag is a usage error" 1 "not expected: --bogus" "$B" simulate --bogus
 check "13 bad number is a usage error" 1 "Could not convert" "$B" simulate --periods abc
 check "13 +-1" 1 "Could not convert" "$B" simulate --periods +-1
+printf 't_s,current_A\n0,1\n0.001,+-1\n' >w_sign.csv
+check "13 +-1 in a CSV cell" 2 "w_sign.csv:3: non-numeric cell '\+-1'" "$B" simulate --waveform w_sign.csv --out s
+check "13 +-1 in a list" 2 "'\+-1' is not a finite number" "$B" sweep --temperatures 20,+-1 --out sw
 # One argument may hold at most 128 KiB (Linux MAX_ARG_STRLEN): 100 kB.
 long="$(head -c 100000 /dev/zero | tr '\0' '7')x"
 out="$("$B" simulate --periods "$long" 2>&1)"
