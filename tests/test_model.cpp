@@ -25,7 +25,9 @@ std::atomic<bool> g_counting{false};
 std::atomic<long> g_allocations{0};
 }  // namespace
 #if defined(GMASIM_SANITIZE)
-#include <sanitizer/allocator_interface.h>
+// Declared here: GCC does not ship <sanitizer/allocator_interface.h>; libasan exports it.
+extern "C" int __sanitizer_install_malloc_and_free_hooks(
+    void (*malloc_hook)(const volatile void*, std::size_t), void (*free_hook)(const volatile void*));
 namespace {
 void count_malloc(const volatile void*, std::size_t) {
   if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
