@@ -173,7 +173,8 @@ double lowest_resonance_Hz(const Model& m, const ResonanceRun& run) {
     r.bias_A = run.bias;
     r.stepped_sine = false;
     r.threads = 1;
-    const FrfCurve& cv = run_frf(m, r).curves.at(0);
+    const FrfResult frf = run_frf(m, r);  // kept alive: cv refers into it
+    const FrfCurve& cv = frf.curves.at(0);
     return run.kind == TargetKind::FrfPeakHz ? cv.first_resonance_Hz : cv.bandwidth_3dB_Hz;
   }
   const Conditions c = make_conditions(m, run.T);
