@@ -17,10 +17,12 @@ std::string json_string(std::string_view s) {
   return io_detail::json_string(s, io_detail::BackspaceFormFeed::Unicode);
 }
 
-// Shortest representation that reads back to the same double; JSON has no NaN/Inf.
+// Shortest representation that reads back to the same double. A value that is not a finite
+// number (not measured, not defined: a stepped-sine column of a linear-only response) is
+// missing: null in JSON, an empty cell in CSV, never the ambiguous text "nan" or "inf".
 std::string number(double v, bool json) {
   if (json) return io_detail::json_number(v);
-  if (!std::isfinite(v)) return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
+  if (!std::isfinite(v)) return "";
   return fmt::format("{}", v);
 }
 
