@@ -194,8 +194,9 @@ Checkpoint read_checkpoint(const std::string& path) {
   Checkpoint c;
   const std::string head = in.next();
   if (head.rfind(kMagic, 0) != 0) in.fail("not a gmasim identify checkpoint");
-  c.version = static_cast<int>(in.nums(head.substr(std::strlen(kMagic)), 1)[0]);
-  if (c.version != 1) in.fail(fmt::format("version {} is not supported (expected 1)", c.version));
+  const double version = in.nums(head.substr(std::strlen(kMagic)), 1)[0];
+  if (version != 1.0) in.fail(fmt::format("version {:g} is not supported (expected 1)", version));
+  c.version = 1;
   c.fp_parameters = in.expect("fp_parameters");
   c.fp_data = in.expect("fp_data");
   c.fp_settings = in.expect("fp_settings");
@@ -222,6 +223,11 @@ Checkpoint read_checkpoint(const std::string& path) {
     for (double x : v)
       if (!(std::isfinite(x) && x >= 0.0))
         in.fail(fmt::format("history: {:g} is not a finite value >= 0", x));
+    // The step and the evaluation count become integers: in range first (found by
+    // fuzz_checkpoint: 1.1e88 converted to int).
+    if (!(v[0] <= 1e9 && v[1] <= 1e15 && v[0] == std::floor(v[0]) && v[1] == std::floor(v[1])))
+      in.fail(fmt::format("history: step {:g} / evaluations {:g}: not a count in range", v[0],
+                          v[1]));
     const std::string phase = l.substr(0, sp);
     if (phase != "ga" && phase != "refine")
       in.fail(fmt::format("history: unknown phase '{}'", phase));

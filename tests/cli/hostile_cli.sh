@@ -51,6 +51,10 @@ sed 's/^best_u .*/best_u 7.5/' ck.txt >c_out.txt
 check "1 point outside the bounds" 2 "coordinate 7.5 is outside \[0, 1\]" "${R[@]}" c_out.txt
 sed 's/^population 8$/population 0/' ck.txt >c_pop0.txt
 check "1 population 0" 2 "population 0: must be an integer in" "${R[@]}" c_pop0.txt
+sed '1s/.*/gmasim-identify-checkpoint 1e88/' ck.txt >c_ver.txt
+check "1 version 1e88 (fuzz_checkpoint: float-to-int overflow)" 2 "version 1e\+88 is not supported" "${R[@]}" c_ver.txt
+awk '/^ga 1 /{$2="1e88"} {print}' ck.txt >c_hist.txt
+check "1 history step 1e88" 2 "history: step 1e\+88 / evaluations .*: not a count in range" "${R[@]}" c_hist.txt
 sed 's/^islands 1$/islands 1e18/' ck.txt >c_isl.txt
 check "1 islands 1e18" 2 "islands 1e\+18: must be an integer" "${R[@]}" c_isl.txt
 
