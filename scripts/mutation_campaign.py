@@ -189,7 +189,7 @@ def classify(rc: int | None, out: str, err: str, d: pathlib.Path, mutated: str,
         if NONFINITE.search(out.encode()) and "simulate" in cmd:
             return "nonsense", "non-finite value in the summary"
         return "ok", "accepted"
-    if rc == 3:
+    if rc == 3:  # a divergence must name its time (and rod, quantity) on stderr
         return ("ok", "diverged") if "diverged at t =" in err else ("unclear", err.strip()[:200])
     if rc in (1, 2):
         msg = err.strip()
@@ -229,12 +229,14 @@ def main(argv=None) -> int:
     if not 1 <= a.runs <= 10_000_000 or not 1 <= a.jobs <= 256 or not 0 < a.timeout <= 3600:
         print("mutation_campaign.py: --runs 1..1e7, --jobs 1..256, --timeout (0, 3600] s", file=sys.stderr)
         return 1
-    bin_ = str(pathlib.Path(a.bin).resolve())
     out = pathlib.Path(a.out)
     if out.exists():
         shutil.rmtree(out)
     keep = out / "findings"
     keep.mkdir(parents=True)
+    # A private copy: a rebuild during the campaign must not change (or lock) the binary.
+    bin_ = str(out / "gmasim")
+    shutil.copy2(pathlib.Path(a.bin).resolve(), bin_)
     with tempfile.TemporaryDirectory(prefix="gmasim_seed_") as tmp:
         s = seeds(pathlib.Path(tmp), bin_)
     kinds = ["model"] * 30 + ["waveform"] * 15 + ["measurement"] * 10 + ["manifest"] * 8 + \

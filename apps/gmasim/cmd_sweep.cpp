@@ -52,8 +52,15 @@ int run_sweep_cmd(SweepArgs& a) {
   }
   fmt::print("  wrote {}\n", fmt::join(files, ", "));
   if (diverged > 0) {
-    print_error(fmt::format("{} of {} points diverged (recorded in the output)", diverged,
-                            res.points.size()));
+    for (const auto& p : res.points)
+      if (p.diverged) {  // the first one's diagnosis (time, rod, quantity) on stderr too
+        print_error(fmt::format(
+            "{} of {} points diverged (recorded in the output); first at {:g} degC, {:g} A, "
+            "{:g} Hz: {}",
+            diverged, res.points.size(), p.temperature_C, p.current_pp_A, p.frequency_Hz,
+            p.error));
+        break;
+      }
     return 3;
   }
   return 0;

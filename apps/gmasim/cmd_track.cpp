@@ -60,7 +60,13 @@ int run_track_cmd(TrackArgs& a) {
   fmt::print("  {} points on {} threads in {:.2f} s\n  wrote {}\n", res.points.size(), res.threads,
              res.wall_time_s, fmt::join(files, ", "));
   if (diverged > 0) {
-    print_error(fmt::format("{} of {} points diverged", diverged, res.points.size()));
+    for (const auto& p : res.points)
+      if (p.diverged) {  // the first one's diagnosis (time, rod, quantity) on stderr too
+        print_error(fmt::format("{} of {} points diverged; first at {:g} degC, {:g} um, {:g} Hz: {}",
+                                diverged, res.points.size(), p.temperature_C, p.amplitude_um,
+                                p.frequency_Hz, p.error));
+        break;
+      }
     return 3;
   }
   return 0;

@@ -90,6 +90,9 @@ TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& p
   require_in(r.bias_A, -kMaxCurrent_A, kMaxCurrent_A, "bias current", "A");
   require_in(r.current_limit_A, 0.0, kMaxCurrent_A, "current limit", "A");
   for (double g : {r.gains.kp, r.gains.ki, r.gains.kd}) require_finite(g, "PID gain");
+  // The gains are per sample at this rate (Pid): a rate of 4.9e-324 Hz would scale kd by
+  // 1e300+ (found by the mutation campaign).
+  require_in(r.gains.reference_rate_Hz, 1e-3, 1e9, "PID gain reference rate", "Hz");
   require_in(r.sensor_noise_um, 0.0, kMaxTrackAmplitude_um, "sensor noise", "um");
   require_in(r.periods, 1.0, kMaxPeriods, "periods");
   const double runs = static_cast<double>(r.temperatures_C.size()) *

@@ -160,8 +160,9 @@ void fill_covariance(const Objective& obj, BatchEvaluator& ev, const std::vector
       lam.minCoeff() > 0 ? lmax / lam.minCoeff() : std::numeric_limits<double>::infinity();
   out.covariance_note = fmt::format(
       "{} residuals, {} parameters; residual variance from the fit (m - n degrees of freedom: "
-      "RMS sqrt(m / (m - n)) = {:.4g} %); condition number of the column-scaled J^T J {:.3g}",
-      m, n, out.residual_sigma * std::sqrt(static_cast<double>(m)), cond);
+      "RMS sqrt(m / (m - n)) = {:.4g} %); condition number of the column-scaled J^T J {}",
+      m, n, out.residual_sigma * std::sqrt(static_cast<double>(m)),
+      std::isfinite(cond) ? fmt::format("{:.3g}", cond) : std::string("infinite (singular)"));
   if (rank_deficiency > 0) {
     out.covariance_note += fmt::format(
         "; J^T J is rank-deficient by {}: some parameter "
