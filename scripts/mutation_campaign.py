@@ -229,7 +229,7 @@ def main(argv=None) -> int:
     if not 1 <= a.runs <= 10_000_000 or not 1 <= a.jobs <= 256 or not 0 < a.timeout <= 3600:
         print("mutation_campaign.py: --runs 1..1e7, --jobs 1..256, --timeout (0, 3600] s", file=sys.stderr)
         return 1
-    out = pathlib.Path(a.out)
+    out = pathlib.Path(a.out).resolve()
     if out.exists():
         shutil.rmtree(out)
     keep = out / "findings"
