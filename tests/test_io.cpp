@@ -926,3 +926,52 @@ TEST(Input, TomlGuardRefusesWhatTomlPlusPlusMishandles) {
   EXPECT_THAT(err, Not(HasSubstr("malformed")));
   EXPECT_THAT(err, Not(HasSubstr("expected a key")));
 }
+
+// model_toml / apply_assignments (issue 9, item 6): a changed model saves to a file that
+// loads back with exactly its values, every other line untouched.
+TEST(ModelWriter, SavedFileCarriesExactlyTheChangedValues) {
+  const gmasim::ModelSpec base = gmasim::builtin_model_spec();
+  const gmasim::ModelSpec changed = gmasim::apply_assignments(
+      base, {"material.Ms_A_per_m=7.123456789012345e5", "rod2.ja.k0_A_per_m = 2500",
+             "options.magnetic_state=printed"});
+  const std::string text = gmasim::model_toml(changed, "test");
+  const gmasim::ModelSpec back = gmasim::parse_model_spec(text, "saved");
+  for (const auto& [name, pv] : changed.params)
+    EXPECT_EQ(back.params.at(name).value, pv.value) << name;
+  EXPECT_EQ(back.options, changed.options);
+  EXPECT_EQ(back.params.at("material.Ms_A_per_m").value, 7.123456789012345e5);
+  EXPECT_THAT(back.params.at("rod2.ja.k0_A_per_m").provenance, StartsWith("set: test; was "));
+  // Only the three changed lines differ.
+  std::istringstream a(base.text), b(text);
+  std::string la, lb;
+  int differ = 0, lines = 0;
+  while (std::getline(a, la) && std::getline(b, lb)) {
+    ++lines;
+    differ += la != lb;
+  }
+  EXPECT_EQ(differ, 3);
+  EXPECT_GT(lines, 100);
+  // An unchanged model saves to its own text.
+  EXPECT_EQ(gmasim::model_toml(base, "test"), base.text);
+}
+
+TEST(ModelWriter, AssignmentsAreCheckedLikeTheFile) {
+  const gmasim::ModelSpec base = gmasim::builtin_model_spec();
+  auto fails = [&](const std::string& a, const std::string& what) {
+    try {
+      (void)gmasim::apply_assignments(base, {a});
+      ADD_FAILURE() << a << " was accepted";
+    } catch (const gmasim::InputError& e) {
+      EXPECT_THAT(e.what(), HasSubstr(what)) << a;
+    }
+  };
+  fails("material.Ms_A_per_m", "expected name=value");
+  fails("=3", "expected name=value");
+  fails("material.Ms_A_per_m=inf", "not a finite number");
+  fails("material.Ms_A_per_m=1e400", "not a finite number");
+  fails("material.Ms_A_per_m=7e5x", "not a finite number");
+  fails("rod1.length_m=-0.01", "must be > 0");
+  fails("nothing.here=1", "unknown parameter");
+  fails("options.nothing=x", "has no option 'options.nothing'");
+  fails("options.magnetic_state=a b", "one word");
+}

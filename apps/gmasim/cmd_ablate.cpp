@@ -13,12 +13,13 @@ namespace gmasim::cli {
 namespace {
 
 struct AblateArgs {
-  std::string model, out = "out/ablate", frequencies = "10,200";
+  ModelArgs model;
+  std::string out = "out/ablate", frequencies = "10,200";
   AblateRequest req;
 };
 
 int run_ablate_cmd(AblateArgs& a) {
-  const Model model = load_model(a.model);
+  const Model model = load_model_args(a.model);
   a.req.frequencies_Hz = parse_list(a.frequencies, "--frequencies", "Hz");
   ensure_output_dir(a.out);
   const AblateResult res = run_ablate(model, a.req);
@@ -59,7 +60,7 @@ Runner add_ablate(CLI::App& app) {
       "Freeze the temperature dependence of mu_G, rho_G, M, E_G, E_t (and F_pm, geometry) at "
       "20 degC one at a time; deviation from the full model (Fig. 20). Writes ablate.csv, "
       "ablate.json");
-  sub->add_option("--model", a->model, "Model file (TOML); default: the built-in MDMA model");
+  add_model_options(sub, a->model);
   sub->add_option("--temperature", a->req.temperature_C, "Operating temperature [degC]")
       ->capture_default_str();
   sub->add_option("--frequencies", a->frequencies, "Excitation frequencies [Hz]; list or range")

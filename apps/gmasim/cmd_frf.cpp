@@ -19,14 +19,15 @@ namespace {
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
 struct FrfArgs {
-  std::string model, out = "out/frf", temperatures = "20,70", method = "both",
+  ModelArgs model;
+  std::string out = "out/frf", temperatures = "20,70", method = "both",
                      bias_state = "anhysteretic";
   FrfRequest req;
   bool progress = false;
 };
 
 int run_frf_cmd(FrfArgs& a) {
-  const Model model = load_model(a.model);
+  const Model model = load_model_args(a.model);
   a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
   a.req.stepped_sine = a.method != "linear";
   a.req.small_signal = a.method != "stepped";
@@ -108,7 +109,7 @@ Runner add_frf(CLI::App& app) {
       "Frequency response current -> displacement (Fig. 15): stepped sine and/or small-signal "
       "linearisation about a DC bias, first resonance, -3 dB bandwidth, eq. (15) modes. Writes "
       "frf.csv, frf_summary.csv, frf_modes.csv, frf_eddy.csv and frf.json");
-  sub->add_option("--model", a->model, "Model file (TOML); default: the built-in MDMA model");
+  add_model_options(sub, a->model);
   sub->add_option("--temperatures", a->temperatures, "Temperatures [degC]; list or range")
       ->capture_default_str();
   sub->add_option("--f-min", a->req.f_min_Hz, "Lowest frequency [Hz]")->capture_default_str();

@@ -116,14 +116,15 @@ if __name__ == "__main__":
 )PY";
 
 struct IdentifyArgs {
-  std::string data, fit, out, model, report, mpi = "auto";
+  std::string data, fit, out, report, mpi = "auto";
+  ModelArgs model;
   IdentifyOptions opt;
   bool no_refine = false, no_profile = false, no_plots = false, quiet = false;
 };
 
 struct SynthArgs {
-  std::string out, model;
-  std::vector<std::string> sets;
+  std::string out;
+  ModelArgs model;
   SyntheticRequest req;
   bool no_flux = false;
 };
@@ -149,8 +150,6 @@ std::string command_line() {
   return cmd.empty() ? "gmasim identify" : cmd;
 }
 
-std::string read_file_text(const std::string& path) { return read_input_file(path, "model file"); }
-
 int env_int(const char* name, int fallback) {
   const char* v = std::getenv(name);
   return v ? std::atoi(v) : fallback;
@@ -163,8 +162,8 @@ void write_outputs(const IdentifyArgs& a, const IdentifyResult& r, const ModelSp
   p.fit = a.fit;
   p.start_model = model_label(a.model);
   p.report_dir = a.report;
-  const std::string start_text =
-      a.model.empty() ? std::string(kBuiltinModelToml) : read_file_text(a.model);
+  // The start's own text: the file as read, with any --set values written into it.
+  const std::string start_text = a.model.sets.empty() ? start.text : model_toml(start, "--set");
   const fs::path out(a.out);
   if (out.has_parent_path()) ensure_output_dir(out.parent_path().string());
   write_file_atomic(a.out, fitted_model_toml(start_text, start, r, p));
@@ -237,7 +236,7 @@ int run_identify_body(IdentifyArgs& a, Communicator& comm) {
     fs::path p(a.out);
     a.report = (p.parent_path() / (p.stem().string() + "_report")).string();
   }
-  const ModelSpec start = a.model.empty() ? builtin_model_spec() : load_model_spec(a.model);
+  const ModelSpec start = load_model_spec_args(a.model);
   const MeasurementSet data = a.data.empty() ? MeasurementSet{} : load_manifest(a.data);
   const FitSpec fit = load_fit_spec(a.fit);
   IdentifyOptions o = a.opt;
@@ -314,24 +313,17 @@ int run_identify(IdentifyArgs& a) {
 }
 
 int run_synthesize(SynthArgs& a) {
-  ModelSpec spec = a.model.empty() ? builtin_model_spec() : load_model_spec(a.model);
-  std::string truth =
-      fmt::format("# truth of the synthetic measurements\nmodel = \"{}\"\n", model_label(a.model));
-  for (const auto& s : a.sets) {
-    const auto eq = s.find('=');
-    if (eq == std::string::npos)
-      throw InputError(fmt::format("--set '{}': expected name=value", s));
-    const std::string name = s.substr(0, eq);
-    double v = 0;
-    try {
-      std::size_t used = 0;
-      v = std::stod(s.substr(eq + 1), &used);
-      if (used != s.size() - eq - 1) throw std::invalid_argument("trailing");
-    } catch (const std::exception&) {
-      throw InputError(fmt::format("--set '{}': the value is not a number", s));
+  const ModelSpec spec = load_model_spec_args(a.model);
+  std::string truth = fmt::format("# truth of the synthetic measurements\nmodel = \"{}\"\n",
+                                  model_label(a.model.path));
+  for (const auto& s : a.model.sets) {
+    std::string name = s.substr(0, s.find('='));
+    std::erase_if(name, [](char c) { return c == ' ' || c == '\t'; });
+    if (name.starts_with("options.")) {
+      truth += fmt::format("# {}\n", s);
+    } else {
+      truth += fmt::format("{} = {:.17g}\n", name, spec.get(name));
     }
-    spec.set(name, v);
-    truth += fmt::format("{} = {:.17g}\n", name, v);
   }
   if (a.no_flux) a.req.with_flux = false;
   const Model m = compile(spec);
@@ -362,7 +354,7 @@ Runner add_identify(CLI::App& app) {
                   "Fit spec: TOML file ([[parameter]], [[target]]) or inline "
                   "'name:lower:upper[:log],...'");
   sub->add_option("--out", a->out, "Calibrated model file to write (TOML)");
-  sub->add_option("--model", a->model, "Start model (TOML); default: the built-in MDMA model");
+  add_model_options(sub, a->model, "Start model (TOML); default: the built-in MDMA model");
   sub->add_option("--report", a->report,
                   "Fit report directory; default: <out>_report next to --out");
   sub->add_option("--algorithm", o.algorithm,
@@ -422,8 +414,7 @@ Runner add_identify(CLI::App& app) {
       "Write synthetic measurements (CSV + manifest) from a model: biased sines at every "
       "temperature x current x frequency, with Gaussian noise");
   syn->add_option("--out", s->out, "Output directory")->required();
-  syn->add_option("--model", s->model, "Model (TOML); default: the built-in MDMA model");
-  syn->add_option("--set", s->sets, "Override a model parameter: name=value (repeatable)");
+  add_model_options(syn, s->model);
   syn->add_option("--temperatures", s->req.temperatures_C, "Temperatures [degC]")
       ->delimiter(',')
       ->capture_default_str();

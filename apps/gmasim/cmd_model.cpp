@@ -13,22 +13,36 @@ namespace gmasim::cli {
 Runner add_model(CLI::App& app) {
   auto* sub = app.add_subcommand("model", "Inspect and validate model files");
   sub->require_subcommand(1);
-  auto show_path = std::make_shared<std::string>();
+  auto show_model = std::make_shared<ModelArgs>();
+  auto save_model_args = std::make_shared<ModelArgs>();
+  auto save_out = std::make_shared<std::string>();
   auto check_path = std::make_shared<std::string>();
   auto* show =
       sub->add_subcommand("show", "List every parameter with its value, unit and provenance");
-  show->add_option("--model", *show_path, "Model file (TOML); default: the built-in MDMA model");
+  add_model_options(show, *show_model);
+  auto* save = sub->add_subcommand(
+      "save",
+      "Write a model file with --set changes applied (each changed value keeps its line and "
+      "gets a 'set:' provenance comment naming the old value)");
+  add_model_options(save, *save_model_args);
+  save->add_option("--out", *save_out, "Model file to write (TOML)")->required();
   auto* check = sub->add_subcommand("check", "Validate a model file and explain each problem");
   check->add_option("file", *check_path, "Model file (TOML)")->required();
   return [=]() -> int {
     if (show->parsed()) {
-      const ModelSpec spec =
-          show_path->empty() ? builtin_model_spec() : load_model_spec(*show_path);
+      const ModelSpec spec = load_model_spec_args(*show_model);
       (void)compile(spec);  // show only valid models
-      fmt::print("# {}\n", spec.source);
+      fmt::print("# {}\n", model_label(*show_model));
       fmt::print("{:<48} {:>14}  {:<10} {}\n", "parameter", "value", "unit", "provenance");
       for (const auto& row : describe_model(spec))
         fmt::print("{:<48} {:>14}  {:<10} {}\n", row.name, row.value, row.unit, row.provenance);
+      return 0;
+    }
+    if (save->parsed()) {
+      const ModelSpec spec = load_model_spec_args(*save_model_args);
+      save_model(spec, *save_out, "gmasim model save --set");
+      fmt::print("wrote {} ({} with {} change{})\n", *save_out, model_label(save_model_args->path),
+                 save_model_args->sets.size(), save_model_args->sets.size() == 1 ? "" : "s");
       return 0;
     }
     if (check->parsed()) {

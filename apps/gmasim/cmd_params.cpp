@@ -13,7 +13,8 @@ namespace gmasim::cli {
 namespace {
 
 struct ParamsArgs {
-  std::string model, out = "out/params", temperatures = "20,40,60,80,100,120,150",
+  ModelArgs model;
+  std::string out = "out/params", temperatures = "20,40,60,80,100,120,150",
                      retention = "6,8,10,12";
   ParamsVsTemperatureRequest req;
 };
@@ -28,7 +29,7 @@ void print_thermal(const ThermalExpansionResult& t) {
 }
 
 int run_params_cmd(ParamsArgs& a) {
-  const Model model = load_model(a.model);
+  const Model model = load_model_args(a.model);
   a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
   a.req.retention_currents_pp_A = parse_list(a.retention, "--retention-currents", "A");
   ensure_output_dir(a.out);
@@ -77,7 +78,7 @@ Runner add_params(CLI::App& app) {
       "mu_G, rho_G, M_G, E_G and E_t against temperature (Fig. 19), stroke retention (Fig. 18) "
       "and the thermal expansion coefficient (eq. 21). Writes params*.csv, params.json, "
       "thermal.csv, thermal.json");
-  sub->add_option("--model", a->model, "Model file (TOML); default: the built-in MDMA model");
+  add_model_options(sub, a->model);
   sub->add_option("--temperatures", a->temperatures, "Temperatures [degC]; list or range")
       ->capture_default_str();
   sub->add_option("--current-pp", a->req.current_pp_A,
@@ -99,17 +100,17 @@ Runner add_params(CLI::App& app) {
 }
 
 Runner add_thermal(CLI::App& app) {
-  auto model = std::make_shared<std::string>();
+  auto model = std::make_shared<ModelArgs>();
   auto out = std::make_shared<std::string>("out/thermal");
   auto* sub = app.add_subcommand(
       "thermal",
       "Thermal expansion coefficient of the stack, eq. (21), against the paper's 0.662 (model) "
       "and 0.712 (measured) um/degC. Writes thermal.csv, thermal.json");
-  sub->add_option("--model", *model, "Model file (TOML); default: the built-in MDMA model");
+  add_model_options(sub, *model);
   sub->add_option("--out", *out, "Output directory")->capture_default_str();
   return [=]() -> int {
     if (!sub->parsed()) return -1;
-    const Model m = load_model(*model);
+    const Model m = load_model_args(*model);
     ensure_output_dir(*out);
     const auto th = thermal_expansion_coefficient(m);
     const auto files = write_report(*out, "thermal", thermal_report(m, th));

@@ -20,7 +20,8 @@ namespace gmasim::cli {
 namespace {
 
 struct ReproduceArgs {
-  std::string model, out = "out/reproduce", doc, python = "/usr/bin/python3";
+  ModelArgs model;
+  std::string out = "out/reproduce", doc, python = "/usr/bin/python3";
   std::string doc_notes;  // markdown "### <claim id>" explanations of failing claims, for --doc
   std::string claims;     // claims file (data/claims.toml format); "" = the built-in claims
   std::vector<std::string> compare;  // other model files (readings) scored on the same claims
@@ -30,7 +31,7 @@ struct ReproduceArgs {
 };
 
 int run_reproduce_cmd(const ReproduceArgs& a) {
-  const Model model = load_model(a.model);
+  const Model model = load_model_args(a.model);
   const ClaimsData claims = a.claims.empty() ? builtin_claims() : load_claims(a.claims);
   if (!a.doc_notes.empty() && a.doc.empty())
     throw InputError("--doc-notes " + a.doc_notes +
@@ -79,7 +80,7 @@ Runner add_reproduce(CLI::App& app) {
                                  "Run the paper's whole study (sweeps, FRF, tracking, ablation, "
                                  "20-150 degC) and write the report "
                                  "with the claims table");
-  sub->add_option("--model", a->model, "Model file (TOML); default: the built-in MDMA model");
+  add_model_options(sub, a->model);
   sub->add_option("--out", a->out, "Output directory (report.md, claims, data/, figures/)")
       ->capture_default_str();
   sub->add_option(

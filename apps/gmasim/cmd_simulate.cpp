@@ -13,7 +13,8 @@ namespace gmasim::cli {
 namespace {
 
 struct SimulateArgs {
-  std::string model, waveform_csv, kind = "sine", out = "out/simulate";
+  ModelArgs model;
+  std::string waveform_csv, kind = "sine", out = "out/simulate";
   double temperature_C = 20.0, pp_A = 8.0, min_A = -3.0, frequency_Hz = 10.0, periods = 3.0;
   double dt_s = 0.0, level_A = 0.0, step_to_A = 0.0, step_time_s = 0.0;
   double f0_Hz = 1.0, f1_Hz = 1000.0, amplitude_A = 1.0, offset_A = 0.0, duration_s = 0.0;
@@ -49,7 +50,7 @@ Waveform make_waveform(const SimulateArgs& a) {
 }
 
 int run_simulate(const SimulateArgs& a) {
-  const Model model = load_model(a.model);
+  const Model model = load_model_args(a.model);
   SimulationSettings s;
   s.temperature_C = a.temperature_C;
   s.waveform = make_waveform(a);
@@ -97,7 +98,7 @@ Runner add_simulate(CLI::App& app) {
   auto a = std::make_shared<SimulateArgs>();
   auto* sub = app.add_subcommand(
       "simulate", "Run the model in the time domain; writes timeseries.csv and metrics.json");
-  sub->add_option("--model", a->model, "Model file (TOML); default: the built-in MDMA model");
+  add_model_options(sub, a->model);
   sub->add_option("--temperature", a->temperature_C, "Operating temperature [degC]")
       ->capture_default_str();
   sub->add_option("--waveform-kind", a->kind,

@@ -14,14 +14,15 @@ namespace gmasim::cli {
 namespace {
 
 struct SweepArgs {
-  std::string model, out = "out/sweep";
+  ModelArgs model;
+  std::string out = "out/sweep";
   std::string temperatures = "20:10:70", currents = "6,8,10,12", frequencies = "10";
   SweepRequest req;
   bool progress = false;
 };
 
 int run_sweep_cmd(SweepArgs& a) {
-  const Model model = load_model(a.model);
+  const Model model = load_model_args(a.model);
   a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
   a.req.currents_pp_A = parse_list(a.currents, "--currents", "A");
   a.req.frequencies_Hz = parse_list(a.frequencies, "--frequencies", "Hz");
@@ -75,7 +76,7 @@ Runner add_sweep(CLI::App& app) {
       "Grid over temperature x current peak-to-peak x frequency (Fig. 12-14): stroke, "
       "hysteresis, B peak-to-peak and their change vs a reference temperature; points run in "
       "parallel. Writes sweep.csv and sweep.json");
-  sub->add_option("--model", a->model, "Model file (TOML); default: the built-in MDMA model");
+  add_model_options(sub, a->model);
   sub->add_option("--temperatures", a->temperatures,
                   "Temperatures [degC]: list '20,30,40' or range start:step:stop")
       ->capture_default_str();

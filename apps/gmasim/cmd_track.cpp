@@ -14,14 +14,15 @@ namespace gmasim::cli {
 namespace {
 
 struct TrackArgs {
-  std::string model, out = "out/track", temperatures = "20:10:70", amplitudes = "10,20",
+  ModelArgs model;
+  std::string out = "out/track", temperatures = "20:10:70", amplitudes = "10,20",
                      frequencies = "10,100";
   TrackRequest req;
   bool progress = false;
 };
 
 int run_track_cmd(TrackArgs& a) {
-  const Model model = load_model(a.model);
+  const Model model = load_model_args(a.model);
   a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
   a.req.amplitudes_um = parse_list(a.amplitudes, "--amplitudes", "um");
   a.req.frequencies_Hz = parse_list(a.frequencies, "--frequencies", "Hz");
@@ -80,7 +81,7 @@ Runner add_track(CLI::App& app) {
       "track",
       "Closed-loop displacement tracking with the paper's discrete PID (Fig. 16): RMS and peak "
       "tracking error against temperature. Writes track.csv, track.json, track_example.csv");
-  sub->add_option("--model", a->model, "Model file (TOML); default: the built-in MDMA model");
+  add_model_options(sub, a->model);
   sub->add_option("--temperatures", a->temperatures, "Temperatures [degC]; list or range")
       ->capture_default_str();
   sub->add_option("--amplitudes", a->amplitudes, "Reference amplitudes [um] (sine about y_bias)")

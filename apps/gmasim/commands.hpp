@@ -5,6 +5,9 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
+#include <vector>
+
+#include "gmasim/model.hpp"
 
 namespace gmasim::cli {
 
@@ -20,6 +23,19 @@ Runner add_track(CLI::App& app);    // cmd_track.cpp
 Runner add_ablate(CLI::App& app);   // cmd_ablate.cpp
 Runner add_params(CLI::App& app);   // cmd_params.cpp: params-vs-temperature
 Runner add_thermal(CLI::App& app);  // cmd_params.cpp: thermal
+
+// --model FILE and --set name=value (repeatable), on every command that runs a model.
+struct ModelArgs {
+  std::string path;               // empty: the built-in MDMA model
+  std::vector<std::string> sets;  // "name=value" (gmasim::apply_assignments)
+};
+void add_model_options(CLI::App* sub, ModelArgs& a,
+                       const std::string& what = "Model file (TOML); default: the built-in MDMA "
+                                                 "model");
+ModelSpec load_model_spec_args(const ModelArgs& a);  // the file (or built-in) with --set applied
+Model load_model_args(const ModelArgs& a);           // ... compiled
+// "models/mdma.toml (built-in)" or the path, plus " with --set a=1, b=2" when there are any.
+std::string model_label(const ModelArgs& a);
 
 // Shared helpers.
 std::string model_label(const std::string& path);  // "models/mdma.toml (built-in)" or path

@@ -2,6 +2,7 @@
 // 3 numerical divergence (partial output written), 4 internal error. A parse error (an
 // unknown flag, a value that is not a number, a non-finite number) is a usage error, 1.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <CLI/CLI.hpp>
 #include <cmath>
@@ -12,6 +13,7 @@
 
 #include "commands.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/io.hpp"
 
 namespace gmasim::cli {
 
@@ -42,6 +44,27 @@ void require_finite_numbers(const CLI::App& app) { check_options(app); }
 
 std::string model_label(const std::string& path) {
   return path.empty() ? std::string("models/mdma.toml (built-in)") : path;
+}
+
+void add_model_options(CLI::App* sub, ModelArgs& a, const std::string& what) {
+  sub->add_option("--model", a.path, what);
+  sub->add_option("--set", a.sets,
+                  "Change a model parameter for this run: name=value in the file's units (e.g. "
+                  "--set material.Ms_A_per_m=7e5 --set options.magnetic_state=printed); "
+                  "repeatable; `gmasim model show` lists the names");
+}
+
+ModelSpec load_model_spec_args(const ModelArgs& a) {
+  ModelSpec spec = a.path.empty() ? builtin_model_spec() : load_model_spec(a.path);
+  return apply_assignments(std::move(spec), a.sets, "--set");
+}
+
+Model load_model_args(const ModelArgs& a) { return compile(load_model_spec_args(a)); }
+
+std::string model_label(const ModelArgs& a) {
+  std::string s = model_label(a.path);
+  if (!a.sets.empty()) s += " with --set " + clip_error_message(fmt::format("{}", fmt::join(a.sets, ", ")));
+  return s;
 }
 
 }  // namespace gmasim::cli

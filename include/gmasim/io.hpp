@@ -28,6 +28,21 @@ ModelSpec builtin_model_spec();
 // Convenience: load (path empty -> built-in) and compile.
 Model load_model(const std::string& path);
 
+// Applies "name=value" assignments (the --set flag of every command; Python
+// Model.with_params): a number to a parameter by its dotted name (or a unique suffix of it,
+// under ModelSpec::set's rules), or a word to an option ("options.magnetic_state=printed",
+// whose allowed values compile() checks). `flag` names the source in messages. Throws
+// InputError.
+ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assignments,
+                            std::string_view flag = "--set");
+
+// The spec as a model file: its source text (ModelSpec::text) with every value that differs
+// from the text's own replaced on its line; a changed value's comment becomes
+// "set: <why>; was <old> (<old provenance>)". The result is re-parsed, must carry exactly the
+// spec's values and must compile. save_model writes it atomically.
+std::string model_toml(const ModelSpec& spec, const std::string& why);
+void save_model(const ModelSpec& spec, const std::string& path, const std::string& why);
+
 // One row per parameter: dotted name, value, unit, provenance; and the options.
 struct ParamRow {
   std::string name, value, unit, provenance;

@@ -32,6 +32,7 @@ struct SpecBranch {
 
 struct ModelSpec {
   std::string source;  // file path, or "models/mdma.toml (built-in)"
+  std::string text;    // the TOML text it was parsed from (model_toml() edits it)
   // Every numeric parameter by its dotted TOML name ("rod1.ja.k0_A_per_m").
   std::map<std::string, ParamValue> params;
   // Every string/boolean option by dotted name ("options.eq10_temperature_scale").

@@ -142,11 +142,29 @@ PYBIND11_MODULE(_gmasim, mod) {
         return d;
       }, "Every numeric parameter: name -> (value, unit, provenance)")
       .def("get", [](const Model& m, const std::string& name) { return m.spec.get(name); }, py::arg("name"))
-      .def("with_params", [](const Model& m, const std::map<std::string, double>& values) {
+      .def("with_params", [](const Model& m, const py::dict& values) {
         ModelSpec spec = m.spec;
-        for (const auto& [k, v] : values) spec.set(k, v);
+        for (const auto& [k, v] : values) {
+          const std::string name = py::str(k);
+          if (py::isinstance<py::str>(v)) {
+            spec = apply_assignments(std::move(spec), {name + "=" + v.cast<std::string>()},
+                                     "with_params");
+          } else {
+            spec.set(name, v.cast<double>());
+          }
+        }
         return std::make_shared<Model>(compile(spec));
-      }, py::arg("values"), "A new model with some parameters changed (dotted names)");
+      }, py::arg("values"),
+         "A new model with some parameters changed: {dotted name: number in the file's units} "
+         "or {'options.<name>': 'word'}; the same rules as the CLI's --set")
+      .def("toml", [](const Model& m, const std::string& why) { return model_toml(m.spec, why); },
+           py::arg("why") = "Python Model.toml",
+           "The model file text: the source file with each changed value replaced on its line "
+           "and a 'set: <why>; was <old>' comment")
+      .def("save", [](const Model& m, const std::string& path, const std::string& why) {
+        save_model(m.spec, path, why);
+      }, py::arg("path"), py::arg("why") = "Python Model.save",
+         "Write the model file (see toml()) atomically; Model(path) loads it back unchanged");
 
   mod.def("simulate", &simulate_py, py::arg("model"), py::arg("temperature_C") = 20.0,
           py::arg("current_pp_A") = 8.0, py::arg("frequency_Hz") = 10.0, py::arg("periods") = 3.0,

@@ -134,29 +134,12 @@ std::string fitted_model_toml(const std::string& start_text, const ModelSpec& st
     }
     std::string& line = lines[static_cast<std::size_t>(it->second.line - 1)];
     const std::string leaf = fp.name.substr(fp.name.rfind('.') + 1);
-    // Find "leaf = value" on the line (plain or inside an inline table).
-    std::size_t pos = 0, vbeg = std::string::npos;
-    while ((pos = line.find(leaf, pos)) != std::string::npos) {
-      const bool left_ok =
-          pos == 0 || std::string_view(" \t{,").find(line[pos - 1]) != std::string_view::npos;
-      std::size_t q = pos + leaf.size();
-      while (q < line.size() && (line[q] == ' ' || line[q] == '\t')) ++q;
-      if (left_ok && q < line.size() && line[q] == '=') {
-        ++q;
-        while (q < line.size() && (line[q] == ' ' || line[q] == '\t')) ++q;
-        vbeg = q;
-        break;
-      }
-      pos += leaf.size();
-    }
-    if (vbeg == std::string::npos) {
+    const auto span = schema::value_span(line, leaf);
+    if (!span) {
       throw std::runtime_error(fmt::format("fitted_model_toml: '{} =' not found on line {} of {}",
                                            leaf, it->second.line, start.source));
     }
-    std::size_t vend = vbeg;
-    while (vend < line.size() &&
-           std::string_view(" \t,}#").find(line[vend]) == std::string_view::npos)
-      ++vend;
+    const std::size_t vbeg = span->begin, vend = span->end;
     const std::string old_comment = original_provenance(schema::trailing_comment(line));
     const bool simple = line.find('{') == std::string::npos;
     std::string ci = ci_text(fp);

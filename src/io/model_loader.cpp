@@ -979,7 +979,9 @@ std::string source_text(const std::string& source) {
 }  // namespace
 
 ModelSpec parse_model_spec(const std::string& toml_text, const std::string& source_name) {
-  return Loader(toml_text, source_name).run();
+  ModelSpec spec = Loader(toml_text, source_name).run();
+  spec.text = toml_text;
+  return spec;
 }
 
 ModelSpec load_model_spec(const std::string& path) {

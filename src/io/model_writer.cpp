@@ -1,0 +1,170 @@
+// Changing and saving models: "name=value" assignments (the --set flag of every command,
+// Python Model.with_params) and the model file of a changed spec (Model.save, `gmasim model
+// save`). The file is the spec's own source text with each changed value replaced on its
+// line, so comments, layout and the provenance of unchanged values survive.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <stdexcept>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/io.hpp"
+#include "gmasim/validate.hpp"
+#include "io/schema.hpp"
+#include "io/text_io.hpp"
+
+namespace gmasim {
+
+namespace schema {
+
+std::optional<ValueSpan> value_span(std::string_view line, std::string_view leaf) {
+  std::size_t pos = 0;
+  while ((pos = line.find(leaf, pos)) != std::string_view::npos) {
+    const bool left_ok =
+        pos == 0 || std::string_view(" \t{,").find(line[pos - 1]) != std::string_view::npos;
+    std::size_t q = pos + leaf.size();
+    while (q < line.size() && (line[q] == ' ' || line[q] == '\t')) ++q;
+    if (left_ok && q < line.size() && line[q] == '=') {
+      ++q;
+      while (q < line.size() && (line[q] == ' ' || line[q] == '\t')) ++q;
+      std::size_t end = q;
+      if (q < line.size() && line[q] == '"') {  // a basic string: up to its closing quote
+        end = line.find('"', q + 1);
+        end = end == std::string_view::npos ? line.size() : end + 1;
+      } else {
+        while (end < line.size() &&
+               std::string_view(" \t,}#").find(line[end]) == std::string_view::npos)
+          ++end;
+      }
+      return ValueSpan{q, end};
+    }
+    pos += leaf.size();
+  }
+  return std::nullopt;
+}
+
+std::string toml_float(double v) {
+  std::string s = fmt::format("{}", v);  // shortest text that reads back as v
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+
+}  // namespace schema
+
+namespace {
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    auto end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    lines.push_back(text.substr(start, end - start));
+    start = end + 1;
+  }
+  return lines;
+}
+
+// Replaces the value of `leaf` on line `line_no` (1-based) by `value_text`; on a plain line
+// the trailing comment becomes `comment`.
+void replace_value(std::vector<std::string>& lines, long line_no, std::string_view leaf,
+                   const std::string& value_text, const std::string& comment,
+                   const std::string& source) {
+  if (line_no < 1 || line_no > static_cast<long>(lines.size()))
+    throw InputError(fmt::format("{}: no source line for '{}'", source, leaf));
+  std::string& line = lines[static_cast<std::size_t>(line_no - 1)];
+  const auto span = schema::value_span(line, leaf);
+  if (!span)
+    throw InputError(fmt::format("{}:{}: '{} =' not found on its line", source, line_no, leaf));
+  if (line.find('{') == std::string::npos) {
+    line = line.substr(0, span->begin) + value_text + "  # " + comment;
+  } else {
+    line = line.substr(0, span->begin) + value_text + line.substr(span->end);
+  }
+}
+
+}  // namespace
+
+ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assignments,
+                            std::string_view flag) {
+  for (const std::string& a : assignments) {
+    const std::string shown = clip_for_message(a);
+    const auto eq = a.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw InputError(fmt::format("{} '{}': expected name=value (e.g. material.Ms_A_per_m=7e5 or "
+                                   "options.magnetic_state=printed)",
+                                   flag, shown));
+    const std::string name(io_detail::trim(std::string_view(a).substr(0, eq)));
+    const std::string value(io_detail::trim(std::string_view(a).substr(eq + 1)));
+    if (name.starts_with("options.")) {
+      const auto it = spec.options.find(name);
+      if (it == spec.options.end())
+        throw InputError(fmt::format("{} '{}': the model has no option '{}'", flag, shown, name));
+      if (value.empty() || value.find_first_of(" \t\"'#") != std::string::npos)
+        throw InputError(
+            fmt::format("{} '{}': an option value is one word (no spaces or quotes)", flag, shown));
+      it->second = value;  // its allowed values are checked by compile()
+      continue;
+    }
+    double v = 0;
+    if (io_detail::parse_finite(value, v) != io_detail::CellError::None)
+      throw InputError(
+          fmt::format("{} '{}': the value '{}' is not a finite number", flag, shown, value));
+    spec.set(name, v);
+  }
+  return spec;
+}
+
+std::string model_toml(const ModelSpec& spec, const std::string& why) {
+  if (spec.text.empty())
+    throw InputError(fmt::format("{}: the model has no source text to save from", spec.source));
+  const ModelSpec original = parse_model_spec(spec.text, spec.source);
+  std::vector<std::string> lines = lines_of(spec.text);
+  auto leaf_of = [](const std::string& dotted) { return dotted.substr(dotted.rfind('.') + 1); };
+  for (const auto& [name, pv] : spec.params) {
+    const auto it = original.params.find(name);
+    if (it == original.params.end())
+      throw InputError(fmt::format("{}: parameter '{}' is not in its source text", spec.source,
+                                   name));
+    const ParamValue& was = it->second;
+    if (std::bit_cast<std::uint64_t>(was.value) == std::bit_cast<std::uint64_t>(pv.value))
+      continue;
+    const std::string comment =
+        fmt::format("set: {}; was {}{}", why, schema::toml_float(was.value),
+                    was.provenance.empty() ? "" : fmt::format(" ({})", was.provenance));
+    replace_value(lines, was.line, leaf_of(name), schema::toml_float(pv.value), comment,
+                  spec.source);
+  }
+  for (const auto& [name, value] : spec.options) {
+    const auto it = original.options.find(name);
+    if (it == original.options.end() || it->second == value) continue;
+    const long line_no = spec.line_of(name);
+    const std::string& line = lines.at(static_cast<std::size_t>(std::max(1L, line_no) - 1));
+    const auto span = schema::value_span(line, leaf_of(name));
+    const bool quoted = span && span->begin < line.size() && line[span->begin] == '"';
+    replace_value(lines, line_no, leaf_of(name), quoted ? "\"" + value + "\"" : value,
+                  fmt::format("set: {}; was {}", why, it->second), spec.source);
+  }
+  std::string text;
+  for (const auto& l : lines) text += l + "\n";
+  // The file must load, carry exactly the spec's values, and compile.
+  const ModelSpec check = parse_model_spec(text, spec.source);
+  for (const auto& [name, pv] : spec.params) {
+    if (std::bit_cast<std::uint64_t>(check.params.at(name).value) !=
+        std::bit_cast<std::uint64_t>(pv.value))
+      throw std::runtime_error(fmt::format("model_toml: {} reads back as {} instead of {}", name,
+                                           check.params.at(name).value, pv.value));
+  }
+  if (check.options != spec.options)
+    throw std::runtime_error("model_toml: the options do not read back");
+  (void)compile(check);
+  return text;
+}
+
+void save_model(const ModelSpec& spec, const std::string& path, const std::string& why) {
+  write_file_atomic(path, model_toml(spec, why));
+}
+
+}  // namespace gmasim
