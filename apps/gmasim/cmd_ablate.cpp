@@ -13,6 +13,7 @@ namespace gmasim::cli {
 namespace {
 
 struct AblateArgs {
+  bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
   ModelArgs model;
   std::string out = "out/ablate", frequencies = "10,200";
   AblateRequest req;
@@ -23,7 +24,7 @@ int run_ablate_cmd(AblateArgs& a) {
   a.req.frequencies_Hz = parse_list(a.frequencies, "--frequencies", "Hz");
   ensure_output_dir(a.out);
   const AblateResult res = run_ablate(model, a.req);
-  const auto files = write_report(a.out, "ablate", ablate_report(model, a.req, res));
+  auto files = write_report(a.out, "ablate", ablate_report(model, a.req, res));
 
   fmt::print("gmasim ablate  model: {}\n", model_label(a.model));
   fmt::print(
@@ -47,6 +48,7 @@ int run_ablate_cmd(AblateArgs& a) {
                  row.stroke_change_pct, row.hysteresis_change_pct);
     }
   }
+  if (a.plot) files.push_back(render_plot("ablate", a.out));
   fmt::print("\n  wrote {}\n", fmt::join(files, ", "));
   return 0;
 }
@@ -73,6 +75,7 @@ Runner add_ablate(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--threads", a->req.threads, "Worker threads [-]; 0 = all cores")
       ->capture_default_str();
+  sub->add_flag("--plot", a->plot, "Also draw <out>/ablate.png and .svg (matplotlib)");
   sub->add_option("--out", a->out, "Output directory")->capture_default_str();
   return [a, sub]() -> int { return sub->parsed() ? run_ablate_cmd(*a) : -1; };
 }

@@ -19,6 +19,7 @@ namespace {
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
 struct FrfArgs {
+  bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
   ModelArgs model;
   std::string out = "out/frf", temperatures = "20,70", method = "both",
                      bias_state = "anhysteretic";
@@ -35,7 +36,7 @@ int run_frf_cmd(FrfArgs& a) {
       a.bias_state == "initial-curve" ? BiasState::InitialCurve : BiasState::Anhysteretic;
   ensure_output_dir(a.out);
   const FrfResult res = run_frf(model, a.req, stderr_progress("frf", a.progress));
-  const auto files = write_report(a.out, "frf", frf_report(model, a.req, res));
+  auto files = write_report(a.out, "frf", frf_report(model, a.req, res));
 
   fmt::print("gmasim frf  model: {}\n", model_label(a.model));
   fmt::print(
@@ -96,6 +97,7 @@ int run_frf_cmd(FrfArgs& a) {
         "of eq. (15) with Table 6's masses and stiffnesses; its diagonal oscillators ring at the "
         "frequencies above and the eddy-current lag sets the roll-off (docs/experiments.md).\n");
   }
+  if (a.plot) files.push_back(render_plot("frf", a.out));
   fmt::print("  wrote {}\n", fmt::join(files, ", "));
   return 0;
 }
@@ -138,6 +140,7 @@ Runner add_frf(CLI::App& app) {
   sub->add_option("--threads", a->req.threads, "Worker threads [-]; 0 = all cores")
       ->capture_default_str();
   sub->add_flag("--progress", a->progress, "Progress on stderr even when it is not a terminal");
+  sub->add_flag("--plot", a->plot, "Also draw <out>/frf.png and .svg (matplotlib)");
   sub->add_option("--out", a->out, "Output directory")->capture_default_str();
   return [a, sub]() -> int { return sub->parsed() ? run_frf_cmd(*a) : -1; };
 }

@@ -13,6 +13,7 @@ namespace gmasim::cli {
 namespace {
 
 struct ParamsArgs {
+  bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
   ModelArgs model;
   std::string out = "out/params", temperatures = "20,40,60,80,100,120,150",
                      retention = "6,8,10,12";
@@ -65,6 +66,7 @@ int run_params_cmd(ParamsArgs& a) {
                w.hysteresis_retention_pct);
   fmt::print("\n");
   print_thermal(th);
+  if (a.plot) files.push_back(render_plot("params", a.out));
   fmt::print("  wrote {}\n", fmt::join(files, ", "));
   return 0;
 }
@@ -95,6 +97,7 @@ Runner add_params(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--threads", a->req.threads, "Worker threads [-]; 0 = all cores")
       ->capture_default_str();
+  sub->add_flag("--plot", a->plot, "Also draw <out>/params.png and .svg (matplotlib)");
   sub->add_option("--out", a->out, "Output directory")->capture_default_str();
   return [a, sub]() -> int { return sub->parsed() ? run_params_cmd(*a) : -1; };
 }

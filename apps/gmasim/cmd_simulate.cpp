@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
 #include "gmasim/simulate.hpp"
@@ -19,6 +20,7 @@ struct SimulateArgs {
   double dt_s = 0.0, level_A = 0.0, step_to_A = 0.0, step_time_s = 0.0;
   double f0_Hz = 1.0, f1_Hz = 1000.0, amplitude_A = 1.0, offset_A = 0.0, duration_s = 0.0;
   int record_every = 1;
+  bool plot = false;
   std::vector<std::string> quantities;
 };
 
@@ -72,18 +74,26 @@ int run_simulate(const SimulateArgs& a) {
   fmt::print("  temperature {:.1f} degC, dt {:.4g} us, {} steps, wall time {:.3f} s\n",
              s.temperature_C, r.dt_s * 1e6, r.steps, r.wall_time_s);
   if (r.has_metrics) {
-    fmt::print("  stroke      {:9.3f} um   (peak-to-peak of y over the last period)\n",
-               r.metrics.stroke_um);
+    const char* window = s.waveform.periodic() ? "over the last period" : "over the whole run";
+    fmt::print("  stroke      {:9.3f} um   (peak-to-peak of y {})\n", r.metrics.stroke_um, window);
     fmt::print("  hysteresis  {:9.3f} um   (widest rising/falling gap at equal current)\n",
                r.metrics.hysteresis_um);
     fmt::print("  B p-p       {:9.4f} T    (induction coil)\n", r.metrics.B_pp_T);
+    fmt::print("  y mean      {:9.3f} um\n", r.metrics.y_mean_um);
   }
+  if (r.step.valid)
+    fmt::print(
+        "  step        y {:.3f} -> {:.3f} um, rise (10-90 %) {:.4g} ms, overshoot {:.2f} %, "
+        "settling (2 %) {:.4g} ms\n",
+        r.step.y_initial_um, r.step.y_final_um, r.step.rise_time_s * 1e3, r.step.overshoot_pct,
+        r.step.settling_time_s * 1e3);
   for (const auto& q : r.quantities)
     fmt::print("  {:<22} rms {:.6g}  peak {:.6g}  p-p {:.6g}  mean {:.6g}\n", q.name, q.rms, q.peak,
                q.pp, q.mean);
   fmt::print("  thermal expansion {:.3f} um ({} the output y)\n", r.thermal_expansion_um,
              model.options.thermal_expansion_in_output ? "included in" : "not in");
   fmt::print("  wrote {}/timeseries.csv and {}/metrics.json\n", a.out, a.out);
+  if (a.plot && r.steps > 0) fmt::print("  wrote {}\n", render_plot("simulate", a.out));
   if (r.diverged) {
     print_error(r.error +
                 fmt::format(" (the {} steps before it are in {}/timeseries.csv)", r.steps, a.out));
@@ -137,6 +147,7 @@ Runner add_simulate(CLI::App& app) {
   sub->add_option(
       "--quantity", a->quantities,
       "Also report RMS, peak, p-p and mean of these columns (e.g. rod1_F_N) [column units]");
+  sub->add_flag("--plot", a->plot, "Also draw <out>/simulate.png and .svg (matplotlib)");
   sub->add_option("--out", a->out, "Output directory")->capture_default_str();
   return [a, sub]() -> int { return sub->parsed() ? run_simulate(*a) : -1; };
 }

@@ -14,6 +14,7 @@ namespace gmasim::cli {
 namespace {
 
 struct SweepArgs {
+  bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
   ModelArgs model;
   std::string out = "out/sweep";
   std::string temperatures = "20:10:70", currents = "6,8,10,12", frequencies = "10";
@@ -28,7 +29,7 @@ int run_sweep_cmd(SweepArgs& a) {
   a.req.frequencies_Hz = parse_list(a.frequencies, "--frequencies", "Hz");
   ensure_output_dir(a.out);
   const SweepResult res = run_sweep(model, a.req, stderr_progress("sweep", a.progress));
-  const auto files = write_report(a.out, "sweep", sweep_report(model, a.req, res));
+  auto files = write_report(a.out, "sweep", sweep_report(model, a.req, res));
 
   fmt::print("gmasim sweep  model: {}\n", model_label(a.model));
   fmt::print(
@@ -51,6 +52,7 @@ int run_sweep_cmd(SweepArgs& a) {
                p.metrics.hysteresis_um, p.metrics.B_pp_T, p.stroke_change_pct,
                p.hysteresis_change_pct, p.B_pp_change_pct);
   }
+  if (a.plot) files.push_back(render_plot("sweep", a.out));
   fmt::print("  wrote {}\n", fmt::join(files, ", "));
   if (diverged > 0) {
     for (const auto& p : res.points)
@@ -99,6 +101,7 @@ Runner add_sweep(CLI::App& app) {
   sub->add_option("--threads", a->req.threads, "Worker threads [-]; 0 = all cores")
       ->capture_default_str();
   sub->add_flag("--progress", a->progress, "Progress on stderr even when it is not a terminal");
+  sub->add_flag("--plot", a->plot, "Also draw <out>/sweep.png and .svg (matplotlib)");
   sub->add_option("--out", a->out, "Output directory")->capture_default_str();
   return [a, sub]() -> int { return sub->parsed() ? run_sweep_cmd(*a) : -1; };
 }

@@ -14,6 +14,7 @@ namespace gmasim::cli {
 namespace {
 
 struct TrackArgs {
+  bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
   ModelArgs model;
   std::string out = "out/track", temperatures = "20:10:70", amplitudes = "10,20",
                      frequencies = "10,100";
@@ -58,6 +59,7 @@ int run_track_cmd(TrackArgs& a) {
                p.error_rms_pct, p.error_change_pct, p.current_min_A, p.current_max_A,
                p.saturated ? " saturated" : "");
   }
+  if (a.plot) files.push_back(render_plot("track", a.out));
   fmt::print("  {} points on {} threads in {:.2f} s\n  wrote {}\n", res.points.size(), res.threads,
              res.wall_time_s, fmt::join(files, ", "));
   if (diverged > 0) {
@@ -122,6 +124,7 @@ Runner add_track(CLI::App& app) {
   sub->add_option("--threads", a->req.threads, "Worker threads [-]; 0 = all cores")
       ->capture_default_str();
   sub->add_flag("--progress", a->progress, "Progress on stderr even when it is not a terminal");
+  sub->add_flag("--plot", a->plot, "Also draw <out>/track.png and .svg (matplotlib)");
   sub->add_option("--out", a->out, "Output directory")->capture_default_str();
   return [a, sub]() -> int { return sub->parsed() ? run_track_cmd(*a) : -1; };
 }

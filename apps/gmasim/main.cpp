@@ -86,6 +86,7 @@ int main(int argc, char** argv) {
   runners.push_back(gmasim::cli::add_ablate(app));
   runners.push_back(gmasim::cli::add_params(app));
   runners.push_back(gmasim::cli::add_thermal(app));
+  runners.push_back(gmasim::cli::add_compensate(app));
   try {
     app.parse(argc, argv);
     gmasim::cli::require_finite_numbers(app);

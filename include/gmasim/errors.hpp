@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -27,6 +28,11 @@ class DivergenceError : public std::runtime_error {
  public:
   DivergenceError(double time_s, std::string rod, std::string quantity, double value,
                   const std::string& why);
+  // A run that diverged, reported by a caller (its own diagnosis already in `message`).
+  explicit DivergenceError(const std::string& message)
+      : std::runtime_error(message),
+        time_s(std::numeric_limits<double>::quiet_NaN()),
+        value(std::numeric_limits<double>::quiet_NaN()) {}
   double time_s;
   std::string rod;
   std::string quantity;

@@ -212,6 +212,19 @@ class Pid {
   bool first_ = true;
 };
 
+// Temperature feed-forward (gmasim compensate, include/gmasim/compensate.hpp): at operating
+// temperature T the coil current is
+//   i = bias + g(T) (u_PID + (r(t) - y_bias) / K_ref),   clipped to +-current_limit_A,
+// where g(T) interpolates (temperatures_C, gains) linearly (held beyond the ends) and K_ref
+// is the static gain dy/di at the bias [um/A] (0: no reference feed-forward, the schedule
+// only scales the PID). Off while `gains` is empty.
+struct TemperatureFeedforward {
+  std::vector<double> temperatures_C, gains;
+  double static_gain_um_per_A = 0.0;
+  bool enabled() const { return !gains.empty(); }
+  double gain_at(double temperature_C) const;  // 1 when off
+};
+
 struct TrackRequest {
   std::vector<double> temperatures_C{20, 30, 40, 50, 60, 70};
   std::vector<double> amplitudes_um{10, 20};
@@ -225,6 +238,7 @@ struct TrackRequest {
   double periods = 4.0;             // errors over the last period
   double dt_s = 0.0;                // plant step; 0: <= 10 us, <= T/2000, divides 1/fs
   int threads = 0;
+  TemperatureFeedforward feedforward;
 };
 
 struct TrackPoint {
@@ -235,6 +249,7 @@ struct TrackPoint {
   double y_bias_um = 0;                         // operating point the reference is centred on
   double current_min_A = 0, current_max_A = 0;  // coil current over the last period
   bool saturated = false;                       // the current hit +-current_limit_A
+  double feedforward_gain = 1.0;                // g(T) of the temperature feed-forward
   bool diverged = false;
   std::string error;
 };

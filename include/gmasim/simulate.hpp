@@ -73,6 +73,18 @@ struct Metrics {
   double y_mean_um = 0;
 };
 
+// Step response of a Step waveform (y over the run after the step time): 10-90 % rise time,
+// overshoot beyond the final value, 2 % settling time. `valid` is false when the step moves
+// y by less than 1e-9 um or the run records fewer than 3 samples after it.
+struct StepMetrics {
+  bool valid = false;
+  double y_initial_um = 0, y_final_um = 0;  // y at the step; mean y over the last 10 % of the run
+  double rise_time_s = 0;                   // 10 % -> 90 % of the change
+  double overshoot_pct = 0;                 // largest excursion beyond y_final, % of the change
+  double settling_time_s = 0;               // after the step, last leaving +-2 % of the change
+};
+StepMetrics step_metrics(const TimeSeries& ts, double step_time_s);
+
 struct QuantityStats {
   std::string name;  // a column of the series, e.g. "rod1_F_N"
   double rms = 0, peak = 0, pp = 0, mean = 0;
@@ -81,8 +93,10 @@ struct QuantityStats {
 struct Result {
   TimeSeries series;
   std::vector<QuantityStats> quantities;  // filled by add_quantity_stats()
+  // Periodic runs: over the last whole period; other waveforms: over the whole run.
   Metrics metrics;
-  bool has_metrics = false;  // periodic runs only
+  bool has_metrics = false;
+  StepMetrics step;  // Step waveforms
   double dt_s = 0;
   long steps = 0;
   double wall_time_s = 0;

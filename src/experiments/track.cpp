@@ -54,10 +54,39 @@ double Pid::update(double e) {
   return u;
 }
 
+double TemperatureFeedforward::gain_at(double T) const {
+  if (gains.empty()) return 1.0;
+  if (T <= temperatures_C.front()) return gains.front();
+  if (T >= temperatures_C.back()) return gains.back();
+  const auto hi = std::upper_bound(temperatures_C.begin(), temperatures_C.end(), T);
+  const auto k = static_cast<std::size_t>(hi - temperatures_C.begin());
+  const double w = (T - temperatures_C[k - 1]) / (temperatures_C[k] - temperatures_C[k - 1]);
+  return gains[k - 1] + w * (gains[k] - gains[k - 1]);
+}
+
 // ---------------------------------------------------------------------------------------
 // The experiment
 // ---------------------------------------------------------------------------------------
 namespace {
+
+void check_feedforward(const TemperatureFeedforward& ff) {
+  if (!ff.enabled()) return;
+  if (ff.gains.size() != ff.temperatures_C.size())
+    throw InputError(fmt::format("temperature feed-forward: {} gains for {} temperatures",
+                                 ff.gains.size(), ff.temperatures_C.size()));
+  if (static_cast<double>(ff.gains.size()) > kMaxListValues)
+    throw InputError(fmt::format("temperature feed-forward: {} points (limit {:g})",
+                                 ff.gains.size(), kMaxListValues));
+  for (std::size_t k = 0; k < ff.gains.size(); ++k) {
+    require_finite(ff.temperatures_C[k], "feed-forward temperature", "degC");
+    require_in(ff.gains[k], 1e-3, 1e3, "feed-forward gain");
+    if (k > 0 && !(ff.temperatures_C[k] > ff.temperatures_C[k - 1]))
+      throw InputError(fmt::format(
+          "temperature feed-forward: temperatures must increase ({} degC after {} degC)",
+          ff.temperatures_C[k], ff.temperatures_C[k - 1]));
+  }
+  require_in(ff.static_gain_um_per_A, 0.0, 1e6, "feed-forward static gain", "um/A");
+}
 
 struct Job {
   double T, A, f;
@@ -120,6 +149,7 @@ TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& p
     throw InputError(fmt::format("periods {}: must be >= 1", r.periods));
   if (!(r.dt_s >= 0.0) || !std::isfinite(r.dt_s))
     throw InputError(fmt::format("dt {} s: must be > 0 (or 0 for the automatic rule)", r.dt_s));
+  check_feedforward(r.feedforward);
   {
     Pid probe(r.gains, r.sample_rate_Hz, -1.0, 1.0);  // validates the gains' reference rate
     (void)probe;
@@ -170,8 +200,13 @@ TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& p
         const double t_window = t_end - period;  // errors over the last period
         std::mt19937_64 rng(r.noise_seed + idx);
         std::normal_distribution<double> noise(0.0, 1.0);
-        Pid pid(r.gains, r.sample_rate_Hz, -r.current_limit_A - r.bias_A,
-                r.current_limit_A - r.bias_A);
+        // With the temperature feed-forward, i = bias + g (u + r'/K_ref): the PID's own limits
+        // are those of u = (i - bias) / g, so its anti-windup acts where the current clips.
+        const double g = r.feedforward.gain_at(j.T);
+        const double K_ref = r.feedforward.static_gain_um_per_A;
+        p.feedforward_gain = g;
+        Pid pid(r.gains, r.sample_rate_Hz, (-r.current_limit_A - r.bias_A) / g,
+                (r.current_limit_A - r.bias_A) / g);
         const bool record = idx == 0;
         TimeSeries ex;
         if (record) {
@@ -193,7 +228,10 @@ TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& p
             const double y_meas =
                 s.y_m * 1e6 + r.sensor_noise_um * (r.sensor_noise_um > 0.0 ? noise(rng) : 0.0);
             const double u = pid.update(ref(tk) - y_meas);
-            I = r.bias_A + u;
+            const double ff = K_ref > 0.0 ? (ref(tk) - y_bias_um) / K_ref : 0.0;
+            I = r.feedforward.enabled()
+                    ? std::clamp(r.bias_A + g * (u + ff), -r.current_limit_A, r.current_limit_A)
+                    : r.bias_A + u;
             if (record) {
               ex.columns[0].push_back(tk);
               ex.columns[1].push_back(ref(tk));

@@ -288,6 +288,13 @@ std::string metrics_json(const Result& r, const SimulationSettings& s, const Mod
     mo.number("y_mean_um", r.metrics.y_mean_um);
     mo.number("window_start_s", r.metrics.window_start_s);
     mo.number("window_end_s", r.metrics.window_end_s);
+    if (r.step.valid) {
+      mo.number("step_y_initial_um", r.step.y_initial_um);
+      mo.number("step_y_final_um", r.step.y_final_um);
+      mo.number("step_rise_time_s", r.step.rise_time_s);
+      mo.number("step_overshoot_pct", r.step.overshoot_pct);
+      mo.number("step_settling_time_s", r.step.settling_time_s);
+    }
     o.raw("metrics", mo.str());
   }
   if (!r.quantities.empty()) {

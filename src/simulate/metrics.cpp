@@ -138,6 +138,51 @@ Metrics compute_metrics(const TimeSeries& ts, double t0, double t1) {
   return m;
 }
 
+StepMetrics step_metrics(const TimeSeries& ts, double step_time_s) {
+  const auto& t = ts.column("t_s");
+  const auto& y = ts.column("y_um");
+  StepMetrics s;
+  const std::size_t n = t.size();
+  std::size_t k0 = 0;  // last sample at or before the step
+  while (k0 + 1 < n && t[k0 + 1] <= step_time_s) ++k0;
+  if (n < k0 + 4) return s;
+  s.y_initial_um = y[k0];
+  const double t_end = t[n - 1];
+  const double tail_from = t_end - 0.1 * (t_end - t[k0]);
+  double sum = 0;
+  std::size_t cnt = 0;
+  for (std::size_t k = k0; k < n; ++k)
+    if (t[k] >= tail_from) {
+      sum += y[k];
+      ++cnt;
+    }
+  s.y_final_um = sum / static_cast<double>(cnt);
+  const double d = s.y_final_um - s.y_initial_um;
+  if (!(std::fabs(d) > 1e-9)) return s;
+  const double sgn = d > 0 ? 1.0 : -1.0;
+  auto crossing = [&](double frac) {  // first time y passes y0 + frac d, interpolated
+    const double level = s.y_initial_um + frac * d;
+    for (std::size_t k = k0 + 1; k < n; ++k)
+      if (sgn * (y[k] - level) >= 0.0) {
+        const double a = sgn * (y[k - 1] - level), b = sgn * (y[k] - level);
+        const double w = b - a > 0.0 ? -a / (b - a) : 1.0;
+        return t[k - 1] + std::clamp(w, 0.0, 1.0) * (t[k] - t[k - 1]);
+      }
+    return std::nan("");
+  };
+  s.rise_time_s = crossing(0.9) - crossing(0.1);
+  double over = 0.0;
+  std::size_t last_out = k0;
+  for (std::size_t k = k0 + 1; k < n; ++k) {
+    over = std::max(over, sgn * (y[k] - s.y_final_um));
+    if (std::fabs(y[k] - s.y_final_um) > 0.02 * std::fabs(d)) last_out = k;
+  }
+  s.overshoot_pct = over / std::fabs(d) * 100.0;
+  s.settling_time_s = (last_out + 1 < n ? t[last_out + 1] : t_end) - t[k0];
+  s.valid = std::isfinite(s.rise_time_s);
+  return s;
+}
+
 }  // namespace gmasim
 
 namespace gmasim {

@@ -186,6 +186,10 @@ Result simulate(const Model& m, const SimulationSettings& s) {
     const double per = w.period_s();
     r.metrics = compute_metrics(r.series, duration - per, duration);
     r.has_metrics = true;
+  } else if (!r.diverged && r.series.rows() >= 3) {
+    r.metrics = compute_metrics(r.series, 0.0, duration);
+    r.has_metrics = true;
+    if (w.kind == WaveformKind::Step) r.step = step_metrics(r.series, w.step_time_s);
   }
   return r;
 }

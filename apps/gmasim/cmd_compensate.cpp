@@ -1,0 +1,168 @@
+// gmasim compensate: the drive that restores a target stroke at each temperature, the gain
+// schedule, and tracking with the schedule as temperature feed-forward beside the plain PID.
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <memory>
+
+#include "commands.hpp"
+#include "experiment_cli.hpp"
+#include "gmasim/compensate.hpp"
+#include "gmasim/errors.hpp"
+#include "gmasim/io.hpp"
+
+namespace gmasim::cli {
+namespace {
+
+struct CompensateArgs {
+  ModelArgs model;
+  std::string out = "out/compensate", temperatures = "20:10:150", adjust = "amplitude";
+  std::string track_temperatures, track_amplitudes = "10,20", track_frequencies = "10,100";
+  CompensateRequest req;
+  TrackRequest track;
+  bool no_track = false, progress = false, plot = false;
+};
+
+void print_schedule(const CompensateArgs& a, const CompensateResult& res) {
+  const auto& r = a.req;
+  fmt::print(
+      "  target stroke {:.3f} um ({}); drive: biased sine at {} Hz, adjusting {}; |i| <= {} A\n",
+      res.target_stroke_um,
+      r.target_stroke_um > 0.0
+          ? std::string("given")
+          : fmt::format("{} A p-p from {} A at {} degC", r.reference_current_pp_A,
+                        r.current_min_A, r.reference_temperature_C),
+      r.frequency_Hz,
+      a.adjust == "amplitude" ? "the p-p (minimum held)"
+      : a.adjust == "swing"   ? "the p-p about the mean"
+                              : "min and p-p together",
+      r.max_current_A);
+  fmt::print("  {:>6} {:>9} {:>9} {:>9} {:>7} {:>10} {:>12} {:>8} {:>5}\n", "T degC", "i_pp A",
+             "i_min A", "i_max A", "gain", "stroke um", "uncomp. um", "hyst um", "sims");
+  for (const auto& p : res.points) {
+    if (p.diverged) {
+      fmt::print("  {:6.1f}  diverged: {}\n", p.temperature_C, p.error);
+      continue;
+    }
+    fmt::print("  {:6.1f} {:9.4f} {:9.4f} {:9.4f} {:7.4f} {:10.3f} {:12.3f} {:8.3f} {:5d}{}\n",
+               p.temperature_C, p.current_pp_A, p.current_min_A, p.current_max_A, p.gain,
+               p.stroke_um, p.uncompensated_stroke_um, p.hysteresis_um, p.evaluations,
+               p.reachable ? "" : "  not reachable: the largest drive falls short");
+  }
+}
+
+void print_track(const CompensatedTrack& t) {
+  fmt::print(
+      "\n  tracking (PID of `gmasim track`), plain vs with the schedule as temperature "
+      "feed-forward\n  (i = bias + g(T) (u_PID + (r - y_bias)/K_ref); g(T): the swing schedule "
+      "about the bias, K_ref = {:.4f} um/A at the reference temperature):\n",
+      t.static_gain_um_per_A);
+  fmt::print("  {:>6} {:>6} {:>6} {:>12} {:>12} {:>10} {:>10} {:>6}\n", "T degC", "A um", "f Hz",
+             "e_rms PID", "e_rms FF", "growth PID", "growth FF", "g");
+  for (std::size_t i = 0; i < t.plain.points.size(); ++i) {
+    const auto& a = t.plain.points[i];
+    const auto& b = t.compensated.points[i];
+    fmt::print("  {:6.1f} {:6.2f} {:6.1f} {:9.4f} um {:9.4f} um {:+9.1f}% {:+9.1f}% {:6.3f}{}\n",
+               a.temperature_C, a.amplitude_um, a.frequency_Hz, a.error_rms_um, b.error_rms_um,
+               a.error_change_pct, b.error_change_pct, b.feedforward_gain,
+               a.saturated || b.saturated ? " saturated" : "");
+  }
+}
+
+int run_compensate_cmd(CompensateArgs& a) {
+  const Model model = load_model_args(a.model);
+  a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
+  a.req.adjust = a.adjust == "scale"   ? CompensationAdjust::Scale
+                 : a.adjust == "swing" ? CompensationAdjust::Swing
+                                       : CompensationAdjust::Amplitude;
+  if (!a.no_track) {
+    a.track.temperatures_C = a.track_temperatures.empty()
+                                 ? a.req.temperatures_C
+                                 : parse_list(a.track_temperatures, "--track-temperatures", "degC");
+    a.track.amplitudes_um = parse_list(a.track_amplitudes, "--track-amplitudes", "um");
+    a.track.frequencies_Hz = parse_list(a.track_frequencies, "--track-frequencies", "Hz");
+    a.track.threads = a.req.threads;
+  }
+  ensure_output_dir(a.out);
+  const CompensateResult res =
+      run_compensate(model, a.req, stderr_progress("compensate", a.progress));
+  std::unique_ptr<CompensatedTrack> tr;
+  if (!a.no_track)
+    tr = std::make_unique<CompensatedTrack>(run_compensated_track(
+        model, a.req, a.track, stderr_progress("compensate track", a.progress)));
+  auto files =
+      write_report(a.out, "compensate", compensate_report(model, a.req, res, tr.get()));
+  fmt::print("gmasim compensate  model: {}\n", model_label(a.model));
+  print_schedule(a, res);
+  if (tr) print_track(*tr);
+  if (a.plot) files.push_back(render_plot("compensate", a.out));
+  fmt::print("  {} temperatures in {:.2f} s on {} threads\n  wrote {}\n", res.points.size(),
+             res.wall_time_s, res.threads, fmt::join(files, ", "));
+  for (const auto& p : res.points)
+    if (p.diverged) {
+      print_error(fmt::format("diverged at {:g} degC: {}", p.temperature_C, p.error));
+      return 3;
+    }
+  return 0;
+}
+
+}  // namespace
+
+Runner add_compensate(CLI::App& app) {
+  auto a = std::make_shared<CompensateArgs>();
+  auto* sub = app.add_subcommand(
+      "compensate",
+      "Temperature compensation: the drive current that restores a target stroke at each "
+      "temperature (gain schedule), and PID tracking with that schedule as feed-forward beside "
+      "the plain PID. Writes compensate.csv (schedule), compensate_track.csv, compensate.json");
+  add_model_options(sub, a->model);
+  auto& r = a->req;
+  sub->add_option("--reference-temperature", r.reference_temperature_C,
+                  "Temperature whose stroke is the target [degC]")
+      ->capture_default_str();
+  sub->add_option("--reference-current-pp", r.reference_current_pp_A,
+                  "Reference drive: biased-sine current peak-to-peak [A]")
+      ->capture_default_str();
+  sub->add_option("--current-min", r.current_min_A, "Reference drive: current minimum [A]")
+      ->capture_default_str();
+  sub->add_option("--target-stroke", r.target_stroke_um,
+                  "Target stroke [um]; 0 = the reference drive's stroke at the reference "
+                  "temperature")
+      ->capture_default_str();
+  sub->add_option("--temperatures", a->temperatures,
+                  "Temperatures of the schedule [degC]: list or start:step:stop")
+      ->capture_default_str();
+  sub->add_option("--frequency", r.frequency_Hz, "Drive frequency [Hz]")->capture_default_str();
+  sub->add_option("--periods", r.periods, "Periods per run; the stroke is over the last [-]")
+      ->capture_default_str();
+  sub->add_option("--adjust", a->adjust,
+                  "amplitude: change the p-p with the minimum held; swing: the p-p about the "
+                  "mean; scale: scale the whole waveform (an amplifier gain)")
+      ->check(CLI::IsMember({"amplitude", "swing", "scale"}))
+      ->capture_default_str();
+  sub->add_option("--max-current", r.max_current_A, "Largest |current| any drive may reach [A]")
+      ->capture_default_str();
+  sub->add_option("--tolerance", r.tolerance_um, "Stroke tolerance of the solved drive [um]")
+      ->capture_default_str();
+  sub->add_option("--dt", r.dt_s, "Time step [s]; 0 = automatic rule")->capture_default_str();
+  sub->add_option("--threads", r.threads, "Worker threads [-]; 0 = all cores")
+      ->capture_default_str();
+  sub->add_flag("--no-track", a->no_track, "Skip the tracking comparison");
+  sub->add_option("--track-temperatures", a->track_temperatures,
+                  "Tracking temperatures [degC]; default: the schedule's");
+  sub->add_option("--track-amplitudes", a->track_amplitudes, "Tracking amplitudes [um]")
+      ->capture_default_str();
+  sub->add_option("--track-frequencies", a->track_frequencies, "Tracking frequencies [Hz]")
+      ->capture_default_str();
+  sub->add_option("--bias", a->track.bias_A, "Tracking: coil bias current [A]")
+      ->capture_default_str();
+  sub->add_option("--current-limit", a->track.current_limit_A,
+                  "Tracking: amplifier limit +- [A]")
+      ->capture_default_str();
+  sub->add_flag("--progress", a->progress, "Progress on stderr even when it is not a terminal");
+  sub->add_flag("--plot", a->plot, "Also draw compensate.png (matplotlib)");
+  sub->add_option("--out", a->out, "Output directory")->capture_default_str();
+  return [a, sub]() -> int { return sub->parsed() ? run_compensate_cmd(*a) : -1; };
+}
+
+}  // namespace gmasim::cli

@@ -1,0 +1,228 @@
+"""The figure of one gmasim command, drawn from the files the command wrote (``--plot``).
+
+    /usr/bin/python3 -m gmasim.command_figures COMMAND OUT_DIR
+
+writes OUT_DIR/COMMAND.png and .svg (atomically, :func:`gmasim.plots.save`). The C++ side
+writes only data; everything drawn here is read back from those CSV and JSON files, so a
+figure can be redrawn later from a finished run.
+"""
+from __future__ import annotations
+
+import json
+import pathlib
+import sys
+
+import numpy as np
+
+from gmasim import plots
+from gmasim.plots import plt, read_csv
+
+
+def _meta(out, stem):
+    p = pathlib.Path(out) / f"{stem}.json"
+    return json.loads(p.read_text())["meta"] if p.exists() else {}
+
+
+def simulate(out):
+    ts = read_csv(pathlib.Path(out) / "timeseries.csv")
+    heat = pathlib.Path(out) / "self_heating.csv"
+    rows = 3 if heat.exists() else 2
+    fig = plt.figure(figsize=(10, 3.4 * rows))
+    ax_t = fig.add_subplot(rows, 2, 1)
+    ax_t.plot(ts["t_s"], ts["y_um"], lw=0.8)
+    ax_t.set_xlabel("time (s)")
+    ax_t.set_ylabel("displacement y (µm)")
+    ax_i = ax_t.twinx()
+    ax_i.plot(ts["t_s"], ts["current_A"], color="tab:orange", lw=0.6, alpha=0.6)
+    ax_i.set_ylabel("current (A)", color="tab:orange")
+    ax_l = fig.add_subplot(rows, 2, 2)
+    ax_l.plot(ts["current_A"], ts["y_um"], lw=0.8)
+    ax_l.set_xlabel("current (A)")
+    ax_l.set_ylabel("displacement y (µm)")
+    ax_l.set_title("y against current")
+    ax_b = fig.add_subplot(rows, 2, 3)
+    ax_b.plot(ts["t_s"], ts["B_T"], lw=0.8, color="tab:green")
+    ax_b.set_xlabel("time (s)")
+    ax_b.set_ylabel("flux density B (T)")
+    ax_h = fig.add_subplot(rows, 2, 4)
+    rods = sorted({n.split("_")[0] for n in ts if n.startswith("rod") and n.endswith("_H_A_per_m")})
+    for r in rods:
+        ax_h.plot(ts[f"{r}_H_A_per_m"] / 1e3, ts[f"{r}_B_T"], lw=0.8, label=r)
+    ax_h.set_xlabel("field H (kA/m)")
+    ax_h.set_ylabel("rod flux density φ/A (T)")
+    ax_h.legend(fontsize=7)
+    if heat.exists():
+        h = read_csv(heat)
+        ax_T = fig.add_subplot(rows, 2, 5)
+        for col, lab in (("coil_C", "coil"), ("rods_C", "rods"), ("housing_C", "housing")):
+            ax_T.plot(h["t_s"], h[col], label=lab)
+        ax_T.set_xlabel("time (s)")
+        ax_T.set_ylabel("temperature (°C)")
+        ax_T.legend(fontsize=7)
+        ax_T.set_title("self-heating")
+        ax_s = fig.add_subplot(rows, 2, 6)
+        ax_s.plot(h["t_s"], h["stroke_um"], color="tab:red")
+        ax_s.set_xlabel("time (s)")
+        ax_s.set_ylabel("stroke over the interval (µm)")
+        ax_s.set_title("stroke drift")
+    for ax in fig.axes:
+        ax.grid(alpha=0.3)
+    meta = json.loads((pathlib.Path(out) / "metrics.json").read_text())
+    fig.suptitle(f"gmasim simulate: {meta.get('settings', {}).get('temperature_C', '')} °C")
+    fig.tight_layout()
+    return fig
+
+
+def bode_db(out):
+    """Bode plot in dB (re 1 µm/A) with the first resonance and the -3 dB bandwidth marked,
+    and the stimulus (bias, amplitude) in the title."""
+    frf = read_csv(pathlib.Path(out) / "frf.csv")
+    summ = read_csv(pathlib.Path(out) / "frf_summary.csv")
+    meta = _meta(out, "frf")
+    temps = np.unique(frf["temperature_C"])
+    fig, (am, ap) = plt.subplots(2, 1, figsize=(7.5, 6.4), sharex=True)
+    cmap = plt.get_cmap("coolwarm")
+    for k, T in enumerate(temps):
+        c = cmap(k / max(1, len(temps) - 1))
+        sel = np.isclose(frf["temperature_C"], T)
+        f = frf["frequency_Hz"][sel]
+        for key, style, lab in (("linear", "-", "linearised"), ("stepped", "o", "stepped sine")):
+            mag = frf[f"{key}_mag_um_per_A"][sel]
+            if np.any(np.isfinite(mag)):
+                am.semilogx(f, 20 * np.log10(mag), style, color=c, ms=3.5, mfc="none",
+                            label=f"{T:g} °C, {lab}")
+                ap.semilogx(f, frf[f"{key}_phase_deg"][sel], style, color=c, ms=3.5, mfc="none")
+        s = np.isclose(summ["temperature_C"], T)
+        if np.any(s):
+            g0 = summ["static_gain_um_per_A"][s][0]
+            fr = summ["first_resonance_Hz"][s][0]
+            bw = summ["bandwidth_3dB_Hz"][s][0]
+            if np.isfinite(g0) and g0 > 0:
+                am.axhline(20 * np.log10(g0) - 3, color=c, ls=":", lw=0.8)
+            if np.isfinite(fr) and fr > 0:
+                am.axvline(fr, color=c, ls="--", lw=0.8)
+                am.annotate(f"resonance {fr:.0f} Hz", (fr, am.get_ylim()[1]), color=c, fontsize=7,
+                            rotation=90, va="top", ha="right")
+            if np.isfinite(bw) and bw > 0:
+                am.axvline(bw, color=c, ls=":", lw=0.8)
+                am.annotate(f"-3 dB {bw:.0f} Hz", (bw, am.get_ylim()[0]), color=c, fontsize=7,
+                            rotation=90, va="bottom", ha="right")
+    am.set_ylabel("|Y/I| (dB re 1 µm/A)")
+    ap.set_ylabel("phase (°)")
+    ap.set_xlabel("frequency (Hz)")
+    for ax in (am, ap):
+        ax.grid(alpha=0.3, which="both")
+    am.legend(fontsize=7)
+    bias, amp = meta.get("bias_A"), meta.get("amplitude_A")
+    am.set_title(f"Frequency response about a {bias:g} A bias, stimulus ±{amp * 1e3:g} mA "
+                 "(small signal)\n(dotted horizontal: static gain -3 dB)" if bias is not None and amp
+                 is not None else "Frequency response")
+    fig.tight_layout()
+    return fig
+
+
+def sweep(out):
+    return plots.sweep_vs_temperature(read_csv(pathlib.Path(out) / "sweep.csv"))
+
+
+def track(out):
+    t = read_csv(pathlib.Path(out) / "track.csv")
+    ex = read_csv(pathlib.Path(out) / "track_example.csv")
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
+    refs = sorted(set(zip(t["amplitude_um"], t["frequency_Hz"])))
+    for A, f in refs:
+        sel = np.isclose(t["amplitude_um"], A) & np.isclose(t["frequency_Hz"], f)
+        a.plot(t["temperature_C"][sel], t["error_rms_um"][sel], "o-", label=f"{A:g} µm, {f:g} Hz")
+    a.set_xlabel("temperature (°C)")
+    a.set_ylabel("RMS tracking error (µm)")
+    a.legend(fontsize=7)
+    b.plot(ex["t_s"], ex["reference_um"], label="reference")
+    b.plot(ex["t_s"], ex["y_um"], label="y")
+    b.set_xlabel("time (s)")
+    b.set_ylabel("displacement (µm)")
+    b.set_title("first point")
+    b.legend(fontsize=7)
+    for ax in (a, b):
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def compensate(out):
+    s = read_csv(pathlib.Path(out) / "compensate.csv")
+    meta = _meta(out, "compensate")
+    trk = pathlib.Path(out) / "compensate_track.csv"
+    fig, axes = plt.subplots(1, 3 if trk.exists() else 2, figsize=(15 if trk.exists() else 10, 4))
+    a, b = axes[0], axes[1]
+    a.plot(s["temperature_C"], s["current_pp_A"], "o-", label="current p-p")
+    a.plot(s["temperature_C"], s["current_max_A"], "s--", label="current max")
+    a.set_xlabel("temperature (°C)")
+    a.set_ylabel("current (A)")
+    a2 = a.twinx()
+    a2.plot(s["temperature_C"], s["gain"], "k:", label="gain")
+    a2.set_ylabel("gain (-)")
+    a.legend(fontsize=7, loc="upper left")
+    a.set_title("gain schedule")
+    b.plot(s["temperature_C"], s["uncompensated_stroke_um"], "o-", label="reference drive")
+    b.plot(s["temperature_C"], s["stroke_um"], "s-", label="compensated")
+    tgt = meta.get("target_stroke_um")
+    if tgt is not None:
+        b.axhline(tgt, color="gray", ls=":", label=f"target {tgt:.2f} µm")
+    b.set_xlabel("temperature (°C)")
+    b.set_ylabel("stroke (µm)")
+    b.legend(fontsize=7)
+    b.set_title("stroke")
+    if trk.exists():
+        t = read_csv(trk)
+        c = axes[2]
+        for A, f in sorted(set(zip(t["amplitude_um"], t["frequency_Hz"]))):
+            sel = np.isclose(t["amplitude_um"], A) & np.isclose(t["frequency_Hz"], f)
+            line, = c.plot(t["temperature_C"][sel], t["error_rms_um_pid"][sel], "o--",
+                           label=f"PID {A:g} µm {f:g} Hz")
+            c.plot(t["temperature_C"][sel], t["error_rms_um_ff"][sel], "s-", color=line.get_color(),
+                   label=f"PID + feed-forward {A:g} µm {f:g} Hz")
+        c.set_xlabel("temperature (°C)")
+        c.set_ylabel("RMS tracking error (µm)")
+        c.legend(fontsize=6)
+        c.set_title("tracking")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def ablate(out):
+    return plots.ablation(read_csv(pathlib.Path(out) / "ablate.csv"))
+
+
+def params(out):
+    return plots.params_vs_temperature(read_csv(pathlib.Path(out) / "params.csv"))
+
+
+RENDERERS = {"simulate": simulate, "frf": bode_db, "sweep": sweep, "track": track,
+             "compensate": compensate, "ablate": ablate, "params": params}
+
+
+def render(command: str, out) -> list[pathlib.Path]:
+    if command not in RENDERERS:
+        raise SystemExit(f"gmasim.command_figures: no figure for '{command}' "
+                         f"(known: {', '.join(sorted(RENDERERS))})")
+    return plots.save(RENDERERS[command](out), out, command)
+
+
+def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if len(argv) != 2:
+        print("usage: python3 -m gmasim.command_figures COMMAND OUT_DIR", file=sys.stderr)
+        return 1
+    try:
+        files = render(argv[0], argv[1])
+    except (OSError, KeyError, ValueError) as e:
+        print(f"gmasim.command_figures: {argv[0]} in {argv[1]}: {e}", file=sys.stderr)
+        return 2
+    del files
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

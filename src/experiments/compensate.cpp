@@ -1,0 +1,288 @@
+// gmasim compensate: the drive that restores a target stroke at each temperature (a root of
+// stroke(drive) - target, bracketed and solved with Boost.Math's TOMS 748), the gain
+// schedule those drives define, and tracking with the schedule as temperature feed-forward.
+// docs/experiments.md, "Temperature compensation".
+#include "gmasim/compensate.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <boost/math/tools/roots.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+
+#include "experiments/parallel.hpp"
+#include "gmasim/errors.hpp"
+#include "gmasim/simulate.hpp"
+#include "gmasim/validate.hpp"
+
+namespace gmasim {
+namespace {
+
+// The biased sine of drive x: x = pp (Amplitude) or x = g (Scale).
+Waveform drive(const CompensateRequest& r, double x) {
+  if (r.adjust == CompensationAdjust::Amplitude)
+    return biased_sine(x, r.frequency_Hz, r.current_min_A);
+  if (r.adjust == CompensationAdjust::Swing)
+    return biased_sine(x, r.frequency_Hz, r.current_min_A + 0.5 * (r.reference_current_pp_A - x));
+  return biased_sine(x * r.reference_current_pp_A, r.frequency_Hz, x * r.current_min_A);
+}
+
+// Largest drive whose peak |i| stays within max_current_A.
+double max_drive(const CompensateRequest& r) {
+  if (r.adjust == CompensationAdjust::Amplitude) return r.max_current_A - r.current_min_A;
+  if (r.adjust == CompensationAdjust::Swing)
+    return 2.0 * (r.max_current_A - std::fabs(r.current_min_A + 0.5 * r.reference_current_pp_A));
+  const double peak = std::max(std::fabs(r.current_min_A),
+                               std::fabs(r.current_min_A + r.reference_current_pp_A));
+  return r.max_current_A / peak;
+}
+
+double reference_drive(const CompensateRequest& r) {
+  return r.adjust == CompensationAdjust::Scale ? 1.0 : r.reference_current_pp_A;
+}
+
+struct Run {
+  Metrics metrics;
+  bool diverged = false;
+  std::string error;
+};
+
+Run run_drive(const Model& m, const CompensateRequest& r, double T, double x) {
+  SimulationSettings s;
+  s.temperature_C = T;
+  s.waveform = drive(r, x);
+  s.periods = r.periods;
+  s.dt_s = r.dt_s;
+  s.record_every = 1;
+  const Result res = simulate(m, s);
+  Run out;
+  out.metrics = res.metrics;
+  out.diverged = res.diverged;
+  out.error = res.error;
+  return out;
+}
+
+void validate_request(const Model& m, const CompensateRequest& r) {
+  require_finite(r.reference_temperature_C, "reference temperature", "degC");
+  require_in(r.max_current_A, 0.0, kMaxCurrent_A, "maximum current", "A");
+  if (!(r.max_current_A > 0.0)) throw InputError("maximum current: must be > 0 A");
+  require_in(r.current_min_A, -r.max_current_A, r.max_current_A, "current minimum", "A");
+  require_in(r.reference_current_pp_A, 0.0, 2.0 * kMaxCurrent_A, "reference current p-p", "A");
+  if (!(r.reference_current_pp_A > 0.0))
+    throw InputError("reference current peak-to-peak 0 A: must be > 0");
+  if (std::fabs(r.current_min_A + r.reference_current_pp_A) > r.max_current_A)
+    throw InputError(fmt::format(
+        "reference drive {} A + {} A p-p peaks at {} A, beyond the maximum current {} A",
+        r.current_min_A, r.reference_current_pp_A, r.current_min_A + r.reference_current_pp_A,
+        r.max_current_A));
+  require_in(r.target_stroke_um, 0.0, kMaxTrackAmplitude_um, "target stroke", "um");
+  if (r.temperatures_C.empty()) throw InputError("compensate: no temperature given");
+  if (static_cast<double>(r.temperatures_C.size()) > kMaxListValues)
+    throw InputError(fmt::format("compensate: {} temperatures (limit {:g})",
+                                 r.temperatures_C.size(), kMaxListValues));
+  for (std::size_t k = 0; k < r.temperatures_C.size(); ++k) {
+    (void)make_conditions(m, r.temperatures_C[k]);  // finite, below T_c, above 0 K
+    if (k > 0 && !(r.temperatures_C[k] > r.temperatures_C[k - 1]))
+      throw InputError(fmt::format("compensate: temperatures must increase ({} after {} degC)",
+                                   r.temperatures_C[k], r.temperatures_C[k - 1]));
+  }
+  (void)make_conditions(m, r.reference_temperature_C);
+  require_positive(r.frequency_Hz, "frequency", "Hz");
+  require_in(r.frequency_Hz, 0.0, kMaxFrequency_Hz, "frequency", "Hz");
+  require_in(r.periods, 1.0, kMaxPeriods, "periods");
+  require_in(r.tolerance_um, 1e-9, 1e3, "stroke tolerance", "um");
+  if (!(r.dt_s >= 0.0) || !std::isfinite(r.dt_s))
+    throw InputError(fmt::format("dt {} s: must be > 0 (or 0 for the automatic rule)", r.dt_s));
+  // Every drive the search may try is a valid run (step counts, currents).
+  SimulationSettings s;
+  s.waveform = drive(r, max_drive(r));
+  s.periods = r.periods;
+  s.dt_s = r.dt_s;
+  validate(s);
+}
+
+}  // namespace
+
+CompensateResult run_compensate(const Model& m, const CompensateRequest& r,
+                                const ProgressFn& progress) {
+  validate_request(m, r);
+  CompensateResult res;
+  const auto wall0 = std::chrono::steady_clock::now();
+  const Run ref = run_drive(m, r, r.reference_temperature_C, reference_drive(r));
+  if (ref.diverged) throw DivergenceError("compensate: the reference drive diverged: " + ref.error);
+  res.reference = ref.metrics;
+  res.target_stroke_um = r.target_stroke_um > 0.0 ? r.target_stroke_um : ref.metrics.stroke_um;
+  if (!(res.target_stroke_um > 0.0))
+    throw InputError("compensate: the reference drive gives no stroke (0 um): no target");
+
+  res.points.resize(r.temperatures_C.size());
+  res.threads = resolve_thread_count(r.threads, r.temperatures_C.size());
+  const double x_hi = max_drive(r);
+  const double x_ref = reference_drive(r);
+  detail::parallel_for(
+      r.temperatures_C.size(), res.threads,
+      [&](std::size_t i) {
+        CompensatePoint& p = res.points[i];
+        p.temperature_C = r.temperatures_C[i];
+        const double target = res.target_stroke_um;
+        int evals = 0;
+        auto stroke = [&](double x) {
+          ++evals;
+          const Run run = run_drive(m, r, p.temperature_C, x);
+          if (run.diverged) throw DivergenceError(run.error);
+          return run.metrics;
+        };
+        try {
+          p.uncompensated_stroke_um = stroke(x_ref).stroke_um;
+          Metrics top = stroke(x_hi);
+          double x = x_hi;
+          if (top.stroke_um < target) {
+            p.reachable = false;  // the point holds the largest drive
+          } else {
+            // Bracket: the reference drive brackets from one side or the other; else the
+            // search runs over (0, x_hi].
+            double a = 1e-3 * x_ref, b = x_hi;
+            double fa = std::nan(""), fb = top.stroke_um - target;
+            const double f_ref = p.uncompensated_stroke_um - target;
+            if (f_ref < 0.0) {
+              a = x_ref;
+              fa = f_ref;
+            } else {
+              b = x_ref;
+              fb = f_ref;
+              fa = stroke(a).stroke_um - target;
+            }
+            if (fb == 0.0) {
+              x = b;
+            } else if (fa >= 0.0) {
+              x = a;  // even the smallest drive reaches the target
+            } else {
+              // Stop when the bracket is narrower than the drive change that moves the stroke
+              // by the tolerance (secant slope of the bracket).
+              auto tol = [&](double lo, double hi) {
+                return hi - lo <= 1e-12 * hi || (hi - lo) * (fb - fa) / (b - a) < 0.5 * r.tolerance_um;
+              };
+              std::uintmax_t iters = 60;
+              const auto [lo, hi] = boost::math::tools::toms748_solve(
+                  [&](double v) { return stroke(v).stroke_um - target; }, a, b, fa, fb, tol,
+                  iters);
+              x = 0.5 * (lo + hi);
+            }
+          }
+          const Metrics fin = stroke(x);
+          const Waveform w = drive(r, x);
+          p.current_pp_A = w.pp_A;
+          p.current_min_A = w.min_A;
+          p.current_max_A = w.min_A + w.pp_A;
+          p.gain = x / x_ref;
+          p.stroke_um = fin.stroke_um;
+          p.hysteresis_um = fin.hysteresis_um;
+          p.B_pp_T = fin.B_pp_T;
+        } catch (const DivergenceError& e) {
+          p.diverged = true;
+          p.error = e.what();
+        }
+        p.evaluations = evals;
+      },
+      progress);
+  res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return res;
+}
+
+double schedule_gain(const CompensateResult& r, double T) {
+  TemperatureFeedforward ff;
+  for (const auto& p : r.points)
+    if (p.reachable && !p.diverged) {
+      ff.temperatures_C.push_back(p.temperature_C);
+      ff.gains.push_back(p.gain);
+    }
+  if (ff.gains.empty())
+    throw InputError("compensate: no temperature reached the target stroke: no schedule");
+  return ff.gain_at(T);
+}
+
+CompensatedTrack run_compensated_track(const Model& m, const CompensateRequest& creq,
+                                       TrackRequest treq, const ProgressFn& progress) {
+  CompensatedTrack out;
+  const double half = std::min(1.0, 0.5 * treq.current_limit_A);
+  CompensateRequest q = creq;
+  q.adjust = CompensationAdjust::Swing;
+  q.current_min_A = treq.bias_A - half;
+  q.reference_current_pp_A = 2.0 * half;
+  q.target_stroke_um = 0.0;
+  q.max_current_A = treq.current_limit_A;
+  q.temperatures_C = treq.temperatures_C;
+  std::sort(q.temperatures_C.begin(), q.temperatures_C.end());
+  q.temperatures_C.erase(std::unique(q.temperatures_C.begin(), q.temperatures_C.end()),
+                         q.temperatures_C.end());
+  out.loop_schedule = run_compensate(m, q, progress);
+  out.static_gain_um_per_A = out.loop_schedule.reference.stroke_um / q.reference_current_pp_A;
+  treq.feedforward = {};
+  out.plain = run_track(m, treq, progress);
+  for (const auto& p : out.loop_schedule.points) {
+    if (!p.reachable || p.diverged) continue;
+    treq.feedforward.temperatures_C.push_back(p.temperature_C);
+    treq.feedforward.gains.push_back(p.gain);
+  }
+  if (treq.feedforward.gains.empty())
+    throw InputError("compensate: no track temperature reached the target stroke: no schedule");
+  treq.feedforward.static_gain_um_per_A = out.static_gain_um_per_A;
+  out.compensated = run_track(m, treq, progress);
+  return out;
+}
+
+Report compensate_report(const Model& m, const CompensateRequest& req, const CompensateResult& res,
+                         const CompensatedTrack* track) {
+  Report r;
+  r.experiment = "compensate";
+  r.meta.emplace_back("model", m.spec.source);
+  r.meta.emplace_back("adjust", req.adjust == CompensationAdjust::Amplitude ? "amplitude"
+                               : req.adjust == CompensationAdjust::Swing   ? "swing"
+                                                                           : "scale");
+  r.meta.emplace_back("reference_temperature_C", req.reference_temperature_C);
+  r.meta.emplace_back("reference_current_pp_A", req.reference_current_pp_A);
+  r.meta.emplace_back("reference_current_min_A", req.current_min_A);
+  r.meta.emplace_back("frequency_Hz", req.frequency_Hz);
+  r.meta.emplace_back("target_stroke_um", res.target_stroke_um);
+  r.meta.emplace_back("reference_stroke_um", res.reference.stroke_um);
+  r.meta.emplace_back("max_current_A", req.max_current_A);
+  r.meta.emplace_back("tolerance_um", req.tolerance_um);
+  r.meta.emplace_back("wall_time_s", res.wall_time_s);
+  Table t;
+  t.name = "schedule";
+  t.columns = {"temperature_C", "current_pp_A",  "current_min_A", "current_max_A",
+               "gain",          "stroke_um",     "uncompensated_stroke_um",
+               "hysteresis_um", "B_pp_T",        "evaluations",   "reachable", "status", "error"};
+  const double nan = std::nan("");
+  for (const auto& p : res.points) {
+    const bool ok = !p.diverged;
+    t.rows.push_back({p.temperature_C, ok ? p.current_pp_A : nan, ok ? p.current_min_A : nan,
+                      ok ? p.current_max_A : nan, ok ? p.gain : nan, ok ? p.stroke_um : nan,
+                      ok ? p.uncompensated_stroke_um : nan, ok ? p.hysteresis_um : nan,
+                      ok ? p.B_pp_T : nan, p.evaluations, p.reachable,
+                      p.diverged ? "diverged" : "ok", p.error});
+  }
+  r.tables.push_back(std::move(t));
+  if (track != nullptr) {
+    r.meta.emplace_back("track_static_gain_um_per_A", track->static_gain_um_per_A);
+    Table k;
+    k.name = "track";
+    k.columns = {"temperature_C",        "amplitude_um",          "frequency_Hz",
+                 "error_rms_um_pid",     "error_rms_um_ff",       "error_change_pct_pid",
+                 "error_change_pct_ff",  "feedforward_gain",      "saturated_pid",
+                 "saturated_ff"};
+    for (std::size_t i = 0; i < track->plain.points.size(); ++i) {
+      const TrackPoint& a = track->plain.points[i];
+      const TrackPoint& b = track->compensated.points[i];
+      k.rows.push_back({a.temperature_C, a.amplitude_um, a.frequency_Hz, a.error_rms_um,
+                        b.error_rms_um, a.error_change_pct, b.error_change_pct,
+                        b.feedforward_gain, a.saturated, b.saturated});
+    }
+    r.tables.push_back(std::move(k));
+  }
+  return r;
+}
+
+}  // namespace gmasim
