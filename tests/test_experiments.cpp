@@ -1,5 +1,6 @@
 // The experiments of sections 4.4, 4.5 and 5 (src/experiments): numbers, not plumbing.
 // Tolerances are about 10x the residual observed on this model (noted at each check).
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -15,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "gmasim/compensate.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
 #include "gmasim/io.hpp"
@@ -754,4 +756,114 @@ TEST(ReproductionDoc, FailingClaimsCarryTheirExplanations) {
   std::ofstream(notes_path) << "### \n";
   EXPECT_THROW((void)gmasim::load_claim_notes(notes_path.string()), gmasim::InputError);
   fs::remove_all(dir);
+}
+
+// ---------------------------------------------------------------------------------------
+// Temperature compensation (issue 9, item 2)
+// ---------------------------------------------------------------------------------------
+TEST(Compensate, SolvedDriveRestoresTheTargetStrokeInEveryMode) {
+  const gmasim::Model m = gmasim::load_model("");
+  for (auto adjust : {gmasim::CompensationAdjust::Amplitude, gmasim::CompensationAdjust::Swing,
+                      gmasim::CompensationAdjust::Scale}) {
+    gmasim::CompensateRequest r;
+    r.temperatures_C = {20.0, 90.0};
+    r.adjust = adjust;
+    r.periods = 2.0;
+    r.tolerance_um = 1e-3;
+    const auto res = gmasim::run_compensate(m, r);
+    ASSERT_EQ(res.points.size(), 2u);
+    EXPECT_NEAR(res.points[0].gain, 1.0, 1e-9);  // the reference temperature needs no change
+    const auto& hot = res.points[1];
+    ASSERT_TRUE(hot.reachable && !hot.diverged) << hot.error;
+    EXPECT_NEAR(hot.stroke_um, res.target_stroke_um, r.tolerance_um);
+    EXPECT_LT(hot.uncompensated_stroke_um, res.target_stroke_um - 1.0);  // it was lost
+    EXPECT_GT(hot.gain, 1.05);
+    // The drive, rerun independently, gives that stroke.
+    gmasim::SimulationSettings s;
+    s.temperature_C = 90.0;
+    s.waveform = gmasim::biased_sine(hot.current_pp_A, r.frequency_Hz, hot.current_min_A);
+    s.periods = r.periods;
+    EXPECT_NEAR(gmasim::simulate(m, s).metrics.stroke_um, hot.stroke_um, 1e-9);
+    EXPECT_LT(hot.evaluations, 30);
+  }
+}
+
+TEST(Compensate, UnreachableTargetsAndBadRequestsAreReported) {
+  const gmasim::Model m = gmasim::load_model("");
+  gmasim::CompensateRequest r;
+  r.temperatures_C = {150.0};
+  r.max_current_A = 6.0;  // the reference 5 A peak fits, the hot drive does not
+  r.periods = 2.0;
+  const auto res = gmasim::run_compensate(m, r);
+  EXPECT_FALSE(res.points[0].reachable);
+  EXPECT_NEAR(res.points[0].current_max_A, 6.0, 1e-12);
+  EXPECT_LT(res.points[0].stroke_um, res.target_stroke_um);
+  auto refused = [&](auto edit, const char* what) {
+    gmasim::CompensateRequest q;
+    q.temperatures_C = {20.0};
+    edit(q);
+    EXPECT_THROW(
+        {
+          try {
+            (void)gmasim::run_compensate(m, q);
+          } catch (const gmasim::InputError& e) {
+            EXPECT_THAT(std::string(e.what()), ::testing::HasSubstr(what));
+            throw;
+          }
+        },
+        gmasim::InputError);
+  };
+  refused([](auto& q) { q.temperatures_C = {20.0, std::nan("")}; }, "temperature");
+  refused([](auto& q) { q.temperatures_C = {400.0}; }, "Curie");
+  refused([](auto& q) { q.temperatures_C = {70.0, 20.0}; }, "must increase");
+  refused([](auto& q) { q.max_current_A = 4.0; }, "beyond the maximum current");
+  refused([](auto& q) { q.max_current_A = 2.0; }, "current minimum = -3 A: must be in");
+  refused([](auto& q) { q.reference_current_pp_A = 0.0; }, "must be > 0");
+  refused([](auto& q) { q.target_stroke_um = 1e300; }, "target stroke");
+  refused([](auto& q) { q.tolerance_um = 0.0; }, "stroke tolerance");
+}
+
+TEST(Compensate, UnitFeedforwardIsThePlainPid) {
+  // g = 1 everywhere and no reference feed-forward: the same loop, to the last bit, as long
+  // as the current does not clip.
+  const gmasim::Model m = gmasim::load_model("");
+  gmasim::TrackRequest t;
+  t.temperatures_C = {20.0, 70.0};
+  t.amplitudes_um = {10.0};
+  t.frequencies_Hz = {10.0};
+  t.periods = 2.0;
+  const auto plain = gmasim::run_track(m, t);
+  t.feedforward.temperatures_C = {20.0, 70.0};
+  t.feedforward.gains = {1.0, 1.0};
+  const auto unit = gmasim::run_track(m, t);
+  for (std::size_t i = 0; i < plain.points.size(); ++i) {
+    ASSERT_FALSE(plain.points[i].saturated);
+    EXPECT_EQ(plain.points[i].error_rms_um, unit.points[i].error_rms_um);
+  }
+  EXPECT_DOUBLE_EQ(t.feedforward.gain_at(45.0), 1.0);
+  t.feedforward.gains = {1.0, 2.0};
+  EXPECT_DOUBLE_EQ(t.feedforward.gain_at(45.0), 1.5);
+  EXPECT_DOUBLE_EQ(t.feedforward.gain_at(-10.0), 1.0);  // held beyond the ends
+  EXPECT_DOUBLE_EQ(t.feedforward.gain_at(900.0), 2.0);
+  t.feedforward.gains = {1.0};
+  EXPECT_THROW((void)gmasim::run_track(m, t), gmasim::InputError);
+}
+
+TEST(StepMetrics, FirstOrderLagHasItsAnalyticRiseAndSettlingTimes) {
+  // y = 1 - exp(-(t - t0)/tau) after t0: rise 10-90 % = tau ln 9, settling 2 % = tau ln 50.
+  gmasim::TimeSeries ts;
+  ts.names = {"t_s", "y_um"};
+  ts.columns.assign(2, {});
+  const double tau = 1e-3, t0 = 2e-3, dt = 1e-6;
+  for (int k = 0; k <= 20000; ++k) {
+    const double t = k * dt;
+    ts.columns[0].push_back(t);
+    ts.columns[1].push_back(t <= t0 ? 0.0 : 5.0 * (1.0 - std::exp(-(t - t0) / tau)));
+  }
+  const auto s = gmasim::step_metrics(ts, t0);
+  ASSERT_TRUE(s.valid);
+  EXPECT_NEAR(s.y_final_um, 5.0, 5.0 * 2e-6);
+  EXPECT_NEAR(s.rise_time_s, tau * std::log(9.0), 2 * dt);
+  EXPECT_NEAR(s.settling_time_s, tau * std::log(50.0), 2 * dt);
+  EXPECT_NEAR(s.overshoot_pct, 0.0, 1e-3);
 }

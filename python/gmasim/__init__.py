@@ -12,9 +12,9 @@ adds plotting helpers (``gmasim.plots``). Units are SI and named in every key
     gmasim.plots.sweep_vs_temperature(s["points"])
 """
 from ._gmasim import *  # noqa: F401,F403
-from ._gmasim import (DivergenceError, InputError, Model, ablate, claims, frf,  # noqa: F401
-                      params_vs_temperature, simulate, sweep, thermal_expansion, track)
+from ._gmasim import (DivergenceError, InputError, Model, ablate, claims, compensate,  # noqa: F401
+                      frf, params_vs_temperature, simulate, sweep, thermal_expansion, track)
 from . import plots  # noqa: F401
 
-__all__ = ["Model", "simulate", "sweep", "frf", "track", "ablate", "params_vs_temperature",
+__all__ = ["Model", "simulate", "sweep", "frf", "track", "compensate", "ablate", "params_vs_temperature",
            "thermal_expansion", "claims", "plots", "InputError", "DivergenceError"]

@@ -3,6 +3,8 @@
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "gmasim/compensate.hpp"
+#include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
 #include "gmasim/reproduce.hpp"
 
@@ -118,6 +120,50 @@ void bind_experiments(py::module_& mod) {
       py::arg("kp") = 0.2, py::arg("ki") = 0.03, py::arg("kd") = 0.007, py::arg("sample_rate_Hz") = 10000.0,
       py::arg("bias_A") = 1.0, py::arg("sensor_noise_um") = 0.0, py::arg("periods") = 4.0, py::arg("threads") = 0,
       "Closed-loop tracking with the discrete PID (Fig. 16); gains' units in docs/experiments.md");
+  mod.def(
+      "compensate",
+      [](const Model& m, std::vector<double> temperatures_C, double reference_temperature_C,
+         double reference_current_pp_A, double current_min_A, double target_stroke_um,
+         double frequency_Hz, const std::string& adjust, double max_current_A, double tolerance_um,
+         bool track, std::vector<double> track_amplitudes_um, std::vector<double> track_frequencies_Hz,
+         double bias_A, int threads) {
+        CompensateRequest r;
+        r.temperatures_C = std::move(temperatures_C);
+        r.reference_temperature_C = reference_temperature_C;
+        r.reference_current_pp_A = reference_current_pp_A;
+        r.current_min_A = current_min_A;
+        r.target_stroke_um = target_stroke_um;
+        r.frequency_Hz = frequency_Hz;
+        if (adjust == "amplitude") r.adjust = CompensationAdjust::Amplitude;
+        else if (adjust == "swing") r.adjust = CompensationAdjust::Swing;
+        else if (adjust == "scale") r.adjust = CompensationAdjust::Scale;
+        else throw InputError("adjust '" + adjust + "': must be amplitude, swing or scale");
+        r.max_current_A = max_current_A;
+        r.tolerance_um = tolerance_um;
+        r.threads = threads;
+        return report_dict(without_gil([&] {
+          const CompensateResult res = run_compensate(m, r);
+          if (!track) return compensate_report(m, r, res);
+          TrackRequest t;
+          t.temperatures_C = r.temperatures_C;
+          t.amplitudes_um = track_amplitudes_um;
+          t.frequencies_Hz = track_frequencies_Hz;
+          t.bias_A = bias_A;
+          t.threads = threads;
+          const CompensatedTrack ct = run_compensated_track(m, r, t);
+          return compensate_report(m, r, res, &ct);
+        }));
+      },
+      py::arg("model"), py::arg("temperatures_C") = CompensateRequest{}.temperatures_C,
+      py::arg("reference_temperature_C") = 20.0, py::arg("reference_current_pp_A") = 8.0,
+      py::arg("current_min_A") = -3.0, py::arg("target_stroke_um") = 0.0, py::arg("frequency_Hz") = 10.0,
+      py::arg("adjust") = "amplitude", py::arg("max_current_A") = 30.0, py::arg("tolerance_um") = 1e-3,
+      py::arg("track") = false, py::arg("track_amplitudes_um") = std::vector<double>{10.0},
+      py::arg("track_frequencies_Hz") = std::vector<double>{10.0}, py::arg("bias_A") = 1.0,
+      py::arg("threads") = 0,
+      "Temperature compensation: the drive restoring the target stroke at each temperature "
+      "(table 'schedule'), and with track=True PID tracking plain vs with temperature "
+      "feed-forward (table 'track'). docs/experiments.md");
   mod.def(
       "ablate",
       [](const Model& m, double temperature_C, std::vector<double> frequencies_Hz, double current_pp_A) {
