@@ -1,6 +1,7 @@
 // gmasim simulate: one time-domain run of the model.
 #include <fmt/format.h>
 
+#include <cmath>
 #include <filesystem>
 #include <memory>
 
@@ -21,6 +22,8 @@ struct SimulateArgs {
   double f0_Hz = 1.0, f1_Hz = 1000.0, amplitude_A = 1.0, offset_A = 0.0, duration_s = 0.0;
   int record_every = 1;
   bool plot = false;
+  bool self_heating = false;
+  double thermal_step_s = 0.0, ambient_C = std::nan("");
   std::vector<std::string> quantities;
 };
 
@@ -60,6 +63,9 @@ int run_simulate(const SimulateArgs& a) {
   s.duration_s = a.duration_s;
   s.dt_s = a.dt_s;
   s.record_every = a.record_every;
+  s.self_heating.enabled = a.self_heating;
+  s.self_heating.thermal_step_s = a.thermal_step_s;
+  s.self_heating.ambient_C = a.ambient_C;
   ensure_output_dir(a.out);  // fail before the run, not after it
   Result r = simulate(model, s);
   if (!r.diverged && !a.quantities.empty()) add_quantity_stats(r, a.quantities);
@@ -67,8 +73,12 @@ int run_simulate(const SimulateArgs& a) {
   // One set: both temporaries are complete before either is renamed, and metrics.json
   // (renamed last) names the hash of its timeseries.csv.
   const std::string csv = timeseries_csv(r.series);
-  write_files_atomic({{(dir / "timeseries.csv").string(), csv},
-                      {(dir / "metrics.json").string(), metrics_json(r, s, model, csv)}});
+  std::vector<std::pair<std::string, std::string>> files = {
+      {(dir / "timeseries.csv").string(), csv}};
+  if (s.self_heating.enabled)
+    files.emplace_back((dir / "self_heating.csv").string(), timeseries_csv(r.heating));
+  files.emplace_back((dir / "metrics.json").string(), metrics_json(r, s, model, csv));
+  write_files_atomic(files);
 
   fmt::print("gmasim simulate  model: {}\n", model_label(a.model));
   fmt::print("  temperature {:.1f} degC, dt {:.4g} us, {} steps, wall time {:.3f} s\n",
@@ -92,7 +102,28 @@ int run_simulate(const SimulateArgs& a) {
                q.pp, q.mean);
   fmt::print("  thermal expansion {:.3f} um ({} the output y)\n", r.thermal_expansion_um,
              model.options.thermal_expansion_in_output ? "included in" : "not in");
-  fmt::print("  wrote {}/timeseries.csv and {}/metrics.json\n", a.out, a.out);
+  if (r.heating.rows() > 1) {
+    const auto& h = r.heating;
+    const std::size_t n = h.rows() - 1;
+    // The first thermal step holds the virgin magnetisation curve: the drift is read from the
+    // second one on when there is one.
+    const std::size_t b = n >= 2 ? 2 : 1;
+    const double balance = r.energy_in_J - r.energy_stored_J - r.energy_out_J;
+    fmt::print(
+        "  self-heating over {:.1f} s (thermal step {:.3g} s, ambient {:.1f} degC):\n"
+        "    coil {:.2f} degC, rods {:.2f} degC, housing {:.2f} degC at the end\n"
+        "    losses at the end: copper {:.3f} W, eddy {:.4f} W, hysteresis {:.4f} W\n"
+        "    stroke {:.3f} um over thermal step {}, {:.3f} um over the last ({:+.2f} %)\n"
+        "    energy: in {:.2f} J = stored {:.2f} J + to ambient {:.2f} J (residual {:.2e} J)\n",
+        h.columns[0][n], h.columns[0][1], std::isnan(a.ambient_C) ? a.temperature_C : a.ambient_C,
+        h.column("coil_C")[n], h.column("rods_C")[n], h.column("housing_C")[n],
+        h.column("P_copper_W")[n], h.column("P_eddy_W")[n], h.column("P_hysteresis_W")[n],
+        h.column("stroke_um")[b], b, h.column("stroke_um")[n],
+        (h.column("stroke_um")[n] / h.column("stroke_um")[b] - 1.0) * 100.0, r.energy_in_J,
+        r.energy_stored_J, r.energy_out_J, balance);
+  }
+  fmt::print("  wrote {}/timeseries.csv{} and {}/metrics.json\n", a.out,
+             s.self_heating.enabled ? fmt::format(", {}/self_heating.csv", a.out) : "", a.out);
   if (a.plot && r.steps > 0) fmt::print("  wrote {}\n", render_plot("simulate", a.out));
   if (r.diverged) {
     print_error(r.error +
@@ -147,6 +178,15 @@ Runner add_simulate(CLI::App& app) {
   sub->add_option(
       "--quantity", a->quantities,
       "Also report RMS, peak, p-p and mean of these columns (e.g. rod1_F_N) [column units]");
+  sub->add_flag("--self-heating", a->self_heating,
+                "Let the actuator heat itself: coil copper loss and rod eddy/hysteresis losses "
+                "drive the [thermal_network] (coil, rods, housing, ambient); the rods' "
+                "temperature updates the model every thermal step. Writes self_heating.csv");
+  sub->add_option("--thermal-step", a->thermal_step_s,
+                  "Self-heating: thermal step [s]; 0 = whole periods spanning >= 0.1 s")
+      ->capture_default_str();
+  sub->add_option("--ambient", a->ambient_C,
+                  "Self-heating: ambient temperature [degC]; default: --temperature");
   sub->add_flag("--plot", a->plot, "Also draw <out>/simulate.png and .svg (matplotlib)");
   sub->add_option("--out", a->out, "Output directory")->capture_default_str();
   return [a, sub]() -> int { return sub->parsed() ? run_simulate(*a) : -1; };

@@ -138,6 +138,17 @@ struct OutputStageModel {
   double mass_kg = 0, stiffness_N_per_m = 0, damping_N_s_per_m = 0;
 };
 
+// Lumped thermal network of self-heating (optional table [thermal_network], every key
+// defaulted; docs/model.md, "Self-heating"). Nodes: the coil, the rods (lumped), the
+// housing; the ambient is a boundary at a given temperature.
+struct ThermalNetworkModel {
+  double coil_resistance_ohm = 0;  // at T_ref_C
+  double coil_alpha_per_K = 0;     // R(T) = R (1 + alpha (T - T_ref))
+  double coil_C_J_per_K = 0, rods_C_J_per_K = 0, housing_C_J_per_K = 0;  // heat capacities
+  double G_coil_rods_W_per_K = 0, G_coil_housing_W_per_K = 0, G_rods_housing_W_per_K = 0,
+         G_housing_ambient_W_per_K = 0;  // thermal conductances
+};
+
 struct ChainLink {  // one member of a rod's load chain
   enum Kind { Element, Sleeve, Rod } kind;
   int index;
@@ -159,6 +170,7 @@ struct Model {
   std::vector<SleeveModel> sleeves;
   std::vector<std::vector<ChainLink>> chains;  // per rod
   OutputStageModel output_stage;
+  ThermalNetworkModel thermal_network;
   // eq. (21) alpha*l products of the stack [m/K]
   double xT_rod_m_per_K = 0, xT_magnetizer_m_per_K = 0, xT_output_rod_m_per_K = 0,
          xT_sleeve_m_per_K = 0;

@@ -1,6 +1,7 @@
 // Excitations, the fixed-step run loop, recording and metrics.
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -40,14 +41,24 @@ Waveform biased_sine(double pp_A, double frequency_Hz, double min_A = -3.0);
 // ---------------------------------------------------------------------------------------
 // Run settings and results.
 // ---------------------------------------------------------------------------------------
+// Self-heating (gmasim/self_heating.hpp): the run starts with coil, rods and housing at
+// temperature_C; every thermal step the losses of that interval heat the network and the
+// Conditions are recomputed at the rods' new temperature.
+struct SelfHeatingSettings {
+  bool enabled = false;
+  double thermal_step_s = 0.0;  // 0: whole periods spanning >= 0.1 s (periodic), else 0.1 s
+  double ambient_C = std::numeric_limits<double>::quiet_NaN();  // NaN: temperature_C
+};
+
 struct SimulationSettings {
-  double temperature_C = 20.0;
+  double temperature_C = 20.0;  // start temperature of every node (self-heating) or the fixed one
   Waveform waveform;
   double periods = 3.0;     // run length for periodic waveforms
   double duration_s = 0.0;  // run length for the others (Table: its last time if 0)
   double dt_s = 0.0;        // 0: the automatic rule, auto_dt()
   int record_every = 1;     // decimation of the recorded time series
   Freeze freeze;
+  SelfHeatingSettings self_heating;
 };
 
 // The documented time-step rule (docs/model.md, "Time step"): a periodic run takes
@@ -103,6 +114,11 @@ struct Result {
   bool diverged = false;
   std::string error;  // DivergenceError message when diverged
   double thermal_expansion_um = 0;
+  // Self-heating: one row per thermal step (t_s, coil_C, rods_C, housing_C, P_copper_W,
+  // P_eddy_W, P_hysteresis_W, P_ambient_W, stroke_um over the step, E_in_J, E_stored_J,
+  // E_out_J cumulative) and the run's energy balance.
+  TimeSeries heating;
+  double energy_in_J = 0, energy_stored_J = 0, energy_out_J = 0;
 };
 
 // The validation layer (gmasim/validate.hpp): throws InputError naming the field, its value

@@ -25,6 +25,14 @@ def _meta(out, stem):
 
 def simulate(out):
     ts = read_csv(pathlib.Path(out) / "timeseries.csv")
+    meta = json.loads((pathlib.Path(out) / "metrics.json").read_text())
+    m = meta.get("metrics") or {}
+    if "window_start_s" in m and m["window_end_s"] > m["window_start_s"]:
+        # A long run: its time traces show the last few metrics windows, not a solid band.
+        t0 = m["window_end_s"] - 3 * (m["window_end_s"] - m["window_start_s"])
+        keep = ts["t_s"] >= t0
+        if keep.sum() > 10:
+            ts = {k: v[keep] for k, v in ts.items()}
     heat = pathlib.Path(out) / "self_heating.csv"
     rows = 3 if heat.exists() else 2
     fig = plt.figure(figsize=(10, 3.4 * rows))
@@ -61,14 +69,15 @@ def simulate(out):
         ax_T.legend(fontsize=7)
         ax_T.set_title("self-heating")
         ax_s = fig.add_subplot(rows, 2, 6)
-        ax_s.plot(h["t_s"], h["stroke_um"], color="tab:red")
+        # Row 0 is the start, row 1 the virgin-curve step: the drift is drawn from row 2.
+        ax_s.plot(h["t_s"][2:], h["stroke_um"][2:], color="tab:red")
         ax_s.set_xlabel("time (s)")
         ax_s.set_ylabel("stroke over the interval (µm)")
         ax_s.set_title("stroke drift")
     for ax in fig.axes:
         ax.grid(alpha=0.3)
-    meta = json.loads((pathlib.Path(out) / "metrics.json").read_text())
-    fig.suptitle(f"gmasim simulate: {meta.get('settings', {}).get('temperature_C', '')} °C")
+    fig.suptitle(f"gmasim simulate: {meta.get('model', '')}, {meta.get('temperature_C', '')} °C"
+                 + (", self-heating" if heat.exists() else ""))
     fig.tight_layout()
     return fig
 

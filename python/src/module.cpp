@@ -63,8 +63,12 @@ using namespace gmasim::py_bind;
 py::dict simulate_py(const Model& m, double temperature_C, double current_pp_A, double frequency_Hz,
                      double periods, double current_min_A, double dt_s, int record_every,
                      const std::string& kind, py::object waveform, double duration_s,
-                     const std::vector<std::string>& freeze, const std::vector<std::string>& quantities) {
+                     const std::vector<std::string>& freeze, const std::vector<std::string>& quantities,
+                     bool self_heating, double thermal_step_s, py::object ambient_C) {
   SimulationSettings s;
+  s.self_heating.enabled = self_heating;
+  s.self_heating.thermal_step_s = thermal_step_s;
+  if (!ambient_C.is_none()) s.self_heating.ambient_C = ambient_C.cast<double>();
   s.temperature_C = temperature_C;
   s.periods = periods;
   s.dt_s = dt_s;
@@ -107,6 +111,12 @@ py::dict simulate_py(const Model& m, double temperature_C, double current_pp_A, 
   d["diverged"] = r.diverged;
   d["error"] = r.error;
   d["thermal_expansion_um"] = r.thermal_expansion_um;
+  if (self_heating) {
+    d["heating"] = series_dict(r.heating);
+    d["energy_in_J"] = r.energy_in_J;
+    d["energy_stored_J"] = r.energy_stored_J;
+    d["energy_out_J"] = r.energy_out_J;
+  }
   py::dict q;
   for (const auto& qs : r.quantities) {
     py::dict e;
@@ -171,6 +181,9 @@ PYBIND11_MODULE(_gmasim, mod) {
           py::arg("current_min_A") = -3.0, py::arg("dt_s") = 0.0, py::arg("record_every") = 1,
           py::arg("kind") = "sine", py::arg("waveform") = py::none(), py::arg("duration_s") = 0.0,
           py::arg("freeze") = std::vector<std::string>{}, py::arg("quantities") = std::vector<std::string>{},
-          "Time-domain run. Returns {'series': {column: ndarray}, 'metrics': {...}, ...}");
+          py::arg("self_heating") = false, py::arg("thermal_step_s") = 0.0, py::arg("ambient_C") = py::none(),
+          "Time-domain run. Returns {'series': {column: ndarray}, 'metrics': {...}, ...}; with "
+          "self_heating=True also 'heating' (one row per thermal step: node temperatures, losses, "
+          "stroke) and the energy balance (energy_in_J = energy_stored_J + energy_out_J)");
   gmasim::py_bind::bind_experiments(mod);
 }

@@ -100,3 +100,14 @@ def test_model_save_round_trip(tmp_path):
     assert a == b
     with pytest.raises(ValueError, match="one word"):
         gmasim.Model().with_params({"options.magnetic_state": "a b"})
+
+
+def test_self_heating_from_python():
+    """Issue 9, item 1: a heated run returns the thermal history and a closed energy balance."""
+    m = gmasim.Model().with_params({"thermal_network.coil_heat_capacity_J_per_K": 2.0,
+                                    "thermal_network.housing_heat_capacity_J_per_K": 4.0})
+    r = gmasim.simulate(m, periods=20, dt_s=5e-5, record_every=100, self_heating=True)
+    h = r["heating"]
+    assert h["coil_C"][-1] > 25.0
+    assert r["energy_in_J"] == pytest.approx(r["energy_stored_J"] + r["energy_out_J"], rel=1e-9)
+    assert np.all(np.diff(h["coil_C"]) >= 0.0)

@@ -27,7 +27,7 @@ using R = Rule;
 
 constexpr std::string_view kReserved[] = {
     "meta",  "options", "reference", "material",  "preload",          "magnet",
-    "stack", "circuit", "sensor",    "mechanics", "thermal_expansion"};
+    "stack", "circuit", "sensor",    "mechanics", "thermal_expansion", "thermal_network"};
 
 constexpr Field kReference[] = {{"T_ref_C", R::AboveAbsoluteZero}};
 
@@ -109,6 +109,10 @@ struct Suffix {
 };
 // Longer suffixes first where one ends another ("_ohm_m" before "_m", "_Pa_per_C" before "_C").
 constexpr Suffix kSuffixes[] = {
+    {"_J_per_kg_K", "J/(kg K)"},
+    {"_J_per_K", "J/K"},
+    {"_W_per_K", "W/K"},
+    {"_ohm", "ohm"},
     {"_ohm_m_per_K", "ohm m/K"},
     {"_N_s_per_m", "N s/m"},
     {"_Pa_per_C", "Pa/degC"},
@@ -149,6 +153,27 @@ bool is_rod(const ModelSpec& spec, const std::string& name) {
   return std::find(spec.rods.begin(), spec.rods.end(), name) != spec.rods.end();
 }
 
+// [thermal_network] (optional, self-heating; docs/model.md, "Self-heating"): every key has a
+// default, used (with this provenance) when the key or the whole table is absent.
+constexpr DefaultedField kThermalNetwork[] = {
+    {{"coil_resistance_ohm", R::Positive}, 1.5,
+     "default: estimate for the MDMA coil (720 turns of ~0.8 mm copper), at reference.T_ref_C"},
+    {{"coil_alpha_per_K", R::NonNegative}, 3.93e-3, "default: copper, handbook value"},
+    {{"coil_heat_capacity_J_per_K", R::Positive}, 80.0,
+     "default: estimate, ~0.2 kg of copper x 385 J/(kg K)"},
+    {{"rod_specific_heat_J_per_kg_K", R::Positive}, 350.0,
+     "default: Terfenol-D, ~0.35 kJ/(kg K) (manufacturer data)"},
+    {{"housing_heat_capacity_J_per_K", R::Positive}, 450.0,
+     "default: estimate, ~1 kg of steel x 460 J/(kg K)"},
+    {{"coil_to_rods_W_per_K", R::Positive}, 0.5,
+     "default: estimate, conduction across the coil former and air gap"},
+    {{"coil_to_housing_W_per_K", R::Positive}, 1.0, "default: estimate, coil potted to the housing"},
+    {{"rods_to_housing_W_per_K", R::Positive}, 0.5,
+     "default: estimate, conduction through the magnetizers and end caps"},
+    {{"housing_to_ambient_W_per_K", R::Positive}, 0.4,
+     "default: estimate, natural convection ~10 W/(m^2 K) over ~0.04 m^2"},
+};
+
 }  // namespace
 
 std::span<const std::string_view> reserved_tables() { return kReserved; }
@@ -163,6 +188,7 @@ std::span<const Field> sleeve_modulus_fields() { return kSleeveModulus; }
 std::span<const Field> output_stage_fields() { return kOutputStage; }
 std::span<const Field> sleeve_fields() { return kSleeve; }
 std::span<const Field> thermal_expansion_fields() { return kThermal; }
+std::span<const DefaultedField> thermal_network_defaults() { return kThermalNetwork; }
 std::span<const Field> branch_number_fields() { return kBranchNumbers; }
 
 std::string unit_from_suffix(std::string_view key) {
@@ -184,6 +210,9 @@ std::optional<Field> field_of(const ModelSpec& spec, const std::string& dotted) 
     if (p[0] == "preload") return find_field(kPreload, p[1]);
     if (p[0] == "magnet") return find_field(kMagnet, p[1]);
     if (p[0] == "thermal_expansion") return find_field(kThermal, p[1]);
+    if (p[0] == "thermal_network")
+      for (const auto& d : kThermalNetwork)
+        if (d.field.key == p[1]) return d.field;
     if (is_rod(spec, p[0])) return find_field(kRod, p[1]);
   } else if (p.size() == 3) {
     if (p[0] == "mechanics" && p[1] == "sleeve_modulus") return find_field(kSleeveModulus, p[2]);
@@ -579,6 +608,35 @@ class Loader {
     read_mechanics(root);
     read_table_fields(root, "thermal_expansion", "thermal_expansion", 1,
                       schema::thermal_expansion_fields());
+    read_thermal_network(root);
+  }
+
+  // Optional, every key defaulted (schema::thermal_network_defaults()).
+  void read_thermal_network(const toml::table& root) {
+    const toml::table* t = nullptr;
+    if (const toml::node* n = root.get("thermal_network")) {
+      t = table_at(root, "thermal_network", "thermal_network", 1);
+      if (t == nullptr) return;
+      spec_.option_lines["[thermal_network]"] = node_line(*n);
+      std::vector<std::string> keys;
+      for (const auto& d : schema::thermal_network_defaults()) keys.emplace_back(d.field.key);
+      check_keys(*t, "[thermal_network]", keys);
+    }
+    for (const auto& d : schema::thermal_network_defaults()) {
+      const std::string dotted = "thermal_network." + std::string(d.field.key);
+      if (t != nullptr) {
+        if (const toml::node* node = t->get(d.field.key)) {
+          store_number(*node, dotted, d.field);
+          continue;
+        }
+      }
+      ParamValue pv;
+      pv.value = d.value;
+      pv.unit = schema::unit_of(d.field);
+      pv.provenance = std::string(d.provenance);
+      pv.line = 0;
+      spec_.params[dotted] = std::move(pv);
+    }
   }
 
   void read_meta(const toml::table& root) {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstdint>
+#include <map>
 #include <stdexcept>
 
 #include "gmasim/errors.hpp"
@@ -123,6 +124,7 @@ std::string model_toml(const ModelSpec& spec, const std::string& why) {
   const ModelSpec original = parse_model_spec(spec.text, spec.source);
   std::vector<std::string> lines = lines_of(spec.text);
   auto leaf_of = [](const std::string& dotted) { return dotted.substr(dotted.rfind('.') + 1); };
+  std::map<std::string, std::vector<std::string>> added;  // table -> new "key = value" lines
   for (const auto& [name, pv] : spec.params) {
     const auto it = original.params.find(name);
     if (it == original.params.end())
@@ -134,6 +136,11 @@ std::string model_toml(const ModelSpec& spec, const std::string& why) {
     const std::string comment =
         fmt::format("set: {}; was {}{}", why, schema::toml_float(was.value),
                     was.provenance.empty() ? "" : fmt::format(" ({})", was.provenance));
+    if (was.line == 0) {  // a defaulted key the file does not hold: added below
+      added[name.substr(0, name.rfind('.'))].push_back(
+          fmt::format("{} = {}  # {}", leaf_of(name), schema::toml_float(pv.value), comment));
+      continue;
+    }
     replace_value(lines, was.line, leaf_of(name), schema::toml_float(pv.value), comment,
                   spec.source);
   }
@@ -147,8 +154,26 @@ std::string model_toml(const ModelSpec& spec, const std::string& why) {
     replace_value(lines, line_no, leaf_of(name), quoted ? "\"" + value + "\"" : value,
                   fmt::format("set: {}; was {}", why, it->second), spec.source);
   }
+  // Defaulted keys: below their table's header if the file has one, else in a new table at
+  // the end (bottom-up, so earlier line numbers stay valid).
+  std::vector<std::pair<long, std::string>> inserts;
+  std::string appended;
+  for (const auto& [table, keys] : added) {
+    const auto it = original.option_lines.find("[" + table + "]");
+    std::string block;
+    for (const auto& k : keys) block += (block.empty() ? "" : "\n") + k;
+    if (it != original.option_lines.end() && it->second > 0) {
+      inserts.emplace_back(it->second, block);
+    } else {
+      appended += fmt::format("\n[{}]  # added by: {}\n{}\n", table, why, block);
+    }
+  }
+  std::sort(inserts.begin(), inserts.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (const auto& [line_no, block] : inserts)
+    lines.insert(lines.begin() + std::min<long>(line_no, static_cast<long>(lines.size())), block);
   std::string text;
   for (const auto& l : lines) text += l + "\n";
+  text += appended;
   // The file must load, carry exactly the spec's values, and compile.
   const ModelSpec check = parse_model_spec(text, spec.source);
   for (const auto& [name, pv] : spec.params) {

@@ -310,6 +310,23 @@ std::string metrics_json(const Result& r, const SimulationSettings& s, const Mod
     o.raw("quantities", qo.str());
   }
   o.number("thermal_expansion_um", r.thermal_expansion_um);
+  if (r.heating.rows() > 0) {
+    // Self-heating: the end state of the network and its energy balance (self_heating.csv).
+    JsonObject ho(2);
+    const auto last = r.heating.rows() - 1;
+    ho.number("thermal_step_s", r.heating.rows() > 1 ? r.heating.columns[0][1] : 0.0);
+    ho.number("coil_C", r.heating.column("coil_C")[last]);
+    ho.number("rods_C", r.heating.column("rods_C")[last]);
+    ho.number("housing_C", r.heating.column("housing_C")[last]);
+    // The first thermal step holds the virgin curve: the drift starts at the second.
+    ho.number("stroke_start_um",
+              r.heating.column("stroke_um")[std::min<std::size_t>(last, 2)]);
+    ho.number("stroke_last_um", r.heating.column("stroke_um")[last]);
+    ho.number("energy_in_J", r.energy_in_J);
+    ho.number("energy_stored_J", r.energy_stored_J);
+    ho.number("energy_out_J", r.energy_out_J);
+    o.raw("self_heating", ho.str());
+  }
   if (!timeseries_csv_text.empty()) {
     // Pairs this file with the timeseries.csv written with it (write_files_atomic).
     JsonObject to(2);

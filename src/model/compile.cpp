@@ -222,6 +222,21 @@ Model compile(const ModelSpec& spec) {
     os.stiffness_N_per_m = r.num("mechanics.output_stage.stiffness_N_per_m");
     os.damping_N_s_per_m = r.num("mechanics.output_stage.damping_N_s_per_m");
   }
+  {
+    auto& n = m.thermal_network;
+    const std::string p = "thermal_network.";
+    n.coil_resistance_ohm = r.num(p + "coil_resistance_ohm");
+    n.coil_alpha_per_K = r.num(p + "coil_alpha_per_K");
+    n.coil_C_J_per_K = r.num(p + "coil_heat_capacity_J_per_K");
+    double rod_mass_kg = 0.0;
+    for (const auto& rod : m.rods) rod_mass_kg += rod.mass_kg;
+    n.rods_C_J_per_K = r.num(p + "rod_specific_heat_J_per_kg_K") * rod_mass_kg;
+    n.housing_C_J_per_K = r.num(p + "housing_heat_capacity_J_per_K");
+    n.G_coil_rods_W_per_K = r.num(p + "coil_to_rods_W_per_K");
+    n.G_coil_housing_W_per_K = r.num(p + "coil_to_housing_W_per_K");
+    n.G_rods_housing_W_per_K = r.num(p + "rods_to_housing_W_per_K");
+    n.G_housing_ambient_W_per_K = r.num(p + "housing_to_ambient_W_per_K");
+  }
   m.Et_Pa = r.num("mechanics.sleeve_modulus.Et_Pa");
   m.dEt_dT_Pa_per_C = r.num("mechanics.sleeve_modulus.dEt_dT_Pa_per_C");
   for (const auto& s : spec.sleeve_names) {

@@ -1,9 +1,11 @@
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/self_heating.hpp"
 #include "gmasim/simulate.hpp"
 #include "gmasim/validate.hpp"
 
@@ -83,6 +85,123 @@ RunLength run_length(const SimulationSettings& s) {
   return L;
 }
 
+
+// The slower thermal clock of self-heating (gmasim/self_heating.hpp): accumulates the
+// losses of each thermal step, advances the network, recomputes the Conditions at the rods'
+// new temperature. The per-step work is allocation-free; the Conditions update once per
+// thermal step is not (make_conditions).
+struct SelfHeatingRun {
+  bool enabled = false;
+  long steps_per_interval = 0, in_interval = 0;
+  double interval_s = 0, ambient_C = 0, T_ref_C = 20;
+  const ThermalNetworkModel* net = nullptr;
+  NodeTemperatures T, T0;
+  double E_copper = 0, E_eddy = 0, E_hyst = 0, y_min = 0, y_max = 0, i_prev = 0;
+  double E_in_total = 0, E_out_total = 0;
+  std::vector<double> volume_m3, Hc_prev, H_prev, M_prev;  // per rod, sized once
+
+  SelfHeatingRun(const Model& m, const SimulationSettings& s, const RunLength& L, Result& r) {
+    enabled = s.self_heating.enabled;
+    if (!enabled) return;
+    net = &m.thermal_network;
+    T_ref_C = m.T_ref_C;
+    const auto& h = s.self_heating;
+    ambient_C = std::isnan(h.ambient_C) ? s.temperature_C : h.ambient_C;
+    double want = h.thermal_step_s;
+    if (want == 0.0) {
+      want = 0.1;
+      if (s.waveform.periodic())
+        want = s.waveform.period_s() * std::ceil(0.1 / s.waveform.period_s() - 1e-9);
+    }
+    steps_per_interval = std::max(1L, std::lround(want / L.dt_s));
+    interval_s = static_cast<double>(steps_per_interval) * L.dt_s;
+    const double tau = fastest_time_constant_s(*net);
+    if (interval_s > tau)
+      throw InputError(fmt::format(
+          "thermal step {:.4g} s: longer than the thermal network's fastest time constant "
+          "{:.4g} s (min C/G over coil, rods, housing); shorten the thermal step",
+          interval_s, tau));
+    T = T0 = {s.temperature_C, s.temperature_C, s.temperature_C};
+    const std::size_t n = m.rods.size();
+    volume_m3.assign(n, 0.0);
+    Hc_prev.assign(n, 0.0);
+    H_prev.assign(n, 0.0);
+    M_prev.assign(n, 0.0);
+    r.heating.names = {"t_s",      "coil_C",         "rods_C",      "housing_C", "P_copper_W",
+                       "P_eddy_W", "P_hysteresis_W", "P_ambient_W", "stroke_um", "E_in_J",
+                       "E_stored_J", "E_out_J"};
+    r.heating.columns.assign(r.heating.names.size(), {});
+    const double rows = static_cast<double>(L.steps) / static_cast<double>(steps_per_interval) + 2;
+    for (auto& col : r.heating.columns) col.reserve(static_cast<std::size_t>(rows));
+  }
+
+  void remember(std::size_t i, const RodState& rs) {
+    Hc_prev[i] = rs.Hc_A_per_m;
+    H_prev[i] = rs.H_A_per_m;
+    M_prev[i] = rs.M_A_per_m;
+  }
+
+  void push_row(Result& r, double t, double Pc, double Pe, double Ph, double Pa, double stroke) {
+    const double row[] = {t,  T.coil_C, T.rods_C, T.housing_C, Pc, Pe,
+                          Ph, Pa,       stroke,   E_in_total,  stored_heat_J(*net, T, T0),
+                          E_out_total};
+    for (std::size_t j = 0; j < r.heating.columns.size(); ++j) r.heating.columns[j].push_back(row[j]);
+  }
+
+  void begin(const Conditions& c, const State& st, Result& r) {
+    if (!enabled) return;
+    for (std::size_t i = 0; i < volume_m3.size(); ++i) {
+      volume_m3[i] = c.rods[i].area_m2 * c.rods[i].length_m;
+      remember(i, st.rods[i]);
+    }
+    i_prev = st.current_A;
+    y_min = y_max = st.y_m;
+    push_row(r, st.t_s, 0, 0, 0, 0, 0);
+  }
+
+  void after_step(const Model& m, const SimulationSettings& s, Conditions& c, const State& st,
+                  double dt, bool last, Result& r) {
+    E_copper += copper_loss_J(i_prev, st.current_A,
+                              coil_resistance_ohm(*net, T_ref_C, T.coil_C), dt);
+    i_prev = st.current_A;
+    for (std::size_t i = 0; i < volume_m3.size(); ++i) {
+      const RodState& rs = st.rods[i];
+      const RodLoss l = rod_loss_J(volume_m3[i], Hc_prev[i], H_prev[i], M_prev[i], rs.Hc_A_per_m,
+                                   rs.H_A_per_m, rs.M_A_per_m);
+      E_eddy += l.eddy_J;
+      E_hyst += l.hysteresis_J;
+      remember(i, rs);
+    }
+    y_min = std::min(y_min, st.y_m);
+    y_max = std::max(y_max, st.y_m);
+    if (++in_interval < steps_per_interval && !last) return;
+    // One thermal step: the interval's mean powers heat the network. The magnetic work of an
+    // interval that is not whole periods holds a change of stored field energy, which may be
+    // negative: the rods then receive no heat from it (never a cooling by the field).
+    const double span = static_cast<double>(in_interval) * dt;
+    const double Pc = E_copper / span, Pe = std::max(0.0, E_eddy) / span,
+                 Ph = std::max(0.0, E_hyst) / span;
+    const double E_out = thermal_network_step(*net, T, Pc, Pe + Ph, ambient_C, span);
+    E_in_total += (Pc + Pe + Ph) * span;
+    E_out_total += E_out;
+    push_row(r, st.t_s, Pc, Pe, Ph, E_out / span, (y_max - y_min) * 1e6);
+    in_interval = 0;
+    E_copper = E_eddy = E_hyst = 0;
+    y_min = y_max = st.y_m;
+    try {
+      c = make_conditions(m, T.rods_C, s.freeze);
+    } catch (const InputError& e) {
+      throw DivergenceError(fmt::format(
+          "self-heating: at t = {:.6g} s the rods reached {:.2f} degC, where the model is not "
+          "defined ({})",
+          st.t_s, T.rods_C, e.what()));
+    }
+    r.energy_in_J = E_in_total;
+    r.energy_out_J = E_out_total;
+    r.energy_stored_J = stored_heat_J(*net, T, T0);
+  }
+};
+
 }  // namespace
 
 void validate(const Waveform& w) {
@@ -151,7 +270,15 @@ void validate(const SimulationSettings& s) {
     require_in(s.periods, 1.0, kMaxPeriods, "periods");
   }
   require_nonnegative(s.duration_s, "duration", "s");
-  (void)run_length(s);
+  const RunLength L = run_length(s);
+  if (s.self_heating.enabled) {
+    const auto& h = s.self_heating;
+    require_nonnegative(h.thermal_step_s, "thermal step", "s");
+    if (!std::isnan(h.ambient_C)) require_in(h.ambient_C, -273.15, 1e4, "ambient temperature", "degC");
+    if (h.thermal_step_s > 0.0 && h.thermal_step_s < L.dt_s)
+      throw InputError(fmt::format("thermal step {} s: shorter than the time step {} s",
+                                   h.thermal_step_s, L.dt_s));
+  }
 }
 
 Result simulate(const Model& m, const SimulationSettings& s) {
@@ -161,19 +288,22 @@ Result simulate(const Model& m, const SimulationSettings& s) {
   const double duration = L.duration_s, dt = L.dt_s;
   const long nsteps = L.steps;
 
-  const Conditions c = make_conditions(m, s.temperature_C, s.freeze);
+  Conditions c = make_conditions(m, s.temperature_C, s.freeze);
   Result r;
   r.dt_s = dt;
   r.thermal_expansion_um = c.thermal_expansion_m * 1e6;
   make_columns(m, r.series, static_cast<std::size_t>(nsteps / s.record_every + 2));
+  SelfHeatingRun heat(m, s, L, r);
   const auto wall0 = std::chrono::steady_clock::now();
   try {
     State st = make_state(m, c, w.current_at(0.0));
     record(c, st, r.series);
+    heat.begin(c, st, r);
     for (long k = 1; k <= nsteps; ++k) {
       const double t = static_cast<double>(k) * dt;
       step(m, c, st, {w.current_at(t), dt});
       st.t_s = t;  // avoid drift from repeated addition
+      if (heat.enabled) heat.after_step(m, s, c, st, dt, k == nsteps, r);
       if (k % s.record_every == 0 || k == nsteps) record(c, st, r.series);
       r.steps = k;
     }

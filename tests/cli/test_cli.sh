@@ -49,6 +49,15 @@ check "set rule" 2 "rod1.length_m = -1 m: must be > 0" "$B" ablate --set rod1.le
 check "model save" 0 "with 2 changes" "$B" model save --set material.Ms_A_per_m=7e5 --set options.magnetic_state=printed --out "$T/saved.toml"
 check "saved model loads" 0 "Ms_A_per_m +700000 .*set: gmasim model save" "$B" model show --model "$T/saved.toml"
 check "saved option" 0 "options.magnetic_state +printed" "$B" model show --model "$T/saved.toml"
+# Self-heating, compensation and --plot (issue 9).
+check "self-heating" 0 "energy: in .* J = stored .* J \+ to ambient" "$B" simulate --self-heating --set thermal_network.coil_heat_capacity_J_per_K=2 --periods 10 --dt 5e-5 --record-every 50 --out "$T/heat"
+[[ -s "$T/heat/self_heating.csv" ]] && grep -q '"self_heating"' "$T/heat/metrics.json" && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: self-heating outputs"; }
+check "thermal step too long" 2 "fastest time constant" "$B" simulate --self-heating --set thermal_network.coil_heat_capacity_J_per_K=0.01 --periods 2 --out "$T/heat2"
+check "compensate" 0 "70.0 +9\.[0-9]+ +-3.0000" "$B" compensate --temperatures 20,70 --no-track --periods 2 --out "$T/comp"
+check "compensate bad list" 2 "temperatures must increase" "$B" compensate --temperatures 70,20 --no-track --out "$T/comp2"
+check "step metrics" 0 "step +y .* rise \(10-90 %\)" "$B" simulate --waveform-kind step --level 0 --step-to 4 --step-time 0.002 --duration 0.01 --out "$T/step"
+check "plot" 0 "wrote .*frf.png" "$B" frf --method linear --points 8 --temperatures 20 --plot --out "$T/frfplot"
+[[ -s "$T/frfplot/frf.svg" ]] && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: frf.svg"; }
 check "help has units" 0 "Operating temperature \[degC\]" "$B" simulate --help
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]
