@@ -975,3 +975,21 @@ TEST(ModelWriter, AssignmentsAreCheckedLikeTheFile) {
   fails("options.nothing=x", "has no option 'options.nothing'");
   fails("options.magnetic_state=a b", "one word");
 }
+
+TEST(ModelWriter, DefaultedKeysAreWrittenIntoTheirTable) {
+  // [thermal_network] is absent from the built-in file: a changed default is saved in a new
+  // table; a file that has the table gets the key below its header.
+  const gmasim::ModelSpec base = gmasim::builtin_model_spec();
+  EXPECT_EQ(base.params.at("thermal_network.coil_resistance_ohm").line, 0);
+  const auto changed =
+      gmasim::apply_assignments(base, {"thermal_network.coil_resistance_ohm=2.25"});
+  const std::string text = gmasim::model_toml(changed, "test");
+  EXPECT_THAT(text, HasSubstr("\n[thermal_network]  # added by: test\ncoil_resistance_ohm = 2.25"));
+  const auto back = gmasim::parse_model_spec(text, "saved");
+  EXPECT_EQ(back.params.at("thermal_network.coil_resistance_ohm").value, 2.25);
+  EXPECT_GT(back.params.at("thermal_network.coil_resistance_ohm").line, 0);
+  const auto again = gmasim::apply_assignments(back, {"thermal_network.coil_alpha_per_K=0.004"});
+  const auto back2 = gmasim::parse_model_spec(gmasim::model_toml(again, "test"), "saved");
+  EXPECT_EQ(back2.params.at("thermal_network.coil_alpha_per_K").value, 0.004);
+  EXPECT_EQ(back2.params.at("thermal_network.coil_resistance_ohm").value, 2.25);
+}
