@@ -185,7 +185,8 @@ TEST(ModelFile, DescribeGivesProvenanceForEveryParameter) {
   const auto spec = gmasim::builtin_model_spec();  // the real built-in file: its provenance
   const auto rows = gmasim::describe_model(spec);
   const std::vector<std::string> prefixes = {"Table",     "eq.",     "derived",    "literature",
-                                             "judgement", "section", "identified", "inferred"};
+                                             "judgement", "section", "identified", "inferred",
+                                             "default"};  // [thermal_network] defaults
   std::size_t numeric = 0;
   long previous_line = 0;
   for (const auto& row : rows) {
