@@ -57,7 +57,8 @@ TEST(ThermalNetwork, BackwardEulerIsFirstOrder) {
   const auto n = network();
   auto run = [&](int steps) {
     gmasim::NodeTemperatures T{20, 20, 20};
-    for (int k = 0; k < steps; ++k) gmasim::thermal_network_step(n, T, 15.0, 0.2, 20.0, 600.0 / steps);
+    for (int k = 0; k < steps; ++k)
+      gmasim::thermal_network_step(n, T, 15.0, 0.2, 20.0, 600.0 / steps);
     return T.rods_C;
   };
   const double ref = run(64000);
@@ -91,9 +92,10 @@ gmasim::SimulationSettings heated(double periods) {
 TEST(SelfHeating, EnergyBalanceAndCopperLossOfTheCoupledRun) {
   // Small capacities so that 3 s of operation heat the actuator by tens of kelvin.
   const gmasim::ModelSpec spec = gmasim::apply_assignments(
-      gmasim::builtin_model_spec(),
-      {"thermal_network.coil_heat_capacity_J_per_K=2", "thermal_network.rod_specific_heat_J_per_kg_K=20",
-       "thermal_network.housing_heat_capacity_J_per_K=4", "thermal_network.coil_to_rods_W_per_K=5"});
+      gmasim::builtin_model_spec(), {"thermal_network.coil_heat_capacity_J_per_K=2",
+                                     "thermal_network.rod_specific_heat_J_per_kg_K=20",
+                                     "thermal_network.housing_heat_capacity_J_per_K=4",
+                                     "thermal_network.coil_to_rods_W_per_K=5"});
   const gmasim::Model m = gmasim::compile(spec);
   const gmasim::SimulationSettings s = heated(60.0);
   const gmasim::Result r = gmasim::simulate(m, s);
@@ -122,9 +124,9 @@ TEST(SelfHeating, EnergyBalanceAndCopperLossOfTheCoupledRun) {
 
 TEST(SelfHeating, HugeCapacitiesLeaveTheRunUnchanged) {
   const gmasim::ModelSpec spec = gmasim::apply_assignments(
-      gmasim::builtin_model_spec(),
-      {"thermal_network.coil_heat_capacity_J_per_K=1e12", "thermal_network.rod_specific_heat_J_per_kg_K=1e14",
-       "thermal_network.housing_heat_capacity_J_per_K=1e12"});
+      gmasim::builtin_model_spec(), {"thermal_network.coil_heat_capacity_J_per_K=1e12",
+                                     "thermal_network.rod_specific_heat_J_per_kg_K=1e14",
+                                     "thermal_network.housing_heat_capacity_J_per_K=1e12"});
   const gmasim::Model m = gmasim::compile(spec);
   gmasim::SimulationSettings s = heated(3.0);
   const gmasim::Result hot = gmasim::simulate(m, s);

@@ -30,8 +30,8 @@ void print_schedule(const CompensateArgs& a, const CompensateResult& res) {
       res.target_stroke_um,
       r.target_stroke_um > 0.0
           ? std::string("given")
-          : fmt::format("{} A p-p from {} A at {} degC", r.reference_current_pp_A,
-                        r.current_min_A, r.reference_temperature_C),
+          : fmt::format("{} A p-p from {} A at {} degC", r.reference_current_pp_A, r.current_min_A,
+                        r.reference_temperature_C),
       r.frequency_Hz,
       a.adjust == "amplitude" ? "the p-p (minimum held)"
       : a.adjust == "swing"   ? "the p-p about the mean"
@@ -90,8 +90,7 @@ int run_compensate_cmd(CompensateArgs& a) {
   if (!a.no_track)
     tr = std::make_unique<CompensatedTrack>(run_compensated_track(
         model, a.req, a.track, stderr_progress("compensate track", a.progress)));
-  auto files =
-      write_report(a.out, "compensate", compensate_report(model, a.req, res, tr.get()));
+  auto files = write_report(a.out, "compensate", compensate_report(model, a.req, res, tr.get()));
   fmt::print("gmasim compensate  model: {}\n", model_label(a.model));
   print_schedule(a, res);
   if (tr) print_track(*tr);
@@ -156,8 +155,7 @@ Runner add_compensate(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--bias", a->track.bias_A, "Tracking: coil bias current [A]")
       ->capture_default_str();
-  sub->add_option("--current-limit", a->track.current_limit_A,
-                  "Tracking: amplifier limit +- [A]")
+  sub->add_option("--current-limit", a->track.current_limit_A, "Tracking: amplifier limit +- [A]")
       ->capture_default_str();
   sub->add_flag("--progress", a->progress, "Progress on stderr even when it is not a terminal");
   sub->add_flag("--plot", a->plot, "Also draw compensate.png (matplotlib)");

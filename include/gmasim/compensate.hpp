@@ -37,11 +37,11 @@ struct CompensateRequest {
 struct CompensatePoint {
   double temperature_C = 0;
   double current_pp_A = 0, current_min_A = 0, current_max_A = 0;  // the compensated drive
-  double gain = 0;                   // pp / pp_ref (Amplitude, Swing) or g (Scale) [-]
-  double stroke_um = 0;              // with the compensated drive
-  double uncompensated_stroke_um = 0;  // with the reference drive at this temperature
+  double gain = 0;                       // pp / pp_ref (Amplitude, Swing) or g (Scale) [-]
+  double stroke_um = 0;                  // with the compensated drive
+  double uncompensated_stroke_um = 0;    // with the reference drive at this temperature
   double hysteresis_um = 0, B_pp_T = 0;  // with the compensated drive
-  int evaluations = 0;               // simulations of the root search
+  int evaluations = 0;                   // simulations of the root search
   bool reachable = true;  // false: even max_current_A gives less than the target (the point
                           // then holds that largest drive and its stroke)
   bool diverged = false;

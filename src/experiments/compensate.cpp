@@ -34,8 +34,8 @@ double max_drive(const CompensateRequest& r) {
   if (r.adjust == CompensationAdjust::Amplitude) return r.max_current_A - r.current_min_A;
   if (r.adjust == CompensationAdjust::Swing)
     return 2.0 * (r.max_current_A - std::fabs(r.current_min_A + 0.5 * r.reference_current_pp_A));
-  const double peak = std::max(std::fabs(r.current_min_A),
-                               std::fabs(r.current_min_A + r.reference_current_pp_A));
+  const double peak =
+      std::max(std::fabs(r.current_min_A), std::fabs(r.current_min_A + r.reference_current_pp_A));
   return r.max_current_A / peak;
 }
 
@@ -162,12 +162,12 @@ CompensateResult run_compensate(const Model& m, const CompensateRequest& r,
               // Stop when the bracket is narrower than the drive change that moves the stroke
               // by the tolerance (secant slope of the bracket).
               auto tol = [&](double lo, double hi) {
-                return hi - lo <= 1e-12 * hi || (hi - lo) * (fb - fa) / (b - a) < 0.5 * r.tolerance_um;
+                return hi - lo <= 1e-12 * hi ||
+                       (hi - lo) * (fb - fa) / (b - a) < 0.5 * r.tolerance_um;
               };
               std::uintmax_t iters = 60;
               const auto [lo, hi] = boost::math::tools::toms748_solve(
-                  [&](double v) { return stroke(v).stroke_um - target; }, a, b, fa, fb, tol,
-                  iters);
+                  [&](double v) { return stroke(v).stroke_um - target; }, a, b, fa, fb, tol, iters);
               x = 0.5 * (lo + hi);
             }
           }
@@ -239,8 +239,8 @@ Report compensate_report(const Model& m, const CompensateRequest& req, const Com
   r.experiment = "compensate";
   r.meta.emplace_back("model", m.spec.source);
   r.meta.emplace_back("adjust", req.adjust == CompensationAdjust::Amplitude ? "amplitude"
-                               : req.adjust == CompensationAdjust::Swing   ? "swing"
-                                                                           : "scale");
+                                : req.adjust == CompensationAdjust::Swing   ? "swing"
+                                                                            : "scale");
   r.meta.emplace_back("reference_temperature_C", req.reference_temperature_C);
   r.meta.emplace_back("reference_current_pp_A", req.reference_current_pp_A);
   r.meta.emplace_back("reference_current_min_A", req.current_min_A);
@@ -252,9 +252,19 @@ Report compensate_report(const Model& m, const CompensateRequest& req, const Com
   r.meta.emplace_back("wall_time_s", res.wall_time_s);
   Table t;
   t.name = "schedule";
-  t.columns = {"temperature_C", "current_pp_A",  "current_min_A", "current_max_A",
-               "gain",          "stroke_um",     "uncompensated_stroke_um",
-               "hysteresis_um", "B_pp_T",        "evaluations",   "reachable", "status", "error"};
+  t.columns = {"temperature_C",
+               "current_pp_A",
+               "current_min_A",
+               "current_max_A",
+               "gain",
+               "stroke_um",
+               "uncompensated_stroke_um",
+               "hysteresis_um",
+               "B_pp_T",
+               "evaluations",
+               "reachable",
+               "status",
+               "error"};
   const double nan = std::nan("");
   for (const auto& p : res.points) {
     const bool ok = !p.diverged;
@@ -269,16 +279,16 @@ Report compensate_report(const Model& m, const CompensateRequest& req, const Com
     r.meta.emplace_back("track_static_gain_um_per_A", track->static_gain_um_per_A);
     Table k;
     k.name = "track";
-    k.columns = {"temperature_C",        "amplitude_um",          "frequency_Hz",
-                 "error_rms_um_pid",     "error_rms_um_ff",       "error_change_pct_pid",
-                 "error_change_pct_ff",  "feedforward_gain",      "saturated_pid",
+    k.columns = {"temperature_C",       "amplitude_um",     "frequency_Hz",
+                 "error_rms_um_pid",    "error_rms_um_ff",  "error_change_pct_pid",
+                 "error_change_pct_ff", "feedforward_gain", "saturated_pid",
                  "saturated_ff"};
     for (std::size_t i = 0; i < track->plain.points.size(); ++i) {
       const TrackPoint& a = track->plain.points[i];
       const TrackPoint& b = track->compensated.points[i];
       k.rows.push_back({a.temperature_C, a.amplitude_um, a.frequency_Hz, a.error_rms_um,
-                        b.error_rms_um, a.error_change_pct, b.error_change_pct,
-                        b.feedforward_gain, a.saturated, b.saturated});
+                        b.error_rms_um, a.error_change_pct, b.error_change_pct, b.feedforward_gain,
+                        a.saturated, b.saturated});
     }
     r.tables.push_back(std::move(k));
   }

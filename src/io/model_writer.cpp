@@ -94,9 +94,10 @@ ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assi
     const std::string shown = clip_for_message(a);
     const auto eq = a.find('=');
     if (eq == std::string::npos || eq == 0)
-      throw InputError(fmt::format("{} '{}': expected name=value (e.g. material.Ms_A_per_m=7e5 or "
-                                   "options.magnetic_state=printed)",
-                                   flag, shown));
+      throw InputError(
+          fmt::format("{} '{}': expected name=value (e.g. material.Ms_A_per_m=7e5 or "
+                      "options.magnetic_state=printed)",
+                      flag, shown));
     const std::string name(io_detail::trim(std::string_view(a).substr(0, eq)));
     const std::string value(io_detail::trim(std::string_view(a).substr(eq + 1)));
     if (name.starts_with("options.")) {
@@ -128,11 +129,10 @@ std::string model_toml(const ModelSpec& spec, const std::string& why) {
   for (const auto& [name, pv] : spec.params) {
     const auto it = original.params.find(name);
     if (it == original.params.end())
-      throw InputError(fmt::format("{}: parameter '{}' is not in its source text", spec.source,
-                                   name));
+      throw InputError(
+          fmt::format("{}: parameter '{}' is not in its source text", spec.source, name));
     const ParamValue& was = it->second;
-    if (std::bit_cast<std::uint64_t>(was.value) == std::bit_cast<std::uint64_t>(pv.value))
-      continue;
+    if (std::bit_cast<std::uint64_t>(was.value) == std::bit_cast<std::uint64_t>(pv.value)) continue;
     const std::string comment =
         fmt::format("set: {}; was {}{}", why, schema::toml_float(was.value),
                     was.provenance.empty() ? "" : fmt::format(" ({})", was.provenance));
@@ -168,7 +168,8 @@ std::string model_toml(const ModelSpec& spec, const std::string& why) {
       appended += fmt::format("\n[{}]  # added by: {}\n{}\n", table, why, block);
     }
   }
-  std::sort(inserts.begin(), inserts.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::sort(inserts.begin(), inserts.end(),
+            [](const auto& a, const auto& b) { return a.first > b.first; });
   for (const auto& [line_no, block] : inserts)
     lines.insert(lines.begin() + std::min<long>(line_no, static_cast<long>(lines.size())), block);
   std::string text;

@@ -67,8 +67,8 @@ double stored_heat_J(const ThermalNetworkModel& n, const NodeTemperatures& T,
 
 double fastest_time_constant_s(const ThermalNetworkModel& n) {
   const Eigen::Matrix3d G = conductance(n);
-  return std::min({n.coil_C_J_per_K / G(0, 0), n.rods_C_J_per_K / G(1, 1),
-                   n.housing_C_J_per_K / G(2, 2)});
+  return std::min(
+      {n.coil_C_J_per_K / G(0, 0), n.rods_C_J_per_K / G(1, 1), n.housing_C_J_per_K / G(2, 2)});
 }
 
 }  // namespace gmasim
