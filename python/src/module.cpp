@@ -155,4 +155,5 @@ PYBIND11_MODULE(_gmasim, mod) {
           py::arg("freeze") = std::vector<std::string>{}, py::arg("quantities") = std::vector<std::string>{},
           "Time-domain run. Returns {'series': {column: ndarray}, 'metrics': {...}, ...}");
   gmasim::py_bind::bind_experiments(mod);
+  gmasim::py_bind::bind_stepper(mod);
 }
