@@ -14,8 +14,9 @@ using gmasim_test::g_counting;
 
 #if defined(GMASIM_SANITIZE)
 // Declared here: GCC does not ship <sanitizer/allocator_interface.h>; libasan exports it.
-extern "C" int __sanitizer_install_malloc_and_free_hooks(
-    void (*malloc_hook)(const volatile void*, std::size_t), void (*free_hook)(const volatile void*));
+extern "C" int __sanitizer_install_malloc_and_free_hooks(void (*malloc_hook)(const volatile void*,
+                                                                             std::size_t),
+                                                         void (*free_hook)(const volatile void*));
 namespace {
 void count_malloc(const volatile void*, std::size_t) {
   if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);

@@ -107,7 +107,8 @@ TEST(CApi, SteppingIsBitIdenticalToGmasimStep) {
     const double t = static_cast<double>(k) * dt;
     gmasim::step(model, c, st, {w.current_at(t), dt});
     st.t_s = t;
-    ASSERT_EQ(gmasim_sim_step(s.get(), w.current_at(t)), GMASIM_OK) << gmasim_sim_last_error(s.get());
+    ASSERT_EQ(gmasim_sim_step(s.get(), w.current_at(t)), GMASIM_OK)
+        << gmasim_sim_last_error(s.get());
     gmasim_outputs o;
     ASSERT_EQ(gmasim_sim_outputs(s.get(), &o), GMASIM_OK);
     mismatches += std::memcmp(&o.y_m, &st.y_m, sizeof(double)) != 0;

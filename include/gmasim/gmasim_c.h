@@ -150,8 +150,8 @@ GMASIM_API int gmasim_sim_dt_s(const gmasim_sim* sim, double* out);          /* 
 GMASIM_API int gmasim_sim_steps(const gmasim_sim* sim, long* out);           /* steps taken */
 GMASIM_API int gmasim_sim_current_A(const gmasim_sim* sim, double* out);     /* coil [A] */
 GMASIM_API int gmasim_sim_temperature_C(const gmasim_sim* sim, double* out); /* [degC] */
-GMASIM_API int gmasim_sim_y_m(const gmasim_sim* sim, double* out);   /* output [m] */
-GMASIM_API int gmasim_sim_y_um(const gmasim_sim* sim, double* out);  /* output [um] */
+GMASIM_API int gmasim_sim_y_m(const gmasim_sim* sim, double* out);           /* output [m] */
+GMASIM_API int gmasim_sim_y_um(const gmasim_sim* sim, double* out);          /* output [um] */
 GMASIM_API int gmasim_sim_B_T(const gmasim_sim* sim, double* out);   /* coil flux density [T] */
 GMASIM_API int gmasim_sim_diverged(const gmasim_sim* sim, int* out); /* 1 if stopped, else 0 */
 GMASIM_API int gmasim_sim_rod_count(const gmasim_sim* sim, int* out);

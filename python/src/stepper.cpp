@@ -1,6 +1,8 @@
 // gmasim.Stepper: the actuator stepped sample by sample from Python (gmasim::Stepper, the
 // session under the C API too). Also the module's __version__ (bind_stepper is the module's
 // one hook for this file).
+#include "gmasim/stepper.hpp"
+
 #include <fmt/format.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -14,7 +16,6 @@
 #include "bindings.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/simulate.hpp"
-#include "gmasim/stepper.hpp"
 #include "gmasim/version.h"
 
 namespace py = pybind11;
@@ -42,12 +43,12 @@ class PyStepper {
   // After a divergence Stepper::step refuses with a DivergenceError naming the first one.
   double step(double current_A) { return get().step(current_A) * 1e6; }
 
-  py::array_t<double> run(const py::array_t<double, py::array::c_style | py::array::forcecast>& in) {
+  py::array_t<double> run(
+      const py::array_t<double, py::array::c_style | py::array::forcecast>& in) {
     Stepper& s = get();
     if (in.ndim() != 1)
       throw InputError(fmt::format(
-          "Stepper.run: currents_A must be a 1-D array of coil currents [A], not {}-D",
-          in.ndim()));
+          "Stepper.run: currents_A must be a 1-D array of coil currents [A], not {}-D", in.ndim()));
     const double* I = in.data();
     const py::ssize_t n = in.shape(0);
     // Every sample is checked before the first step: a bad one leaves the stepper untouched.
@@ -144,38 +145,43 @@ gmasim.DivergenceError, after which step() refuses until reset().)doc")
       .def("run", &PyStepper::run, py::arg("currents_A"),
            "One step per sample of the 1-D array currents_A [A], without the GIL; returns the "
            "ndarray of y [um] after each step. Every sample is checked first.")
-      .def("reset", [](PyStepper& s, double current_A) { s.get().reset(current_A); },
-           py::arg("current_A") = 0.0,
-           "Back to t = 0 at rest under current_A [A] at the present temperature; clears a "
-           "divergence.")
-      .def("set_temperature",
-           [](PyStepper& s, double temperature_C) { s.get().set_temperature(temperature_C); },
-           py::arg("temperature_C"),
-           "Recompute the temperature-dependent constants at temperature_C [degC]; the state, "
-           "t_s and steps carry on.")
+      .def(
+          "reset", [](PyStepper& s, double current_A) { s.get().reset(current_A); },
+          py::arg("current_A") = 0.0,
+          "Back to t = 0 at rest under current_A [A] at the present temperature; clears a "
+          "divergence.")
+      .def(
+          "set_temperature",
+          [](PyStepper& s, double temperature_C) { s.get().set_temperature(temperature_C); },
+          py::arg("temperature_C"),
+          "Recompute the temperature-dependent constants at temperature_C [degC]; the state, "
+          "t_s and steps carry on.")
       .def("outputs", &PyStepper::outputs,
            "Every quantity simulate() records, under its column names (y_um, B_T, rod1_F_N, "
            "...), plus temperature_C, dt_s and steps.")
-      .def_property_readonly("t_s", [](const PyStepper& s) { return s.get().t_s(); },
-                             "Time since creation/reset [s]")
-      .def_property_readonly("y_um", [](const PyStepper& s) { return s.get().y_m() * 1e6; },
-                             "Output displacement [um]")
-      .def_property_readonly("y_m", [](const PyStepper& s) { return s.get().y_m(); },
-                             "Output displacement [m]")
-      .def_property_readonly("B_T", [](const PyStepper& s) { return s.get().B_T(); },
-                             "Flux density seen by the induction coil [T]")
-      .def_property_readonly("current_A",
-                             [](const PyStepper& s) { return s.get().state().current_A; },
-                             "Coil current at t_s [A]")
-      .def_property_readonly("temperature_C",
-                             [](const PyStepper& s) { return s.get().temperature_C(); },
-                             "Operating temperature [degC]")
-      .def_property_readonly("dt_s", [](const PyStepper& s) { return s.get().dt_s(); },
-                             "Time step [s]")
-      .def_property_readonly("steps", [](const PyStepper& s) { return s.get().steps(); },
-                             "Steps since creation/reset")
-      .def_property_readonly("diverged", [](const PyStepper& s) { return s.get().diverged(); },
-                             "True after a divergence, until reset()")
+      .def_property_readonly(
+          "t_s", [](const PyStepper& s) { return s.get().t_s(); }, "Time since creation/reset [s]")
+      .def_property_readonly(
+          "y_um", [](const PyStepper& s) { return s.get().y_m() * 1e6; },
+          "Output displacement [um]")
+      .def_property_readonly(
+          "y_m", [](const PyStepper& s) { return s.get().y_m(); }, "Output displacement [m]")
+      .def_property_readonly(
+          "B_T", [](const PyStepper& s) { return s.get().B_T(); },
+          "Flux density seen by the induction coil [T]")
+      .def_property_readonly(
+          "current_A", [](const PyStepper& s) { return s.get().state().current_A; },
+          "Coil current at t_s [A]")
+      .def_property_readonly(
+          "temperature_C", [](const PyStepper& s) { return s.get().temperature_C(); },
+          "Operating temperature [degC]")
+      .def_property_readonly(
+          "dt_s", [](const PyStepper& s) { return s.get().dt_s(); }, "Time step [s]")
+      .def_property_readonly(
+          "steps", [](const PyStepper& s) { return s.get().steps(); }, "Steps since creation/reset")
+      .def_property_readonly(
+          "diverged", [](const PyStepper& s) { return s.get().diverged(); },
+          "True after a divergence, until reset()")
       .def_property_readonly(
           "rod_forces_N",
           [](const PyStepper& s) { return s.per_rod([](const RodState& r) { return r.F_N; }); },
@@ -184,15 +190,16 @@ gmasim.DivergenceError, after which step() refuses until reset().)doc")
           "rod_strains",
           [](const PyStepper& s) { return s.per_rod([](const RodState& r) { return r.lambda; }); },
           "Magnetostrictive strain lambda of each rod, eq. (11) [-]")
-      .def_property_readonly("rod_magnetisations_A_per_m",
-                             [](const PyStepper& s) {
-                               return s.per_rod([](const RodState& r) { return r.M_A_per_m; });
-                             },
-                             "Magnetisation M of each rod [A/m]")
+      .def_property_readonly(
+          "rod_magnetisations_A_per_m",
+          [](const PyStepper& s) {
+            return s.per_rod([](const RodState& r) { return r.M_A_per_m; });
+          },
+          "Magnetisation M of each rod [A/m]")
       .def("__repr__", [](const PyStepper& s) {
         const Stepper& st = s.get();
-        return "gmasim.Stepper(model='" + st.model().spec.source + "', temperature_C=" +
-               py::repr(py::float_(st.temperature_C())).cast<std::string>() +
+        return "gmasim.Stepper(model='" + st.model().spec.source +
+               "', temperature_C=" + py::repr(py::float_(st.temperature_C())).cast<std::string>() +
                ", dt_s=" + py::repr(py::float_(st.dt_s())).cast<std::string>() +
                ", t_s=" + py::repr(py::float_(st.t_s())).cast<std::string>() + ")";
       });

@@ -1,7 +1,5 @@
 // The C API (gmasim/gmasim_c.h) over gmasim::Stepper: status codes instead of exceptions, error
 // messages in fixed buffers (setting one allocates nothing), no exception crosses the boundary.
-#include "gmasim/gmasim_c.h"
-
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -11,6 +9,7 @@
 #include <string>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/gmasim_c.h"
 #include "gmasim/io.hpp"
 #include "gmasim/simulate.hpp"
 #include "gmasim/stepper.hpp"
@@ -147,12 +146,18 @@ const char* gmasim_git_describe(void) { return GMASIM_GIT_DESCRIBE; }
 
 const char* gmasim_status_name(int status) {
   switch (status) {
-    case GMASIM_OK: return "GMASIM_OK";
-    case GMASIM_E_INPUT: return "GMASIM_E_INPUT";
-    case GMASIM_E_DIVERGED: return "GMASIM_E_DIVERGED";
-    case GMASIM_E_ARGUMENT: return "GMASIM_E_ARGUMENT";
-    case GMASIM_E_INTERNAL: return "GMASIM_E_INTERNAL";
-    default: return "unknown status";
+    case GMASIM_OK:
+      return "GMASIM_OK";
+    case GMASIM_E_INPUT:
+      return "GMASIM_E_INPUT";
+    case GMASIM_E_DIVERGED:
+      return "GMASIM_E_DIVERGED";
+    case GMASIM_E_ARGUMENT:
+      return "GMASIM_E_ARGUMENT";
+    case GMASIM_E_INTERNAL:
+      return "GMASIM_E_INTERNAL";
+    default:
+      return "unknown status";
   }
 }
 
@@ -295,8 +300,7 @@ int gmasim_sim_y_m(const gmasim_sim* sim, double* out) {
 }
 
 int gmasim_sim_y_um(const gmasim_sim* sim, double* out) {
-  return get(sim, out, "gmasim_sim_y_um",
-             [](const gmasim::Stepper& s) { return s.y_m() * 1e6; });
+  return get(sim, out, "gmasim_sim_y_um", [](const gmasim::Stepper& s) { return s.y_m() * 1e6; });
 }
 
 int gmasim_sim_B_T(const gmasim_sim* sim, double* out) {

@@ -11,21 +11,21 @@
 
 static int failures = 0;
 
-#define CHECK(cond, ...)                             \
-  do {                                               \
-    if (!(cond)) {                                   \
-      ++failures;                                    \
+#define CHECK(cond, ...)                                   \
+  do {                                                     \
+    if (!(cond)) {                                         \
+      ++failures;                                          \
       fprintf(stderr, "FAIL %s:%d: ", __FILE__, __LINE__); \
-      fprintf(stderr, __VA_ARGS__);                  \
-      fprintf(stderr, "\n");                         \
-    }                                                \
+      fprintf(stderr, __VA_ARGS__);                        \
+      fprintf(stderr, "\n");                               \
+    }                                                      \
   } while (0)
 
-#define CHECK_STATUS(call, want)                                                       \
-  do {                                                                                 \
-    const int rc_ = (call);                                                            \
-    CHECK(rc_ == (want), "%s returned %s, expected %s (%s)", #call,                    \
-          gmasim_status_name(rc_), gmasim_status_name(want), gmasim_last_error());     \
+#define CHECK_STATUS(call, want)                                                             \
+  do {                                                                                       \
+    const int rc_ = (call);                                                                  \
+    CHECK(rc_ == (want), "%s returned %s, expected %s (%s)", #call, gmasim_status_name(rc_), \
+          gmasim_status_name(want), gmasim_last_error());                                    \
   } while (0)
 
 static const double kPi = 3.14159265358979323846;
@@ -62,9 +62,10 @@ static void run_sine(const gmasim_model* model) {
   }
   CHECK_STATUS(gmasim_sim_time_s(sim, &t_s), GMASIM_OK);
   CHECK(fabs(t_s - 0.1) < 1e-12, "t = %.15g s after %ld steps, expected 0.1 s", t_s, steps);
-  printf("10 Hz biased sine, -3..5 A, 20 degC, one period: stroke %.3f um (y %.3f..%.3f um), "
-         "B %.4f..%.4f T\n",
-         y_max - y_min, y_min, y_max, B_min, B_max);
+  printf(
+      "10 Hz biased sine, -3..5 A, 20 degC, one period: stroke %.3f um (y %.3f..%.3f um), "
+      "B %.4f..%.4f T\n",
+      y_max - y_min, y_min, y_max, B_min, B_max);
   /* The MDMA prototype strokes tens of micrometres at 8 A peak-to-peak (Fig. 11-12). */
   CHECK(y_max - y_min > 10.0 && y_max - y_min < 200.0, "stroke %.3f um outside (10, 200) um",
         y_max - y_min);
@@ -77,8 +78,8 @@ static void run_sine(const gmasim_model* model) {
     CHECK_STATUS(gmasim_sim_rod_force_N(sim, r, &F), GMASIM_OK);
     CHECK_STATUS(gmasim_sim_rod_strain(sim, r, &lambda), GMASIM_OK);
     CHECK_STATUS(gmasim_sim_rod_magnetisation_A_per_m(sim, r, &M), GMASIM_OK);
-    CHECK(isfinite(F) && isfinite(lambda) && isfinite(M), "rod %d: F %g N, lambda %g, M %g A/m",
-          r, F, lambda, M);
+    CHECK(isfinite(F) && isfinite(lambda) && isfinite(M), "rod %d: F %g N, lambda %g, M %g A/m", r,
+          F, lambda, M);
     CHECK(F == out.rod_F_N[r] && lambda == out.rod_strain[r] && M == out.rod_M_A_per_m[r],
           "rod %d: getters disagree with gmasim_sim_outputs", r);
   }
@@ -126,7 +127,9 @@ int main(void) {
   run_sine(model);
   error_paths(model);
   gmasim_model_free(model);
-  if (failures) fprintf(stderr, "%d check(s) failed\n", failures);
-  else printf("all checks passed\n");
+  if (failures)
+    fprintf(stderr, "%d check(s) failed\n", failures);
+  else
+    printf("all checks passed\n");
   return failures ? 1 : 0;
 }
