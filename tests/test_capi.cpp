@@ -288,7 +288,7 @@ TEST(CApi, BadNumbersAreRefusedAndLeaveTheSimUntouched) {
   EXPECT_EQ(gmasim_sim_create(m.get(), 20.0, 0.0, 0.0, &bad), GMASIM_E_INPUT);
   EXPECT_THAT(gmasim_last_error(), HasSubstr("time step dt = 0 s: must be > 0"));
   EXPECT_EQ(gmasim_sim_create(m.get(), 20.0, 2e-3, 0.0, &bad), GMASIM_E_INPUT);
-  EXPECT_THAT(gmasim_last_error(), HasSubstr("time step dt = 0.002 s: must be in [0 s, 0.001 s]"));
+  EXPECT_THAT(gmasim_last_error(), HasSubstr("time step dt = 0.002 s: must be <= 0.001 s"));
   EXPECT_EQ(gmasim_sim_create(m.get(), 20.0, -INFINITY, 0.0, &bad), GMASIM_E_ARGUMENT);
   EXPECT_EQ(gmasim_sim_create(m.get(), 20.0, 1e-5, -1001.0, &bad), GMASIM_E_INPUT);
   EXPECT_EQ(bad, nullptr);

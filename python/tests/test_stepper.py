@@ -91,7 +91,7 @@ def test_bad_numbers_raise_and_leave_the_stepper_untouched(mdma):
         gmasim.Stepper(mdma, temperature_C=400)
     with pytest.raises(gmasim.InputError, match="time step dt = 0 s: must be > 0"):
         gmasim.Stepper(mdma, dt_s=0.0)
-    with pytest.raises(gmasim.InputError, match=r"time step dt = 0.01 s: must be in \[0 s, 0.001 s\]"):
+    with pytest.raises(gmasim.InputError, match="time step dt = 0.01 s: must be <= 0.001 s"):
         gmasim.Stepper(mdma, dt_s=1e-2)
     with pytest.raises(gmasim.InputError, match="unknown law"):
         gmasim.Stepper(mdma, freeze=["nonsense"])

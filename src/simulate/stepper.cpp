@@ -24,7 +24,12 @@ double checked_current(double current_A) {
 
 double checked_dt(double dt_s) {
   require_positive(dt_s, "time step dt", "s");
-  return require_in(dt_s, 0.0, kMaxStepperDt_s, "time step dt", "s");
+  if (dt_s > kMaxStepperDt_s)
+    throw InputError(fmt::format(
+        "time step dt = {:g} s: must be <= {:g} s (a longer step resolves neither the eddy "
+        "currents nor the mechanical modes)",
+        dt_s, kMaxStepperDt_s));
+  return dt_s;
 }
 
 }  // namespace
