@@ -9,6 +9,7 @@ PACKAGES=(
   libeigen3-dev libtomlplusplus-dev libcli11-dev libfmt-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   pybind11-dev python3-dev python3-numpy python3-scipy python3-matplotlib python3-pytest
+  python3-pip python3-venv python3-setuptools python3-wheel
   libpagmo-dev libboost-serialization-dev libtbb-dev libopenmpi-dev openmpi-bin libceres-dev
   clang-format git ca-certificates
 )

@@ -14,6 +14,7 @@
 #include "commands.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
+#include "gmasim/version.h"
 
 namespace gmasim::cli {
 
@@ -75,6 +76,11 @@ int main(int argc, char** argv) {
       "model; built-in model: the MDMA prototype). SI units inside; units are named in every "
       "flag and output column."};
   app.require_subcommand(1);
+  // "gmasim 0.1.0", plus the git describe of the source tree at configure time if it had one.
+  const std::string git_describe = GMASIM_GIT_DESCRIBE;
+  app.set_version_flag("--version", std::string("gmasim " GMASIM_VERSION) +
+                                        (git_describe.empty() ? "" : " (" + git_describe + ")"),
+                       "Print the version and exit");
   std::vector<gmasim::cli::Runner> runners;
   runners.push_back(gmasim::cli::add_simulate(app));
   runners.push_back(gmasim::cli::add_model(app));

@@ -10,11 +10,16 @@ adds plotting helpers (``gmasim.plots``). Units are SI and named in every key
     r["metrics"]["stroke_um"], r["series"]["y_um"]
     s = gmasim.sweep(m, temperatures_C=[20, 70])   # {'meta', 'points': {column: ndarray}}
     gmasim.plots.sweep_vs_temperature(s["points"])
+    st = gmasim.Stepper(m, temperature_C=20, dt_s=1e-5)  # sample by sample (docs/c_api.md)
+    y_um = st.step(1.5)
 """
 from ._gmasim import *  # noqa: F401,F403
-from ._gmasim import (DivergenceError, InputError, Model, ablate, claims, compensate,  # noqa: F401
-                      frf, params_vs_temperature, simulate, sweep, thermal_expansion, track)
+from ._gmasim import (DivergenceError, InputError, Model, Stepper, ablate, claims,  # noqa: F401
+                      compensate, frf, params_vs_temperature, simulate, sweep, thermal_expansion,
+                      track)
+from ._gmasim import __git_describe__, __version__  # noqa: F401
 from . import plots  # noqa: F401
 
-__all__ = ["Model", "simulate", "sweep", "frf", "track", "compensate", "ablate", "params_vs_temperature",
+__all__ = ["Model", "Stepper", "simulate", "sweep", "frf", "track", "compensate", "ablate",
+           "params_vs_temperature",
            "thermal_expansion", "claims", "plots", "InputError", "DivergenceError"]

@@ -186,4 +186,5 @@ PYBIND11_MODULE(_gmasim, mod) {
           "self_heating=True also 'heating' (one row per thermal step: node temperatures, losses, "
           "stroke) and the energy balance (energy_in_J = energy_stored_J + energy_out_J)");
   gmasim::py_bind::bind_experiments(mod);
+  gmasim::py_bind::bind_stepper(mod);
 }

@@ -1,0 +1,368 @@
+// The C API (gmasim/gmasim_c.h) over gmasim::Stepper: status codes instead of exceptions, error
+// messages in fixed buffers (setting one allocates nothing), no exception crosses the boundary.
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <new>
+#include <string>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/gmasim_c.h"
+#include "gmasim/io.hpp"
+#include "gmasim/simulate.hpp"
+#include "gmasim/stepper.hpp"
+#include "gmasim/version.h"
+
+static_assert(GMASIM_MAX_DT_S == gmasim::kMaxStepperDt_s, "gmasim_c.h: GMASIM_MAX_DT_S");
+static_assert(GMASIM_MAX_CURRENT_A == gmasim::kMaxCurrent_A, "gmasim_c.h: GMASIM_MAX_CURRENT_A");
+
+namespace {
+
+// Room for a clipped library message (kMaxErrorChars) and the function name before it.
+constexpr std::size_t kErrorBuffer = gmasim::kMaxErrorChars + 512;
+
+struct ErrorText {
+  char text[kErrorBuffer] = {};
+};
+
+thread_local ErrorText t_last_error;
+
+}  // namespace
+
+struct gmasim_model {
+  std::shared_ptr<const gmasim::Model> model;
+  mutable ErrorText error;
+};
+
+struct gmasim_sim {
+  gmasim::Stepper stepper;
+  mutable ErrorText error;
+};
+
+namespace {
+
+// Writes "<fn>: <message>" into the thread's buffer and, if given, the handle's.
+void set_error(ErrorText* handle, const char* fn, const char* format, ...)
+    __attribute__((format(printf, 3, 4)));
+void set_error(ErrorText* handle, const char* fn, const char* format, ...) {
+  char* t = t_last_error.text;
+  const int n = std::snprintf(t, kErrorBuffer, "%s: ", fn);
+  if (n >= 0 && static_cast<std::size_t>(n) < kErrorBuffer) {
+    va_list args;
+    va_start(args, format);
+    std::vsnprintf(t + n, kErrorBuffer - static_cast<std::size_t>(n), format, args);
+    va_end(args);
+  }
+  if (handle) std::snprintf(handle->text, kErrorBuffer, "%s", t);
+}
+
+ErrorText* error_of(const gmasim_model* m) { return m ? &m->error : nullptr; }
+ErrorText* error_of(const gmasim_sim* s) { return s ? &s->error : nullptr; }
+
+// Runs f() and turns every exception into a status code and a message.
+template <class Handle, class F>
+int guarded(const Handle* h, const char* fn, F&& f) noexcept {
+  try {
+    return f();
+  } catch (const gmasim::InputError& e) {
+    set_error(error_of(h), fn, "%s", e.what());
+    return GMASIM_E_INPUT;
+  } catch (const gmasim::DivergenceError& e) {
+    set_error(error_of(h), fn, "%s", e.what());
+    return GMASIM_E_DIVERGED;
+  } catch (const std::bad_alloc&) {
+    set_error(error_of(h), fn, "out of memory");
+    return GMASIM_E_INTERNAL;
+  } catch (const std::exception& e) {
+    set_error(error_of(h), fn, "internal error: %s", e.what());
+    return GMASIM_E_INTERNAL;
+  } catch (...) {
+    set_error(error_of(h), fn, "internal error: unknown exception");
+    return GMASIM_E_INTERNAL;
+  }
+}
+
+template <class Handle>
+int null_argument(const Handle* h, const char* fn, const char* what) {
+  set_error(error_of(h), fn, "%s is NULL", what);
+  return GMASIM_E_ARGUMENT;
+}
+
+// A finite number, else GMASIM_E_ARGUMENT naming it.
+int check_finite(const gmasim_sim* h, const char* fn, const char* what, const char* unit,
+                 double v) {
+  if (std::isfinite(v)) return GMASIM_OK;
+  set_error(error_of(h), fn, "%s = %g %s: must be a finite number", what, v, unit);
+  return GMASIM_E_ARGUMENT;
+}
+
+int check_rod(const gmasim_sim* s, const char* fn, int rod) {
+  const int n = s->stepper.rod_count();
+  if (rod >= 0 && rod < n) return GMASIM_OK;
+  set_error(error_of(s), fn, "rod index %d: out of range [0, %d) (the model has %d rods)", rod, n,
+            n);
+  return GMASIM_E_ARGUMENT;
+}
+
+// Getter boilerplate: sim and out non-NULL, then *out = value(stepper).
+template <class T, class F>
+int get(const gmasim_sim* s, T* out, const char* fn, F&& value) {
+  if (!s) return null_argument(s, fn, "sim");
+  if (!out) return null_argument(s, fn, "out");
+  *out = value(s->stepper);
+  return GMASIM_OK;
+}
+
+template <class F>
+int get_rod(const gmasim_sim* s, int rod, double* out, const char* fn, F&& value) {
+  if (!s) return null_argument(s, fn, "sim");
+  if (!out) return null_argument(s, fn, "out");
+  if (const int rc = check_rod(s, fn, rod)) return rc;
+  *out = value(s->stepper.state().rods[static_cast<std::size_t>(rod)]);
+  return GMASIM_OK;
+}
+
+int load(std::shared_ptr<const gmasim::Model> (*make)(const char*, const char*), const char* a,
+         const char* b, gmasim_model** out, const char* fn) {
+  if (!out) return null_argument<gmasim_model>(nullptr, fn, "out");
+  *out = nullptr;
+  return guarded<gmasim_model>(nullptr, fn, [&] {
+    auto h = std::make_unique<gmasim_model>();
+    h->model = make(a, b);
+    *out = h.release();
+    return GMASIM_OK;
+  });
+}
+
+}  // namespace
+
+extern "C" {
+
+const char* gmasim_version(void) { return GMASIM_VERSION; }
+
+const char* gmasim_git_describe(void) { return GMASIM_GIT_DESCRIBE; }
+
+const char* gmasim_status_name(int status) {
+  switch (status) {
+    case GMASIM_OK:
+      return "GMASIM_OK";
+    case GMASIM_E_INPUT:
+      return "GMASIM_E_INPUT";
+    case GMASIM_E_DIVERGED:
+      return "GMASIM_E_DIVERGED";
+    case GMASIM_E_ARGUMENT:
+      return "GMASIM_E_ARGUMENT";
+    case GMASIM_E_INTERNAL:
+      return "GMASIM_E_INTERNAL";
+    default:
+      return "unknown status";
+  }
+}
+
+const char* gmasim_last_error(void) { return t_last_error.text; }
+
+// ---- model ------------------------------------------------------------------------------
+
+int gmasim_model_load(const char* path, gmasim_model** out) {
+  return load(
+      [](const char* p, const char*) -> std::shared_ptr<const gmasim::Model> {
+        return std::make_shared<const gmasim::Model>(gmasim::load_model(p ? p : ""));
+      },
+      path, nullptr, out, "gmasim_model_load");
+}
+
+int gmasim_model_load_string(const char* toml_text, const char* source_name, gmasim_model** out) {
+  const char* fn = "gmasim_model_load_string";
+  if (!toml_text) return null_argument<gmasim_model>(nullptr, fn, "toml_text");
+  return load(
+      [](const char* text, const char* name) -> std::shared_ptr<const gmasim::Model> {
+        const std::string source = name && *name ? name : "<string>";
+        return std::make_shared<const gmasim::Model>(
+            gmasim::compile(gmasim::parse_model_spec(text, source)));
+      },
+      toml_text, source_name, out, fn);
+}
+
+void gmasim_model_free(gmasim_model* model) { delete model; }
+
+const char* gmasim_model_last_error(const gmasim_model* model) {
+  return model ? model->error.text : "";
+}
+
+int gmasim_model_rod_count(const gmasim_model* model, int* out) {
+  const char* fn = "gmasim_model_rod_count";
+  if (!model) return null_argument(model, fn, "model");
+  if (!out) return null_argument(model, fn, "out");
+  *out = model->model->rod_count();
+  return GMASIM_OK;
+}
+
+int gmasim_model_rod_name(const gmasim_model* model, int rod, const char** out) {
+  const char* fn = "gmasim_model_rod_name";
+  if (!model) return null_argument(model, fn, "model");
+  if (!out) return null_argument(model, fn, "out");
+  const int n = model->model->rod_count();
+  if (rod < 0 || rod >= n) {
+    set_error(&model->error, fn, "rod index %d: out of range [0, %d) (the model has %d rods)", rod,
+              n, n);
+    return GMASIM_E_ARGUMENT;
+  }
+  *out = model->model->rods[static_cast<std::size_t>(rod)].name.c_str();
+  return GMASIM_OK;
+}
+
+// ---- sim --------------------------------------------------------------------------------
+
+int gmasim_sim_create(const gmasim_model* model, double temperature_C, double dt_s,
+                      double current_A, gmasim_sim** out) {
+  const char* fn = "gmasim_sim_create";
+  if (!out) return null_argument<gmasim_sim>(nullptr, fn, "out");
+  *out = nullptr;
+  if (!model) return null_argument<gmasim_sim>(nullptr, fn, "model");
+  if (int rc = check_finite(nullptr, fn, "temperature", "degC", temperature_C)) return rc;
+  if (int rc = check_finite(nullptr, fn, "time step dt", "s", dt_s)) return rc;
+  if (int rc = check_finite(nullptr, fn, "coil current", "A", current_A)) return rc;
+  return guarded<gmasim_sim>(nullptr, fn, [&] {
+    auto h = std::unique_ptr<gmasim_sim>(
+        new gmasim_sim{gmasim::Stepper(model->model, temperature_C, dt_s, current_A), {}});
+    *out = h.release();
+    return GMASIM_OK;
+  });
+}
+
+void gmasim_sim_free(gmasim_sim* sim) { delete sim; }
+
+const char* gmasim_sim_last_error(const gmasim_sim* sim) { return sim ? sim->error.text : ""; }
+
+int gmasim_sim_reset(gmasim_sim* sim, double current_A) {
+  const char* fn = "gmasim_sim_reset";
+  if (!sim) return null_argument(sim, fn, "sim");
+  if (int rc = check_finite(sim, fn, "coil current", "A", current_A)) return rc;
+  return guarded(sim, fn, [&] {
+    sim->stepper.reset(current_A);
+    return GMASIM_OK;
+  });
+}
+
+int gmasim_sim_step(gmasim_sim* sim, double current_A) {
+  const char* fn = "gmasim_sim_step";
+  if (!sim) return null_argument(sim, fn, "sim");
+  if (int rc = check_finite(sim, fn, "coil current", "A", current_A)) return rc;
+  if (sim->stepper.diverged()) {
+    set_error(&sim->error, fn,
+              "refused: the sim diverged earlier (%s); call gmasim_sim_reset before stepping "
+              "again",
+              sim->stepper.divergence_message().c_str());
+    return GMASIM_E_DIVERGED;
+  }
+  return guarded(sim, fn, [&] {
+    sim->stepper.step(current_A);
+    return GMASIM_OK;
+  });
+}
+
+int gmasim_sim_set_temperature(gmasim_sim* sim, double temperature_C) {
+  const char* fn = "gmasim_sim_set_temperature";
+  if (!sim) return null_argument(sim, fn, "sim");
+  if (int rc = check_finite(sim, fn, "temperature", "degC", temperature_C)) return rc;
+  return guarded(sim, fn, [&] {
+    sim->stepper.set_temperature(temperature_C);
+    return GMASIM_OK;
+  });
+}
+
+int gmasim_sim_time_s(const gmasim_sim* sim, double* out) {
+  return get(sim, out, "gmasim_sim_time_s", [](const gmasim::Stepper& s) { return s.t_s(); });
+}
+
+int gmasim_sim_dt_s(const gmasim_sim* sim, double* out) {
+  return get(sim, out, "gmasim_sim_dt_s", [](const gmasim::Stepper& s) { return s.dt_s(); });
+}
+
+int gmasim_sim_steps(const gmasim_sim* sim, long* out) {
+  return get(sim, out, "gmasim_sim_steps", [](const gmasim::Stepper& s) { return s.steps(); });
+}
+
+int gmasim_sim_current_A(const gmasim_sim* sim, double* out) {
+  return get(sim, out, "gmasim_sim_current_A",
+             [](const gmasim::Stepper& s) { return s.state().current_A; });
+}
+
+int gmasim_sim_temperature_C(const gmasim_sim* sim, double* out) {
+  return get(sim, out, "gmasim_sim_temperature_C",
+             [](const gmasim::Stepper& s) { return s.temperature_C(); });
+}
+
+int gmasim_sim_y_m(const gmasim_sim* sim, double* out) {
+  return get(sim, out, "gmasim_sim_y_m", [](const gmasim::Stepper& s) { return s.y_m(); });
+}
+
+int gmasim_sim_y_um(const gmasim_sim* sim, double* out) {
+  return get(sim, out, "gmasim_sim_y_um", [](const gmasim::Stepper& s) { return s.y_m() * 1e6; });
+}
+
+int gmasim_sim_B_T(const gmasim_sim* sim, double* out) {
+  return get(sim, out, "gmasim_sim_B_T", [](const gmasim::Stepper& s) { return s.B_T(); });
+}
+
+int gmasim_sim_diverged(const gmasim_sim* sim, int* out) {
+  return get(sim, out, "gmasim_sim_diverged",
+             [](const gmasim::Stepper& s) { return s.diverged() ? 1 : 0; });
+}
+
+int gmasim_sim_rod_count(const gmasim_sim* sim, int* out) {
+  return get(sim, out, "gmasim_sim_rod_count",
+             [](const gmasim::Stepper& s) { return s.rod_count(); });
+}
+
+int gmasim_sim_rod_force_N(const gmasim_sim* sim, int rod, double* out) {
+  return get_rod(sim, rod, out, "gmasim_sim_rod_force_N",
+                 [](const gmasim::RodState& r) { return r.F_N; });
+}
+
+int gmasim_sim_rod_strain(const gmasim_sim* sim, int rod, double* out) {
+  return get_rod(sim, rod, out, "gmasim_sim_rod_strain",
+                 [](const gmasim::RodState& r) { return r.lambda; });
+}
+
+int gmasim_sim_rod_magnetisation_A_per_m(const gmasim_sim* sim, int rod, double* out) {
+  return get_rod(sim, rod, out, "gmasim_sim_rod_magnetisation_A_per_m",
+                 [](const gmasim::RodState& r) { return r.M_A_per_m; });
+}
+
+int gmasim_sim_outputs(const gmasim_sim* sim, gmasim_outputs* out) {
+  const char* fn = "gmasim_sim_outputs";
+  if (!sim) return null_argument(sim, fn, "sim");
+  if (!out) return null_argument(sim, fn, "out");
+  const gmasim::Stepper& st = sim->stepper;
+  const gmasim::State& s = st.state();
+  *out = gmasim_outputs{};
+  out->t_s = s.t_s;
+  out->dt_s = st.dt_s();
+  out->current_A = s.current_A;
+  out->temperature_C = st.temperature_C();
+  out->y_m = s.y_m;
+  out->y_um = s.y_m * 1e6;
+  out->y_stack_m = s.y_stack_m;
+  out->B_T = s.B_T;
+  out->thermal_expansion_m = st.conditions().thermal_expansion_m;
+  out->steps = st.steps();
+  out->rod_count = st.rod_count();
+  out->diverged = st.diverged() ? 1 : 0;
+  for (std::size_t i = 0; i < s.rods.size() && i < GMASIM_MAX_RODS; ++i) {
+    const gmasim::RodState& r = s.rods[i];
+    out->rod_F_N[i] = r.F_N;
+    out->rod_strain[i] = r.lambda;
+    out->rod_M_A_per_m[i] = r.M_A_per_m;
+    out->rod_H_A_per_m[i] = r.H_A_per_m;
+    out->rod_B_T[i] = r.B_T;
+    out->rod_x_m[i] = r.x_m;
+    out->rod_E_Pa[i] = r.E_Pa;
+    out->rod_mu_r[i] = r.mu_r;
+  }
+  return GMASIM_OK;
+}
+
+}  // extern "C"
