@@ -22,7 +22,7 @@ struct SimulateArgs {
   double f0_Hz = 1.0, f1_Hz = 1000.0, amplitude_A = 1.0, offset_A = 0.0, duration_s = 0.0;
   int record_every = 1;
   bool plot = false;
-  bool self_heating = false;
+  bool self_heating = false, progress = false;
   double thermal_step_s = 0.0, ambient_C = std::nan("");
   std::vector<std::string> quantities;
 };
@@ -63,6 +63,7 @@ int run_simulate(const SimulateArgs& a) {
   s.duration_s = a.duration_s;
   s.dt_s = a.dt_s;
   s.record_every = a.record_every;
+  s.progress = stderr_progress("simulate", a.progress);
   s.self_heating.enabled = a.self_heating;
   s.self_heating.thermal_step_s = a.thermal_step_s;
   s.self_heating.ambient_C = a.ambient_C;
@@ -178,6 +179,9 @@ Runner add_simulate(CLI::App& app) {
   sub->add_option(
       "--quantity", a->quantities,
       "Also report RMS, peak, p-p and mean of these columns (e.g. rod1_F_N) [column units]");
+  sub->add_flag("--progress", a->progress,
+                "Progress with ETA on stderr even when it is not a terminal (a terminal gets it "
+                "for runs over 2 s)");
   sub->add_flag("--self-heating", a->self_heating,
                 "Let the actuator heat itself: coil copper loss and rod eddy/hysteresis losses "
                 "drive the [thermal_network] (coil, rods, housing, ambient); the rods' "

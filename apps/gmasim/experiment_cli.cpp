@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -80,13 +81,23 @@ std::vector<double> parse_list(const std::string& text, const std::string& flag,
 ProgressFn stderr_progress(const std::string& label, bool force) {
   const bool tty = ::isatty(STDERR_FILENO) == 1;
   if (!tty && !force) return {};
-  return [label, tty](std::size_t done, std::size_t total) {
+  const auto t0 = std::chrono::steady_clock::now();
+  // Shown only for runs that last: nothing before 2 s have passed (unless forced), then the
+  // count, the elapsed time and the remaining time extrapolated from the rate so far.
+  return [label, tty, force, t0](std::size_t done, std::size_t total) {
+    const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (!force && el < 2.0 && done < total) return;
+    const double eta = done > 0 ? el * static_cast<double>(total - done) / static_cast<double>(done)
+                                : 0.0;
+    const std::string text = fmt::format("{}: {}/{} ({:.0f} %), {:.1f} s elapsed, ETA {:.1f} s",
+                                         label, done, total,
+                                         total ? 100.0 * static_cast<double>(done) / total : 100.0,
+                                         el, eta);
     // Serialised by the caller; a terminal gets one updating line, a pipe one line each.
     if (tty)
-      std::fprintf(stderr, "\r%s: %zu/%zu%s", label.c_str(), done, total,
-                   done == total ? "\n" : "");
+      std::fprintf(stderr, "\r%s\033[K%s", text.c_str(), done == total ? "\n" : "");
     else
-      std::fprintf(stderr, "%s: %zu/%zu\n", label.c_str(), done, total);
+      std::fprintf(stderr, "%s\n", text.c_str());
     std::fflush(stderr);
   };
 }

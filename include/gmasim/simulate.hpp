@@ -1,6 +1,7 @@
 // Excitations, the fixed-step run loop, recording and metrics.
 #pragma once
 
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -59,6 +60,8 @@ struct SimulationSettings {
   int record_every = 1;     // decimation of the recorded time series
   Freeze freeze;
   SelfHeatingSettings self_heating;
+  // Called with (steps done, steps in all) about every 1 % of the run (never inside step()).
+  std::function<void(std::size_t, std::size_t)> progress;
 };
 
 // The documented time-step rule (docs/model.md, "Time step"): a periodic run takes

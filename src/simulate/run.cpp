@@ -299,6 +299,7 @@ Result simulate(const Model& m, const SimulationSettings& s) {
     State st = make_state(m, c, w.current_at(0.0));
     record(c, st, r.series);
     heat.begin(c, st, r);
+    const long report_every = std::max(1L, nsteps / 100);
     for (long k = 1; k <= nsteps; ++k) {
       const double t = static_cast<double>(k) * dt;
       step(m, c, st, {w.current_at(t), dt});
@@ -306,6 +307,8 @@ Result simulate(const Model& m, const SimulationSettings& s) {
       if (heat.enabled) heat.after_step(m, s, c, st, dt, k == nsteps, r);
       if (k % s.record_every == 0 || k == nsteps) record(c, st, r.series);
       r.steps = k;
+      if (s.progress && (k % report_every == 0 || k == nsteps))
+        s.progress(static_cast<std::size_t>(k), static_cast<std::size_t>(nsteps));
     }
   } catch (const DivergenceError& e) {
     r.diverged = true;
