@@ -92,15 +92,6 @@ constexpr Field kSleeve[] = {
     {"A3_m2", R::Positive},
 };
 
-constexpr Field kThermal[] = {
-    {"rod_length_m", R::Positive},
-    {"magnetizer_length_m", R::Positive},
-    {"magnetizer_alpha_per_K", R::NonNegative},
-    {"output_rod_length_m", R::Positive},
-    {"output_rod_alpha_per_K", R::NonNegative},
-    {"sleeve_length_m", R::Positive},
-    {"sleeve_alpha_per_K", R::NonNegative},
-};
 
 constexpr Field kBranchNumbers[] = {{"coil_turns", R::NonNegative, "turns"}, {"pm_mmf_At", R::Any}};
 
@@ -174,6 +165,27 @@ constexpr DefaultedField kThermalNetwork[] = {
      "default: estimate, natural convection ~10 W/(m^2 K) over ~0.04 m^2"},
 };
 
+// Tables a single-rod actuator may leave out (issue 9, item 7): their keys default.
+constexpr DefaultedField kMagnetDefaults[] = {
+    {kMagnet[0], 0.0, "default: no permanent-magnet temperature coefficient (or no magnet)"},
+    {kMagnet[1], 0.0, "default: no permanent-magnet temperature coefficient (or no magnet)"},
+};
+constexpr DefaultedField kSleeveModulusDefaults[] = {
+    {kSleeveModulus[0], 200e9, "default: steel; used only by [mechanics.sleeves]"},
+    {kSleeveModulus[1], 0.0, "default: temperature-independent"},
+};
+// [thermal_expansion] (eq. 21) when absent: the rods' own expansion over the longest rod,
+// nothing else in the stack expands (rod_length_m = 0 means "the longest rod").
+constexpr DefaultedField kThermalDefaults[] = {
+    {{"rod_length_m", R::NonNegative}, 0.0, "default: 0 = the longest rod of stack.rods"},
+    {{"magnetizer_length_m", R::NonNegative}, 0.0, "default: no magnetizer in the stack"},
+    {{"magnetizer_alpha_per_K", R::NonNegative}, 0.0, "default: no magnetizer in the stack"},
+    {{"output_rod_length_m", R::NonNegative}, 0.0, "default: no output rod in the stack"},
+    {{"output_rod_alpha_per_K", R::NonNegative}, 0.0, "default: no output rod in the stack"},
+    {{"sleeve_length_m", R::NonNegative}, 0.0, "default: no sleeve in the stack"},
+    {{"sleeve_alpha_per_K", R::NonNegative}, 0.0, "default: no sleeve in the stack"},
+};
+
 }  // namespace
 
 std::span<const std::string_view> reserved_tables() { return kReserved; }
@@ -187,8 +199,10 @@ std::span<const Field> element_fields() { return kElement; }
 std::span<const Field> sleeve_modulus_fields() { return kSleeveModulus; }
 std::span<const Field> output_stage_fields() { return kOutputStage; }
 std::span<const Field> sleeve_fields() { return kSleeve; }
-std::span<const Field> thermal_expansion_fields() { return kThermal; }
 std::span<const DefaultedField> thermal_network_defaults() { return kThermalNetwork; }
+std::span<const DefaultedField> magnet_defaults() { return kMagnetDefaults; }
+std::span<const DefaultedField> sleeve_modulus_defaults() { return kSleeveModulusDefaults; }
+std::span<const DefaultedField> thermal_expansion_defaults() { return kThermalDefaults; }
 std::span<const Field> branch_number_fields() { return kBranchNumbers; }
 
 std::string unit_from_suffix(std::string_view key) {
@@ -209,7 +223,9 @@ std::optional<Field> field_of(const ModelSpec& spec, const std::string& dotted) 
     if (p[0] == "material") return find_field(kMaterial, p[1]);
     if (p[0] == "preload") return find_field(kPreload, p[1]);
     if (p[0] == "magnet") return find_field(kMagnet, p[1]);
-    if (p[0] == "thermal_expansion") return find_field(kThermal, p[1]);
+    if (p[0] == "thermal_expansion")
+      for (const auto& d : kThermalDefaults)
+        if (d.field.key == p[1]) return d.field;
     if (p[0] == "thermal_network")
       for (const auto& d : kThermalNetwork)
         if (d.field.key == p[1]) return d.field;
@@ -601,32 +617,34 @@ class Loader {
     read_table_fields(root, "reference", "reference", 1, schema::reference_fields());
     read_table_fields(root, "material", "material", 1, schema::material_fields());
     read_table_fields(root, "preload", "preload", 1, schema::preload_fields());
-    read_table_fields(root, "magnet", "magnet", 1, schema::magnet_fields());
+    read_defaulted(root, "magnet", "magnet", schema::magnet_defaults());
     read_rods(root);
     read_circuit(root);
     read_sensor(root);
     read_mechanics(root);
-    read_table_fields(root, "thermal_expansion", "thermal_expansion", 1,
-                      schema::thermal_expansion_fields());
-    read_thermal_network(root);
+    read_defaulted(root, "thermal_expansion", "thermal_expansion",
+                   schema::thermal_expansion_defaults());
+    read_defaulted(root, "thermal_network", "thermal_network", schema::thermal_network_defaults());
   }
 
-  // Optional, every key defaulted (schema::thermal_network_defaults()).
-  void read_thermal_network(const toml::table& root) {
+  // An optional table whose every key has a default (schema::DefaultedField): a key or the
+  // whole table may be absent; a defaulted value is stored with line 0 and its provenance.
+  void read_defaulted(const toml::table& parent, std::string_view key, const std::string& dotted,
+                      std::span<const schema::DefaultedField> defaults) {
     const toml::table* t = nullptr;
-    if (const toml::node* n = root.get("thermal_network")) {
-      t = table_at(root, "thermal_network", "thermal_network", 1);
+    if (const toml::node* n = parent.get(key)) {
+      t = table_at(parent, key, dotted, 1);
       if (t == nullptr) return;
-      spec_.option_lines["[thermal_network]"] = node_line(*n);
+      spec_.option_lines["[" + dotted + "]"] = node_line(*n);
       std::vector<std::string> keys;
-      for (const auto& d : schema::thermal_network_defaults()) keys.emplace_back(d.field.key);
-      check_keys(*t, "[thermal_network]", keys);
+      for (const auto& d : defaults) keys.emplace_back(d.field.key);
+      check_keys(*t, "[" + dotted + "]", keys);
     }
-    for (const auto& d : schema::thermal_network_defaults()) {
-      const std::string dotted = "thermal_network." + std::string(d.field.key);
+    for (const auto& d : defaults) {
+      const std::string name = dotted + "." + std::string(d.field.key);
       if (t != nullptr) {
         if (const toml::node* node = t->get(d.field.key)) {
-          store_number(*node, dotted, d.field);
+          store_number(*node, name, d.field);
           continue;
         }
       }
@@ -635,7 +653,7 @@ class Loader {
       pv.unit = schema::unit_of(d.field);
       pv.provenance = std::string(d.provenance);
       pv.line = 0;
-      spec_.params[dotted] = std::move(pv);
+      spec_.params[name] = std::move(pv);
     }
   }
 
@@ -957,9 +975,11 @@ class Loader {
     } else {
       members_ok = false;
     }
-    read_table_fields(*t, "sleeve_modulus", "mechanics.sleeve_modulus", tl,
-                      schema::sleeve_modulus_fields());
-    if (const auto* st = table_at(*t, "sleeves", "mechanics.sleeves", tl)) {
+    read_defaulted(*t, "sleeve_modulus", "mechanics.sleeve_modulus",
+                   schema::sleeve_modulus_defaults());
+    // [mechanics.sleeves] is optional: a stack without sleeves (a single rod) has none.
+    if (!t->get("sleeves")) {
+    } else if (const auto* st = table_at(*t, "sleeves", "mechanics.sleeves", tl)) {
       const auto subs = named_tables(*st, "mechanics.sleeves");
       if (st->size() != subs.size()) members_ok = false;
       for (const auto& [name, sub] : subs) {

@@ -40,7 +40,6 @@ std::span<const Field> element_fields();
 std::span<const Field> sleeve_modulus_fields();
 std::span<const Field> output_stage_fields();
 std::span<const Field> sleeve_fields();
-std::span<const Field> thermal_expansion_fields();
 std::span<const Field> branch_number_fields();
 // A field that may be absent: its default value and the provenance shown for it.
 struct DefaultedField {
@@ -49,6 +48,9 @@ struct DefaultedField {
   std::string_view provenance;
 };
 std::span<const DefaultedField> thermal_network_defaults();
+std::span<const DefaultedField> magnet_defaults();
+std::span<const DefaultedField> sleeve_modulus_defaults();
+std::span<const DefaultedField> thermal_expansion_defaults();
 inline constexpr Field kReluctanceField{"", Rule::Positive, "1/H"};
 
 // Unit of a key: the field's explicit unit, else the suffix table ("_A_per_m" -> "A/m"),

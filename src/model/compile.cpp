@@ -280,7 +280,11 @@ Model compile(const ModelSpec& spec) {
   }
 
   // Eq. (21) products.
-  m.xT_rod_m_per_K = mat.alpha_thermal_per_K * r.num("thermal_expansion.rod_length_m");
+  // rod_length_m = 0 (the default when [thermal_expansion] is absent): the longest rod.
+  double rod_length_m = r.num("thermal_expansion.rod_length_m");
+  if (rod_length_m == 0.0)
+    for (const auto& rod : m.rods) rod_length_m = std::max(rod_length_m, rod.length_m);
+  m.xT_rod_m_per_K = mat.alpha_thermal_per_K * rod_length_m;
   m.xT_magnetizer_m_per_K = r.num("thermal_expansion.magnetizer_alpha_per_K") *
                             r.num("thermal_expansion.magnetizer_length_m");
   m.xT_output_rod_m_per_K = r.num("thermal_expansion.output_rod_alpha_per_K") *

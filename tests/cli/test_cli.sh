@@ -59,6 +59,7 @@ check "step metrics" 0 "step +y .* rise \(10-90 %\)" "$B" simulate --waveform-ki
 check "plot" 0 "wrote .*frf.png" "$B" frf --method linear --points 8 --temperatures 20 --plot --out "$T/frfplot"
 [[ -s "$T/frfplot/frf.svg" ]] && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: frf.svg"; }
 check "progress eta" 0 "simulate: 100000/100000 \(100 %\), .* s elapsed, ETA" "$B" simulate --periods 10 --progress --out "$T/prog"
+check "single-rod template" 0 "OK \(57 parameters, 1 rods" "$B" model check "$(dirname "$0")/../../models/single_rod.toml"
 check "help has units" 0 "Operating temperature \[degC\]" "$B" simulate --help
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]
