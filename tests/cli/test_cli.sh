@@ -56,8 +56,13 @@ check "thermal step too long" 2 "fastest time constant" "$B" simulate --self-hea
 check "compensate" 0 "70.0 +9\.[0-9]+ +-3.0000" "$B" compensate --temperatures 20,70 --no-track --periods 2 --out "$T/comp"
 check "compensate bad list" 2 "temperatures must increase" "$B" compensate --temperatures 70,20 --no-track --out "$T/comp2"
 check "step metrics" 0 "step +y .* rise \(10-90 %\)" "$B" simulate --waveform-kind step --level 0 --step-to 4 --step-time 0.002 --duration 0.01 --out "$T/step"
-check "plot" 0 "wrote .*frf.png" "$B" frf --method linear --points 8 --temperatures 20 --plot --out "$T/frfplot"
-[[ -s "$T/frfplot/frf.svg" ]] && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: frf.svg"; }
+# --plot needs the Python package of this build (absent in the sanitize-native build).
+if compgen -G "$(dirname "$B")/../python/gmasim/_gmasim*.so" >/dev/null; then
+  check "plot" 0 "wrote .*frf.png" "$B" frf --method linear --points 8 --temperatures 20 --plot --out "$T/frfplot"
+  [[ -s "$T/frfplot/frf.svg" ]] && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: frf.svg"; }
+else
+  echo "skip: --plot (no Python module in this build)"
+fi
 check "progress eta" 0 "simulate: 100000/100000 \(100 %\), .* s elapsed, ETA" "$B" simulate --periods 10 --progress --out "$T/prog"
 check "single-rod template" 0 "OK \(57 parameters, 1 rods" "$B" model check "$(dirname "$0")/../../models/single_rod.toml"
 check "help has units" 0 "Operating temperature \[degC\]" "$B" simulate --help
