@@ -120,6 +120,12 @@ CLI_CASES = [
     ("track", ["--temperatures", "--amplitudes", "--frequencies", "--sample-rate", "--current-limit",
                "--bias", "--periods", "--sensor-noise", "--kp", "--ki", "--kd", "--gain-rate"], ["--temperatures", "20", "--amplitudes", "10",
                                                    "--frequencies", "10", "--periods", "1"]),
+    # issue 9: self-heating, compensation and --set take the same hostile values.
+    ("simulate", ["--thermal-step", "--ambient", "--periods", "--frequency", "--dt", "--set"],
+     ["--periods", "2", "--frequency", "100", "--self-heating"]),
+    ("compensate", ["--temperatures", "--reference-temperature", "--reference-current-pp", "--current-min",
+                    "--target-stroke", "--frequency", "--periods", "--max-current", "--tolerance", "--dt",
+                    "--set"], ["--temperatures", "20,70", "--periods", "1", "--frequency", "100", "--no-track"]),
 ]
 
 
@@ -157,6 +163,10 @@ def case(kind: str, rng: random.Random, s: dict, d: pathlib.Path) -> tuple[list[
     args = list(base)
     flag = rng.choice(flags)
     value = rng.choice(HOSTILE_NUMBERS)
+    if flag == "--set":  # a hostile value for a real parameter (or option)
+        value = rng.choice(["material.Ms_A_per_m", "rod1.length_m", "rod2.ja.k0_A_per_m", "preload.force_N",
+                            "thermal_network.coil_heat_capacity_J_per_K", "thermal_network.coil_resistance_ohm",
+                            "options.magnetic_state"]) + "=" + value
     if flag in args:
         args[args.index(flag) + 1] = value
     else:
