@@ -39,6 +39,10 @@ struct Waveform {
 
 Waveform biased_sine(double pp_A, double frequency_Hz, double min_A = -3.0);
 
+// Linear interpolation of y(x) at `at` over increasing x (same length, not empty), held at
+// the end values beyond the ends. Used by Table waveforms and gain schedules.
+double interpolate_held(const std::vector<double>& x, const std::vector<double>& y, double at);
+
 // ---------------------------------------------------------------------------------------
 // Run settings and results.
 // ---------------------------------------------------------------------------------------

@@ -12,6 +12,7 @@
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
 #include "gmasim/physics/magnetic.hpp"
+#include "gmasim/simulate.hpp"
 #include "gmasim/validate.hpp"
 
 namespace gmasim {
@@ -55,13 +56,7 @@ double Pid::update(double e) {
 }
 
 double TemperatureFeedforward::gain_at(double T) const {
-  if (gains.empty()) return 1.0;
-  if (T <= temperatures_C.front()) return gains.front();
-  if (T >= temperatures_C.back()) return gains.back();
-  const auto hi = std::upper_bound(temperatures_C.begin(), temperatures_C.end(), T);
-  const auto k = static_cast<std::size_t>(hi - temperatures_C.begin());
-  const double w = (T - temperatures_C[k - 1]) / (temperatures_C[k] - temperatures_C[k - 1]);
-  return gains[k - 1] + w * (gains[k] - gains[k - 1]);
+  return gains.empty() ? 1.0 : interpolate_held(temperatures_C, gains, T);
 }
 
 // ---------------------------------------------------------------------------------------

@@ -33,17 +33,19 @@ double Waveform::current_at(double t) const {
       const double phase = two_pi * (f0_Hz * tt + 0.5 * (f1_Hz - f0_Hz) * tt * tt / duration_s);
       return offset_A + amplitude_A * std::sin(phase);
     }
-    case WaveformKind::Table: {
-      const auto& ts = table_t_s;
-      if (t <= ts.front()) return table_current_A.front();
-      if (t >= ts.back()) return table_current_A.back();
-      const auto it = std::upper_bound(ts.begin(), ts.end(), t);
-      const auto j = static_cast<std::size_t>(it - ts.begin());
-      const double f = (t - ts[j - 1]) / (ts[j] - ts[j - 1]);
-      return table_current_A[j - 1] + f * (table_current_A[j] - table_current_A[j - 1]);
-    }
+    case WaveformKind::Table:
+      return interpolate_held(table_t_s, table_current_A, t);
   }
   return 0.0;
+}
+
+double interpolate_held(const std::vector<double>& x, const std::vector<double>& y, double at) {
+  if (at <= x.front()) return y.front();
+  if (at >= x.back()) return y.back();
+  const auto it = std::upper_bound(x.begin(), x.end(), at);
+  const auto j = static_cast<std::size_t>(it - x.begin());
+  const double f = (at - x[j - 1]) / (x[j] - x[j - 1]);
+  return y[j - 1] + f * (y[j] - y[j - 1]);
 }
 
 double auto_dt(const Waveform& w) {
