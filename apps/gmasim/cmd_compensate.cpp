@@ -33,9 +33,9 @@ void print_schedule(const CompensateArgs& a, const CompensateResult& res) {
           : fmt::format("{} A p-p from {} A at {} degC", r.reference_current_pp_A, r.current_min_A,
                         r.reference_temperature_C),
       r.frequency_Hz,
-      a.adjust == "amplitude" ? "the p-p (minimum held)"
-      : a.adjust == "swing"   ? "the p-p about the mean"
-                              : "min and p-p together",
+      r.adjust == CompensationAdjust::Amplitude ? "the p-p (minimum held)"
+      : r.adjust == CompensationAdjust::Swing   ? "the p-p about the mean"
+                                                : "min and p-p together",
       r.max_current_A);
   fmt::print("  {:>6} {:>9} {:>9} {:>9} {:>7} {:>10} {:>12} {:>8} {:>5}\n", "T degC", "i_pp A",
              "i_min A", "i_max A", "gain", "stroke um", "uncomp. um", "hyst um", "sims");
@@ -72,9 +72,7 @@ void print_track(const CompensatedTrack& t) {
 int run_compensate_cmd(CompensateArgs& a) {
   const Model model = load_model_args(a.model);
   a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
-  a.req.adjust = a.adjust == "scale"   ? CompensationAdjust::Scale
-                 : a.adjust == "swing" ? CompensationAdjust::Swing
-                                       : CompensationAdjust::Amplitude;
+  a.req.adjust = parse_compensation_adjust(a.adjust);
   if (!a.no_track) {
     a.track.temperatures_C = a.track_temperatures.empty()
                                  ? a.req.temperatures_C

@@ -16,6 +16,10 @@ namespace gmasim {
 //   Swing:     pp about a fixed mean current (min + pp/2 of the reference drive);
 //   Scale:     min and pp together by a gain g (an amplifier gain: the waveform's shape kept).
 enum class CompensationAdjust { Amplitude, Swing, Scale };
+// The names of the adjust modes ("amplitude", "swing", "scale"), one table for the CLI, the
+// Python module and the report. parse_compensation_adjust throws InputError naming them.
+const char* compensation_adjust_name(CompensationAdjust a);
+CompensationAdjust parse_compensation_adjust(const std::string& name);
 
 struct CompensateRequest {
   // The target: the stroke of the reference drive at the reference temperature, or

@@ -134,10 +134,7 @@ void bind_experiments(py::module_& mod) {
         r.current_min_A = current_min_A;
         r.target_stroke_um = target_stroke_um;
         r.frequency_Hz = frequency_Hz;
-        if (adjust == "amplitude") r.adjust = CompensationAdjust::Amplitude;
-        else if (adjust == "swing") r.adjust = CompensationAdjust::Swing;
-        else if (adjust == "scale") r.adjust = CompensationAdjust::Scale;
-        else throw InputError("adjust '" + adjust + "': must be amplitude, swing or scale");
+        r.adjust = parse_compensation_adjust(adjust);
         r.max_current_A = max_current_A;
         r.tolerance_um = tolerance_um;
         r.threads = threads;

@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
@@ -103,7 +104,25 @@ void validate_request(const Model& m, const CompensateRequest& r) {
   validate(s);
 }
 
+constexpr std::pair<CompensationAdjust, const char*> kAdjustNames[] = {
+    {CompensationAdjust::Amplitude, "amplitude"},
+    {CompensationAdjust::Swing, "swing"},
+    {CompensationAdjust::Scale, "scale"},
+};
+
 }  // namespace
+
+const char* compensation_adjust_name(CompensationAdjust a) {
+  for (const auto& [mode, name] : kAdjustNames)
+    if (mode == a) return name;
+  return "?";
+}
+
+CompensationAdjust parse_compensation_adjust(const std::string& name) {
+  for (const auto& [mode, n] : kAdjustNames)
+    if (name == n) return mode;
+  throw InputError("adjust '" + clip_for_message(name) + "': must be amplitude, swing or scale");
+}
 
 CompensateResult run_compensate(const Model& m, const CompensateRequest& r,
                                 const ProgressFn& progress) {
@@ -238,9 +257,7 @@ Report compensate_report(const Model& m, const CompensateRequest& req, const Com
   Report r;
   r.experiment = "compensate";
   r.meta.emplace_back("model", m.spec.source);
-  r.meta.emplace_back("adjust", req.adjust == CompensationAdjust::Amplitude ? "amplitude"
-                                : req.adjust == CompensationAdjust::Swing   ? "swing"
-                                                                            : "scale");
+  r.meta.emplace_back("adjust", compensation_adjust_name(req.adjust));
   r.meta.emplace_back("reference_temperature_C", req.reference_temperature_C);
   r.meta.emplace_back("reference_current_pp_A", req.reference_current_pp_A);
   r.meta.emplace_back("reference_current_min_A", req.current_min_A);

@@ -97,7 +97,6 @@ struct SelfHeatingRun {
   const ThermalNetworkModel* net = nullptr;
   NodeTemperatures T, T0;
   double E_copper = 0, E_eddy = 0, E_hyst = 0, y_min = 0, y_max = 0, i_prev = 0;
-  double E_in_total = 0, E_out_total = 0;
   std::vector<double> volume_m3, Hc_prev, H_prev, M_prev;  // per rod, sized once
 
   SelfHeatingRun(const Model& m, const SimulationSettings& s, const RunLength& L, Result& r) {
@@ -143,8 +142,8 @@ struct SelfHeatingRun {
 
   void push_row(Result& r, double t, double Pc, double Pe, double Ph, double Pa, double stroke) {
     const double row[] = {t,  T.coil_C, T.rods_C, T.housing_C, Pc, Pe,
-                          Ph, Pa,       stroke,   E_in_total,  stored_heat_J(*net, T, T0),
-                          E_out_total};
+                          Ph, Pa,       stroke,   r.energy_in_J, r.energy_stored_J,
+                          r.energy_out_J};
     for (std::size_t j = 0; j < r.heating.columns.size(); ++j) r.heating.columns[j].push_back(row[j]);
   }
 
@@ -182,8 +181,9 @@ struct SelfHeatingRun {
     const double Pc = E_copper / span, Pe = std::max(0.0, E_eddy) / span,
                  Ph = std::max(0.0, E_hyst) / span;
     const double E_out = thermal_network_step(*net, T, Pc, Pe + Ph, ambient_C, span);
-    E_in_total += (Pc + Pe + Ph) * span;
-    E_out_total += E_out;
+    r.energy_in_J += (Pc + Pe + Ph) * span;
+    r.energy_out_J += E_out;
+    r.energy_stored_J = stored_heat_J(*net, T, T0);
     push_row(r, st.t_s, Pc, Pe, Ph, E_out / span, (y_max - y_min) * 1e6);
     in_interval = 0;
     E_copper = E_eddy = E_hyst = 0;
@@ -196,9 +196,6 @@ struct SelfHeatingRun {
           "defined ({})",
           st.t_s, T.rods_C, e.what()));
     }
-    r.energy_in_J = E_in_total;
-    r.energy_out_J = E_out_total;
-    r.energy_stored_J = stored_heat_J(*net, T, T0);
   }
 };
 
