@@ -72,25 +72,30 @@ def main():
         o = read_csv(os.path.join(d, c["overlay"]))
         idx = [i for i, k in enumerate(o["compared"]) if k > 0.5]
         fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
-        cur = [o["current_A"][i] for i in idx]
-        a1.plot(cur, [o["measured_um"][i] for i in idx], ".", ms=2.5, label="measured")
-        a1.plot(cur, [o["simulated_um"][i] for i in idx], "-", lw=1.2, label="simulated")
-        a1.set_xlabel("current [A]")
-        a1.set_ylabel("displacement [um]")
+        cols = list(o.keys())  # time/sample, drive, measured, simulated, compared, ...
+        unit = c.get("response_unit", "um")
+        cur = [o[cols[1]][i] for i in idx]
+        mk, sk = cols[2], cols[3]
+        xlabel = {"current_A": "current [A]", "field_A_per_m": "field H [A/m]"}.get(cols[1], cols[1])
+        ylabel = "strain [ppm]" if unit == "ppm" else "displacement [um]"
+        a1.plot(cur, [o[mk][i] for i in idx], ".", ms=2.5, label="measured")
+        a1.plot(cur, [o[sk][i] for i in idx], "-", lw=1.2, label="simulated")
+        a1.set_xlabel(xlabel)
+        a1.set_ylabel(ylabel)
         a1.legend(loc="upper left")
         a1.set_title("loop (compared samples)")
-        t = o["t_s"]
-        a2.plot(t, o["measured_um"], ".", ms=2.0, label="measured")
-        a2.plot(t, o["simulated_um"], "-", lw=1.0, label="simulated")
+        t = o[cols[0]]
+        a2.plot(t, o[mk], ".", ms=2.0, label="measured")
+        a2.plot(t, o[sk], "-", lw=1.0, label="simulated")
         if idx:
             a2.axvspan(t[0], t[idx[0]], color="0.9", label="not compared")
-        a2.set_xlabel("t [s]")
-        a2.set_ylabel("displacement [um]")
+        a2.set_xlabel("t [s]" if cols[0] == "t_s" else "sample")
+        a2.set_ylabel(ylabel)
         a2.legend(loc="upper left")
         freq = c["frequency_Hz"]
         cond = f'{c["temperature_C"]:g} degC' + (
             f', {c["current_pp_A"]:g} A p-p, {freq:g} Hz' if freq else "")
-        fig.suptitle(f'{c["label"]}: {cond}; RMS {c["rms_um"]:.3f} um = {c["rms_pct"]:.2f} % of p-p')
+        fig.suptitle(f'{c["label"]}: {cond}; RMS {c["rms_um"]:.3f} {unit} = {c["rms_pct"]:.2f} % of p-p')
         fig.tight_layout()
         fig.savefig(os.path.join(d, c["overlay"][:-4] + ".png"), dpi=110)
         plt.close(fig)
@@ -127,6 +132,7 @@ struct SynthArgs {
   ModelArgs model;
   SyntheticRequest req;
   bool no_flux = false;
+  std::string drive = "current", response = "displacement", offset = "absolute";
 };
 
 // The command line, for provenance (Linux: /proc/self/cmdline).
@@ -216,7 +222,8 @@ void print_summary(const IdentifyArgs& a, const IdentifyResult& r) {
     if (c.failed)
       fmt::print("  {:<34} failed: {}\n", c.label, c.error);
     else
-      fmt::print("  {:<34} RMS {:8.4f} um = {:6.3f} %\n", c.label, c.rms_um, c.rms_pct);
+      fmt::print("  {:<34} RMS {:8.4f} {} = {:6.3f} %\n", c.label, c.rms_um, c.response_unit,
+                 c.rms_pct);
   }
   for (const auto& t : r.targets)
     fmt::print("  {:<34} target {:.5g}, simulated {:.5g} ({:+.2f} %)\n", t.label, t.value,
@@ -326,6 +333,11 @@ int run_synthesize(SynthArgs& a) {
     }
   }
   if (a.no_flux) a.req.with_flux = false;
+  a.req.drive = a.drive == "field" ? DriveInput::Field : DriveInput::Current;
+  a.req.response = a.response == "strain" ? ResponseOutput::Strain : ResponseOutput::Displacement;
+  a.req.offset = a.offset == "first_sample" ? OffsetMode::FirstSample
+                 : a.offset == "fitted"     ? OffsetMode::Fitted
+                                            : OffsetMode::Absolute;
   const Model m = compile(spec);
   const MeasurementSet set = synthesize_measurements(m, a.req);
   write_measurement_set(set, a.out);
@@ -393,6 +405,9 @@ Runner add_identify(CLI::App& app) {
   sub->add_option("--steps-per-period", o.objective.steps_per_period,
                   "Time steps per period of periodic conditions and targets")
       ->capture_default_str();
+  sub->add_option("--quasi-static-increments", o.objective.quasi_static_increments,
+                  "Quasi-static records: increments of the drive over its whole range")
+      ->capture_default_str();
   sub->add_option("--flux-weight", o.objective.flux_weight,
                   "Weight of the flux_T residuals of files that have them (0: ignore flux)")
       ->capture_default_str();
@@ -441,6 +456,31 @@ Runner add_identify(CLI::App& app) {
       ->capture_default_str();
   syn->add_option("--steps-per-period", s->req.objective.steps_per_period,
                   "Time steps per period (use the same value for identify)")
+      ->capture_default_str();
+  syn->add_flag("--quasi-static", s->req.quasi_static,
+                "Quasi-static records: the sine's samples as equilibria, no t_s column (one "
+                "record per temperature x current; --frequencies is ignored)");
+  syn->add_option("--drive", s->drive,
+                  "Drive column: current (current_A) or field (field_A_per_m: the rod's applied "
+                  "field that the current produced)")
+      ->check(CLI::IsMember({"current", "field"}))
+      ->capture_default_str();
+  syn->add_option("--response", s->response,
+                  "Response column: displacement (displacement_um) or strain (strain_ppm of "
+                  "the rod)")
+      ->check(CLI::IsMember({"displacement", "strain"}))
+      ->capture_default_str();
+  syn->add_option("--rod", s->req.rod, "Rod of the field / strain columns (default: the first)");
+  syn->add_option("--offset", s->offset,
+                  "Response reference: absolute, first_sample (written relative to the first "
+                  "sample) or fitted (shifted by --response-offset)")
+      ->check(CLI::IsMember({"absolute", "first_sample", "fitted"}))
+      ->capture_default_str();
+  syn->add_option("--response-offset", s->req.response_offset,
+                  "Constant added to the response with --offset fitted [um or ppm]")
+      ->capture_default_str();
+  syn->add_option("--precycles", s->req.precycles,
+                  "Pre-cycles written into each record (then every period is compared)")
       ->capture_default_str();
 
   return [a, s, sub, syn]() -> int {

@@ -237,12 +237,14 @@ std::string fit_report_json(const IdentifyResult& r, const FitProvenance& p) {
         "\"current_pp_A\": {}, \"weight\": {}, \"samples\": {}, \"compared\": {}, \"pp_um\": {}, "
         "\"rms_um\": {}, \"rms_pct\": {}, \"max_err_um\": {}, \"flux_rms_pct\": {}, \"failed\": "
         "{}, "
-        "\"error\": {}, \"overlay\": {}}}{}\n",
+        "\"error\": {}, \"overlay\": {}, \"response_unit\": {}, \"quasi_static\": {}, "
+        "\"offset\": {}}}{}\n",
         json_str(c.label), json_str(c.path), jnum(c.condition.temperature_C),
         jnum(c.condition.frequency_Hz), jnum(c.condition.current_pp_A), jnum(c.weight), c.samples,
         c.compared, jnum(c.pp_um), jnum(c.rms_um), jnum(c.rms_pct), jnum(c.max_err_um),
         c.flux_rms_pct >= 0 ? jnum(c.flux_rms_pct) : "null", c.failed, json_str(c.error),
-        json_str(c.overlay_file), i + 1 < r.conditions.size() ? "," : "");
+        json_str(c.overlay_file), json_str(c.response_unit), c.condition.quasi_static,
+        json_str(offset_mode_name(c.condition.offset)), i + 1 < r.conditions.size() ? "," : "");
   }
   s += "  ],\n  \"targets\": [\n";
   for (std::size_t i = 0; i < r.targets.size(); ++i) {
@@ -323,9 +325,10 @@ std::string fit_report_markdown(const IdentifyResult& r, const FitProvenance& p)
          "parameters.\n\n";
   }
   if (!r.conditions.empty()) {
-    s += "## Conditions\n\n| condition | T [degC] | f [Hz] | I p-p [A] | weight | p-p [um] | RMS "
-         "[um] | RMS [%] | max err [um] | flux RMS [%] "
-         "|\n|---|---|---|---|---|---|---|---|---|---|\n";
+    s += "## Conditions\n\np-p, RMS and max err are in the record's response unit: um of "
+         "displacement_um, ppm of strain_ppm. f = 0: not periodic (or quasi-static).\n\n"
+         "| condition | T [degC] | f [Hz] | I p-p [A] | weight | p-p | RMS | RMS [%] | max err | "
+         "flux RMS [%] |\n|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& c : r.conditions) {
       if (c.failed) {
         s += fmt::format("| {} | {:g} | {:g} | {:g} | {:g} | - | failed: {} | | | |\n", c.label,
@@ -334,9 +337,10 @@ std::string fit_report_markdown(const IdentifyResult& r, const FitProvenance& p)
         continue;
       }
       s += fmt::format(
-          "| {} | {:g} | {:g} | {:g} | {:g} | {:.3f} | {:.4f} | {:.3f} | {:.4f} | {} |\n", c.label,
-          c.condition.temperature_C, c.condition.frequency_Hz, c.condition.current_pp_A, c.weight,
-          c.pp_um, c.rms_um, c.rms_pct, c.max_err_um,
+          "| {} | {:g} | {:g} | {:g} | {:g} | {:.3f} {} | {:.4f} {} | {:.3f} | {:.4f} {} | {} |\n",
+          c.label, c.condition.temperature_C, c.condition.frequency_Hz, c.condition.current_pp_A,
+          c.weight, c.pp_um, c.response_unit, c.rms_um, c.response_unit, c.rms_pct, c.max_err_um,
+          c.response_unit,
           c.flux_rms_pct >= 0 ? fmt::format("{:.3f}", c.flux_rms_pct) : "-");
     }
     s += "\nOverlays (measured vs simulated): `overlay_<condition>.csv`, plotted by "
