@@ -475,10 +475,14 @@ Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const F
               ? fmt::format("{:.4g} quasi-static increments over the record: too many (limit "
                             "{:g}); lower the increments per drive range",
                             n, kMaxSteps)
-              : fmt::format("{:.4g} steps over the record's {:g} s (pre-cycles included): too "
-                            "many (limit {:g}); give --dt, or a frequency_Hz condition for a "
-                            "periodic record",
-                            n, meas.t_s.back() - meas.t_s.front(), kMaxSteps)));
+              : fmt::format("{:.4g} steps of {:g} s over the record's {:g} s: too many (limit "
+                            "{:g}, pre-cycles included); give --dt, or a frequency_Hz "
+                            "condition for a periodic record",
+                            n,
+                            identify_detail::objective_step(
+                                settings, meas.periodic() ? 1.0 / meas.condition.frequency_Hz
+                                                          : 0.0),
+                            meas.t_s.back() - meas.t_s.front(), kMaxSteps)));
   }
   // ---- residual layout and scales ----
   std::size_t off = 0;
@@ -682,8 +686,10 @@ std::vector<TargetFit> Objective::target_fits(const std::vector<double>& u) cons
 // =======================================================================================
 MeasurementSet synthesize_measurements(const Model& truth, const SyntheticRequest& r) {
   if (r.samples_per_period < 8) throw InputError("samples per period: must be >= 8");
-  if (!(r.periods >= 1.5)) throw InputError("periods: must be >= 1.5 (the first is not compared)");
-  require_in(r.periods, 1.5, kMaxPeriods, "periods");
+  if (r.precycles == 0 && !(r.periods >= 1.5))
+    throw InputError("periods: must be >= 1.5 (the first is not compared)");
+  if (!(r.periods >= 1.0)) throw InputError("periods: must be >= 1 (one whole loop)");
+  require_in(r.periods, 1.0, kMaxPeriods, "periods");
   require_in(r.current_min_A, -kMaxCurrent_A, kMaxCurrent_A, "current minimum", "A");
   require_in(r.noise_pct, 0.0, 100.0, "noise", "%");
   require_in(r.flux_noise_pct, 0.0, 100.0, "flux noise", "%");
