@@ -3,6 +3,7 @@
 
 #include <functional>
 #include <limits>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -144,6 +145,9 @@ Result simulate(const Model& m, const SimulationSettings& s);
 
 // Metrics over [t0, t1] of a recorded run (uses columns t_s, current_A, y_um, B_T).
 Metrics compute_metrics(const TimeSeries& ts, double t0_s, double t1_s);
+
+// max - min of v; 0 for an empty span. The one peak-to-peak of metrics, fits and records.
+double peak_to_peak(std::span<const double> v);
 
 // Largest gap between the rising-current and falling-current branches of y(I) at equal
 // current, over one period of samples [um]. Both branches are interpolated onto a

@@ -12,6 +12,7 @@
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
+#include "gmasim/rod_laws.hpp"
 #include "gmasim/physics/jiles_atherton.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
@@ -27,10 +28,9 @@ using cd = std::complex<double>;
 constexpr double kTwoPi = 2.0 * kPi;
 constexpr double kSettleDt_s = 10e-6;
 
-// The eq. (3) permeability of rod i at magnetisation M (as step() evaluates it).
-double mu_at(const Model& m, const RodConditions& rc, double M) {
-  return permeability(
-      inverse_susceptibility(M / rc.MsT_mu, m.material.chi_m, rc.S_mu_J_per_m3, rc.MsT_mu));
+// The eq. (3) permeability of rod i at magnetisation M (rod_laws.hpp, as step() evaluates it).
+double mu_at(const Model& m, std::size_t i, const RodConditions& rc, double M) {
+  return rod_permeability(rc, m.material.chi_m, M, 0.0, m.rods[i].name);
 }
 
 // Static fields H_c,i (eq. 7 first line) of every rod for coil current I and rod
@@ -40,7 +40,7 @@ std::vector<double> static_fields(const Model& m, const Conditions& c, CircuitWo
   const std::size_t n = M.size();
   std::vector<double> R(n), mu(n), Hc(n);
   for (std::size_t i = 0; i < n; ++i) {
-    mu[i] = mu_at(m, c.rods[i], M[i]);
+    mu[i] = mu_at(m, i, c.rods[i], M[i]);
     R[i] = rod_reluctance(c.rods[i].length_m, mu[i], c.rods[i].area_m2);
   }
   if (!solve_circuit(m.circuit, R, I, c.pm_scale, ws, false))
@@ -52,15 +52,16 @@ std::vector<double> static_fields(const Model& m, const Conditions& c, CircuitWo
   return Hc;
 }
 
-// Rod force (eq. 11-14) and rod stiffness (eq. 17) at magnetisation M, as step() does.
+// Rod force (eq. 11-14) and rod stiffness (eq. 17) at magnetisation M: update_rod_mechanics
+// of rod_laws.hpp, as step() does.
 struct ForceStiffness {
   double F, k_rod;
 };
 ForceStiffness force_at(const Model& m, const RodConditions& rc, double M) {
-  const double E = delta_e_modulus(M / rc.MsT_E, rc.dE);
-  const double lambda =
-      magnetostriction(M / rc.Ms_strain_A_per_m, m.material.lambda_s, rc.sigma_p_Pa, E);
-  return {rod_force(lambda, E, rc.area_m2), axial_stiffness(E, rc.area_m2, rc.length_m)};
+  RodState r;
+  r.M_A_per_m = M;
+  update_rod_mechanics(m.material, rc, r);
+  return {r.F_N, r.k_rod_N_per_m};
 }
 
 void run_dc(const Model& m, const Conditions& c, State& s, double I, double duration_s) {
@@ -210,7 +211,7 @@ SmallSignalModel linearise(const Model& m, const Conditions& c, const State& s) 
   for (std::size_t i = 0; i < n && !L.consistent; ++i) {
     const auto& rc = c.rods[i];
     const auto& r = s.rods[i];
-    L.tau_s.push_back(mu_at(m, rc, r.M_A_per_m) * rc.eddy_geometry_s_m_per_H);
+    L.tau_s.push_back(mu_at(m, i, rc, r.M_A_per_m) * rc.eddy_geometry_s_m_per_H);
     const double He = r.H_A_per_m + rc.ja.alpha * r.M_A_per_m;
     const double dMan = anhysteretic_slope(He, rc.MsT_ja, rc.ja.a_A_per_m);
     L.chi.push_back(rc.ja.c * dMan / (1.0 - rc.ja.alpha * rc.ja.c * dMan));

@@ -241,8 +241,7 @@ void read_record_keys(const KeyMap& keys, const Measurement& m, MeasurementCondi
       first = w.current_at(m.t_s.front());
       last = w.current_at(m.t_s.back());
     }
-    const auto [lo, hi] = std::minmax_element(m.drive.begin(), m.drive.end());
-    const double range = c.current_source == "sine" ? c.current_pp_A : *hi - *lo;
+    const double range = c.current_source == "sine" ? c.current_pp_A : peak_to_peak(m.drive);
     if (!(std::fabs(last - first) <= 0.02 * range))
       fail("precycles",
            fmt::format("precycles = {}: pre-cycling repeats the record's drive, which must end "
@@ -250,8 +249,7 @@ void read_record_keys(const KeyMap& keys, const Measurement& m, MeasurementCondi
                        c.precycles, range, first, last));
   }
   if (c.quasi_static) {
-    const auto [lo, hi] = std::minmax_element(m.drive.begin(), m.drive.end());
-    if (!(*hi > *lo))
+    if (!(peak_to_peak(m.drive) > 0.0))
       throw InputError(located(m.path, 0,
                                fmt::format("the {} column does not vary: a quasi-static record "
                                            "needs a drive that moves",

@@ -10,6 +10,7 @@
 #include <limits>
 #include <optional>
 #include <set>
+#include <span>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
@@ -133,10 +134,8 @@ SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings
     rec(k);
   }
   SineMetrics r;
-  const auto [ylo, yhi] = std::minmax_element(y.begin(), y.end());
-  const auto [blo, bhi] = std::minmax_element(B.begin(), B.end());
-  r.stroke_um = *yhi - *ylo;
-  r.B_pp_T = *bhi - *blo;
+  r.stroke_um = peak_to_peak(y);
+  r.B_pp_T = peak_to_peak(B);
   r.hysteresis_um = hysteresis_width(I, y, 0, y.size());
   return r;
 }
@@ -399,10 +398,7 @@ Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const F
     } catch (const InputError& e) {
       throw InputError(e.what());
     }
-    const auto [lo, hi] = std::minmax_element(
-        meas.response.begin() + static_cast<std::ptrdiff_t>(cd.compare_begin),
-        meas.response.end());
-    cd.pp_um = *hi - *lo;
+    cd.pp_um = peak_to_peak(std::span<const double>(meas.response).subspan(cd.compare_begin));
     if (!(cd.pp_um > 0.0)) {
       throw InputError(located(meas.path, 0,
                                fmt::format("the measured {} does not vary over the compared "
@@ -411,9 +407,7 @@ Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const F
     }
     cd.flux = settings.flux_weight > 0.0 && !meas.flux_T.empty();
     if (cd.flux) {
-      const auto [blo, bhi] = std::minmax_element(
-          meas.flux_T.begin() + static_cast<std::ptrdiff_t>(cd.compare_begin), meas.flux_T.end());
-      cd.ppB = *bhi - *blo;
+      cd.ppB = peak_to_peak(std::span<const double>(meas.flux_T).subspan(cd.compare_begin));
       if (!(cd.ppB > 0.0)) {
         throw InputError(located(meas.path, 0, "flux_T does not vary: set the flux weight to 0"));
       }
@@ -626,10 +620,9 @@ std::vector<ConditionFit> Objective::condition_fits(const std::vector<double>& u
     f.rms_um = std::sqrt(ss / static_cast<double>(f.compared));
     f.rms_pct = 100.0 * f.rms_um / f.pp_um;
     if (has_flux) {
-      const auto [blo, bhi] = std::minmax_element(
-          meas.flux_T.begin() + static_cast<std::ptrdiff_t>(cd.compare_begin), meas.flux_T.end());
-      if (*bhi > *blo)
-        f.flux_rms_pct = 100.0 * std::sqrt(ssB / static_cast<double>(f.compared)) / (*bhi - *blo);
+      const double ppB =
+          peak_to_peak(std::span<const double>(meas.flux_T).subspan(cd.compare_begin));
+      if (ppB > 0.0) f.flux_rms_pct = 100.0 * std::sqrt(ssB / static_cast<double>(f.compared)) / ppB;
     }
     TimeSeries& ts = f.overlay;
     // Timed current/displacement records keep their historical column names; the others
@@ -766,8 +759,7 @@ MeasurementSet synthesize_measurements(const Model& truth, const SyntheticReques
           m.drive = H;
           m.drive_kind = DriveInput::Field;
         }
-        const auto [ylo, yhi] = std::minmax_element(y.begin(), y.end());
-        const double sy = r.noise_pct / 100.0 * (*yhi - *ylo);
+        const double sy = r.noise_pct / 100.0 * peak_to_peak(y);
         m.response = y;
         for (double& v : m.response) v += sy * gauss();
         if (r.offset == OffsetMode::FirstSample) {
@@ -777,8 +769,7 @@ MeasurementSet synthesize_measurements(const Model& truth, const SyntheticReques
           for (double& v : m.response) v += r.response_offset;
         }
         if (r.with_flux) {
-          const auto [blo, bhi] = std::minmax_element(B.begin(), B.end());
-          const double sb = r.flux_noise_pct / 100.0 * (*bhi - *blo);
+          const double sb = r.flux_noise_pct / 100.0 * peak_to_peak(B);
           m.flux_T = B;
           for (double& v : m.flux_T) v += sb * gauss();
         }

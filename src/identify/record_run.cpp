@@ -162,8 +162,7 @@ double record_step_count(const Measurement& meas, const ObjectiveSettings& s) {
   const auto& c = meas.condition;
   const double passes = 1.0 + static_cast<double>(c.precycles);
   if (c.quasi_static) {
-    const auto [lo, hi] = std::minmax_element(meas.drive.begin(), meas.drive.end());
-    const double inc = (*hi - *lo) / s.quasi_static_increments;
+    const double inc = peak_to_peak(meas.drive) / s.quasi_static_increments;
     double n = std::ceil(std::fabs(meas.drive.front()) / inc);  // a field record's ramp
     for (std::size_t i = 1; i < meas.drive.size(); ++i)
       n += std::max(1.0, std::ceil(std::fabs(meas.drive[i] - meas.drive[i - 1]) / inc - 1e-9));
@@ -191,8 +190,7 @@ void run_record(const Model& m, const Conditions& c, State st, const Measurement
   const long passes = 1 + cond.precycles;
 
   if (cond.quasi_static) {
-    const auto [lo, hi] = std::minmax_element(meas.drive.begin(), meas.drive.end());
-    const double inc = (*hi - *lo) / s.quasi_static_increments;
+    const double inc = peak_to_peak(meas.drive) / s.quasi_static_increments;
     // Moves from the drive value `from` to `to` in equal increments of at most inc.
     auto travel = [&](double from, double to) {
       const long k_n =
@@ -238,8 +236,7 @@ void run_record(const Model& m, const Conditions& c, State st, const Measurement
     // From rest at zero current to the first field, quasi-statically (the record starts
     // there at rest, as a current record starts at rest at its first current).
     const double from = st.rods[rod].Hc_A_per_m, to = drive(t0);
-    const auto [lo, hi] = std::minmax_element(meas.drive.begin(), meas.drive.end());
-    const double inc = std::max(*hi - *lo, 1e-300) / s.quasi_static_increments;
+    const double inc = std::max(peak_to_peak(meas.drive), 1e-300) / s.quasi_static_increments;
     const long k_n = std::max(1L, checked_ceil_count(std::fabs(to - from) / inc, kMaxSteps,
                                                      meas.path + ": ramp to the first field"));
     for (long k = 1; k <= k_n; ++k)

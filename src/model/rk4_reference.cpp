@@ -9,7 +9,7 @@
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
-#include "model/rod_update.hpp"
+#include "gmasim/rod_laws.hpp"
 
 namespace gmasim {
 namespace {
@@ -26,25 +26,25 @@ void rhs(const Model& m, const Conditions& c, State& s, Y& y, double I, Y& dy) {
   for (std::size_t i = 0; i < n; ++i) {
     const auto& rc = c.rods[i];
     y.M[i] = ja_total_magnetisation(y.H[i], y.Mirr[i], y.M[i], rc.MsT_ja, rc.ja);
-    s.rod_reluctance[i] = detail::set_rod_permeability(m, i, rc, s.rods[i], y.M[i], s.t_s);
+    s.rod_reluctance[i] = set_rod_permeability(m, i, rc, s.rods[i], y.M[i], s.t_s);
   }
   if (!solve_circuit(m.circuit, s.rod_reluctance, I, c.pm_scale, s.circuit))
     throw DivergenceError(s.t_s, "", "nodal matrix of the circuit", 0.0, "not positive definite");
   std::array<RodState, kMax> stage{};  // force and stiffness of this stage, per rod
   for (std::size_t i = 0; i < n; ++i) {
     const auto& rc = c.rods[i];
-    const double Hc = detail::rod_static_field(m, i, rc, s.rods[i], s.circuit);
+    const double Hc = rod_static_field(m, i, rc, s.rods[i], s.circuit);
     const double tau = s.rods[i].mu_r * kMu0 * rc.eddy_geometry_s_m_per_H;
     dy.H[i] = (Hc - y.H[i]) / tau;
     const double delta = dy.H[i] >= 0.0 ? 1.0 : -1.0;
     dy.Mirr[i] =
         ja_irreversible_slope(y.H[i], y.M[i], y.Mirr[i], delta, rc.MsT_ja, rc.ja) * dy.H[i];
     stage[i].M_A_per_m = y.M[i];
-    detail::update_rod_mechanics(m.material, rc, stage[i]);
+    update_rod_mechanics(m.material, rc, stage[i]);
   }
   for (std::size_t i = 0; i < n; ++i) {
     const auto& rc = c.rods[i];
-    const double K = stage[i].k_rod_N_per_m + detail::load_stiffness(rc, [&](int j) {
+    const double K = stage[i].k_rod_N_per_m + load_stiffness(rc, [&](int j) {
                        return stage[static_cast<std::size_t>(j)].k_rod_N_per_m;
                      });
     dy.x[i] = y.v[i];
@@ -95,7 +95,7 @@ void rk4_reference_step(const Model& m, const Conditions& c, State& s, double I0
     r.M_prev_A_per_m = r.M_A_per_m;
     r.M_A_per_m = ja_total_magnetisation(r.H_A_per_m, r.Mirr_A_per_m, yt.M[i], c.rods[i].MsT_ja,
                                          c.rods[i].ja);
-    detail::update_rod_mechanics(m.material, c.rods[i], r);
+    update_rod_mechanics(m.material, c.rods[i], r);
     if (!std::isfinite(r.x_m) || std::fabs(r.x_m) > 1.0)
       throw DivergenceError(s.t_s + h, m.rods[i].name, "x [m] (RK4)", r.x_m,
                             "explicit RK4 unstable");

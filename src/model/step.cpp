@@ -11,14 +11,12 @@
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
-#include "model/rod_update.hpp"
+#include "gmasim/rod_laws.hpp"
 
 namespace gmasim {
 namespace {
 
 using namespace physics;
-using detail::load_stiffness;
-using detail::update_rod_mechanics;
 
 inline void check(double value, double t, const std::string& rod, const char* quantity,
                   double limit) {
@@ -150,13 +148,13 @@ void quasi_static_magnetic_update(const Model& m, const Conditions& c, State& s,
   }
   for (std::size_t i = 0; i < n; ++i)
     s.rod_reluctance[i] =
-        detail::set_rod_permeability(m, i, c.rods[i], s.rods[i], s.rods[i].M_A_per_m, t);
+        set_rod_permeability(m, i, c.rods[i], s.rods[i], s.rods[i].M_A_per_m, t);
   if (!solve_circuit(m.circuit, s.rod_reluctance, current_A, pm_scale, s.circuit))
     throw DivergenceError(t, "", "nodal matrix of the circuit", 0.0, "not positive definite");
   for (std::size_t i = 0; i < n; ++i) {
     const auto& rc = c.rods[i];
     auto& r = s.rods[i];
-    const double Hc = detail::rod_static_field(m, i, rc, r, s.circuit);
+    const double Hc = rod_static_field(m, i, rc, r, s.circuit);
     ja_step(r.H_A_per_m, Hc, rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m);
     r.H_A_per_m = Hc;
     r.Hc_A_per_m = Hc;
@@ -246,7 +244,7 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
       double Mx = 2.0 * r.M_A_per_m - r.M_prev_A_per_m;
       const double lim = 0.999 * rc.MsT_mu;
       Mx = Mx > lim ? lim : (Mx < -lim ? -lim : Mx);
-      s.rod_reluctance[i] = detail::set_rod_permeability(m, i, rc, r, Mx, t1);
+      s.rod_reluctance[i] = set_rod_permeability(m, i, rc, r, Mx, t1);
     }
     if (!solve_circuit(m.circuit, s.rod_reluctance, in.current_A, c.pm_scale, s.circuit, false))
       throw DivergenceError(t1, "", "nodal matrix of the circuit", 0.0, "not positive definite");
@@ -255,7 +253,7 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
     for (std::size_t i = 0; i < n; ++i) {
       const auto& rc = c.rods[i];
       auto& r = s.rods[i];
-      const double Hc1 = detail::rod_static_field(m, i, rc, r, s.circuit);
+      const double Hc1 = rod_static_field(m, i, rc, r, s.circuit);
       r.tau_s = r.mu_r * kMu0 * rc.eddy_geometry_s_m_per_H;
       const double H1 = first_order_lag_step(r.H_A_per_m, r.Hc_A_per_m, Hc1, h, r.tau_s);
       const double M_guess = 2.0 * r.M_A_per_m - r.M_prev_A_per_m;  // linear extrapolation

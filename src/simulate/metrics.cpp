@@ -112,14 +112,19 @@ std::pair<std::size_t, std::size_t> window_rows(const std::vector<double>& t, do
 
 // Peak-to-peak and mean of v over rows [b, e), e > b.
 std::pair<double, double> pp_and_mean(const std::vector<double>& v, std::size_t b, std::size_t e) {
-  const auto [lo, hi] =
-      std::minmax_element(v.begin() + static_cast<long>(b), v.begin() + static_cast<long>(e));
   double s = 0.0;
   for (std::size_t i = b; i < e; ++i) s += v[i];
-  return {*hi - *lo, s / static_cast<double>(e - b)};
+  return {peak_to_peak(std::span<const double>(v).subspan(b, e - b)),
+          s / static_cast<double>(e - b)};
 }
 
 }  // namespace
+
+double peak_to_peak(std::span<const double> v) {
+  if (v.empty()) return 0.0;
+  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+  return *hi - *lo;
+}
 
 Metrics compute_metrics(const TimeSeries& ts, double t0, double t1) {
   const auto& t = ts.column("t_s");

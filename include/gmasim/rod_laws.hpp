@@ -1,6 +1,7 @@
-// Per-rod pieces shared by the production step (step.cpp) and the RK4 reference
-// (rk4_reference.cpp): one implementation of each law's use, so the two integrators differ
-// only in how they advance time.
+// Per-rod laws at a rod's present state, shared by the production step (step.cpp), the RK4
+// reference (rk4_reference.cpp) and the small-signal linearisation (frf.cpp): one
+// implementation of each law's use, so the integrators differ only in how they advance time
+// and the linearisation differentiates exactly what step() evaluates.
 #pragma once
 
 #include <string>
@@ -11,7 +12,7 @@
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
 
-namespace gmasim::detail {
+namespace gmasim {
 
 // Permeability of a rod at magnetisation M (eq. 3); throws on a non-physical value.
 inline double rod_permeability(const RodConditions& rc, double chi_m, double M, double t,
@@ -61,4 +62,4 @@ inline double load_stiffness(const RodConditions& rc, const State& s) {
                         [&](int j) { return s.rods[static_cast<std::size_t>(j)].k_rod_N_per_m; });
 }
 
-}  // namespace gmasim::detail
+}  // namespace gmasim
