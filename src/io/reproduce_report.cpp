@@ -3,7 +3,6 @@
 // package gmasim.report_figures from those CSVs).
 #include <fmt/format.h>
 
-#include <cstdlib>
 #include <filesystem>
 
 #include "gmasim/errors.hpp"
@@ -45,13 +44,16 @@ std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
   std::string figures_note;
   bool figures = false;
   if (!python_exe.empty()) {
-    const std::string cmd =
-        fmt::format("PYTHONPATH='{}' MPLBACKEND=Agg '{}' -m gmasim.report_figures '{}' 1>&2",
-                    python_path, python_exe, dir.string());
-    const int rc = std::system(cmd.c_str());
+    PythonCommand c;
+    c.python = python_exe;
+    c.python_path = python_path;
+    c.module = "gmasim.report_figures";
+    c.args = {dir.string()};
+    c.stdout_to_stderr = true;  // our standard output is the command's summary
+    const int rc = run_python(c);
     figures = rc == 0;
     if (!figures)
-      figures_note = fmt::format("(figure rendering failed: `{}` exited with {})", cmd, rc);
+      figures_note = fmt::format("(figure rendering failed: `{}` exited with {})", c.text(), rc);
   } else {
     figures_note = "(figures not rendered: --no-figures)";
   }
@@ -114,13 +116,9 @@ std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
 std::vector<std::pair<std::string, std::string>> load_claim_notes(const std::string& path) {
   const std::string text = io_detail::read_text_file(path, "claim notes");
   std::vector<std::pair<std::string, std::string>> notes;
-  std::size_t pos = 0;
-  int line_no = 0;
+  std::size_t line_no = 0;
   bool in_note = false;
-  while (pos < text.size()) {
-    const std::size_t end = std::min(text.find('\n', pos), text.size());
-    const std::string_view line(text.data() + pos, end - pos);
-    pos = end + 1;
+  for (const std::string_view line : io_detail::split_lines(text)) {
     ++line_no;
     if (line.starts_with("### ")) {
       const std::string id(io_detail::trim(line.substr(4)));
