@@ -84,12 +84,12 @@ std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
     for (double f : c.mode_frequencies_Hz)
       modes += fmt::format("{}{:.0f}", modes.empty() ? "" : ", ", f);
     md += fmt::format(
-        "- {:g} degC: first resonance in the band {} (paper 1270 Hz), -3 dB bandwidth {:.0f} Hz "
-        "(paper > 2000 Hz), modes of eq. 15 at the bias point: {} Hz\n",
+        "- {:g} degC: first resonance in the band {} (paper {:g} Hz), -3 dB bandwidth {:.0f} Hz "
+        "(paper > {:g} Hz), modes of eq. 15 at the bias point: {} Hz\n",
         c.temperature_C,
         c.first_resonance_Hz > 0 ? fmt::format("{:.0f} Hz", c.first_resonance_Hz)
                                  : std::string("none"),
-        c.bandwidth_3dB_Hz, modes);
+        r.frf.paper_first_resonance_Hz, c.bandwidth_3dB_Hz, r.frf.paper_bandwidth_Hz, modes);
   }
   md += "\n";
   md += fig(
@@ -107,8 +107,8 @@ std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
   md += fig("ablate",
             "Change of the output when one temperature law is frozen at 20 degC, 6 A, 70 degC");
   md += fmt::format(
-      "## Thermal expansion (eq. 21)\n\n{:.3f} um/degC (paper: model 0.662, measured 0.712).\n",
-      r.thermal.um_per_C);
+      "## Thermal expansion (eq. 21)\n\n{:.3f} um/degC (paper: model {:g}, measured {:g}).\n",
+      r.thermal.um_per_C, r.thermal.paper_model_um_per_C, r.thermal.paper_measured_um_per_C);
   write_file_atomic((dir / "report.md").string(), md);
   return md;
 }
