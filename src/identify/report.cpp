@@ -82,6 +82,80 @@ std::string data_label(const IdentifyResult& r, const FitProvenance& p) {
   return "scalar targets only";
 }
 
+using io_detail::JsonLayout;
+using io_detail::JsonWriter;
+
+// fit_report.json: one Inline object per parameter, condition, target and history step.
+void write_parameter(JsonWriter& w, const FittedParameter& fp) {
+  // [lo, hi] on one line.
+  auto pair = [&w](std::string_view key, double lo, double hi) {
+    w.key(key).begin_array(JsonLayout::Inline).number(lo).number(hi).end_array();
+  };
+  w.begin_object(JsonLayout::Inline);
+  w.key("name").string(fp.name);
+  w.key("unit").string(fp.unit);
+  w.key("scale").string(fp.scale == ParamScale::Log ? "log" : "linear");
+  w.numbers({{"lower", fp.lower},
+             {"upper", fp.upper},
+             {"start", fp.start},
+             {"value", fp.value},
+             {"std_error", fp.std_error}});
+  pair("ci95", fp.ci_low, fp.ci_high);
+  pair("ci95_linearised", fp.wald_low, fp.wald_high);
+  w.key("ci_method").string(fp.ci_method);
+  w.key("determined").boolean(fp.determined);
+  w.key("at_bound").boolean(fp.at_bound);
+  w.end_object();
+}
+
+void write_condition(JsonWriter& w, const ConditionFit& c) {
+  w.begin_object(JsonLayout::Inline);
+  w.key("label").string(c.label);
+  w.key("file").string(c.path);
+  w.numbers({{"temperature_C", c.condition.temperature_C},
+             {"frequency_Hz", c.condition.frequency_Hz},
+             {"current_pp_A", c.condition.current_pp_A},
+             {"weight", c.weight}});
+  w.key("samples").integer(static_cast<long long>(c.samples));
+  w.key("compared").integer(static_cast<long long>(c.compared));
+  w.numbers({{"pp_um", c.pp_um},
+             {"rms_um", c.rms_um},
+             {"rms_pct", c.rms_pct},
+             {"max_err_um", c.max_err_um}});
+  w.key("flux_rms_pct");
+  if (c.flux_rms_pct >= 0) {
+    w.number(c.flux_rms_pct);
+  } else {
+    w.null();  // no flux column
+  }
+  w.key("failed").boolean(c.failed);
+  w.key("error").string(c.error);
+  w.key("overlay").string(c.overlay_file);
+  w.end_object();
+}
+
+void write_target(JsonWriter& w, const TargetFit& t) {
+  w.begin_object(JsonLayout::Inline);
+  w.key("label").string(t.label);
+  w.key("kind").string(t.kind);
+  w.numbers({{"value", t.value},
+             {"simulated", t.simulated},
+             {"error_pct", t.error_pct},
+             {"weight", t.weight}});
+  w.key("failed").boolean(t.failed);
+  w.end_object();
+}
+
+void write_history(JsonWriter& w, const HistoryEntry& h) {
+  w.begin_object(JsonLayout::Inline);
+  w.key("phase").string(h.phase);
+  w.key("step").integer(h.step);
+  w.key("evaluations").integer(h.evaluations);
+  w.numbers(
+      {{"best_rms_pct", h.best_rms_pct}, {"wall_s", h.wall_s}, {"evals_per_s", h.evals_per_s}});
+  w.end_object();
+}
+
 }  // namespace
 
 std::string fitted_model_toml(const std::string& start_text, const ModelSpec& start,
@@ -151,21 +225,15 @@ std::string fitted_model_toml(const std::string& start_text, const ModelSpec& st
 }
 
 std::string fit_report_json(const IdentifyResult& r, const FitProvenance& p) {
-  using io_detail::JsonLayout;
-  io_detail::JsonWriter w;
-  // [lo, hi] on one line.
-  auto pair = [&w](std::string_view key, double lo, double hi) {
-    w.key(key).begin_array(JsonLayout::Inline).number(lo).number(hi).end_array();
-  };
+  JsonWriter w;
   w.begin_object();
   w.key("gmasim_identify_report").integer(1);
   w.key("command").string(p.command);
   w.key("data").string(p.data);
   w.key("fit").string(p.fit);
   w.key("start_model").string(p.start_model);
-  w.key("rms_pct").number(r.rms_pct);
-  w.key("start_rms_pct").number(r.start_rms_pct);
-  w.key("ga_rms_pct").number(r.ga_rms_pct);
+  w.numbers(
+      {{"rms_pct", r.rms_pct}, {"start_rms_pct", r.start_rms_pct}, {"ga_rms_pct", r.ga_rms_pct}});
   w.key("interrupted").boolean(r.interrupted);
   w.key("resumed").boolean(r.resumed);
   w.key("algorithm").begin_object(JsonLayout::Inline);
@@ -181,21 +249,7 @@ std::string fit_report_json(const IdentifyResult& r, const FitProvenance& p) {
   w.key("ga_evals_per_s").number(r.ga_evals_per_s);
   w.key("parameters").begin_array();
   for (const auto& fp : r.parameters) {
-    w.begin_object(JsonLayout::Inline);
-    w.key("name").string(fp.name);
-    w.key("unit").string(fp.unit);
-    w.key("scale").string(fp.scale == ParamScale::Log ? "log" : "linear");
-    w.key("lower").number(fp.lower);
-    w.key("upper").number(fp.upper);
-    w.key("start").number(fp.start);
-    w.key("value").number(fp.value);
-    w.key("std_error").number(fp.std_error);
-    pair("ci95", fp.ci_low, fp.ci_high);
-    pair("ci95_linearised", fp.wald_low, fp.wald_high);
-    w.key("ci_method").string(fp.ci_method);
-    w.key("determined").boolean(fp.determined);
-    w.key("at_bound").boolean(fp.at_bound);
-    w.end_object();
+    write_parameter(w, fp);
   }
   w.end_array();
   w.key("correlation").begin_array();
@@ -213,54 +267,17 @@ std::string fit_report_json(const IdentifyResult& r, const FitProvenance& p) {
   w.end_object();
   w.key("conditions").begin_array();
   for (const auto& c : r.conditions) {
-    w.begin_object(JsonLayout::Inline);
-    w.key("label").string(c.label);
-    w.key("file").string(c.path);
-    w.key("temperature_C").number(c.condition.temperature_C);
-    w.key("frequency_Hz").number(c.condition.frequency_Hz);
-    w.key("current_pp_A").number(c.condition.current_pp_A);
-    w.key("weight").number(c.weight);
-    w.key("samples").integer(static_cast<long long>(c.samples));
-    w.key("compared").integer(static_cast<long long>(c.compared));
-    w.key("pp_um").number(c.pp_um);
-    w.key("rms_um").number(c.rms_um);
-    w.key("rms_pct").number(c.rms_pct);
-    w.key("max_err_um").number(c.max_err_um);
-    w.key("flux_rms_pct");
-    if (c.flux_rms_pct >= 0) {
-      w.number(c.flux_rms_pct);
-    } else {
-      w.null();  // no flux column
-    }
-    w.key("failed").boolean(c.failed);
-    w.key("error").string(c.error);
-    w.key("overlay").string(c.overlay_file);
-    w.end_object();
+    write_condition(w, c);
   }
   w.end_array();
   w.key("targets").begin_array();
   for (const auto& t : r.targets) {
-    w.begin_object(JsonLayout::Inline);
-    w.key("label").string(t.label);
-    w.key("kind").string(t.kind);
-    w.key("value").number(t.value);
-    w.key("simulated").number(t.simulated);
-    w.key("error_pct").number(t.error_pct);
-    w.key("weight").number(t.weight);
-    w.key("failed").boolean(t.failed);
-    w.end_object();
+    write_target(w, t);
   }
   w.end_array();
   w.key("history").begin_array();
   for (const auto& h : r.history) {
-    w.begin_object(JsonLayout::Inline);
-    w.key("phase").string(h.phase);
-    w.key("step").integer(h.step);
-    w.key("evaluations").integer(h.evaluations);
-    w.key("best_rms_pct").number(h.best_rms_pct);
-    w.key("wall_s").number(h.wall_s);
-    w.key("evals_per_s").number(h.evals_per_s);
-    w.end_object();
+    write_history(w, h);
   }
   w.end_array();
   w.key("notes").begin_array(JsonLayout::Inline);

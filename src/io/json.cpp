@@ -85,14 +85,15 @@ JsonWriter& JsonWriter::key(std::string_view k) {
   return *this;
 }
 
-void JsonWriter::open(char c, bool object, JsonLayout layout) {
+JsonWriter& JsonWriter::open(char c, bool object, JsonLayout layout) {
   before_value();
   const bool in_inline = !stack_.empty() && stack_.back().inline_;
   stack_.push_back({object, in_inline || layout == JsonLayout::Inline});
   out_ += c;
+  return *this;
 }
 
-void JsonWriter::close(char c, bool object) {
+JsonWriter& JsonWriter::close(char c, bool object) {
   if (stack_.empty() || stack_.back().object != object || have_key_)
     throw std::logic_error("JsonWriter: unbalanced end");
   const Level l = stack_.back();
@@ -103,22 +104,6 @@ void JsonWriter::close(char c, bool object) {
   }
   out_ += c;
   if (stack_.empty()) done_ = true;
-}
-
-JsonWriter& JsonWriter::begin_object(JsonLayout layout) {
-  open('{', true, layout);
-  return *this;
-}
-JsonWriter& JsonWriter::end_object() {
-  close('}', true);
-  return *this;
-}
-JsonWriter& JsonWriter::begin_array(JsonLayout layout) {
-  open('[', false, layout);
-  return *this;
-}
-JsonWriter& JsonWriter::end_array() {
-  close(']', false);
   return *this;
 }
 
@@ -145,6 +130,12 @@ JsonWriter& JsonWriter::string(std::string_view s) {
 JsonWriter& JsonWriter::null() {
   before_value();
   out_ += "null";
+  return *this;
+}
+
+JsonWriter& JsonWriter::numbers(
+    std::initializer_list<std::pair<std::string_view, double>> members) {
+  for (const auto& [k, v] : members) key(k).number(v);
   return *this;
 }
 

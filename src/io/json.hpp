@@ -3,8 +3,10 @@
 // are all written through JsonWriter. Not part of the public API.
 #pragma once
 
+#include <initializer_list>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace gmasim::io_detail {
@@ -32,10 +34,14 @@ enum class JsonLayout { Block, Inline };
 
 class JsonWriter {
  public:
-  JsonWriter& begin_object(JsonLayout layout = JsonLayout::Block);
-  JsonWriter& end_object();
-  JsonWriter& begin_array(JsonLayout layout = JsonLayout::Block);
-  JsonWriter& end_array();
+  JsonWriter& begin_object(JsonLayout layout = JsonLayout::Block) {
+    return open('{', true, layout);
+  }
+  JsonWriter& end_object() { return close('}', true); }
+  JsonWriter& begin_array(JsonLayout layout = JsonLayout::Block) {
+    return open('[', false, layout);
+  }
+  JsonWriter& end_array() { return close(']', false); }
   JsonWriter& key(std::string_view k);
 
   JsonWriter& number(double v);      // json_number
@@ -43,6 +49,8 @@ class JsonWriter {
   JsonWriter& boolean(bool v);
   JsonWriter& string(std::string_view s);
   JsonWriter& null();
+  // Object members "key": number, in the order given (a table of results reads as one).
+  JsonWriter& numbers(std::initializer_list<std::pair<std::string_view, double>> members);
 
   // The document, with a final newline. Throws std::logic_error if a container is open.
   std::string text() const;
@@ -51,8 +59,8 @@ class JsonWriter {
   struct Level {
     bool object, inline_, empty = true;
   };
-  void open(char c, bool object, JsonLayout layout);
-  void close(char c, bool object);
+  JsonWriter& open(char c, bool object, JsonLayout layout);
+  JsonWriter& close(char c, bool object);
   void separate();
   void before_value();
   void put_indent(std::size_t level);

@@ -170,9 +170,7 @@ void write_waveform(JsonWriter& w, const Waveform& wf) {
   switch (wf.kind) {
     case WaveformKind::BiasedSine:
       w.key("kind").string("biased_sine");
-      w.key("pp_A").number(wf.pp_A);
-      w.key("min_A").number(wf.min_A);
-      w.key("frequency_Hz").number(wf.frequency_Hz);
+      w.numbers({{"pp_A", wf.pp_A}, {"min_A", wf.min_A}, {"frequency_Hz", wf.frequency_Hz}});
       break;
     case WaveformKind::DC:
       w.key("kind").string("dc");
@@ -180,17 +178,16 @@ void write_waveform(JsonWriter& w, const Waveform& wf) {
       break;
     case WaveformKind::Step:
       w.key("kind").string("step");
-      w.key("level_A").number(wf.level_A);
-      w.key("step_to_A").number(wf.step_to_A);
-      w.key("step_time_s").number(wf.step_time_s);
+      w.numbers(
+          {{"level_A", wf.level_A}, {"step_to_A", wf.step_to_A}, {"step_time_s", wf.step_time_s}});
       break;
     case WaveformKind::Chirp:
       w.key("kind").string("chirp");
-      w.key("offset_A").number(wf.offset_A);
-      w.key("amplitude_A").number(wf.amplitude_A);
-      w.key("f0_Hz").number(wf.f0_Hz);
-      w.key("f1_Hz").number(wf.f1_Hz);
-      w.key("duration_s").number(wf.duration_s);
+      w.numbers({{"offset_A", wf.offset_A},
+                 {"amplitude_A", wf.amplitude_A},
+                 {"f0_Hz", wf.f0_Hz},
+                 {"f1_Hz", wf.f1_Hz},
+                 {"duration_s", wf.duration_s}});
       break;
     case WaveformKind::Table:
       w.key("kind").string("table");
@@ -198,6 +195,23 @@ void write_waveform(JsonWriter& w, const Waveform& wf) {
       w.key("points").integer(static_cast<long long>(wf.table_t_s.size()));
       break;
   }
+  w.end_object();
+}
+
+// Self-heating: the end state of the network and its energy balance (self_heating.csv).
+void write_self_heating(JsonWriter& w, const Result& r) {
+  const auto last = r.heating.rows() - 1;
+  w.key("self_heating").begin_object();
+  w.numbers({{"thermal_step_s", r.heating.rows() > 1 ? r.heating.columns[0][1] : 0.0},
+             {"coil_C", r.heating.column("coil_C")[last]},
+             {"rods_C", r.heating.column("rods_C")[last]},
+             {"housing_C", r.heating.column("housing_C")[last]}});
+  // The first thermal step holds the virgin curve: the drift starts at the second.
+  w.numbers({{"stroke_start_um", r.heating.column("stroke_um")[std::min<std::size_t>(last, 2)]},
+             {"stroke_last_um", r.heating.column("stroke_um")[last]},
+             {"energy_in_J", r.energy_in_J},
+             {"energy_stored_J", r.energy_stored_J},
+             {"energy_out_J", r.energy_out_J}});
   w.end_object();
 }
 
@@ -243,18 +257,18 @@ std::string metrics_json(const Result& r, const SimulationSettings& s, const Mod
   w.end_array();
   if (r.has_metrics) {
     w.key("metrics").begin_object();
-    w.key("stroke_um").number(r.metrics.stroke_um);
-    w.key("hysteresis_um").number(r.metrics.hysteresis_um);
-    w.key("B_pp_T").number(r.metrics.B_pp_T);
-    w.key("y_mean_um").number(r.metrics.y_mean_um);
-    w.key("window_start_s").number(r.metrics.window_start_s);
-    w.key("window_end_s").number(r.metrics.window_end_s);
+    w.numbers({{"stroke_um", r.metrics.stroke_um},
+               {"hysteresis_um", r.metrics.hysteresis_um},
+               {"B_pp_T", r.metrics.B_pp_T},
+               {"y_mean_um", r.metrics.y_mean_um},
+               {"window_start_s", r.metrics.window_start_s},
+               {"window_end_s", r.metrics.window_end_s}});
     if (r.step.valid) {
-      w.key("step_y_initial_um").number(r.step.y_initial_um);
-      w.key("step_y_final_um").number(r.step.y_final_um);
-      w.key("step_rise_time_s").number(r.step.rise_time_s);
-      w.key("step_overshoot_pct").number(r.step.overshoot_pct);
-      w.key("step_settling_time_s").number(r.step.settling_time_s);
+      w.numbers({{"step_y_initial_um", r.step.y_initial_um},
+                 {"step_y_final_um", r.step.y_final_um},
+                 {"step_rise_time_s", r.step.rise_time_s},
+                 {"step_overshoot_pct", r.step.overshoot_pct},
+                 {"step_settling_time_s", r.step.settling_time_s}});
     }
     w.end_object();
   }
@@ -262,31 +276,13 @@ std::string metrics_json(const Result& r, const SimulationSettings& s, const Mod
     w.key("quantities").begin_object();
     for (const auto& q : r.quantities) {
       w.key(q.name).begin_object();
-      w.key("rms").number(q.rms);
-      w.key("peak").number(q.peak);
-      w.key("pp").number(q.pp);
-      w.key("mean").number(q.mean);
+      w.numbers({{"rms", q.rms}, {"peak", q.peak}, {"pp", q.pp}, {"mean", q.mean}});
       w.end_object();
     }
     w.end_object();
   }
   w.key("thermal_expansion_um").number(r.thermal_expansion_um);
-  if (r.heating.rows() > 0) {
-    // Self-heating: the end state of the network and its energy balance (self_heating.csv).
-    const auto last = r.heating.rows() - 1;
-    w.key("self_heating").begin_object();
-    w.key("thermal_step_s").number(r.heating.rows() > 1 ? r.heating.columns[0][1] : 0.0);
-    w.key("coil_C").number(r.heating.column("coil_C")[last]);
-    w.key("rods_C").number(r.heating.column("rods_C")[last]);
-    w.key("housing_C").number(r.heating.column("housing_C")[last]);
-    // The first thermal step holds the virgin curve: the drift starts at the second.
-    w.key("stroke_start_um").number(r.heating.column("stroke_um")[std::min<std::size_t>(last, 2)]);
-    w.key("stroke_last_um").number(r.heating.column("stroke_um")[last]);
-    w.key("energy_in_J").number(r.energy_in_J);
-    w.key("energy_stored_J").number(r.energy_stored_J);
-    w.key("energy_out_J").number(r.energy_out_J);
-    w.end_object();
-  }
+  if (r.heating.rows() > 0) write_self_heating(w, r);
   if (!timeseries_csv_text.empty()) {
     // Pairs this file with the timeseries.csv written with it (write_files_atomic).
     w.key("timeseries_csv").begin_object();

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <filesystem>
+#include <system_error>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
@@ -165,7 +166,10 @@ void write_reproduction_doc(const ReproduceResult& r, const std::vector<Compared
   const fs::path fig_src = fs::path(out_dir) / "figures";
   const fs::path fig_dst = doc_dir / "figures";
   const bool figures = fs::exists(fig_src / "loops_8A_10Hz.png");
-  if (figures) {
+  // A page written into the output directory itself already has its figures beside it.
+  std::error_code ec;
+  const bool in_place = fs::exists(fig_dst) && fs::equivalent(fig_src, fig_dst, ec);
+  if (figures && !in_place) {
     ensure_output_dir(fig_dst.string());
     for (const auto& e : fs::directory_iterator(fig_src))
       if (e.path().extension() == ".png")
