@@ -234,7 +234,7 @@ TEST(Measurements, RejectsBadFilesWithFileAndLine) {
       {"extra column", std::string(kHead) + rows(5) + "0.5,1,2,3\n", 10,
        "mismatched columns: 4 cells"},
       {"missing column", "# temperature_C = 20\nt_s,current_A\n0,1\n", 2,
-       "missing column 'displacement_um'"},
+       "missing response column ('displacement_um' or 'strain_ppm')"},
       {"unknown column", "# temperature_C = 20\nt_s,current_A,displacement_um,force_N\n", 2,
        "unknown column 'force_N'"},
       {"no temperature",
@@ -320,8 +320,8 @@ TEST(Measurements, WrittenSetReadsBackBitForBit) {
   ASSERT_EQ(back.items.size(), 2u);
   for (std::size_t i = 0; i < 2; ++i) {
     EXPECT_EQ(back.items[i].t_s, set.items[i].t_s);
-    EXPECT_EQ(back.items[i].current_A, set.items[i].current_A);
-    EXPECT_EQ(back.items[i].displacement_um, set.items[i].displacement_um);
+    EXPECT_EQ(back.items[i].drive, set.items[i].drive);
+    EXPECT_EQ(back.items[i].response, set.items[i].response);
     EXPECT_EQ(back.items[i].flux_T, set.items[i].flux_T);
     EXPECT_EQ(back.items[i].condition.compare_from_s, set.items[i].condition.compare_from_s);
   }
@@ -412,7 +412,7 @@ TEST(Objective, WeightsAndFluxEnterTheWeightedRms) {
   r.frequencies_Hz = {10};
   MeasurementSet set = synthesize_measurements(mdma(), r);
   // Scale the measured displacement by 1.02: every residual is 2 % of y, whatever u.
-  for (double& y : set.items[0].displacement_um) y *= 1.02;
+  for (double& y : set.items[0].response) y *= 1.02;
   const FitSpec fit = load_fit_spec("material.chi_m:10:30");
   const Objective obj(printed_spec(), set, fit, ci_objective());
   const double rms = obj.rms_pct(obj.start_unit());

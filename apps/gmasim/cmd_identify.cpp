@@ -47,6 +47,7 @@ struct SynthArgs {
   ModelArgs model;
   SyntheticRequest req;
   bool no_flux = false;
+  std::string drive = "current", response = "displacement", offset = "absolute";
 };
 
 // The command line, for provenance (Linux: /proc/self/cmdline).
@@ -134,7 +135,8 @@ void print_summary(const IdentifyArgs& a, const IdentifyResult& r) {
     if (c.failed)
       fmt::print("  {:<34} failed: {}\n", c.label, c.error);
     else
-      fmt::print("  {:<34} RMS {:8.4f} um = {:6.3f} %\n", c.label, c.rms_um, c.rms_pct);
+      fmt::print("  {:<34} RMS {:8.4f} {} = {:6.3f} %\n", c.label, c.rms_um, c.response_unit,
+                 c.rms_pct);
   }
   for (const auto& t : r.targets)
     fmt::print("  {:<34} target {:.5g}, simulated {:.5g} ({:+.2f} %)\n", t.label, t.value,
@@ -244,6 +246,11 @@ int run_synthesize(SynthArgs& a) {
     }
   }
   if (a.no_flux) a.req.with_flux = false;
+  a.req.drive = a.drive == "field" ? DriveInput::Field : DriveInput::Current;
+  a.req.response = a.response == "strain" ? ResponseOutput::Strain : ResponseOutput::Displacement;
+  a.req.offset = a.offset == "first_sample" ? OffsetMode::FirstSample
+                 : a.offset == "fitted"     ? OffsetMode::Fitted
+                                            : OffsetMode::Absolute;
   const Model m = compile(spec);
   const MeasurementSet set = synthesize_measurements(m, a.req);
   write_measurement_set(set, a.out);
@@ -311,6 +318,9 @@ Runner add_identify(CLI::App& app) {
   sub->add_option("--steps-per-period", o.objective.steps_per_period,
                   "Time steps per period of periodic conditions and targets")
       ->capture_default_str();
+  sub->add_option("--quasi-static-increments", o.objective.quasi_static_increments,
+                  "Quasi-static records: increments of the drive over its whole range")
+      ->capture_default_str();
   sub->add_option("--flux-weight", o.objective.flux_weight,
                   "Weight of the flux_T residuals of files that have them (0: ignore flux)")
       ->capture_default_str();
@@ -361,6 +371,31 @@ Runner add_identify(CLI::App& app) {
       ->capture_default_str();
   syn->add_option("--steps-per-period", s->req.objective.steps_per_period,
                   "Time steps per period (use the same value for identify)")
+      ->capture_default_str();
+  syn->add_flag("--quasi-static", s->req.quasi_static,
+                "Quasi-static records: the sine's samples as equilibria, no t_s column (one "
+                "record per temperature x current; --frequencies is ignored)");
+  syn->add_option("--drive", s->drive,
+                  "Drive column: current (current_A) or field (field_A_per_m: the rod's applied "
+                  "field that the current produced)")
+      ->check(CLI::IsMember({"current", "field"}))
+      ->capture_default_str();
+  syn->add_option("--response", s->response,
+                  "Response column: displacement (displacement_um) or strain (strain_ppm of "
+                  "the rod)")
+      ->check(CLI::IsMember({"displacement", "strain"}))
+      ->capture_default_str();
+  syn->add_option("--rod", s->req.rod, "Rod of the field / strain columns (default: the first)");
+  syn->add_option("--offset", s->offset,
+                  "Response reference: absolute, first_sample (written relative to the first "
+                  "sample) or fitted (shifted by --response-offset)")
+      ->check(CLI::IsMember({"absolute", "first_sample", "fitted"}))
+      ->capture_default_str();
+  syn->add_option("--response-offset", s->req.response_offset,
+                  "Constant added to the response with --offset fitted [um or ppm]")
+      ->capture_default_str();
+  syn->add_option("--precycles", s->req.precycles,
+                  "Pre-cycles written into each record (then every period is compared)")
       ->capture_default_str();
 
   return [a, s, sub, syn]() -> int {

@@ -14,6 +14,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gmasim/model.hpp"
@@ -24,6 +25,27 @@ namespace gmasim {
 // =======================================================================================
 // Measurements (docs/data.md)
 // =======================================================================================
+// What a record's columns hold (docs/data.md, "Columns").
+enum class DriveInput {
+  Current,  // current_A: the coil current [A], which drives the model
+  Field     // field_A_per_m: the applied field H_c (eq. 7) of one rod [A/m]; the model is
+            // driven by the coil current that produces it (found at every step)
+};
+enum class ResponseOutput {
+  Displacement,  // displacement_um: the actuator output y [um] (eq. 20)
+  Strain         // strain_ppm: one rod's strain x_i / l_i [1e-6] (eq. 15's x_i)
+};
+// How the measured response is referenced (relative strain, integrated induction-coil flux).
+enum class OffsetMode {
+  Absolute,     // compared as measured
+  FirstSample,  // measured and simulated both taken relative to their first sample
+  Fitted        // an unknown constant offset, eliminated by least squares per record
+};
+std::string offset_mode_name(OffsetMode m);
+
+inline constexpr double kMaxField_A_per_m = 1e7;  // |field_A_per_m| limit (saturation ~1e5)
+inline constexpr long kMaxPrecycles = 100;
+
 struct MeasurementCondition {
   double temperature_C = 0.0;
   // Periodic (biased-sine) excitation when frequency_Hz > 0: then current_pp_A is set.
@@ -31,19 +53,36 @@ struct MeasurementCondition {
   double current_pp_A = 0.0;
   double current_min_A = -3.0;  // Fig. 11; used only with current_source = "sine"
   // Samples with t_s < compare_from_s are simulated but not compared (the transient from
-  // the demagnetised start). Default: t0 + one period if periodic, else t0.
+  // the demagnetised start). Default: t0 + one period if periodic (and not pre-cycled),
+  // else t0.
   double compare_from_s = 0.0;
   std::string current_source = "measured";  // "measured" (the CSV current) or "sine"
   std::string label;                        // default: the file name without extension
+  // Quasi-static record (no t_s column): the samples are equilibria in measurement order,
+  // t_s holds their index 0, 1, 2, ...; the model moves through them with
+  // quasi_static_step in increments chosen from the record (ObjectiveSettings).
+  bool quasi_static = false;
+  std::string rod;     // rod of the field_A_per_m / strain_ppm columns; "": the first rod
+  long precycles = 0;  // passes of the record's own drive before the compared pass
+  OffsetMode offset = OffsetMode::Absolute;       // of displacement_um / strain_ppm
+  OffsetMode flux_offset = OffsetMode::Absolute;  // of flux_T
 };
 
 struct Measurement {
   std::string path;  // the CSV file
   MeasurementCondition condition;
   double weight = 1.0;
-  std::vector<double> t_s, current_A, displacement_um;
-  std::vector<double> flux_T;  // empty if the file has no flux_T column
+  DriveInput drive_kind = DriveInput::Current;
+  ResponseOutput response_kind = ResponseOutput::Displacement;
+  std::vector<double> t_s;       // [s]; quasi-static records: the sample index
+  std::vector<double> drive;     // current_A [A] or field_A_per_m [A/m] (drive_kind)
+  std::vector<double> response;  // displacement_um [um] or strain_ppm [1e-6] (response_kind)
+  std::vector<double> flux_T;    // empty if the file has no flux_T column
   bool periodic() const { return condition.frequency_Hz > 0.0; }
+  // Column names and units of drive and response, as in the CSV header.
+  std::string_view drive_column() const;
+  std::string_view response_column() const;
+  std::string_view response_unit() const;  // "um" or "ppm"
 };
 
 struct MeasurementSet {
@@ -51,8 +90,8 @@ struct MeasurementSet {
   std::vector<Measurement> items;
 };
 
-// One CSV "t_s,current_A,displacement_um[,flux_T]" with its condition in "# key = value"
-// header comments and/or the sidecar <name>.toml. Throws InputError "file:line: ..." for an
+// One CSV "[t_s,]current_A|field_A_per_m,displacement_um|strain_ppm[,flux_T]" with its
+// condition in "# key = value" header comments and/or the sidecar <name>.toml. Throws InputError "file:line: ..." for an
 // empty file, a bad header, mismatched columns, non-numeric cells, NaN/Inf, duplicate or
 // decreasing time, fewer than 4 rows, a missing or contradictory condition.
 Measurement load_measurement_csv(const std::string& path);
@@ -128,6 +167,12 @@ struct ObjectiveSettings {
   double steps_per_period = 500.0;  // periodic conditions and targets: dt = period / this
   double flux_weight = 0.0;         // weight of the flux_T residuals (files that have them)
   double target_periods = 2.0;      // run length of the scalar-target simulations
+  // Quasi-static records: the drive (current or field) moves in at most this many equal
+  // increments over its whole range min..max; each sample-to-sample change is split into
+  // ceil(|change| / (range / this)) quasi_static_step calls. The loop converges at second
+  // order in the increment: 500 is within 1e-6 of the p-p of a 48 um loop
+  // (tests/test_identify_records.cpp).
+  double quasi_static_increments = 500.0;
 };
 
 // Per-condition outcome at one parameter vector.
@@ -137,6 +182,9 @@ struct ConditionFit {
   MeasurementCondition condition;
   double weight = 1.0;
   std::size_t samples = 0, compared = 0;
+  // pp_um, rms_um and max_err_um are in the record's response unit (response_unit: "um",
+  // or "ppm" for strain_ppm records).
+  std::string response_unit = "um";
   double pp_um = 0.0;    // peak-to-peak of the measured displacement (compared samples)
   double rms_um = 0.0;   // RMS of simulated - measured
   double rms_pct = 0.0;  // rms_um / pp_um [%] (the paper's normalisation)
@@ -221,6 +269,19 @@ struct SyntheticRequest {
   double flux_noise_pct = 1.0;
   unsigned seed = 1;
   ObjectiveSettings objective;  // the same rules as the fit: an exact-model test
+  // Record formats (docs/data.md): quasi-static records hold the biased sine's samples as
+  // equilibria without a time axis; a field record's drive is the rod's applied field H_c
+  // that the current produced (what a Hall probe or H-coil reads); a strain record's
+  // response is the rod's strain in ppm; FirstSample writes the response relative to its
+  // first sample (offset = first_sample), Fitted adds `response_offset` to it
+  // (offset = fitted).
+  bool quasi_static = false;
+  DriveInput drive = DriveInput::Current;
+  ResponseOutput response = ResponseOutput::Displacement;
+  std::string rod;  // rod of the field / strain columns ("": the first rod)
+  OffsetMode offset = OffsetMode::Absolute;
+  double response_offset = 0.0;  // [um or ppm], with OffsetMode::Fitted
+  long precycles = 0;            // written as the records' precycles key
 };
 MeasurementSet synthesize_measurements(const Model& truth, const SyntheticRequest& r);
 

@@ -282,6 +282,15 @@ struct State {
 // under current_A, demagnetised (M_irr = 0) before the field is applied.
 State make_state(const Model& m, const Conditions& c, double current_A);
 
+// Moves the actuator quasi-statically (the limit of a vanishing frequency) to current_A:
+// the magnetic state follows its hysteresis loop without eddy lag (eq. 7 with dB/dt = 0,
+// eq. 9 over the increment) and the mechanics settle at the static equilibrium x = F / K
+// (eq. 15 with x'' = x' = 0); t_s is not advanced. The accuracy of the loop depends on the
+// increment of the field per call (eq. 9 is integrated with a first-order hold): callers
+// sub-divide large changes of current (identify's quasi-static records do). Allocation-free.
+// Throws DivergenceError.
+void quasi_static_step(const Model& m, const Conditions& c, State& s, double current_A);
+
 struct StepInput {
   double current_A;  // coil current at the end of the step
   double dt_s;       // step length

@@ -191,33 +191,38 @@ def compensate(out):
 def identify(out):
     """The figures of a fit report directory (`gmasim identify --report OUT`): per condition
     overlay_<condition>.png (measured against simulated: the loop over the compared samples
-    and the time series), and convergence.png (best weighted RMS error against model
-    evaluations). Yields (stem, figure) pairs."""
+    and the record against time or sample), and convergence.png (best weighted RMS error
+    against model evaluations). Yields (stem, figure) pairs."""
     out = pathlib.Path(out)
     rep = json.loads((out / "fit_report.json").read_text())
     for c in rep["conditions"]:
         if c["failed"]:
             continue
         o = read_csv(out / c["overlay"])
+        # Columns: time or sample, drive (current or field), measured, simulated, compared, ...
+        t_key, drive, measured, simulated = list(o)[:4]
         cmp = o["compared"] > 0.5
+        unit = c.get("response_unit", "um")
+        ylabel = "strain (ppm)" if unit == "ppm" else "displacement (µm)"
         fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
-        a1.plot(o["current_A"][cmp], o["measured_um"][cmp], ".", ms=2.5, label="measured")
-        a1.plot(o["current_A"][cmp], o["simulated_um"][cmp], "-", lw=1.2, label="simulated")
-        a1.set_xlabel("current (A)")
-        a1.set_ylabel("displacement (µm)")
+        a1.plot(o[drive][cmp], o[measured][cmp], ".", ms=2.5, label="measured")
+        a1.plot(o[drive][cmp], o[simulated][cmp], "-", lw=1.2, label="simulated")
+        a1.set_xlabel({"current_A": "current (A)", "field_A_per_m": "field H (A/m)"}.get(drive, drive))
+        a1.set_ylabel(ylabel)
         a1.legend(loc="upper left")
         a1.set_title("loop (compared samples)")
-        t = o["t_s"]
-        a2.plot(t, o["measured_um"], ".", ms=2.0, label="measured")
-        a2.plot(t, o["simulated_um"], "-", lw=1.0, label="simulated")
+        t = o[t_key]
+        a2.plot(t, o[measured], ".", ms=2.0, label="measured")
+        a2.plot(t, o[simulated], "-", lw=1.0, label="simulated")
         if np.any(cmp):
             a2.axvspan(t[0], t[np.argmax(cmp)], color="0.9", label="not compared")
-        a2.set_xlabel("time (s)")
-        a2.set_ylabel("displacement (µm)")
+        a2.set_xlabel("time (s)" if t_key == "t_s" else "sample (-)")
+        a2.set_ylabel(ylabel)
         a2.legend(loc="upper left")
         freq = c["frequency_Hz"]
         cond = f'{c["temperature_C"]:g} °C' + (f', {c["current_pp_A"]:g} A p-p, {freq:g} Hz' if freq else "")
-        fig.suptitle(f'{c["label"]}: {cond}; RMS {c["rms_um"]:.3f} µm = {c["rms_pct"]:.2f} % of p-p')
+        fig.suptitle(f'{c["label"]}: {cond}; RMS {c["rms_um"]:.3f} {"µm" if unit == "um" else unit} '
+                     f'= {c["rms_pct"]:.2f} % of p-p')
         fig.tight_layout()
         yield pathlib.Path(c["overlay"]).stem, fig
     h = read_csv(out / "convergence.csv")

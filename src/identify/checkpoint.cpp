@@ -127,15 +127,25 @@ Fingerprints fingerprints(const Objective& obj, const IdentifyOptions& o, int ra
                      std::filesystem::path(m.path).filename().string(), m.t_s.size(), m.weight,
                      c.temperature_C, c.frequency_Hz, c.current_pp_A, c.current_min_A,
                      c.compare_from_s, c.current_source);
+    // The keys of issue 9 item 7 only when they are not the defaults, so that checkpoints
+    // of current/displacement records written before them still resume.
+    if (m.drive_kind != DriveInput::Current || m.response_kind != ResponseOutput::Displacement ||
+        c.quasi_static || !c.rod.empty() || c.precycles != 0 || c.offset != OffsetMode::Absolute ||
+        c.flux_offset != OffsetMode::Absolute)
+      d += fmt::format("{}|{}|{}|{}|{}|{}|{};", m.drive_column(), m.response_column(),
+                       c.quasi_static, c.rod, c.precycles, offset_mode_name(c.offset),
+                       offset_mode_name(c.flux_offset));
     hash_values(d, m.t_s);
-    hash_values(d, m.current_A);
-    hash_values(d, m.displacement_um);
+    hash_values(d, m.drive);
+    hash_values(d, m.response);
     hash_values(d, m.flux_T);
   }
   fp.data = fnv_hex(d);
   const auto& s = obj.settings();
   std::string st = fmt::format("{:.17g}|{:.17g}|{:.17g}|{:.17g};", s.dt_s, s.steps_per_period,
                                s.flux_weight, s.target_periods);
+  if (s.quasi_static_increments != ObjectiveSettings{}.quasi_static_increments)
+    st += fmt::format("qs{:.17g};", s.quasi_static_increments);
   for (const auto& t : fit.targets) {
     st += fmt::format("{}|{:.17g}|{:.17g}|{:.17g}|{:.17g}|{:.17g}|{:.17g}|{:.17g}|{:.17g}|{:.17g};",
                       target_kind_name(t.kind), t.temperature_C, t.reference_temperature_C,

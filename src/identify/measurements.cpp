@@ -66,6 +66,17 @@ constexpr ConditionKey kConditionKeys[] = {
     {"compare_from_s", KeyType::Number},
     {"current_source", KeyType::Text},
     {"label", KeyType::Text},
+    {"compare_from_sample", KeyType::Number},
+    {"rod", KeyType::Text},
+    {"precycles", KeyType::Number},
+    {"offset", KeyType::Text},
+    {"flux_offset", KeyType::Text},
+};
+
+constexpr std::pair<OffsetMode, std::string_view> kOffsetNames[] = {
+    {OffsetMode::Absolute, "absolute"},
+    {OffsetMode::FirstSample, "first_sample"},
+    {OffsetMode::Fitted, "fitted"},
 };
 
 std::string known_keys() {
@@ -179,6 +190,75 @@ void read_sidecar(const std::string& path, KeyMap& keys) {
   }
 }
 
+OffsetMode parse_offset(const KeyValue& kv, std::string_view key) {
+  for (const auto& [mode, name] : kOffsetNames)
+    if (kv.text == name) return mode;
+  throw InputError(located(kv.file, kv.line,
+                           fmt::format("{} = '{}': must be absolute, first_sample or fitted", key,
+                                       kv.text)));
+}
+
+// The keys of issue 9 item 7: rod, precycles, offset, flux_offset; `fail(key, message)`
+// throws at the key's file:line.
+template <class Fail>
+void read_record_keys(const KeyMap& keys, const Measurement& m, MeasurementCondition& c,
+                      Fail&& fail) {
+  const bool rod_columns =
+      m.drive_kind == DriveInput::Field || m.response_kind == ResponseOutput::Strain;
+  if (keys.count("rod")) {
+    c.rod = keys.at("rod").text;
+    if (!rod_columns)
+      fail("rod",
+           fmt::format("rod = '{}': names the rod of a field_A_per_m or strain_ppm column, and "
+                       "this record has neither",
+                       c.rod));
+    if (!is_identifier(c.rod))
+      fail("rod", fmt::format("rod = '{}': must be a rod name of the model (letters, digits, _)",
+                              c.rod));
+  }
+  if (m.drive_kind == DriveInput::Field && c.current_source == "sine")
+    fail("current_source",
+         "current_source = sine drives the model with a current; this record's drive is "
+         "field_A_per_m");
+  if (keys.count("offset")) c.offset = parse_offset(keys.at("offset"), "offset");
+  if (keys.count("flux_offset")) {
+    c.flux_offset = parse_offset(keys.at("flux_offset"), "flux_offset");
+    if (m.flux_T.empty()) fail("flux_offset", "flux_offset: the record has no flux_T column");
+  }
+  if (keys.count("precycles")) {
+    const double n = keys.at("precycles").number;
+    if (!(n >= 0.0 && n <= static_cast<double>(kMaxPrecycles) && n == std::floor(n)))
+      fail("precycles", fmt::format("precycles = {:g}: must be a whole number in [0, {}]", n,
+                                    kMaxPrecycles));
+    c.precycles = static_cast<long>(n);
+  }
+  if (c.precycles > 0) {
+    // A pass repeats the record's drive: it must end where it starts, or each pass would
+    // end with a jump the real actuator never saw.
+    double first = m.drive.front(), last = m.drive.back();
+    if (c.current_source == "sine") {
+      const Waveform w = biased_sine(c.current_pp_A, c.frequency_Hz, c.current_min_A);
+      first = w.current_at(m.t_s.front());
+      last = w.current_at(m.t_s.back());
+    }
+    const auto [lo, hi] = std::minmax_element(m.drive.begin(), m.drive.end());
+    const double range = c.current_source == "sine" ? c.current_pp_A : *hi - *lo;
+    if (!(std::fabs(last - first) <= 0.02 * range))
+      fail("precycles",
+           fmt::format("precycles = {}: pre-cycling repeats the record's drive, which must end "
+                       "where it starts (within 2 % of its range {:g}): first {:g}, last {:g}",
+                       c.precycles, range, first, last));
+  }
+  if (c.quasi_static) {
+    const auto [lo, hi] = std::minmax_element(m.drive.begin(), m.drive.end());
+    if (!(*hi > *lo))
+      throw InputError(located(m.path, 0,
+                               fmt::format("the {} column does not vary: a quasi-static record "
+                                           "needs a drive that moves",
+                                           m.drive_column())));
+  }
+}
+
 MeasurementCondition make_condition(const KeyMap& keys, const Measurement& m,
                                     const std::string& path, long header_line) {
   MeasurementCondition c;
@@ -202,6 +282,14 @@ MeasurementCondition make_condition(const KeyMap& keys, const Measurement& m,
   if (!(c.temperature_C > -273.15 && c.temperature_C < 1e4))
     fail("temperature_C",
          fmt::format("temperature_C = {:g}: must be > -273.15 degC", c.temperature_C));
+  if (m.condition.quasi_static) {
+    for (const char* k : {"frequency_Hz", "current_pp_A", "current_source", "compare_from_s"})
+      if (keys.count(k))
+        fail(k, fmt::format("{}: a quasi-static record (no t_s column) has no time, frequency "
+                            "or sine; give t_s, or drop {} (compare_from_sample selects the "
+                            "first compared sample)",
+                            k, k));
+  }
   const double t0_rec = m.t_s.front(), t1_rec = m.t_s.back();
   const bool has_f = keys.count("frequency_Hz") > 0;
   const bool has_pp = keys.count("current_pp_A") > 0;
@@ -249,11 +337,31 @@ MeasurementCondition make_condition(const KeyMap& keys, const Measurement& m,
       fail("current_source", "current_source = sine needs frequency_Hz and current_pp_A");
   }
   c.label = keys.count("label") ? keys.at("label").text : fs::path(path).stem().string();
+  c.quasi_static = m.condition.quasi_static;
+  read_record_keys(keys, m, c, fail);
   const double t0 = m.t_s.front(), t1 = m.t_s.back();
+  if (c.quasi_static) {
+    c.compare_from_s = 0.0;
+    if (keys.count("compare_from_sample")) {
+      const double k0 = keys.at("compare_from_sample").number;
+      if (!(k0 >= 0.0 && k0 == std::floor(k0) && k0 + 3.0 <= static_cast<double>(m.t_s.size())))
+        fail("compare_from_sample",
+             fmt::format("compare_from_sample = {:g}: must be a whole sample index in [0, {}] "
+                         "(at least 3 samples compared)",
+                         k0, m.t_s.size() - 3));
+      c.compare_from_s = k0;
+    }
+    return c;
+  }
+  if (keys.count("compare_from_sample"))
+    fail("compare_from_sample",
+         "compare_from_sample is for quasi-static records (no t_s column); a timed record "
+         "uses compare_from_s");
   if (keys.count("compare_from_s")) {
     c.compare_from_s = keys.at("compare_from_s").number;
   } else {
-    c.compare_from_s = has_f ? t0 + 1.0 / c.frequency_Hz : t0;
+    // A pre-cycled record is already on its loop: everything is compared.
+    c.compare_from_s = has_f && c.precycles == 0 ? t0 + 1.0 / c.frequency_Hz : t0;
   }
   // At least 3 compared samples.
   const auto first =
@@ -275,16 +383,39 @@ MeasurementCondition make_condition(const KeyMap& keys, const Measurement& m,
 
 }  // namespace
 
+std::string offset_mode_name(OffsetMode mode) {
+  for (const auto& [m, name] : kOffsetNames)
+    if (m == mode) return std::string(name);
+  return "absolute";
+}
+
+std::string_view Measurement::drive_column() const {
+  return drive_kind == DriveInput::Field ? "field_A_per_m" : "current_A";
+}
+std::string_view Measurement::response_column() const {
+  return response_kind == ResponseOutput::Strain ? "strain_ppm" : "displacement_um";
+}
+std::string_view Measurement::response_unit() const {
+  return response_kind == ResponseOutput::Strain ? "ppm" : "um";
+}
+
 Measurement load_measurement_csv(const std::string& path) {
   const std::string text = read_text_file(path, "measurement file");
   Measurement m;
   m.path = path;
   KeyMap keys;
 
-  enum Col { T, I, Y, B };
-  int col_of[4] = {-1, -1, -1, -1};
+  // Columns (docs/data.md): [t_s], one drive (current_A | field_A_per_m), one response
+  // (displacement_um | strain_ppm), [flux_T].
+  enum Col { T, I, H, Y, S, B, kCols };
+  static constexpr std::string_view kNames[kCols] = {
+      "t_s", "current_A", "field_A_per_m", "displacement_um", "strain_ppm", "flux_T"};
+  constexpr std::string_view kExpected =
+      "[t_s,]current_A|field_A_per_m,displacement_um|strain_ppm[,flux_T]";
+  int col_of[kCols] = {-1, -1, -1, -1, -1, -1};
   std::size_t ncols = 0;
   long header_line = 0;
+  double drive_limit = kMaxCurrent_A;
 
   std::string_view rest = text;
   if (rest.starts_with("\xEF\xBB\xBF")) rest.remove_prefix(3);
@@ -302,16 +433,12 @@ Measurement load_measurement_csv(const std::string& path) {
     }
     const auto cells = split_cells(line);
     if (header_line == 0) {
-      static constexpr std::string_view kNames[4] = {"t_s", "current_A", "displacement_um",
-                                                     "flux_T"};
       for (std::size_t c = 0; c < cells.size(); ++c) {
         const auto it = std::find(std::begin(kNames), std::end(kNames), cells[c]);
         if (it == std::end(kNames)) {
-          throw InputError(located(path, line_no,
-                                   fmt::format("unknown column '{}' in the header; expected "
-                                               "t_s,current_A,displacement_um and optionally "
-                                               "flux_T",
-                                               cells[c])));
+          throw InputError(located(
+              path, line_no,
+              fmt::format("unknown column '{}' in the header; expected {}", cells[c], kExpected)));
         }
         const auto k = static_cast<std::size_t>(it - std::begin(kNames));
         if (col_of[k] >= 0)
@@ -319,14 +446,23 @@ Measurement load_measurement_csv(const std::string& path) {
               located(path, line_no, fmt::format("column '{}' appears twice", cells[c])));
         col_of[k] = static_cast<int>(c);
       }
-      for (int k = 0; k < 3; ++k) {
-        if (col_of[k] < 0) {
+      auto exactly_one = [&](int a, int b, std::string_view what) {
+        if (col_of[a] >= 0 && col_of[b] >= 0)
           throw InputError(located(path, line_no,
-                                   fmt::format("missing column '{}' in the header '{}'; expected "
-                                               "t_s,current_A,displacement_um[,flux_T]",
-                                               kNames[k], line)));
-        }
-      }
+                                   fmt::format("columns '{}' and '{}' are both given: a record "
+                                               "has one {} column",
+                                               kNames[a], kNames[b], what)));
+        if (col_of[a] < 0 && col_of[b] < 0)
+          throw InputError(located(path, line_no,
+                                   fmt::format("missing {} column ('{}' or '{}') in the header "
+                                               "'{}'; expected {}",
+                                               what, kNames[a], kNames[b], line, kExpected)));
+      };
+      exactly_one(I, H, "drive");
+      exactly_one(Y, S, "response");
+      m.drive_kind = col_of[H] >= 0 ? DriveInput::Field : DriveInput::Current;
+      m.response_kind = col_of[S] >= 0 ? ResponseOutput::Strain : ResponseOutput::Displacement;
+      drive_limit = col_of[H] >= 0 ? kMaxField_A_per_m : kMaxCurrent_A;
       ncols = cells.size();
       header_line = line_no;
       continue;
@@ -336,14 +472,20 @@ Measurement load_measurement_csv(const std::string& path) {
                                fmt::format("mismatched columns: {} cells, the header has {} ('{}')",
                                            cells.size(), ncols, line)));
     }
-    double v[4] = {0, 0, 0, 0};
-    static constexpr std::string_view kCol[4] = {"t_s", "current_A", "displacement_um", "flux_T"};
-    for (int k = 0; k < 4; ++k) {
+    double v[kCols] = {0, 0, 0, 0, 0, 0};
+    for (int k = 0; k < kCols; ++k) {
       if (col_of[k] < 0) continue;
       if (auto bad = parse_number(cells[static_cast<std::size_t>(col_of[k])], v[k]))
-        throw InputError(located(path, line_no, fmt::format("{} in column {}", *bad, kCol[k])));
+        throw InputError(located(path, line_no, fmt::format("{} in column {}", *bad, kNames[k])));
     }
-    if (!m.t_s.empty()) {
+    const int drive_col = col_of[H] >= 0 ? H : I;
+    if (!(std::fabs(v[drive_col]) <= drive_limit))
+      throw InputError(located(path, line_no,
+                               fmt::format("{} = {:g}: must be in [-{:g}, {:g}]", kNames[drive_col],
+                                           v[drive_col], drive_limit, drive_limit)));
+    if (col_of[T] < 0) {
+      v[T] = static_cast<double>(m.t_s.size());  // quasi-static: the sample index
+    } else if (!m.t_s.empty()) {
       const double prev = m.t_s.back();
       if (v[T] == prev) {
         throw InputError(
@@ -356,19 +498,20 @@ Measurement load_measurement_csv(const std::string& path) {
       }
     }
     m.t_s.push_back(v[T]);
-    m.current_A.push_back(v[I]);
-    m.displacement_um.push_back(v[Y]);
+    m.drive.push_back(v[drive_col]);
+    m.response.push_back(v[col_of[S] >= 0 ? S : Y]);
     if (col_of[B] >= 0) m.flux_T.push_back(v[B]);
   }
   if (header_line == 0) {
-    throw InputError(
-        located(path, line_no > 0 ? line_no : 1,
-                line_no > 0 ? "no header: expected t_s,current_A,displacement_um" : "empty file"));
+    throw InputError(located(path, line_no > 0 ? line_no : 1,
+                             line_no > 0 ? fmt::format("no header: expected {}", kExpected)
+                                         : std::string("empty file")));
   }
   if (m.t_s.size() < 4) {
     throw InputError(
         located(path, line_no, fmt::format("needs at least 4 data rows, found {}", m.t_s.size())));
   }
+  m.condition.quasi_static = col_of[T] < 0;
   const std::string side = sidecar_path(path);
   std::error_code ec;
   if (fs::exists(side, ec)) read_sidecar(side, keys);
@@ -451,12 +594,23 @@ std::string measurement_csv(const Measurement& m) {
     s += fmt::format("# current_pp_A = {:.17g}\n", c.current_pp_A);
     s += fmt::format("# current_min_A = {:.17g}\n", c.current_min_A);
   }
-  s += fmt::format("# compare_from_s = {:.17g}\n", c.compare_from_s);
+  if (c.quasi_static) {
+    if (c.compare_from_s > 0.0) s += fmt::format("# compare_from_sample = {:.17g}\n", c.compare_from_s);
+  } else {
+    s += fmt::format("# compare_from_s = {:.17g}\n", c.compare_from_s);
+  }
   if (c.current_source != "measured") s += fmt::format("# current_source = {}\n", c.current_source);
+  if (!c.rod.empty()) s += fmt::format("# rod = {}\n", c.rod);
+  if (c.precycles > 0) s += fmt::format("# precycles = {}\n", c.precycles);
+  if (c.offset != OffsetMode::Absolute) s += fmt::format("# offset = {}\n", offset_mode_name(c.offset));
+  if (c.flux_offset != OffsetMode::Absolute)
+    s += fmt::format("# flux_offset = {}\n", offset_mode_name(c.flux_offset));
   const bool flux = !m.flux_T.empty();
-  s += flux ? "t_s,current_A,displacement_um,flux_T\n" : "t_s,current_A,displacement_um\n";
+  if (!c.quasi_static) s += "t_s,";
+  s += fmt::format("{},{}{}\n", m.drive_column(), m.response_column(), flux ? ",flux_T" : "");
   for (std::size_t i = 0; i < m.t_s.size(); ++i) {
-    s += fmt::format("{:.17g},{:.17g},{:.17g}", m.t_s[i], m.current_A[i], m.displacement_um[i]);
+    if (!c.quasi_static) s += fmt::format("{:.17g},", m.t_s[i]);
+    s += fmt::format("{:.17g},{:.17g}", m.drive[i], m.response[i]);
     if (flux) s += fmt::format(",{:.17g}", m.flux_T[i]);
     s += '\n';
   }

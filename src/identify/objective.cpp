@@ -17,6 +17,7 @@
 #include "gmasim/io.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/validate.hpp"
+#include "identify/record_run.hpp"
 
 namespace gmasim {
 namespace {
@@ -73,26 +74,8 @@ std::string resolve_key(const ModelSpec& spec, const std::string& name) {
   throw InputError(fmt::format("unknown parameter '{}'", name));
 }
 
-// Linear interpolation of the measured current, with a forward-moving index (time only
-// increases during a run): O(1) per call, no allocation.
-struct TableCurrent {
-  const std::vector<double>& t;
-  const std::vector<double>& i;
-  std::size_t j = 1;
-  double operator()(double time) {
-    if (time <= t.front()) return i.front();
-    if (time >= t.back()) return i.back();
-    while (j + 1 < t.size() && t[j] < time) ++j;
-    while (j > 1 && t[j - 1] > time) --j;
-    const double f = (time - t[j - 1]) / (t[j] - t[j - 1]);
-    return i[j - 1] + f * (i[j] - i[j - 1]);
-  }
-};
-
 double step_for(const ObjectiveSettings& s, double period_s) {
-  if (s.dt_s > 0.0) return s.dt_s;
-  if (period_s > 0.0) return period_s / s.steps_per_period;
-  return kMaxDt_s;
+  return identify_detail::objective_step(s, period_s);
 }
 
 // Conditions and the state at rest per (temperature, initial current): runs that share both
@@ -118,14 +101,6 @@ class StartCache {
   const Model& m_;
   std::deque<Entry> entries_;
 };
-
-double initial_current(const Measurement& meas) {
-  const auto& c = meas.condition;
-  if (c.current_source == "sine")
-    return biased_sine(c.current_pp_A, c.frequency_Hz, c.current_min_A)
-        .current_at(meas.t_s.front());
-  return meas.current_A.front();
-}
 
 SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings& s,
                      std::vector<double>& I, std::vector<double>& y, std::vector<double>& B,
@@ -190,64 +165,12 @@ double lowest_resonance_Hz(const Model& m, const ResonanceRun& run) {
 
 }  // namespace
 
-// =======================================================================================
-namespace {
-
-void run_measurement(const Model& m, const Conditions& c, State st, const Measurement& meas,
-                     const ObjectiveSettings& s, std::vector<double>& y_um,
-                     std::vector<double>* B_T) {
-  const auto& ts = meas.t_s;
-  const std::size_t n = ts.size();
-  const double t0 = ts.front(), t1 = ts.back();
-  const auto& cond = meas.condition;
-  const bool sine = cond.current_source == "sine";
-  const Waveform w =
-      sine ? biased_sine(cond.current_pp_A, cond.frequency_Hz, cond.current_min_A) : Waveform{};
-  TableCurrent table{ts, meas.current_A};
-  auto current = [&](double t) { return sine ? w.current_at(t) : table(t); };
-
-  const double dt_target = step_for(s, meas.periodic() ? 1.0 / cond.frequency_Hz : 0.0);
-  const long nsteps = std::max(1L, checked_ceil_count((t1 - t0) / dt_target, kMaxSteps,
-                                                      meas.path + ": steps over the record"));
-  const double dt = (t1 - t0) / static_cast<double>(nsteps);
-
-  st.t_s = t0;
-  y_um.resize(n);
-  if (B_T) B_T->resize(n);
-  std::size_t j = 0;
-  while (j < n && ts[j] <= t0) {
-    y_um[j] = st.y_m * 1e6;
-    if (B_T) (*B_T)[j] = st.B_T;
-    ++j;
-  }
-  double y_prev = st.y_m, B_prev = st.B_T, t_prev = t0;
-  for (long k = 1; k <= nsteps; ++k) {
-    const double t = k == nsteps ? t1 : t0 + static_cast<double>(k) * dt;
-    step(m, c, st, {current(t), t - t_prev});
-    st.t_s = t;
-    while (j < n && ts[j] <= t) {
-      const double f = (ts[j] - t_prev) / (t - t_prev);
-      y_um[j] = (y_prev + f * (st.y_m - y_prev)) * 1e6;
-      if (B_T) (*B_T)[j] = B_prev + f * (st.B_T - B_prev);
-      ++j;
-    }
-    y_prev = st.y_m;
-    B_prev = st.B_T;
-    t_prev = t;
-  }
-  for (; j < n; ++j) {
-    y_um[j] = st.y_m * 1e6;
-    if (B_T) (*B_T)[j] = st.B_T;
-  }
-}
-
-}  // namespace
-
 void simulate_measurement(const Model& m, const Measurement& meas, const ObjectiveSettings& s,
                           std::vector<double>& y_um, std::vector<double>* B_T) {
   StartCache starts(m);
-  const auto& [c, st] = starts.get(meas.condition.temperature_C, initial_current(meas));
-  run_measurement(m, c, st, meas, s, y_um, B_T);
+  const auto& [c, st] =
+      starts.get(meas.condition.temperature_C, identify_detail::record_initial_current(meas));
+  identify_detail::run_record(m, c, st, meas, s, y_um, B_T);
 }
 
 // =======================================================================================
@@ -290,11 +213,16 @@ struct Objective::Impl {
       std::vector<double> y, B;
       for (const auto& cd : conds) {
         const Measurement& meas = data.items[cd.index];
-        const auto& [c, st] = starts.get(meas.condition.temperature_C, initial_current(meas));
-        run_measurement(model, c, st, meas, settings, y, cd.flux ? &B : nullptr);
+        const auto& [c, st] = starts.get(meas.condition.temperature_C,
+                                         identify_detail::record_initial_current(meas));
+        identify_detail::run_record(model, c, st, meas, settings, y, cd.flux ? &B : nullptr);
+        identify_detail::apply_offset(meas.condition.offset, meas.response, cd.compare_begin, y);
+        if (cd.flux)
+          identify_detail::apply_offset(meas.condition.flux_offset, meas.flux_T, cd.compare_begin,
+                                        B);
         const std::size_t n = meas.t_s.size();
         for (std::size_t i = cd.compare_begin; i < n; ++i) {
-          r[cd.r_offset + i - cd.compare_begin] = cd.y_scale * (y[i] - meas.displacement_um[i]);
+          r[cd.r_offset + i - cd.compare_begin] = cd.y_scale * (y[i] - meas.response[i]);
           if (cd.flux)
             r[cd.rB_offset + i - cd.compare_begin] = cd.B_scale * (B[i] - meas.flux_T[i]);
         }
@@ -379,6 +307,7 @@ Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const F
   require_in(settings.steps_per_period, 8.0, 1e6, "steps per period");
   require_in(settings.target_periods, 1.0, 1e4, "target periods");
   require_in(settings.flux_weight, 0.0, 1e6, "flux weight");
+  require_in(settings.quasi_static_increments, 10.0, 1e6, "quasi-static increments per range");
   if (fit.parameters.empty()) throw InputError(located(fit.source, 0, "no parameter to fit"));
   if (data.items.empty() && fit.targets.empty()) {
     throw InputError(
@@ -465,14 +394,20 @@ Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const F
     if (nc < 3) {
       throw InputError(located(meas.path, 0, "fewer than 3 samples after compare_from_s"));
     }
+    try {
+      (void)identify_detail::record_rod(start_model, meas);
+    } catch (const InputError& e) {
+      throw InputError(e.what());
+    }
     const auto [lo, hi] = std::minmax_element(
-        meas.displacement_um.begin() + static_cast<std::ptrdiff_t>(cd.compare_begin),
-        meas.displacement_um.end());
+        meas.response.begin() + static_cast<std::ptrdiff_t>(cd.compare_begin),
+        meas.response.end());
     cd.pp_um = *hi - *lo;
     if (!(cd.pp_um > 0.0)) {
       throw InputError(located(meas.path, 0,
-                               "the measured displacement does not vary over the compared "
-                               "samples: the RMS / peak-to-peak error is undefined"));
+                               fmt::format("the measured {} does not vary over the compared "
+                                           "samples: the RMS / peak-to-peak error is undefined",
+                                           meas.response_column())));
     }
     cd.flux = settings.flux_weight > 0.0 && !meas.flux_T.empty();
     if (cd.flux) {
@@ -532,16 +467,22 @@ Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const F
   }
   for (const auto& cd : I.conds) {
     const Measurement& meas = data.items[cd.index];
-    const double span = meas.t_s.back() - meas.t_s.front();
-    const double dt_target =
-        step_for(settings, meas.periodic() ? 1.0 / meas.condition.frequency_Hz : 0.0);
-    const double n = std::ceil(span / dt_target - 1e-9);
+    const double n = identify_detail::record_step_count(meas, settings);
     if (!(n <= kMaxSteps))
       throw InputError(located(
           meas.path, 0,
-          fmt::format("{:.4g} steps of {:g} s over the record's {:g} s: too many (limit {:g}); "
-                      "give --dt, or a frequency_Hz condition for a periodic record",
-                      n, dt_target, span, kMaxSteps)));
+          meas.condition.quasi_static
+              ? fmt::format("{:.4g} quasi-static increments over the record: too many (limit "
+                            "{:g}); lower the increments per drive range",
+                            n, kMaxSteps)
+              : fmt::format("{:.4g} steps of {:g} s over the record's {:g} s: too many (limit "
+                            "{:g}, pre-cycles included); give --dt, or a frequency_Hz "
+                            "condition for a periodic record",
+                            n,
+                            identify_detail::objective_step(
+                                settings, meas.periodic() ? 1.0 / meas.condition.frequency_Hz
+                                                          : 0.0),
+                            meas.t_s.back() - meas.t_s.front(), kMaxSteps)));
   }
   // ---- residual layout and scales ----
   std::size_t off = 0;
@@ -659,11 +600,16 @@ std::vector<ConditionFit> Objective::condition_fits(const std::vector<double>& u
     f.samples = meas.t_s.size();
     f.compared = f.samples - cd.compare_begin;
     f.pp_um = cd.pp_um;
+    f.response_unit = std::string(meas.response_unit());
     std::vector<double> y, B;
     const bool has_flux = !meas.flux_T.empty();
     try {
       if (!model) throw InputError(model_error);
       simulate_measurement(*model, meas, I.settings, y, has_flux ? &B : nullptr);
+      identify_detail::apply_offset(meas.condition.offset, meas.response, cd.compare_begin, y);
+      if (has_flux)
+        identify_detail::apply_offset(meas.condition.flux_offset, meas.flux_T, cd.compare_begin,
+                                      B);
     } catch (const std::exception& e) {
       f.failed = true;
       f.error = e.what();
@@ -672,7 +618,7 @@ std::vector<ConditionFit> Objective::condition_fits(const std::vector<double>& u
     }
     double ss = 0.0, ssB = 0.0;
     for (std::size_t i = cd.compare_begin; i < f.samples; ++i) {
-      const double d = y[i] - meas.displacement_um[i];
+      const double d = y[i] - meas.response[i];
       ss += d * d;
       f.max_err_um = std::max(f.max_err_um, std::fabs(d));
       if (has_flux) ssB += (B[i] - meas.flux_T[i]) * (B[i] - meas.flux_T[i]);
@@ -686,9 +632,12 @@ std::vector<ConditionFit> Objective::condition_fits(const std::vector<double>& u
         f.flux_rms_pct = 100.0 * std::sqrt(ssB / static_cast<double>(f.compared)) / (*bhi - *blo);
     }
     TimeSeries& ts = f.overlay;
-    ts.names = {"t_s", "current_A", "measured_um", "simulated_um", "compared"};
-    ts.columns = {meas.t_s, meas.current_A, meas.displacement_um, y,
-                  std::vector<double>(f.samples, 0.0)};
+    // Timed current/displacement records keep their historical column names; the others
+    // name their own columns (sample index, field, strain).
+    const std::string unit = f.response_unit;
+    ts.names = {meas.condition.quasi_static ? "sample" : "t_s", std::string(meas.drive_column()),
+                "measured_" + unit, "simulated_" + unit, "compared"};
+    ts.columns = {meas.t_s, meas.drive, meas.response, y, std::vector<double>(f.samples, 0.0)};
     for (std::size_t i = cd.compare_begin; i < f.samples; ++i) ts.columns[4][i] = 1.0;
     if (has_flux) {
       ts.names.insert(ts.names.end(), {"measured_flux_T", "simulated_flux_T"});
@@ -737,11 +686,16 @@ std::vector<TargetFit> Objective::target_fits(const std::vector<double>& u) cons
 // =======================================================================================
 MeasurementSet synthesize_measurements(const Model& truth, const SyntheticRequest& r) {
   if (r.samples_per_period < 8) throw InputError("samples per period: must be >= 8");
-  if (!(r.periods >= 1.5)) throw InputError("periods: must be >= 1.5 (the first is not compared)");
-  require_in(r.periods, 1.5, kMaxPeriods, "periods");
+  if (r.precycles == 0 && !(r.periods >= 1.5))
+    throw InputError("periods: must be >= 1.5 (the first is not compared)");
+  if (!(r.periods >= 1.0)) throw InputError("periods: must be >= 1 (one whole loop)");
+  require_in(r.periods, 1.0, kMaxPeriods, "periods");
   require_in(r.current_min_A, -kMaxCurrent_A, kMaxCurrent_A, "current minimum", "A");
   require_in(r.noise_pct, 0.0, 100.0, "noise", "%");
   require_in(r.flux_noise_pct, 0.0, 100.0, "flux noise", "%");
+  require_in(r.response_offset, -1e6, 1e6, "response offset");
+  if (r.precycles < 0 || r.precycles > kMaxPrecycles)
+    throw InputError(fmt::format("precycles {}: must be in [0, {}]", r.precycles, kMaxPrecycles));
   for (double T : r.temperatures_C) require_finite(T, "temperature", "degC");
   for (double pp : r.currents_pp_A)
     require_in(pp, 0.0, 2.0 * kMaxCurrent_A, "current peak-to-peak", "A");
@@ -768,31 +722,60 @@ MeasurementSet synthesize_measurements(const Model& truth, const SyntheticReques
     const double u1 = next_u01(), u2 = next_u01();
     return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * physics::kPi * u2);
   };
+  // A quasi-static record has no frequency: one record per (temperature, current).
+  const std::vector<double> freqs =
+      r.quasi_static ? std::vector<double>{1.0} : r.frequencies_Hz;
   for (double T : r.temperatures_C) {
     for (double pp : r.currents_pp_A) {
-      for (double f : r.frequencies_Hz) {
+      for (double f : freqs) {
         Measurement m;
         auto& c = m.condition;
         c.temperature_C = T;
-        c.frequency_Hz = f;
-        c.current_pp_A = pp;
-        c.current_min_A = r.current_min_A;
-        c.compare_from_s = 1.0 / f;
-        c.label = fmt::format("T{:g}_I{:g}_f{:g}", T, pp, f);
+        c.quasi_static = r.quasi_static;
+        c.rod = r.rod;
+        c.precycles = r.precycles;
+        c.offset = r.offset;
+        m.response_kind = r.response;
+        if (r.quasi_static) {
+          c.compare_from_s = r.precycles > 0 ? 0.0 : r.samples_per_period;  // sample index
+          c.label = fmt::format("T{:g}_I{:g}_qs", T, pp);
+        } else {
+          c.frequency_Hz = f;
+          c.current_pp_A = pp;
+          c.current_min_A = r.current_min_A;
+          c.compare_from_s = r.precycles > 0 ? 0.0 : 1.0 / f;
+          c.label = fmt::format("T{:g}_I{:g}_f{:g}", T, pp, f);
+        }
         m.path = c.label + ".csv";
         const Waveform w = biased_sine(pp, f, r.current_min_A);
         const long n = std::lround(r.periods * r.samples_per_period);
         for (long k = 0; k <= n; ++k) {
           const double t = static_cast<double>(k) / (f * r.samples_per_period);
-          m.t_s.push_back(t);
-          m.current_A.push_back(w.current_at(t));
+          m.t_s.push_back(r.quasi_static ? static_cast<double>(k) : t);
+          m.drive.push_back(w.current_at(t));
         }
-        std::vector<double> y, B;
-        simulate_measurement(truth, m, r.objective, y, r.with_flux ? &B : nullptr);
+        std::vector<double> y, B, H;
+        {
+          const Conditions cond = make_conditions(truth, T);
+          const State st0 =
+              make_state(truth, cond, identify_detail::record_initial_current(m));
+          identify_detail::run_record(truth, cond, st0, m, r.objective, y,
+                                      r.with_flux ? &B : nullptr, &H);
+        }
+        if (r.drive == DriveInput::Field) {  // what a Hall probe on the rod reads
+          m.drive = H;
+          m.drive_kind = DriveInput::Field;
+        }
         const auto [ylo, yhi] = std::minmax_element(y.begin(), y.end());
         const double sy = r.noise_pct / 100.0 * (*yhi - *ylo);
-        m.displacement_um = y;
-        for (double& v : m.displacement_um) v += sy * gauss();
+        m.response = y;
+        for (double& v : m.response) v += sy * gauss();
+        if (r.offset == OffsetMode::FirstSample) {
+          const double first = m.response.front();
+          for (double& v : m.response) v -= first;
+        } else if (r.offset == OffsetMode::Fitted) {
+          for (double& v : m.response) v += r.response_offset;
+        }
         if (r.with_flux) {
           const auto [blo, bhi] = std::minmax_element(B.begin(), B.end());
           const double sb = r.flux_noise_pct / 100.0 * (*bhi - *blo);

@@ -131,6 +131,9 @@ void write_condition(JsonWriter& w, const ConditionFit& c) {
   w.key("failed").boolean(c.failed);
   w.key("error").string(c.error);
   w.key("overlay").string(c.overlay_file);
+  w.key("response_unit").string(c.response_unit);
+  w.key("quasi_static").boolean(c.condition.quasi_static);
+  w.key("offset").string(offset_mode_name(c.condition.offset));
   w.end_object();
 }
 
@@ -342,9 +345,10 @@ std::string fit_report_markdown(const IdentifyResult& r, const FitProvenance& p)
          "parameters.\n\n";
   }
   if (!r.conditions.empty()) {
-    s += "## Conditions\n\n| condition | T [degC] | f [Hz] | I p-p [A] | weight | p-p [um] | RMS "
-         "[um] | RMS [%] | max err [um] | flux RMS [%] "
-         "|\n|---|---|---|---|---|---|---|---|---|---|\n";
+    s += "## Conditions\n\np-p, RMS and max err are in the record's response unit: um of "
+         "displacement_um, ppm of strain_ppm. f = 0: not periodic (or quasi-static).\n\n"
+         "| condition | T [degC] | f [Hz] | I p-p [A] | weight | p-p | RMS | RMS [%] | max err | "
+         "flux RMS [%] |\n|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& c : r.conditions) {
       if (c.failed) {
         s += fmt::format("| {} | {:g} | {:g} | {:g} | {:g} | - | failed: {} | | | |\n", c.label,
@@ -353,9 +357,10 @@ std::string fit_report_markdown(const IdentifyResult& r, const FitProvenance& p)
         continue;
       }
       s += fmt::format(
-          "| {} | {:g} | {:g} | {:g} | {:g} | {:.3f} | {:.4f} | {:.3f} | {:.4f} | {} |\n", c.label,
-          c.condition.temperature_C, c.condition.frequency_Hz, c.condition.current_pp_A, c.weight,
-          c.pp_um, c.rms_um, c.rms_pct, c.max_err_um,
+          "| {} | {:g} | {:g} | {:g} | {:g} | {:.3f} {} | {:.4f} {} | {:.3f} | {:.4f} {} | {} |\n",
+          c.label, c.condition.temperature_C, c.condition.frequency_Hz, c.condition.current_pp_A,
+          c.weight, c.pp_um, c.response_unit, c.rms_um, c.response_unit, c.rms_pct, c.max_err_um,
+          c.response_unit,
           c.flux_rms_pct >= 0 ? fmt::format("{:.3f}", c.flux_rms_pct) : "-");
     }
     s += "\nOverlays (measured vs simulated): `overlay_<condition>.csv`, drawn into "

@@ -166,10 +166,9 @@ void write_reproduction_doc(const ReproduceResult& r, const std::vector<Compared
   const fs::path fig_src = fs::path(out_dir) / "figures";
   const fs::path fig_dst = doc_dir / "figures";
   const bool figures = fs::exists(fig_src / "loops_8A_10Hz.png");
-  // A page written into the output directory itself already has its figures beside it.
-  std::error_code ec;
-  const bool in_place = fs::exists(fig_dst) && fs::equivalent(fig_src, fig_dst, ec);
-  if (figures && !in_place) {
+  std::error_code same_ec;
+  // --doc in the --out directory: the figures are already where the doc refers to them.
+  if (figures && !fs::equivalent(fig_src, fig_dst, same_ec)) {
     ensure_output_dir(fig_dst.string());
     for (const auto& e : fs::directory_iterator(fig_src))
       if (e.path().extension() == ".png")

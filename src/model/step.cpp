@@ -138,44 +138,37 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
   }
 }
 
-}  // namespace
-
-double oscillator_stiffness(const Conditions& c, const State& s, int rod) {
-  const auto i = static_cast<std::size_t>(rod);
-  return s.rods[i].k_rod_N_per_m + load_stiffness(c.rods[i], s);  // eq. (16)
+// The magnetic state at rest (no eddy lag: eq. 7 with dB/dt = 0) moved along its
+// hysteresis loop to the MMF of current_A and the magnets at pm_scale: one increment of
+// make_state's ramp and of quasi_static_step.
+void quasi_static_magnetic_update(const Model& m, const Conditions& c, State& s,
+                                  double current_A, double pm_scale, double t) {
+  const std::size_t n = s.rods.size();
+  if (m.options.magnetic_state == MagneticState::Consistent) {
+    consistent_magnetic_update(m, c, s, current_A, pm_scale, 1.0, true, t);
+    return;
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    s.rod_reluctance[i] =
+        detail::set_rod_permeability(m, i, c.rods[i], s.rods[i], s.rods[i].M_A_per_m, t);
+  if (!solve_circuit(m.circuit, s.rod_reluctance, current_A, pm_scale, s.circuit))
+    throw DivergenceError(t, "", "nodal matrix of the circuit", 0.0, "not positive definite");
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& rc = c.rods[i];
+    auto& r = s.rods[i];
+    const double Hc = detail::rod_static_field(m, i, rc, r, s.circuit);
+    ja_step(r.H_A_per_m, Hc, rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m);
+    r.H_A_per_m = Hc;
+    r.Hc_A_per_m = Hc;
+  }
 }
 
-State make_state(const Model& m, const Conditions& c, double current_A) {
-  State s;
-  const std::size_t n = m.rods.size();
-  s.rods.assign(n, RodState{});
-  s.rod_reluctance.assign(n, 0.0);
-  s.circuit.resize(m.circuit);
-  s.current_A = current_A;
+// The actuator at rest at its magnetic state: the hold values for the next step, each rod's
+// modulus, strain and force (eq. 11-14), and the static equilibrium x = F / K of eq. (15)
+// with x'' = x' = 0; the output stage rests on the stack.
+void settle_at_rest(const Model& m, const Conditions& c, State& s) {
   const bool consistent = m.options.magnetic_state == MagneticState::Consistent;
-  // Quasi-static ramp of the total MMF from zero (demagnetised rods, no field) to its
-  // value at t = 0, along the initial magnetisation curve; no eddy lag (at rest).
-  const int ramp_steps = 400;
-  for (int k = 1; k <= ramp_steps; ++k) {
-    const double f = static_cast<double>(k) / ramp_steps;
-    if (consistent) {
-      consistent_magnetic_update(m, c, s, f * current_A, f * c.pm_scale, 1.0, true, 0.0);
-      continue;
-    }
-    for (std::size_t i = 0; i < n; ++i)
-      s.rod_reluctance[i] =
-          detail::set_rod_permeability(m, i, c.rods[i], s.rods[i], s.rods[i].M_A_per_m, 0.0);
-    if (!solve_circuit(m.circuit, s.rod_reluctance, f * current_A, f * c.pm_scale, s.circuit))
-      throw DivergenceError(0.0, "", "nodal matrix of the circuit", 0.0, "not positive definite");
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto& rc = c.rods[i];
-      auto& r = s.rods[i];
-      const double Hc = detail::rod_static_field(m, i, rc, r, s.circuit);
-      ja_step(r.H_A_per_m, Hc, rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m);
-      r.H_A_per_m = Hc;
-      r.Hc_A_per_m = Hc;
-    }
-  }
+  const std::size_t n = s.rods.size();
   for (std::size_t i = 0; i < n; ++i) {
     auto& r = s.rods[i];
     r.M_prev_A_per_m = r.M_A_per_m;
@@ -194,7 +187,42 @@ State make_state(const Model& m, const Conditions& c, double current_A) {
   s.z_m = y_stack;  // the output stage at rest on the stack
   s.z_v_m_per_s = 0.0;
   finish_outputs(m, c, s);
+}
+
+}  // namespace
+
+double oscillator_stiffness(const Conditions& c, const State& s, int rod) {
+  const auto i = static_cast<std::size_t>(rod);
+  return s.rods[i].k_rod_N_per_m + load_stiffness(c.rods[i], s);  // eq. (16)
+}
+
+State make_state(const Model& m, const Conditions& c, double current_A) {
+  State s;
+  const std::size_t n = m.rods.size();
+  s.rods.assign(n, RodState{});
+  s.rod_reluctance.assign(n, 0.0);
+  s.circuit.resize(m.circuit);
+  s.current_A = current_A;
+  // Quasi-static ramp of the total MMF from zero (demagnetised rods, no field) to its
+  // value at t = 0, along the initial magnetisation curve; no eddy lag (at rest).
+  const int ramp_steps = 400;
+  for (int k = 1; k <= ramp_steps; ++k) {
+    const double f = static_cast<double>(k) / ramp_steps;
+    quasi_static_magnetic_update(m, c, s, f * current_A, f * c.pm_scale, 0.0);
+  }
+  settle_at_rest(m, c, s);
   return s;
+}
+
+void quasi_static_step(const Model& m, const Conditions& c, State& s, double current_A) {
+  quasi_static_magnetic_update(m, c, s, current_A, c.pm_scale, s.t_s);
+  settle_at_rest(m, c, s);
+  s.current_A = current_A;
+  for (std::size_t i = 0; i < s.rods.size(); ++i) {
+    check(s.rods[i].H_A_per_m, s.t_s, m.rods[i].name, "H [A/m]", 1e9);
+    check(s.rods[i].M_A_per_m, s.t_s, m.rods[i].name, "M [A/m]", 1.5 * c.rods[i].MsT_ja);
+    check(s.rods[i].x_m, s.t_s, m.rods[i].name, "x [m]", 1.0);
+  }
 }
 
 void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {

@@ -191,5 +191,21 @@ check "14 U+03A0 key" 2 "bad_key.toml:1: expected a key" "$B" model check bad_ke
 printf '[meta]\nname = "a\0b"\n' >nul.toml
 check "14 NUL byte" 2 "nul.toml:2: NUL byte" "$B" model check nul.toml
 
+# ---- issue 9 item 7: the new record formats and their options -------------------------
+SYN=(identify synthesize --temperatures 20 --currents 8 --frequencies 10 --no-flux)
+check "precycles < 0" 2 "precycles -1: must be in \[0, 100\]" "$B" "${SYN[@]}" --out sy1 --precycles -1
+check "precycles huge" 1 "Could not convert" "$B" "${SYN[@]}" --out sy2 --precycles 1e30
+check "response offset inf" 1 "must be a finite number" "$B" "${SYN[@]}" --out sy3 --response-offset inf
+check "unknown drive" 1 "bogus not in" "$B" "${SYN[@]}" --out sy4 --drive bogus
+check "rod not in the model" 2 "rod = 'nope' is not a rod of the model" "$B" "${SYN[@]}" --out sy5 --drive field --rod nope
+printf '# temperature_C = 20\n# offset = fitted\nfield_A_per_m,strain_ppm\n0,0\n1e3,5\n2e3,20\n1e3,6\n0,1\n' >qs.csv
+printf '[[measurement]]\nfile = "qs.csv"\n' >qs_manifest.toml
+QS=(identify --data qs_manifest.toml --fit fit.toml --out q.toml --islands 1 --population 8
+    --generations 1 --no-refine --no-plots --quiet --threads 1)
+check "quasi-static increments nan" 1 "must be a finite number" "$B" "${QS[@]}" --quasi-static-increments nan
+check "quasi-static increments 1e300" 2 "quasi-static increments per range" "$B" "${QS[@]}" --quasi-static-increments 1e300
+check "quasi-static increments 0" 2 "quasi-static increments per range" "$B" "${QS[@]}" --quasi-static-increments 0
+check "a quasi-static field loop fits" 0 "" "$B" "${QS[@]}"
+
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Regenerates docs/reproduction.md into a temporary directory with the command that wrote it
+# (the built-in model, the failing-claim notes, the seven readings compared) and checks it is
+# identical to the committed file apart from the wall-time sentence. Exit 0 if identical;
+# 1 with the diff otherwise. Used by ctest (reproduction_doc_unchanged) and by refactors
+# that must keep every result bit-identical (issue 10).
+# Usage: scripts/check_reproduction.sh [path to gmasim]   (default build/ci/bin/gmasim)
+set -euo pipefail
+SRC="$(cd "$(dirname "$0")/.." && pwd)"
+B="${1:-$SRC/build/ci/bin/gmasim}"
+T="$(mktemp -d)"
+trap 'rm -rf "$T"' EXIT
+cd "$SRC"
+CMP=(models/mdma_printed.toml)
+for r in printed__kelvin__compression_negative printed__kelvin__compression_positive \
+         printed__room_referenced__compression_negative printed__room_referenced__compression_positive \
+         mean_field__room_referenced__compression_negative mean_field__room_referenced__compression_positive; do
+  CMP+=("calibration/models/$r.toml")
+done
+mkdir -p "$T/doc"
+"$B" reproduce --out "$T/out" --doc "$T/doc/reproduction.md" --doc-notes docs/failing_claims.md \
+  --compare "${CMP[@]}" >"$T/log" 2>&1 || { cat "$T/log"; exit 1; }
+strip() { sed -E 's/The whole study took [0-9.]+ s/The whole study took N s/' "$1"; }
+if diff <(strip docs/reproduction.md) <(strip "$T/doc/reproduction.md"); then
+  echo "docs/reproduction.md: identical (apart from the wall time)"
+else
+  echo "docs/reproduction.md differs from a fresh run (above: < committed, > fresh)"
+  exit 1
+fi
