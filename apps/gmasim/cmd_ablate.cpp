@@ -58,10 +58,10 @@ int run_ablate_cmd(AblateArgs& a) {
 Runner add_ablate(CLI::App& app) {
   auto a = std::make_shared<AblateArgs>();
   auto* sub = app.add_subcommand(
-      "ablate",
-      "Freeze the temperature dependence of mu_G, rho_G, M, E_G, E_t (and F_pm, geometry) at "
-      "20 degC one at a time; deviation from the full model (Fig. 20). Writes ablate.csv, "
-      "ablate.json");
+      "ablate", fmt::format("Freeze the temperature dependence of each law ({}) at 20 degC one "
+                            "at a time, then all; deviation from the full model (Fig. 20). "
+                            "Writes ablate.csv, ablate.json",
+                            freeze_name_list()));
   add_model_options(sub, a->model);
   sub->add_option("--temperature", a->req.temperature_C, "Operating temperature [degC]")
       ->capture_default_str();

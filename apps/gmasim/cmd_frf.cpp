@@ -93,9 +93,10 @@ int run_frf_cmd(FrfArgs& a) {
         std::sqrt(os.stiffness_N_per_m / os.mass_kg) / (2.0 * 3.141592653589793));
   } else {
     fmt::print(
-        "\n  This model has no output stage: the paper's 1270 Hz first resonance is not a mode "
+        "\n  This model has no output stage: the paper's {:g} Hz first resonance is not a mode "
         "of eq. (15) with Table 6's masses and stiffnesses; its diagonal oscillators ring at the "
-        "frequencies above and the eddy-current lag sets the roll-off (docs/experiments.md).\n");
+        "frequencies above and the eddy-current lag sets the roll-off (docs/experiments.md).\n",
+        res.paper_first_resonance_Hz);
   }
   if (a.plot) files.push_back(render_plot("frf", a.out));
   fmt::print("  wrote {}\n", fmt::join(files, ", "));

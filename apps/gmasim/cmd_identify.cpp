@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "commands.hpp"
+#include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/identify.hpp"
 #include "gmasim/io.hpp"
@@ -33,92 +34,6 @@ extern "C" void on_stop_signal(int sig) {
   g_stop.store(true);
   std::signal(sig, SIG_DFL);  // a second signal ends the process at once
 }
-
-constexpr const char* kPlotScript = R"PY(#!/usr/bin/env python3
-"""Plots a gmasim identify fit report: overlay_*.png (measured vs simulated loop and time
-series per condition) and convergence.png. Usage: /usr/bin/python3 plot_fit.py REPORT_DIR"""
-import csv
-import json
-import os
-import sys
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-
-def read_csv(path):
-    with open(path, newline="") as f:
-        rows = csv.reader(f)
-        head = next(rows)
-        cols = {h: [] for h in head}
-        for row in rows:
-            for h, v in zip(head, row):
-                try:
-                    cols[h].append(float(v))
-                except ValueError:
-                    cols[h].append(v)
-    return cols
-
-
-def main():
-    d = sys.argv[1] if len(sys.argv) > 1 else os.path.dirname(os.path.abspath(__file__))
-    with open(os.path.join(d, "fit_report.json")) as f:
-        rep = json.load(f)
-    for c in rep["conditions"]:
-        if c["failed"]:
-            continue
-        o = read_csv(os.path.join(d, c["overlay"]))
-        idx = [i for i, k in enumerate(o["compared"]) if k > 0.5]
-        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
-        cols = list(o.keys())  # time/sample, drive, measured, simulated, compared, ...
-        unit = c.get("response_unit", "um")
-        cur = [o[cols[1]][i] for i in idx]
-        mk, sk = cols[2], cols[3]
-        xlabel = {"current_A": "current [A]", "field_A_per_m": "field H [A/m]"}.get(cols[1], cols[1])
-        ylabel = "strain [ppm]" if unit == "ppm" else "displacement [um]"
-        a1.plot(cur, [o[mk][i] for i in idx], ".", ms=2.5, label="measured")
-        a1.plot(cur, [o[sk][i] for i in idx], "-", lw=1.2, label="simulated")
-        a1.set_xlabel(xlabel)
-        a1.set_ylabel(ylabel)
-        a1.legend(loc="upper left")
-        a1.set_title("loop (compared samples)")
-        t = o[cols[0]]
-        a2.plot(t, o[mk], ".", ms=2.0, label="measured")
-        a2.plot(t, o[sk], "-", lw=1.0, label="simulated")
-        if idx:
-            a2.axvspan(t[0], t[idx[0]], color="0.9", label="not compared")
-        a2.set_xlabel("t [s]" if cols[0] == "t_s" else "sample")
-        a2.set_ylabel(ylabel)
-        a2.legend(loc="upper left")
-        freq = c["frequency_Hz"]
-        cond = f'{c["temperature_C"]:g} degC' + (
-            f', {c["current_pp_A"]:g} A p-p, {freq:g} Hz' if freq else "")
-        fig.suptitle(f'{c["label"]}: {cond}; RMS {c["rms_um"]:.3f} {unit} = {c["rms_pct"]:.2f} % of p-p')
-        fig.tight_layout()
-        fig.savefig(os.path.join(d, c["overlay"][:-4] + ".png"), dpi=110)
-        plt.close(fig)
-    h = read_csv(os.path.join(d, "convergence.csv"))
-    if h["step"]:
-        fig, ax = plt.subplots(figsize=(7, 4.2))
-        for phase, style in (("ga", "o-"), ("refine", "s-")):
-            idx = [i for i, p in enumerate(h["phase"]) if p == phase]
-            if idx:
-                ax.semilogy([h["evaluations"][i] for i in idx],
-                            [h["best_rms_pct"][i] for i in idx], style, ms=3, label=phase)
-        ax.set_xlabel("model evaluations (all ranks)")
-        ax.set_ylabel("best weighted RMS error [%]")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(os.path.join(d, "convergence.png"), dpi=110)
-        plt.close(fig)
-
-
-if __name__ == "__main__":
-    main()
-)PY";
 
 struct IdentifyArgs {
   std::string data, fit, out, report, mpi = "auto";
@@ -180,19 +95,17 @@ void write_outputs(const IdentifyArgs& a, const IdentifyResult& r, const ModelSp
   write_file_atomic((dir / "convergence.csv").string(), convergence_csv(r));
   for (const auto& c : r.conditions)
     if (!c.failed) write_file_atomic((dir / c.overlay_file).string(), timeseries_csv(c.overlay));
-  const std::string script = (dir / "plot_fit.py").string();
-  write_file_atomic(script, kPlotScript);
   if (!a.no_plots) {
-    std::error_code ec;
-    if (fs::exists("/usr/bin/python3", ec)) {
-      const std::string cmd = fmt::format(
-          "MPLBACKEND=Agg /usr/bin/python3 '{}' '{}' >/dev/null 2>&1", script, a.report);
-      if (std::system(cmd.c_str()) != 0) {
-        std::fprintf(stderr,
-                     "gmasim identify: note: plotting failed (matplotlib missing?); the CSV "
-                     "overlays are written; run %s by hand\n",
-                     script.c_str());
-      }
+    // overlay_<condition>.png and convergence.png, drawn from the files above.
+    PythonCommand c;
+    c.python_path = python_package_path();
+    c.module = "gmasim.command_figures";
+    c.args = {"identify", a.report};
+    if (run_python(c) != 0) {
+      std::fprintf(stderr,
+                   "gmasim identify: note: plotting failed (matplotlib missing?); the CSV "
+                   "overlays are written; draw them with `%s`\n",
+                   c.text().c_str());
     }
   }
 }
@@ -421,7 +334,9 @@ Runner add_identify(CLI::App& app) {
   sub->add_option("--mpi", a->mpi, "MPI: auto (when launched by mpirun/srun), on, off")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
-  sub->add_flag("--no-plots", a->no_plots, "Do not run plot_fit.py (the CSV overlays are written)");
+  sub->add_flag("--no-plots", a->no_plots,
+                "Do not draw overlay_*.png and convergence.png (gmasim.command_figures); the "
+                "CSV overlays are written");
   sub->add_flag("--quiet", a->quiet, "No progress on stderr, no summary");
 
   auto* syn = sub->add_subcommand(

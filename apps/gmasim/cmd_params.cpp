@@ -5,6 +5,7 @@
 
 #include "commands.hpp"
 #include "experiment_cli.hpp"
+#include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
 #include "gmasim/io.hpp"
@@ -56,8 +57,10 @@ int run_params_cmd(ParamsArgs& a) {
         w.temperature_C, w.rod, w.mu_r_mean, w.rho_ohm_m * 1e6, w.M_peak_A_per_m * 1e-3,
         w.MsT_A_per_m * 1e-3, w.E_G_mean_GPa, w.E_t_GPa, w.mu_r_change_pct, w.rho_change_pct,
         w.M_peak_change_pct, w.E_G_change_pct, w.E_t_change_pct);
-  fmt::print("\n  Fig. 18: stroke retention vs {} degC (paper: ~70 % at 150 degC)\n",
-             a.req.temperatures_C.front());
+  const ClaimSpec* c = builtin_claims().find("retention_150C_8A");  // data/claims.toml
+  fmt::print(
+      "\n  Fig. 18: stroke retention vs {} degC{}\n", a.req.temperatures_C.front(),
+      c ? fmt::format(" (paper: ~{:g} % at {:g} degC)", c->paper, c->condition.temperature_C) : "");
   fmt::print("  {:>7} {:>6} {:>10} {:>10} {:>11} {:>9}\n", "I_pp A", "T degC", "stroke um",
              "hyst um", "stroke %", "hyst %");
   for (const auto& w : res.retention)
@@ -107,8 +110,9 @@ Runner add_thermal(CLI::App& app) {
   auto out = std::make_shared<std::string>("out/thermal");
   auto* sub = app.add_subcommand(
       "thermal",
-      "Thermal expansion coefficient of the stack, eq. (21), against the paper's 0.662 (model) "
-      "and 0.712 (measured) um/degC. Writes thermal.csv, thermal.json");
+      fmt::format("Thermal expansion coefficient of the stack, eq. (21), against the paper's "
+                  "{:g} (model) and {:g} (measured) um/degC. Writes thermal.csv, thermal.json",
+                  builtin_paper_value("thermal_model"), builtin_paper_value("thermal_measured")));
   add_model_options(sub, *model);
   sub->add_option("--out", *out, "Output directory")->capture_default_str();
   return [=]() -> int {

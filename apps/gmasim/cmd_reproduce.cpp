@@ -3,18 +3,14 @@
 #include <unistd.h>
 
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <memory>
 
 #include "commands.hpp"
+#include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
 #include "gmasim/reproduce.hpp"
-
-#ifndef GMASIM_PYTHON_PACKAGE_DIR
-#define GMASIM_PYTHON_PACKAGE_DIR ""
-#endif
 
 namespace gmasim::cli {
 namespace {
@@ -25,7 +21,6 @@ struct ReproduceArgs {
   std::string doc_notes;  // markdown "### <claim id>" explanations of failing claims, for --doc
   std::string claims;     // claims file (data/claims.toml format); "" = the built-in claims
   std::vector<std::string> compare;  // other model files (readings) scored on the same claims
-  std::string python_path = GMASIM_PYTHON_PACKAGE_DIR;
   int threads = 0;
   bool quick = false, no_figures = false;
 };
@@ -48,9 +43,8 @@ int run_reproduce_cmd(const ReproduceArgs& a) {
     if (tty) fmt::print(stderr, "\rreproduce: stage {}/{}", done, total);
     if (tty && done == total) fmt::print(stderr, "\n");
   });
-  const std::string py_path =
-      std::getenv("GMASIM_PYTHONPATH") ? std::getenv("GMASIM_PYTHONPATH") : a.python_path;
-  write_reproduce_outputs(model, r, a.out, a.no_figures ? std::string() : a.python, py_path);
+  write_reproduce_outputs(model, r, a.out, a.no_figures ? std::string() : a.python,
+                          python_package_path());
   std::vector<ComparedModel> compared;
   for (const auto& path : a.compare) {
     const Model other = load_model(path);

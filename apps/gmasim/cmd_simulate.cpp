@@ -24,7 +24,7 @@ struct SimulateArgs {
   bool plot = false;
   bool self_heating = false, progress = false;
   double thermal_step_s = 0.0, ambient_C = std::nan("");
-  std::vector<std::string> quantities;
+  std::vector<std::string> quantities, freeze;
 };
 
 Waveform make_waveform(const SimulateArgs& a) {
@@ -67,6 +67,7 @@ int run_simulate(const SimulateArgs& a) {
   s.self_heating.enabled = a.self_heating;
   s.self_heating.thermal_step_s = a.thermal_step_s;
   s.self_heating.ambient_C = a.ambient_C;
+  s.freeze = parse_freeze(a.freeze);
   ensure_output_dir(a.out);  // fail before the run, not after it
   Result r = simulate(model, s);
   if (!r.diverged && !a.quantities.empty()) add_quantity_stats(r, a.quantities);
@@ -179,6 +180,11 @@ Runner add_simulate(CLI::App& app) {
   sub->add_option(
       "--quantity", a->quantities,
       "Also report RMS, peak, p-p and mean of these columns (e.g. rod1_F_N) [column units]");
+  sub->add_option("--freeze", a->freeze,
+                  fmt::format("Hold these temperature laws at T_ref (20 degC), as `ablate` does; "
+                              "comma-separated: {}",
+                              freeze_name_list()))
+      ->delimiter(',');
   sub->add_flag("--progress", a->progress,
                 "Progress with ETA on stderr even when it is not a terminal (a terminal gets it "
                 "for runs over 2 s)");

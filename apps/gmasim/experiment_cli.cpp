@@ -1,11 +1,8 @@
 #include "experiment_cli.hpp"
 
 #include <fmt/format.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -107,37 +104,22 @@ std::vector<std::string> write_report(const std::string& dir, const std::string&
   return write_report_files(dir, stem, r);
 }
 
+std::string python_package_path() {
+  const char* env = std::getenv("GMASIM_PYTHONPATH");
+  return env != nullptr ? env : GMASIM_PYTHON_PACKAGE_DIR;
+}
+
 std::string render_plot(const std::string& command, const std::string& dir) {
-  const char* env_path = std::getenv("GMASIM_PYTHONPATH");
-  std::string py_path = env_path != nullptr ? env_path : GMASIM_PYTHON_PACKAGE_DIR;
-  if (const char* old = std::getenv("PYTHONPATH"); old != nullptr && *old != '\0')
-    py_path += std::string(":") + old;
-  // The child's environment: ours, with PYTHONPATH and MPLBACKEND replaced.
-  std::vector<std::string> env_strings = {"PYTHONPATH=" + py_path, "MPLBACKEND=Agg"};
-  for (char** e = environ; *e != nullptr; ++e) {
-    const std::string_view v(*e);
-    if (!v.starts_with("PYTHONPATH=") && !v.starts_with("MPLBACKEND=")) env_strings.emplace_back(v);
-  }
-  std::vector<char*> envp;
-  for (auto& e : env_strings) envp.push_back(e.data());
-  envp.push_back(nullptr);
-  const std::string python = "/usr/bin/python3";
-  std::vector<std::string> args = {python, "-m", "gmasim.command_figures", command, dir};
-  std::vector<char*> argv;
-  for (auto& s : args) argv.push_back(s.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (posix_spawn(&pid, python.c_str(), nullptr, nullptr, argv.data(), envp.data()) != 0)
-    throw InputError(fmt::format("--plot: cannot run {} (install python3-matplotlib)", python));
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) throw InputError("--plot: lost the figure renderer");
-  }
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+  PythonCommand c;
+  c.python_path = python_package_path();
+  c.module = "gmasim.command_figures";
+  c.args = {command, dir};
+  const int rc = run_python(c);
+  if (rc == 127)
+    throw InputError(fmt::format("--plot: cannot run {} (install python3-matplotlib)", c.python));
+  if (rc != 0)
     throw InputError(fmt::format(
-        "--plot: the figure renderer failed ({} -m gmasim.command_figures {} {}); the data files "
-        "are written",
-        python, command, dir));
+        "--plot: the figure renderer failed ({}); the data files are written", c.text()));
   return (std::filesystem::path(dir) / (command + ".png")).string();
 }
 

@@ -23,10 +23,13 @@ ProgressFn stderr_progress(const std::string& label, bool force);
 std::vector<std::string> write_report(const std::string& dir, const std::string& stem,
                                       const Report& r);
 
+// Where the gmasim Python package is: $GMASIM_PYTHONPATH, else the build tree's package.
+std::string python_package_path();
+
 // Renders the figure of a command's outputs in `dir` with the Python package
-// (`/usr/bin/python3 -m gmasim.command_figures <command> <dir>`, run without a shell;
-// PYTHONPATH: $GMASIM_PYTHONPATH, else the build tree's package). Returns the PNG path.
-// Throws InputError if the renderer fails (its stderr is passed through).
+// (`/usr/bin/python3 -m gmasim.command_figures <command> <dir>` through run_python: no shell).
+// Returns the PNG path. Throws InputError if the renderer fails (its stderr is passed
+// through).
 std::string render_plot(const std::string& command, const std::string& dir);
 
 }  // namespace gmasim::cli

@@ -69,6 +69,11 @@ ClaimsData parse_claims(const std::string& toml_text, const std::string& source_
 ClaimsData load_claims(const std::string& path);
 // data/claims.toml, compiled into the library (parsed once).
 const ClaimsData& builtin_claims();
+// The paper's value of the built-in claim `id`: how the code that shows a paper's number
+// beside ours (FrfResult, ThermalExpansionResult, the reports) reads it, so the number is
+// written once, in data/claims.toml. Throws std::logic_error if the built-in data has no
+// claim `id` (a build error, not a user's).
+double builtin_paper_value(const std::string& id);
 extern const char* const kBuiltinClaimsToml;
 extern const char* const kBuiltinClaimsName;
 

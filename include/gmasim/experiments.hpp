@@ -160,8 +160,9 @@ struct FrfCurve {
 
 struct FrfResult {
   std::vector<FrfCurve> curves;
-  double paper_first_resonance_Hz = 1270.0;  // Fig. 15, for the report
-  double paper_bandwidth_Hz = 2000.0;        // Fig. 15: "exceeds 2000 Hz"
+  // Fig. 15, for the report: the paper's first resonance and the bandwidth it exceeds
+  // (run_frf reads them from data/claims.toml: claims first_resonance and bandwidth).
+  double paper_first_resonance_Hz = 0.0, paper_bandwidth_Hz = 0.0;
 };
 
 // Throws InputError for an empty temperature list, f_min <= 0, f_max <= f_min, fewer than
@@ -351,7 +352,9 @@ struct ThermalExpansionResult {
   double um_per_C = 0;  // d x_T / d T
   double rod_um_per_C = 0, magnetizer_um_per_C = 0, output_rod_um_per_C = 0,
          sleeve_um_per_C = 0;  // the four terms (sleeve counted negative in the sum)
-  double paper_model_um_per_C = 0.662, paper_measured_um_per_C = 0.712;
+  // The paper's values, model and measured (from data/claims.toml: claims thermal_model and
+  // thermal_measured).
+  double paper_model_um_per_C = 0.0, paper_measured_um_per_C = 0.0;
 };
 
 ThermalExpansionResult thermal_expansion_coefficient(const Model& m);

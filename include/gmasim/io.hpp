@@ -90,4 +90,21 @@ std::string metrics_json(const Result& r, const SimulationSettings& s, const Mod
 // FNV-1a 64-bit hash of data, as 16 hex digits.
 std::string fnv1a64_hex(std::string_view data);
 
+// `python -m module args...`: how the library and the CLI run the Python package that draws
+// the figures (gmasim.command_figures, gmasim.report_figures). Started with posix_spawnp
+// (no shell: the arguments are passed as they are, a path with quotes or spaces is safe);
+// the child's environment is ours with MPLBACKEND=Agg and, when python_path is not empty,
+// PYTHONPATH = python_path followed by our PYTHONPATH.
+struct PythonCommand {
+  std::string python = "/usr/bin/python3";  // a path, or a name looked up in PATH
+  std::string python_path;                  // where the gmasim package is; "" = as we have it
+  std::string module;                       // run with -m
+  std::vector<std::string> args;
+  bool stdout_to_stderr = false;  // the child's standard output goes to our standard error
+  std::string text() const;       // "python -m module args..." for messages
+};
+// Runs it and waits: the exit status (0: success), 127 if it could not be started, 128 + N
+// if signal N ended it. The child's standard error is ours.
+int run_python(const PythonCommand& c);
+
 }  // namespace gmasim

@@ -97,6 +97,33 @@ struct Freeze {
   bool geometry = false;        // thermal expansion of lengths and areas
 };
 
+// The Freeze switches by name, one row each (MuJoCo's mjDISABLESTRING style): the one name
+// set of the CLI (`simulate --freeze`, `ablate`), the Python module (`freeze=[...]`), the
+// ablation report and metrics.json ("frozen"), in the order of Fig. 20.
+struct FreezeSwitch {
+  const char* name;         // e.g. "mu_G"
+  bool Freeze::*flag;       // the switch it sets
+  const char* description;  // what it freezes (the ablation report's "freezes" column)
+};
+inline constexpr FreezeSwitch kFreezeSwitches[] = {
+    {"mu_G", &Freeze::permeability,
+     "permeability of the rods, eq. (3)-(4) (and the eddy time constant through mu)"},
+    {"rho_G", &Freeze::resistivity, "resistivity of the rods, eq. (8)"},
+    {"M", &Freeze::magnetisation,
+     "magnetisation process: JA coefficients of eq. (10), M_s^T in eq. (9) and (11)"},
+    {"E_G", &Freeze::modulus, "Delta-E modulus of the rods, eq. (13)"},
+    {"E_t", &Freeze::sleeve_modulus, "sleeve modulus, eq. (19)"},
+    {"F_pm", &Freeze::pm_mmf, "permanent-magnet MMF, eq. (1)"},
+    {"geometry", &Freeze::geometry, "thermal expansion of lengths and areas (eq. 2, 7, 17, 19)"},
+};
+// The switches named in `names` set (kFreezeSwitches names). Throws InputError "unknown law
+// 'x' to freeze; known: mu_G, rho_G, ..." for any other name.
+Freeze parse_freeze(const std::vector<std::string>& names);
+// The names of the switches `f` sets, in table order.
+std::vector<std::string> frozen_names(const Freeze& f);
+// "mu_G, rho_G, M, E_G, E_t, F_pm, geometry": for help texts and messages.
+std::string freeze_name_list();
+
 // ---------------------------------------------------------------------------------------
 // Model: compiled, immutable.
 // ---------------------------------------------------------------------------------------

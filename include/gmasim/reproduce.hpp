@@ -92,7 +92,8 @@ std::string comparison_markdown(const std::vector<ComparedModel>& models);
 Report claims_report(const std::vector<Claim>& claims);
 
 // Writes DIR/report.md, DIR/claims.{csv,json}, and every experiment's data as CSV and JSON
-// in DIR/data (atomically). Figures are rendered by the Python package (gmasim.report_figures) into
+// in DIR/data (atomically). Figures are rendered by the Python package (gmasim.report_figures,
+// through run_python: python_exe, no shell; python_path where the package is) into
 // DIR/figures/*.png|svg when python_exe is not empty; the report links them.
 // Returns the markdown of the report.
 std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,

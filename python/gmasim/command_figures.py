@@ -2,9 +2,9 @@
 
     /usr/bin/python3 -m gmasim.command_figures COMMAND OUT_DIR
 
-writes OUT_DIR/COMMAND.png and .svg (atomically, :func:`gmasim.plots.save`). The C++ side
-writes only data; everything drawn here is read back from those CSV and JSON files, so a
-figure can be redrawn later from a finished run.
+writes OUT_DIR/COMMAND.png and .svg (identify: overlay_<condition> and convergence), atomically
+(:func:`gmasim.plots.save`). The C++ side writes only data; everything drawn here is read back
+from those CSV and JSON files, so a figure can be redrawn later from a finished run.
 """
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ import pathlib
 import sys
 
 import numpy as np
+from matplotlib.figure import Figure
 
 from gmasim import plots
 from gmasim.plots import plt, read_csv
@@ -88,44 +89,31 @@ def bode_db(out):
     frf = read_csv(pathlib.Path(out) / "frf.csv")
     summ = read_csv(pathlib.Path(out) / "frf_summary.csv")
     meta = _meta(out, "frf")
-    temps = np.unique(frf["temperature_C"])
-    fig, (am, ap) = plt.subplots(2, 1, figsize=(7.5, 6.4), sharex=True)
-    cmap = plt.get_cmap("coolwarm")
-    for k, T in enumerate(temps):
-        c = cmap(k / max(1, len(temps) - 1))
-        sel = np.isclose(frf["temperature_C"], T)
-        f = frf["frequency_Hz"][sel]
-        for key, style, lab in (("linear", "-", "linearised"), ("stepped", "o", "stepped sine")):
-            mag = frf[f"{key}_mag_um_per_A"][sel]
-            if np.any(np.isfinite(mag)):
-                am.semilogx(f, 20 * np.log10(mag), style, color=c, ms=3.5, mfc="none",
-                            label=f"{T:g} °C, {lab}")
-                ap.semilogx(f, frf[f"{key}_phase_deg"][sel], style, color=c, ms=3.5, mfc="none")
-        s = np.isclose(summ["temperature_C"], T)
-        if np.any(s):
-            g0 = summ["static_gain_um_per_A"][s][0]
-            fr = summ["first_resonance_Hz"][s][0]
-            bw = summ["bandwidth_3dB_Hz"][s][0]
-            if np.isfinite(g0) and g0 > 0:
-                am.axhline(20 * np.log10(g0) - 3, color=c, ls=":", lw=0.8)
-            if np.isfinite(fr) and fr > 0:
-                am.axvline(fr, color=c, ls="--", lw=0.8)
-                am.annotate(f"resonance {fr:.0f} Hz", (fr, am.get_ylim()[1]), color=c, fontsize=7,
-                            rotation=90, va="top", ha="right")
-            if np.isfinite(bw) and bw > 0:
-                am.axvline(bw, color=c, ls=":", lw=0.8)
-                am.annotate(f"-3 dB {bw:.0f} Hz", (bw, am.get_ylim()[0]), color=c, fontsize=7,
-                            rotation=90, va="bottom", ha="right")
-    am.set_ylabel("|Y/I| (dB re 1 µm/A)")
-    ap.set_ylabel("phase (°)")
-    ap.set_xlabel("frequency (Hz)")
-    for ax in (am, ap):
-        ax.grid(alpha=0.3, which="both")
-    am.legend(fontsize=7)
     bias, amp = meta.get("bias_A"), meta.get("amplitude_A")
-    am.set_title(f"Frequency response about a {bias:g} A bias, stimulus ±{amp * 1e3:g} mA "
-                 "(small signal)\n(dotted horizontal: static gain -3 dB)" if bias is not None and amp
-                 is not None else "Frequency response")
+    title = (f"Frequency response about a {bias:g} A bias, stimulus ±{amp * 1e3:g} mA (small signal)\n"
+             "(dotted horizontal: static gain -3 dB)" if bias is not None and amp is not None
+             else "Frequency response")
+    fig = plots.bode(frf, title=title, db=True)
+    am = fig.axes[0]
+    temps, norm, cmap = plots._temperature_colors(frf["temperature_C"])
+    for T in temps:
+        c = cmap(norm(T))
+        s = np.isclose(summ["temperature_C"], T)
+        if not np.any(s):
+            continue
+        g0 = summ["static_gain_um_per_A"][s][0]
+        fr = summ["first_resonance_Hz"][s][0]
+        bw = summ["bandwidth_3dB_Hz"][s][0]
+        if np.isfinite(g0) and g0 > 0:
+            am.axhline(20 * np.log10(g0) - 3, color=c, ls=":", lw=0.8)
+        if np.isfinite(fr) and fr > 0:
+            am.axvline(fr, color=c, ls="--", lw=0.8)
+            am.annotate(f"resonance {fr:.0f} Hz", (fr, am.get_ylim()[1]), color=c, fontsize=7,
+                        rotation=90, va="top", ha="right")
+        if np.isfinite(bw) and bw > 0:
+            am.axvline(bw, color=c, ls=":", lw=0.8)
+            am.annotate(f"-3 dB {bw:.0f} Hz", (bw, am.get_ylim()[0]), color=c, fontsize=7,
+                        rotation=90, va="bottom", ha="right")
     fig.tight_layout()
     return fig
 
@@ -200,6 +188,58 @@ def compensate(out):
     return fig
 
 
+def identify(out):
+    """The figures of a fit report directory (`gmasim identify --report OUT`): per condition
+    overlay_<condition>.png (measured against simulated: the loop over the compared samples
+    and the record against time or sample), and convergence.png (best weighted RMS error
+    against model evaluations). Yields (stem, figure) pairs."""
+    out = pathlib.Path(out)
+    rep = json.loads((out / "fit_report.json").read_text())
+    for c in rep["conditions"]:
+        if c["failed"]:
+            continue
+        o = read_csv(out / c["overlay"])
+        # Columns: time or sample, drive (current or field), measured, simulated, compared, ...
+        t_key, drive, measured, simulated = list(o)[:4]
+        cmp = o["compared"] > 0.5
+        unit = c.get("response_unit", "um")
+        ylabel = "strain (ppm)" if unit == "ppm" else "displacement (µm)"
+        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
+        a1.plot(o[drive][cmp], o[measured][cmp], ".", ms=2.5, label="measured")
+        a1.plot(o[drive][cmp], o[simulated][cmp], "-", lw=1.2, label="simulated")
+        a1.set_xlabel({"current_A": "current (A)", "field_A_per_m": "field H (A/m)"}.get(drive, drive))
+        a1.set_ylabel(ylabel)
+        a1.legend(loc="upper left")
+        a1.set_title("loop (compared samples)")
+        t = o[t_key]
+        a2.plot(t, o[measured], ".", ms=2.0, label="measured")
+        a2.plot(t, o[simulated], "-", lw=1.0, label="simulated")
+        if np.any(cmp):
+            a2.axvspan(t[0], t[np.argmax(cmp)], color="0.9", label="not compared")
+        a2.set_xlabel("time (s)" if t_key == "t_s" else "sample (-)")
+        a2.set_ylabel(ylabel)
+        a2.legend(loc="upper left")
+        freq = c["frequency_Hz"]
+        cond = f'{c["temperature_C"]:g} °C' + (f', {c["current_pp_A"]:g} A p-p, {freq:g} Hz' if freq else "")
+        fig.suptitle(f'{c["label"]}: {cond}; RMS {c["rms_um"]:.3f} {"µm" if unit == "um" else unit} '
+                     f'= {c["rms_pct"]:.2f} % of p-p')
+        fig.tight_layout()
+        yield pathlib.Path(c["overlay"]).stem, fig
+    h = read_csv(out / "convergence.csv")
+    if len(h["step"]):
+        fig, ax = plt.subplots(figsize=(7, 4.2))
+        for phase, style in (("ga", "o-"), ("refine", "s-")):
+            sel = h["phase"] == phase
+            if np.any(sel):
+                ax.semilogy(h["evaluations"][sel], h["best_rms_pct"][sel], style, ms=3, label=phase)
+        ax.set_xlabel("model evaluations (all ranks)")
+        ax.set_ylabel("best weighted RMS error (%)")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+        fig.tight_layout()
+        yield "convergence", fig
+
+
 def ablate(out):
     return plots.ablation(read_csv(pathlib.Path(out) / "ablate.csv"))
 
@@ -208,15 +248,20 @@ def params(out):
     return plots.params_vs_temperature(read_csv(pathlib.Path(out) / "params.csv"))
 
 
+# A renderer returns the command's figure (saved as OUT/<command>.png|svg) or yields
+# (stem, figure) pairs (OUT/<stem>.png|svg), each saved and closed before the next is drawn.
 RENDERERS = {"simulate": simulate, "frf": bode_db, "sweep": sweep, "track": track,
-             "compensate": compensate, "ablate": ablate, "params": params}
+             "compensate": compensate, "ablate": ablate, "params": params, "identify": identify}
 
 
 def render(command: str, out) -> list[pathlib.Path]:
     if command not in RENDERERS:
         raise SystemExit(f"gmasim.command_figures: no figure for '{command}' "
                          f"(known: {', '.join(sorted(RENDERERS))})")
-    return plots.save(RENDERERS[command](out), out, command)
+    figures = RENDERERS[command](out)
+    if isinstance(figures, Figure):
+        figures = [(command, figures)]
+    return [p for stem, fig in figures for p in plots.save(fig, out, stem)]
 
 
 def main(argv=None) -> int:

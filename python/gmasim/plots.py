@@ -184,44 +184,46 @@ def sweep_vs_temperature(sweep: Columns, frequency_Hz: float | None = None,
     return fig
 
 
-def bode(frf: Columns, title="Frequency response, current to displacement", claims=None):
+def bode(frf: Columns, title="Frequency response, current to displacement", claims=None, db=False):
     """Columns temperature_C, frequency_Hz, stepped_mag_um_per_A, stepped_phase_deg,
     linear_mag_um_per_A, linear_phase_deg (NaN where a method was not run).
 
-    With `claims`, the paper's first resonance (Fig. 15) is marked on our curve at its
+    The magnitude on a log axis in µm/A, or with `db` in dB re 1 µm/A (20 log10 |Y/I|). With
+    `claims`, the paper's first resonance (Fig. 15) is marked on our curve at its
     temperature, and its bandwidth bounds as vertical lines coloured pass/fail."""
     temps, norm, cmap = _temperature_colors(frf["temperature_C"])
     freq = frf["frequency_Hz"] if "frequency_Hz" in frf else frf["f_Hz"]
     fig, (am, ap) = plt.subplots(2, 1, figsize=(6.8, 6), sharex=True)
+
+    def magnitude(m):
+        return 20 * np.log10(m) if db else m
+
+    plot_mag = am.semilogx if db else am.loglog
     for T in temps:
         sel = np.isclose(frf["temperature_C"], T)
         f = freq[sel]
         c = cmap(norm(T))
         if np.any(np.isfinite(frf["linear_mag_um_per_A"][sel])):
-            am.loglog(f, frf["linear_mag_um_per_A"][sel], "-", color=c, label=f"{T:g} °C, linearised")
+            plot_mag(f, magnitude(frf["linear_mag_um_per_A"][sel]), "-", color=c, label=f"{T:g} °C, linearised")
             ap.semilogx(f, frf["linear_phase_deg"][sel], "-", color=c)
         if np.any(np.isfinite(frf["stepped_mag_um_per_A"][sel])):
-            am.loglog(f, frf["stepped_mag_um_per_A"][sel], "o", ms=3.5, mfc="none", color=c,
-                      label=f"{T:g} °C, stepped sine")
+            plot_mag(f, magnitude(frf["stepped_mag_um_per_A"][sel]), "o", ms=3.5, mfc="none", color=c,
+                     label=f"{T:g} °C, stepped sine")
             ap.semilogx(f, frf["stepped_phase_deg"][sel], "o", ms=3.5, mfc="none", color=c)
-    if claims:
-        mag = np.where(np.isfinite(frf["linear_mag_um_per_A"]), frf["linear_mag_um_per_A"],
-                       frf["stepped_mag_um_per_A"])
-        for c in _claims_of(claims, "first_resonance_Hz"):
-            sel = np.isclose(frf["temperature_C"], c["temperature_C"])
-            if np.any(sel):
-                order = np.argsort(freq[sel])
-                y = float(np.interp(c["paper"], freq[sel][order], mag[sel][order]))
-                _mark_paper(am, c["paper"], y, c, None if not c.get("pass") else f"paper: {c['paper']:g} Hz")
-        for c in _claims_of(claims, "bandwidth_Hz"):
-            col = PASS_COLOR if c.get("pass") else FAIL_COLOR
-            am.axvline(c["paper"], color=col, ls=":", lw=1)
-            am.text(c["paper"], am.get_ylim()[0], f" {c['id']}: > {c['paper']:g} Hz" +
-                    ("" if c.get("pass") else " ✗"), color=col, fontsize=6.5, va="bottom", rotation=90)
-    else:
-        am.axvline(1270, color="gray", ls=":", lw=1)
-        am.text(1270, am.get_ylim()[0], " paper: 1270 Hz", color="gray", fontsize=7, va="bottom")
-    am.set_ylabel("|Y/I| (µm/A)")
+    mag = np.where(np.isfinite(frf["linear_mag_um_per_A"]), frf["linear_mag_um_per_A"],
+                   frf["stepped_mag_um_per_A"])
+    for c in _claims_of(claims, "first_resonance_Hz"):
+        sel = np.isclose(frf["temperature_C"], c["temperature_C"])
+        if np.any(sel):
+            order = np.argsort(freq[sel])
+            y = float(np.interp(c["paper"], freq[sel][order], mag[sel][order]))
+            _mark_paper(am, c["paper"], magnitude(y), c, None if not c.get("pass") else f"paper: {c['paper']:g} Hz")
+    for c in _claims_of(claims, "bandwidth_Hz"):
+        col = PASS_COLOR if c.get("pass") else FAIL_COLOR
+        am.axvline(c["paper"], color=col, ls=":", lw=1)
+        am.text(c["paper"], am.get_ylim()[0], f" {c['id']}: > {c['paper']:g} Hz" +
+                ("" if c.get("pass") else " ✗"), color=col, fontsize=6.5, va="bottom", rotation=90)
+    am.set_ylabel("|Y/I| (dB re 1 µm/A)" if db else "|Y/I| (µm/A)")
     ap.set_ylabel("phase (°)")
     ap.set_xlabel("frequency (Hz)")
     for ax in (am, ap):
@@ -263,9 +265,12 @@ def retention(ret: Columns, title="Stroke retention against temperature (10 Hz)"
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     _plot_vs_temperature(ax, ret, "stroke_retention_pct",
                          [(np.isclose(ret["current_pp_A"], I), f"{I:g} A") for I in sorted(set(ret["current_pp_A"]))])
-    ax.axhline(70, color="gray", ls=":", lw=1)
-    ax.text(ax.get_xlim()[0], 70, " paper: ≈70 % at 150 °C", color="gray", fontsize=7, va="bottom")
-    for c in _claims_of(claims, "stroke_retention_pct"):
+    marked = _claims_of(claims, "stroke_retention_pct")
+    for paper, T in sorted({(c["paper"], c["temperature_C"]) for c in marked}):
+        ax.axhline(paper, color="gray", ls=":", lw=1)
+        ax.text(ax.get_xlim()[0], paper, f" paper: ≈{paper:g} % at {T:g} °C", color="gray", fontsize=7,
+                va="bottom")
+    for c in marked:
         _mark_paper(ax, c["temperature_C"], c["paper"], c)
     ax.set_xlabel("temperature (°C)")
     ax.set_ylabel("stroke / stroke at 20 °C (%)")

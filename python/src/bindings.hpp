@@ -12,7 +12,6 @@ namespace gmasim::py_bind {
 pybind11::array_t<double> to_numpy(const std::vector<double>& v);
 pybind11::dict series_dict(const TimeSeries& ts);
 pybind11::dict metrics_dict(const Metrics& m);
-Freeze freeze_from(const std::vector<std::string>& laws);
 void bind_experiments(pybind11::module_& mod);  // experiments.cpp
 void bind_stepper(pybind11::module_& mod);      // stepper.cpp: Stepper, __version__
 }  // namespace gmasim::py_bind

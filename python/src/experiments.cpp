@@ -66,7 +66,7 @@ void bind_experiments(py::module_& mod) {
         r.periods = periods;
         r.dt_s = dt_s;
         r.threads = threads;
-        r.freeze = freeze_from(freeze);
+        r.freeze = parse_freeze(freeze);
         const SweepResult res = without_gil([&] { return run_sweep(m, r); });
         return report_dict(sweep_report(m, r, res));
       },

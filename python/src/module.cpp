@@ -39,21 +39,6 @@ py::dict metrics_dict(const Metrics& m) {
   return d;
 }
 
-Freeze freeze_from(const std::vector<std::string>& laws) {
-  Freeze f;
-  for (const auto& l : laws) {
-    if (l == "mu_G") f.permeability = true;
-    else if (l == "rho_G") f.resistivity = true;
-    else if (l == "M") f.magnetisation = true;
-    else if (l == "E_G") f.modulus = true;
-    else if (l == "E_t") f.sleeve_modulus = true;
-    else if (l == "F_pm") f.pm_mmf = true;
-    else if (l == "geometry") f.geometry = true;
-    else throw InputError("unknown law '" + l + "' to freeze; known: mu_G, rho_G, M, E_G, E_t, F_pm, geometry");
-  }
-  return f;
-}
-
 }  // namespace gmasim::py_bind
 
 namespace {
@@ -74,7 +59,7 @@ py::dict simulate_py(const Model& m, double temperature_C, double current_pp_A, 
   s.dt_s = dt_s;
   s.record_every = record_every;
   s.duration_s = duration_s;
-  s.freeze = freeze_from(freeze);
+  s.freeze = parse_freeze(freeze);
   if (!waveform.is_none()) {
     auto tup = waveform.cast<std::pair<std::vector<double>, std::vector<double>>>();
     Waveform w;
@@ -185,6 +170,10 @@ PYBIND11_MODULE(_gmasim, mod) {
           "Time-domain run. Returns {'series': {column: ndarray}, 'metrics': {...}, ...}; with "
           "self_heating=True also 'heating' (one row per thermal step: node temperatures, losses, "
           "stroke) and the energy balance (energy_in_J = energy_stored_J + energy_out_J)");
+  // The names freeze=[...] takes (simulate, Stepper, sweep), from the C++ table.
+  py::list laws;
+  for (const auto& sw : gmasim::kFreezeSwitches) laws.append(sw.name);
+  mod.attr("FREEZE_LAWS") = py::tuple(laws);
   gmasim::py_bind::bind_experiments(mod);
   gmasim::py_bind::bind_stepper(mod);
 }

@@ -29,7 +29,7 @@ class PyStepper {
  public:
   PyStepper(std::shared_ptr<const Model> m, double temperature_C, double dt_s, double current_A,
             const std::vector<std::string>& freeze)
-      : st_(std::move(m), temperature_C, dt_s, current_A, freeze_from(freeze)) {}
+      : st_(std::move(m), temperature_C, dt_s, current_A, parse_freeze(freeze)) {}
 
   const Stepper& get() const {
     if (busy_) throw std::runtime_error("Stepper: busy in run() on another thread");

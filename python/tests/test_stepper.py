@@ -93,8 +93,10 @@ def test_bad_numbers_raise_and_leave_the_stepper_untouched(mdma):
         gmasim.Stepper(mdma, dt_s=0.0)
     with pytest.raises(gmasim.InputError, match="time step dt = 0.01 s: must be <= 0.001 s"):
         gmasim.Stepper(mdma, dt_s=1e-2)
-    with pytest.raises(gmasim.InputError, match="unknown law"):
+    with pytest.raises(gmasim.InputError, match="unknown law 'nonsense' to freeze; known: mu_G, rho_G"):
         gmasim.Stepper(mdma, freeze=["nonsense"])
+    # One name set (C++ kFreezeSwitches): the ablation's laws, freeze=[...], metrics.json.
+    assert gmasim.FREEZE_LAWS == ("mu_G", "rho_G", "M", "E_G", "E_t", "F_pm", "geometry")
     with pytest.raises(gmasim.InputError, match="no model"):
         gmasim.Stepper(None)
 

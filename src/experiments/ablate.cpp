@@ -15,28 +15,17 @@ namespace gmasim {
 
 std::vector<AblationLaw> ablation_laws() {
   std::vector<AblationLaw> laws;
-  auto add = [&](const char* name, const char* what, auto set) {
+  Freeze all;
+  for (const auto& sw : kFreezeSwitches) {
     AblationLaw l;
-    l.name = name;
-    l.description = what;
-    set(l.freeze);
+    l.name = sw.name;
+    l.description = sw.description;
+    l.freeze.*(sw.flag) = true;
+    all.*(sw.flag) = true;
     laws.push_back(l);
-  };
-  add("mu_G", "permeability of the rods, eq. (3)-(4) (and the eddy time constant through mu)",
-      [](Freeze& f) { f.permeability = true; });
-  add("rho_G", "resistivity of the rods, eq. (8)", [](Freeze& f) { f.resistivity = true; });
-  add("M", "magnetisation process: JA coefficients of eq. (10), M_s^T in eq. (9) and (11)",
-      [](Freeze& f) { f.magnetisation = true; });
-  add("E_G", "Delta-E modulus of the rods, eq. (13)", [](Freeze& f) { f.modulus = true; });
-  add("E_t", "sleeve modulus, eq. (19)", [](Freeze& f) { f.sleeve_modulus = true; });
-  add("F_pm", "permanent-magnet MMF, eq. (1)", [](Freeze& f) { f.pm_mmf = true; });
-  add("geometry", "thermal expansion of lengths and areas (eq. 2, 7, 17, 19)",
-      [](Freeze& f) { f.geometry = true; });
-  add("all", "every law above at once: the 20 degC model run at the operating temperature",
-      [](Freeze& f) {
-        f.permeability = f.resistivity = f.magnetisation = f.modulus = f.sleeve_modulus = f.pm_mmf =
-            f.geometry = true;
-      });
+  }
+  laws.push_back(
+      {"all", "every law above at once: the 20 degC model run at the operating temperature", all});
   return laws;
 }
 

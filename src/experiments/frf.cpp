@@ -10,6 +10,7 @@
 #include <complex>
 
 #include "experiments/parallel.hpp"
+#include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
 #include "gmasim/rod_laws.hpp"
@@ -414,6 +415,8 @@ FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progres
   std::vector<State> bias;
   std::vector<SmallSignalModel> lin;
   FrfResult res;
+  res.paper_first_resonance_Hz = builtin_paper_value("first_resonance");
+  res.paper_bandwidth_Hz = builtin_paper_value("bandwidth");
   for (std::size_t ti = 0; ti < nT; ++ti) {
     bias.push_back(settle_at_bias(m, conds[ti], r.bias_A, r.bias_state));
     lin.push_back(linearise(m, conds[ti], bias.back()));

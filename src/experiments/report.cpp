@@ -13,22 +13,22 @@
 namespace gmasim {
 namespace {
 
-std::string json_string(std::string_view s) {
-  return io_detail::json_string(s, io_detail::BackspaceFormFeed::Unicode);
-}
-
-// Shortest representation that reads back to the same double. A value that is not a finite
-// number (not measured, not defined: a stepped-sine column of a linear-only response) is
-// missing: null in JSON, an empty cell in CSV, never the ambiguous text "nan" or "inf".
-std::string number(double v, bool json) {
-  if (json) return io_detail::json_number(v);
+// A value that is not a finite number (not measured, not defined: a stepped-sine column of a
+// linear-only response) is missing: null in JSON, an empty cell in CSV, never the ambiguous
+// text "nan" or "inf". Numbers are the shortest text that reads back to the same double.
+std::string csv_number(double v) {
   if (!std::isfinite(v)) return "";
   return fmt::format("{}", v);
 }
 
-std::string json_cell(const Cell& c) {
-  if (c.is_bool) return c.text;
-  return c.is_text ? json_string(c.text) : number(c.number, true);
+void write_cell(io_detail::JsonWriter& w, const Cell& c) {
+  if (c.is_bool) {
+    w.boolean(c.text == "true");
+  } else if (c.is_text) {
+    w.string(c.text);
+  } else {
+    w.number(c.number);
+  }
 }
 
 std::string csv_text(const std::string& s) {
@@ -61,7 +61,7 @@ std::string table_csv(const Table& t) {
     for (std::size_t c = 0; c < row.size(); ++c) {
       if (c) out.push_back(',');
       const Cell& cell = row[c];
-      const std::string s = cell.is_text ? csv_text(cell.text) : number(cell.number, false);
+      const std::string s = cell.is_text ? csv_text(cell.text) : csv_number(cell.number);
       out.append(s.data(), s.data() + s.size());
     }
     out.push_back('\n');
@@ -70,43 +70,36 @@ std::string table_csv(const Table& t) {
 }
 
 std::string report_json(const Report& r) {
-  fmt::memory_buffer out;
-  auto put = [&](std::string_view s) { out.append(s.data(), s.data() + s.size()); };
-  put("{\n  \"experiment\": ");
-  put(json_string(r.experiment));
-  put(",\n  \"meta\": {");
-  for (std::size_t i = 0; i < r.meta.size(); ++i) {
-    put(i ? ",\n    " : "\n    ");
-    put(json_string(r.meta[i].first));
-    put(": ");
-    put(json_cell(r.meta[i].second));
+  io_detail::JsonWriter w;
+  w.begin_object();
+  w.key("experiment").string(r.experiment);
+  w.key("meta").begin_object();
+  for (const auto& [name, cell] : r.meta) {
+    w.key(name);
+    write_cell(w, cell);
   }
-  put(r.meta.empty() ? "},\n" : "\n  },\n");
-  put("  \"tables\": {");
-  for (std::size_t ti = 0; ti < r.tables.size(); ++ti) {
-    const Table& t = r.tables[ti];
-    put(ti ? ",\n    " : "\n    ");
-    put(json_string(t.name));
-    put(": {\n      \"columns\": [");
-    for (std::size_t c = 0; c < t.columns.size(); ++c) {
-      put(c ? ", " : "");
-      put(json_string(t.columns[c]));
-    }
-    put("],\n      \"rows\": [");
-    for (std::size_t k = 0; k < t.rows.size(); ++k) {
-      put(k ? ",\n        {" : "\n        {");
-      for (std::size_t c = 0; c < t.rows[k].size() && c < t.columns.size(); ++c) {
-        put(c ? ", " : "");
-        put(json_string(t.columns[c]));
-        put(": ");
-        put(json_cell(t.rows[k][c]));
+  w.end_object();
+  w.key("tables").begin_object();
+  for (const Table& t : r.tables) {
+    w.key(t.name).begin_object();
+    w.key("columns").begin_array(io_detail::JsonLayout::Inline);
+    for (const auto& c : t.columns) w.string(c);
+    w.end_array();
+    w.key("rows").begin_array();
+    for (const auto& row : t.rows) {
+      w.begin_object(io_detail::JsonLayout::Inline);
+      for (std::size_t c = 0; c < row.size() && c < t.columns.size(); ++c) {
+        w.key(t.columns[c]);
+        write_cell(w, row[c]);
       }
-      put("}");
+      w.end_object();
     }
-    put(t.rows.empty() ? "]\n    }" : "\n      ]\n    }");
+    w.end_array();
+    w.end_object();
   }
-  put(r.tables.empty() ? "}\n}\n" : "\n  }\n}\n");
-  return fmt::to_string(out);
+  w.end_object();
+  w.end_object();
+  return w.text();
 }
 
 // ---------------------------------------------------------------------------------------

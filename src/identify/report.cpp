@@ -10,23 +10,12 @@
 #include "gmasim/errors.hpp"
 #include "gmasim/identify.hpp"
 #include "gmasim/io.hpp"
+#include "io/json.hpp"
 #include "io/schema.hpp"
+#include "io/text_io.hpp"
 
 namespace gmasim {
 namespace {
-
-std::vector<std::string> split_lines(const std::string& text) {
-  std::vector<std::string> lines;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    auto end = text.find('\n', start);
-    if (end == std::string::npos) end = text.size();
-    lines.push_back(text.substr(start, end - start));
-    start = end + 1;
-  }
-  if (!lines.empty() && lines.back().empty()) lines.pop_back();
-  return lines;
-}
 
 std::string toml_number(double v) {
   std::string s = fmt::format("{:.12g}", v);
@@ -42,34 +31,6 @@ std::string utc_now() {
   std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
   return buf;
 }
-
-std::string json_str(std::string_view s) {
-  std::string o = "\"";
-  for (char c : s) {
-    switch (c) {
-      case '"':
-        o += "\\\"";
-        break;
-      case '\\':
-        o += "\\\\";
-        break;
-      case '\n':
-        o += "\\n";
-        break;
-      case '\t':
-        o += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20)
-          o += fmt::format("\\u{:04x}", static_cast<int>(c));
-        else
-          o += c;
-    }
-  }
-  return o + "\"";
-}
-
-std::string jnum(double v) { return std::isfinite(v) ? fmt::format("{:.10g}", v) : "null"; }
 
 std::string ci_text(const FittedParameter& p) {
   if (std::isnan(p.ci_low)) return "no interval";
@@ -121,11 +82,89 @@ std::string data_label(const IdentifyResult& r, const FitProvenance& p) {
   return "scalar targets only";
 }
 
+using io_detail::JsonLayout;
+using io_detail::JsonWriter;
+
+// fit_report.json: one Inline object per parameter, condition, target and history step.
+void write_parameter(JsonWriter& w, const FittedParameter& fp) {
+  // [lo, hi] on one line.
+  auto pair = [&w](std::string_view key, double lo, double hi) {
+    w.key(key).begin_array(JsonLayout::Inline).number(lo).number(hi).end_array();
+  };
+  w.begin_object(JsonLayout::Inline);
+  w.key("name").string(fp.name);
+  w.key("unit").string(fp.unit);
+  w.key("scale").string(fp.scale == ParamScale::Log ? "log" : "linear");
+  w.numbers({{"lower", fp.lower},
+             {"upper", fp.upper},
+             {"start", fp.start},
+             {"value", fp.value},
+             {"std_error", fp.std_error}});
+  pair("ci95", fp.ci_low, fp.ci_high);
+  pair("ci95_linearised", fp.wald_low, fp.wald_high);
+  w.key("ci_method").string(fp.ci_method);
+  w.key("determined").boolean(fp.determined);
+  w.key("at_bound").boolean(fp.at_bound);
+  w.end_object();
+}
+
+void write_condition(JsonWriter& w, const ConditionFit& c) {
+  w.begin_object(JsonLayout::Inline);
+  w.key("label").string(c.label);
+  w.key("file").string(c.path);
+  w.numbers({{"temperature_C", c.condition.temperature_C},
+             {"frequency_Hz", c.condition.frequency_Hz},
+             {"current_pp_A", c.condition.current_pp_A},
+             {"weight", c.weight}});
+  w.key("samples").integer(static_cast<long long>(c.samples));
+  w.key("compared").integer(static_cast<long long>(c.compared));
+  w.numbers({{"pp_um", c.pp_um},
+             {"rms_um", c.rms_um},
+             {"rms_pct", c.rms_pct},
+             {"max_err_um", c.max_err_um}});
+  w.key("flux_rms_pct");
+  if (c.flux_rms_pct >= 0) {
+    w.number(c.flux_rms_pct);
+  } else {
+    w.null();  // no flux column
+  }
+  w.key("failed").boolean(c.failed);
+  w.key("error").string(c.error);
+  w.key("overlay").string(c.overlay_file);
+  w.key("response_unit").string(c.response_unit);
+  w.key("quasi_static").boolean(c.condition.quasi_static);
+  w.key("offset").string(offset_mode_name(c.condition.offset));
+  w.end_object();
+}
+
+void write_target(JsonWriter& w, const TargetFit& t) {
+  w.begin_object(JsonLayout::Inline);
+  w.key("label").string(t.label);
+  w.key("kind").string(t.kind);
+  w.numbers({{"value", t.value},
+             {"simulated", t.simulated},
+             {"error_pct", t.error_pct},
+             {"weight", t.weight}});
+  w.key("failed").boolean(t.failed);
+  w.end_object();
+}
+
+void write_history(JsonWriter& w, const HistoryEntry& h) {
+  w.begin_object(JsonLayout::Inline);
+  w.key("phase").string(h.phase);
+  w.key("step").integer(h.step);
+  w.key("evaluations").integer(h.evaluations);
+  w.numbers(
+      {{"best_rms_pct", h.best_rms_pct}, {"wall_s", h.wall_s}, {"evals_per_s", h.evals_per_s}});
+  w.end_object();
+}
+
 }  // namespace
 
 std::string fitted_model_toml(const std::string& start_text, const ModelSpec& start,
                               const IdentifyResult& r, const FitProvenance& p) {
-  std::vector<std::string> lines = split_lines(start_text);
+  const auto views = io_detail::split_lines(start_text);
+  std::vector<std::string> lines(views.begin(), views.end());
   for (const auto& fp : r.parameters) {
     const auto it = start.params.find(fp.name);
     if (it == start.params.end() || it->second.line < 1 ||
@@ -189,85 +228,66 @@ std::string fitted_model_toml(const std::string& start_text, const ModelSpec& st
 }
 
 std::string fit_report_json(const IdentifyResult& r, const FitProvenance& p) {
-  std::string s = "{\n  \"gmasim_identify_report\": 1,\n";
-  s += fmt::format("  \"command\": {},\n  \"data\": {},\n  \"fit\": {},\n  \"start_model\": {},\n",
-                   json_str(p.command), json_str(p.data), json_str(p.fit), json_str(p.start_model));
-  s += fmt::format(
-      "  \"rms_pct\": {},\n  \"start_rms_pct\": {},\n  \"ga_rms_pct\": {},\n  \"interrupted\": "
-      "{},\n"
-      "  \"resumed\": {},\n",
-      jnum(r.rms_pct), jnum(r.start_rms_pct), jnum(r.ga_rms_pct), r.interrupted, r.resumed);
-  s += fmt::format(
-      "  \"algorithm\": {{\"name\": {}, \"ranks\": {}, \"islands\": {}, \"population\": {}, "
-      "\"generations\": {}, \"refine\": {}}},\n",
-      json_str(r.algorithm), r.ranks, r.islands, r.population, r.generations_done,
-      json_str(r.refine_summary));
-  s += fmt::format("  \"evaluations\": {},\n  \"wall_s\": {},\n  \"ga_evals_per_s\": {},\n",
-                   r.evaluations, jnum(r.wall_s), jnum(r.ga_evals_per_s));
-  s += "  \"parameters\": [\n";
-  for (std::size_t j = 0; j < r.parameters.size(); ++j) {
-    const auto& fp = r.parameters[j];
-    s += fmt::format(
-        "    {{\"name\": {}, \"unit\": {}, \"scale\": {}, \"lower\": {}, \"upper\": {}, "
-        "\"start\": {}, \"value\": {}, \"std_error\": {}, \"ci95\": [{}, {}], "
-        "\"ci95_linearised\": [{}, {}], \"ci_method\": {}, \"determined\": {}, "
-        "\"at_bound\": {}}}{}\n",
-        json_str(fp.name), json_str(fp.unit),
-        json_str(fp.scale == ParamScale::Log ? "log" : "linear"), jnum(fp.lower), jnum(fp.upper),
-        jnum(fp.start), jnum(fp.value), jnum(fp.std_error), jnum(fp.ci_low), jnum(fp.ci_high),
-        jnum(fp.wald_low), jnum(fp.wald_high), json_str(fp.ci_method), fp.determined, fp.at_bound,
-        j + 1 < r.parameters.size() ? "," : "");
+  JsonWriter w;
+  w.begin_object();
+  w.key("gmasim_identify_report").integer(1);
+  w.key("command").string(p.command);
+  w.key("data").string(p.data);
+  w.key("fit").string(p.fit);
+  w.key("start_model").string(p.start_model);
+  w.numbers(
+      {{"rms_pct", r.rms_pct}, {"start_rms_pct", r.start_rms_pct}, {"ga_rms_pct", r.ga_rms_pct}});
+  w.key("interrupted").boolean(r.interrupted);
+  w.key("resumed").boolean(r.resumed);
+  w.key("algorithm").begin_object(JsonLayout::Inline);
+  w.key("name").string(r.algorithm);
+  w.key("ranks").integer(r.ranks);
+  w.key("islands").integer(r.islands);
+  w.key("population").integer(r.population);
+  w.key("generations").integer(r.generations_done);
+  w.key("refine").string(r.refine_summary);
+  w.end_object();
+  w.key("evaluations").integer(r.evaluations);
+  w.key("wall_s").number(r.wall_s);
+  w.key("ga_evals_per_s").number(r.ga_evals_per_s);
+  w.key("parameters").begin_array();
+  for (const auto& fp : r.parameters) {
+    write_parameter(w, fp);
   }
-  s += "  ],\n  \"correlation\": [\n";
-  for (std::size_t j = 0; j < r.correlation.size(); ++j) {
-    s += "    [";
-    for (std::size_t k = 0; k < r.correlation[j].size(); ++k)
-      s += (k ? ", " : "") + jnum(r.correlation[j][k]);
-    s += j + 1 < r.correlation.size() ? "],\n" : "]\n";
+  w.end_array();
+  w.key("correlation").begin_array();
+  for (const auto& row : r.correlation) {
+    w.begin_array(JsonLayout::Inline);
+    for (double c : row) w.number(c);
+    w.end_array();
   }
-  s += fmt::format(
-      "  ],\n  \"covariance\": {{\"ok\": {}, \"residuals\": {}, \"residual_sigma_pct\": {}, "
-      "\"note\": {}}},\n",
-      r.covariance_ok, r.residual_count, jnum(r.residual_sigma), json_str(r.covariance_note));
-  s += "  \"conditions\": [\n";
-  for (std::size_t i = 0; i < r.conditions.size(); ++i) {
-    const auto& c = r.conditions[i];
-    s += fmt::format(
-        "    {{\"label\": {}, \"file\": {}, \"temperature_C\": {}, \"frequency_Hz\": {}, "
-        "\"current_pp_A\": {}, \"weight\": {}, \"samples\": {}, \"compared\": {}, \"pp_um\": {}, "
-        "\"rms_um\": {}, \"rms_pct\": {}, \"max_err_um\": {}, \"flux_rms_pct\": {}, \"failed\": "
-        "{}, "
-        "\"error\": {}, \"overlay\": {}, \"response_unit\": {}, \"quasi_static\": {}, "
-        "\"offset\": {}}}{}\n",
-        json_str(c.label), json_str(c.path), jnum(c.condition.temperature_C),
-        jnum(c.condition.frequency_Hz), jnum(c.condition.current_pp_A), jnum(c.weight), c.samples,
-        c.compared, jnum(c.pp_um), jnum(c.rms_um), jnum(c.rms_pct), jnum(c.max_err_um),
-        c.flux_rms_pct >= 0 ? jnum(c.flux_rms_pct) : "null", c.failed, json_str(c.error),
-        json_str(c.overlay_file), json_str(c.response_unit), c.condition.quasi_static,
-        json_str(offset_mode_name(c.condition.offset)), i + 1 < r.conditions.size() ? "," : "");
+  w.end_array();
+  w.key("covariance").begin_object(JsonLayout::Inline);
+  w.key("ok").boolean(r.covariance_ok);
+  w.key("residuals").integer(static_cast<long long>(r.residual_count));
+  w.key("residual_sigma_pct").number(r.residual_sigma);
+  w.key("note").string(r.covariance_note);
+  w.end_object();
+  w.key("conditions").begin_array();
+  for (const auto& c : r.conditions) {
+    write_condition(w, c);
   }
-  s += "  ],\n  \"targets\": [\n";
-  for (std::size_t i = 0; i < r.targets.size(); ++i) {
-    const auto& t = r.targets[i];
-    s += fmt::format(
-        "    {{\"label\": {}, \"kind\": {}, \"value\": {}, \"simulated\": {}, \"error_pct\": {}, "
-        "\"weight\": {}, \"failed\": {}}}{}\n",
-        json_str(t.label), json_str(t.kind), jnum(t.value), jnum(t.simulated), jnum(t.error_pct),
-        jnum(t.weight), t.failed, i + 1 < r.targets.size() ? "," : "");
+  w.end_array();
+  w.key("targets").begin_array();
+  for (const auto& t : r.targets) {
+    write_target(w, t);
   }
-  s += "  ],\n  \"history\": [\n";
-  for (std::size_t i = 0; i < r.history.size(); ++i) {
-    const auto& h = r.history[i];
-    s += fmt::format(
-        "    {{\"phase\": {}, \"step\": {}, \"evaluations\": {}, \"best_rms_pct\": {}, "
-        "\"wall_s\": {}, \"evals_per_s\": {}}}{}\n",
-        json_str(h.phase), h.step, h.evaluations, jnum(h.best_rms_pct), jnum(h.wall_s),
-        jnum(h.evals_per_s), i + 1 < r.history.size() ? "," : "");
+  w.end_array();
+  w.key("history").begin_array();
+  for (const auto& h : r.history) {
+    write_history(w, h);
   }
-  s += "  ],\n  \"notes\": [";
-  for (std::size_t i = 0; i < r.notes.size(); ++i) s += (i ? ", " : "") + json_str(r.notes[i]);
-  s += "]\n}\n";
-  return s;
+  w.end_array();
+  w.key("notes").begin_array(JsonLayout::Inline);
+  for (const auto& n : r.notes) w.string(n);
+  w.end_array();
+  w.end_object();
+  return w.text();
 }
 
 std::string fit_report_markdown(const IdentifyResult& r, const FitProvenance& p) {
@@ -343,8 +363,9 @@ std::string fit_report_markdown(const IdentifyResult& r, const FitProvenance& p)
           c.response_unit,
           c.flux_rms_pct >= 0 ? fmt::format("{:.3f}", c.flux_rms_pct) : "-");
     }
-    s += "\nOverlays (measured vs simulated): `overlay_<condition>.csv`, plotted by "
-         "`plot_fit.py` into `overlay_<condition>.png`.\n\n";
+    s += "\nOverlays (measured vs simulated): `overlay_<condition>.csv`, drawn into "
+         "`overlay_<condition>.png` by `python3 -m gmasim.command_figures identify <this "
+         "directory>`.\n\n";
   }
   if (!r.targets.empty()) {
     s += "## Scalar targets\n\n| target | kind | value | simulated | error [%] | weight |\n"

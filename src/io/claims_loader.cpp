@@ -8,6 +8,7 @@
 #include <cctype>
 #include <cmath>
 #include <map>
+#include <stdexcept>
 #include <string_view>
 
 #include "gmasim/claims.hpp"
@@ -296,6 +297,13 @@ const ClaimsData& builtin_claims() {
   static const ClaimsData data =
       parse_claims(std::string(kBuiltinClaimsToml, kBuiltinClaimsTomlSize), kBuiltinClaimsName);
   return data;
+}
+
+double builtin_paper_value(const std::string& id) {
+  const ClaimSpec* c = builtin_claims().find(id);
+  if (c == nullptr)
+    throw std::logic_error(fmt::format("{} has no claim '{}'", kBuiltinClaimsName, id));
+  return c->paper;
 }
 
 }  // namespace gmasim

@@ -342,20 +342,6 @@ namespace {
 
 using schema::Field;
 
-std::vector<std::string_view> split_lines(std::string_view text) {
-  std::vector<std::string_view> lines;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    auto end = text.find('\n', start);
-    if (end == std::string_view::npos) end = text.size();
-    auto line = text.substr(start, end - start);
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    lines.push_back(line);
-    start = end + 1;
-  }
-  return lines;
-}
-
 std::string join(const std::vector<std::string>& items, std::string_view sep) {
   std::string out;
   for (std::size_t i = 0; i < items.size(); ++i) {
@@ -407,7 +393,7 @@ struct NamedLine {
 class Loader {
  public:
   Loader(std::string_view text, const std::string& source)
-      : text_(text), lines_(split_lines(text)) {
+      : text_(text), lines_(io_detail::split_lines(text, io_detail::StripCR::Yes)) {
     spec_.source = source;
   }
 
@@ -1080,7 +1066,7 @@ Model load_model(const std::string& path) {
 // =======================================================================================
 std::vector<ParamRow> describe_model(const ModelSpec& spec) {
   const std::string text = source_text(spec.source);
-  const auto lines = split_lines(text);
+  const auto lines = io_detail::split_lines(text, io_detail::StripCR::Yes);
   auto comment_at = [&](long line) -> std::string {
     if (line < 1 || line > static_cast<long>(lines.size())) return "";
     return schema::trailing_comment(lines[static_cast<std::size_t>(line - 1)]);

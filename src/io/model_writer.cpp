@@ -56,18 +56,6 @@ std::string toml_float(double v) {
 
 namespace {
 
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> lines;
-  std::size_t start = 0;
-  while (start < text.size()) {
-    auto end = text.find('\n', start);
-    if (end == std::string::npos) end = text.size();
-    lines.push_back(text.substr(start, end - start));
-    start = end + 1;
-  }
-  return lines;
-}
-
 // Replaces the value of `leaf` on line `line_no` (1-based) by `value_text`; on a plain line
 // the trailing comment becomes `comment`.
 void replace_value(std::vector<std::string>& lines, long line_no, std::string_view leaf,
@@ -123,7 +111,8 @@ std::string model_toml(const ModelSpec& spec, const std::string& why) {
   if (spec.text.empty())
     throw InputError(fmt::format("{}: the model has no source text to save from", spec.source));
   const ModelSpec original = parse_model_spec(spec.text, spec.source);
-  std::vector<std::string> lines = lines_of(spec.text);
+  const auto views = io_detail::split_lines(spec.text);
+  std::vector<std::string> lines(views.begin(), views.end());
   auto leaf_of = [](const std::string& dotted) { return dotted.substr(dotted.rfind('.') + 1); };
   std::map<std::string, std::vector<std::string>> added;  // table -> new "key = value" lines
   for (const auto& [name, pv] : spec.params) {

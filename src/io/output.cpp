@@ -163,90 +163,56 @@ std::string timeseries_csv(const TimeSeries& ts) {
 // ---------------------------------------------------------------------------------------
 namespace {
 
-std::string json_string(std::string_view s) {
-  return io_detail::json_string(s, io_detail::BackspaceFormFeed::Short);
-}
+using io_detail::JsonWriter;
 
-using io_detail::json_number;
-
-// Accumulates `"key": value` members of one object at one indentation.
-class JsonObject {
- public:
-  explicit JsonObject(int indent) : indent_(indent) {}
-  void raw(std::string_view key, const std::string& value) {
-    members_.push_back(fmt::format("{:{}}{}: {}", "", indent_ + 2, json_string(key), value));
-  }
-  void number(std::string_view key, double v) { raw(key, json_number(v)); }
-  void integer(std::string_view key, long v) { raw(key, fmt::format("{}", v)); }
-  void string(std::string_view key, std::string_view v) { raw(key, json_string(v)); }
-  std::string str() const {
-    if (members_.empty()) return "{}";
-    std::string out = "{\n";
-    for (std::size_t i = 0; i < members_.size(); ++i) {
-      out += members_[i];
-      out += i + 1 < members_.size() ? ",\n" : "\n";
-    }
-    out += fmt::format("{:{}}}}", "", indent_);
-    return out;
-  }
-
- private:
-  int indent_;
-  std::vector<std::string> members_;
-};
-
-std::string waveform_json(const Waveform& w, int indent) {
-  JsonObject o(indent);
-  switch (w.kind) {
+void write_waveform(JsonWriter& w, const Waveform& wf) {
+  w.begin_object();
+  switch (wf.kind) {
     case WaveformKind::BiasedSine:
-      o.string("kind", "biased_sine");
-      o.number("pp_A", w.pp_A);
-      o.number("min_A", w.min_A);
-      o.number("frequency_Hz", w.frequency_Hz);
+      w.key("kind").string("biased_sine");
+      w.numbers({{"pp_A", wf.pp_A}, {"min_A", wf.min_A}, {"frequency_Hz", wf.frequency_Hz}});
       break;
     case WaveformKind::DC:
-      o.string("kind", "dc");
-      o.number("level_A", w.level_A);
+      w.key("kind").string("dc");
+      w.key("level_A").number(wf.level_A);
       break;
     case WaveformKind::Step:
-      o.string("kind", "step");
-      o.number("level_A", w.level_A);
-      o.number("step_to_A", w.step_to_A);
-      o.number("step_time_s", w.step_time_s);
+      w.key("kind").string("step");
+      w.numbers(
+          {{"level_A", wf.level_A}, {"step_to_A", wf.step_to_A}, {"step_time_s", wf.step_time_s}});
       break;
     case WaveformKind::Chirp:
-      o.string("kind", "chirp");
-      o.number("offset_A", w.offset_A);
-      o.number("amplitude_A", w.amplitude_A);
-      o.number("f0_Hz", w.f0_Hz);
-      o.number("f1_Hz", w.f1_Hz);
-      o.number("duration_s", w.duration_s);
+      w.key("kind").string("chirp");
+      w.numbers({{"offset_A", wf.offset_A},
+                 {"amplitude_A", wf.amplitude_A},
+                 {"f0_Hz", wf.f0_Hz},
+                 {"f1_Hz", wf.f1_Hz},
+                 {"duration_s", wf.duration_s}});
       break;
     case WaveformKind::Table:
-      o.string("kind", "table");
-      o.string("source", w.table_source);
-      o.integer("points", static_cast<long>(w.table_t_s.size()));
+      w.key("kind").string("table");
+      w.key("source").string(wf.table_source);
+      w.key("points").integer(static_cast<long long>(wf.table_t_s.size()));
       break;
   }
-  return o.str();
+  w.end_object();
 }
 
-std::string frozen_json(const Freeze& f) {
-  const std::pair<const char*, bool> laws[] = {
-      {"pm_mmf", f.pm_mmf},           {"permeability", f.permeability},
-      {"resistivity", f.resistivity}, {"magnetisation", f.magnetisation},
-      {"modulus", f.modulus},         {"sleeve_modulus", f.sleeve_modulus},
-      {"geometry", f.geometry},
-  };
-  std::string out = "[";
-  bool first = true;
-  for (const auto& [name, frozen] : laws) {
-    if (!frozen) continue;
-    if (!first) out += ", ";
-    out += json_string(name);
-    first = false;
-  }
-  return out + "]";
+// Self-heating: the end state of the network and its energy balance (self_heating.csv).
+void write_self_heating(JsonWriter& w, const Result& r) {
+  const auto last = r.heating.rows() - 1;
+  w.key("self_heating").begin_object();
+  w.numbers({{"thermal_step_s", r.heating.rows() > 1 ? r.heating.columns[0][1] : 0.0},
+             {"coil_C", r.heating.column("coil_C")[last]},
+             {"rods_C", r.heating.column("rods_C")[last]},
+             {"housing_C", r.heating.column("housing_C")[last]}});
+  // The first thermal step holds the virgin curve: the drift starts at the second.
+  w.numbers({{"stroke_start_um", r.heating.column("stroke_um")[std::min<std::size_t>(last, 2)]},
+             {"stroke_last_um", r.heating.column("stroke_um")[last]},
+             {"energy_in_J", r.energy_in_J},
+             {"energy_stored_J", r.energy_stored_J},
+             {"energy_out_J", r.energy_out_J}});
+  w.end_object();
 }
 
 }  // namespace
@@ -262,79 +228,70 @@ std::string fnv1a64_hex(std::string_view data) {
 
 std::string metrics_json(const Result& r, const SimulationSettings& s, const Model& m,
                          std::string_view timeseries_csv_text) {
-  JsonObject o(0);
-  o.string("status", r.diverged ? "diverged" : "ok");
-  o.raw("error", r.error.empty() ? std::string("null") : json_string(r.error));
-  o.string("model", m.spec.source);
-  if (const auto it = m.spec.options.find("meta.name"); it != m.spec.options.end())
-    o.string("model_name", it->second);
-  o.number("temperature_C", s.temperature_C);
-  o.raw("waveform", waveform_json(s.waveform, 2));
-  if (s.waveform.periodic()) {
-    o.number("periods", s.periods);
+  JsonWriter w;
+  w.begin_object();
+  w.key("status").string(r.diverged ? "diverged" : "ok");
+  w.key("error");
+  if (r.error.empty()) {
+    w.null();
   } else {
-    o.number("duration_s", s.duration_s);
+    w.string(r.error);
   }
-  o.number("dt_s", r.dt_s);
-  o.integer("record_every", s.record_every);
-  o.integer("steps", r.steps);
-  o.number("wall_time_s", r.wall_time_s);
-  o.raw("frozen", frozen_json(s.freeze));
+  w.key("model").string(m.spec.source);
+  if (const auto it = m.spec.options.find("meta.name"); it != m.spec.options.end())
+    w.key("model_name").string(it->second);
+  w.key("temperature_C").number(s.temperature_C);
+  w.key("waveform");
+  write_waveform(w, s.waveform);
+  if (s.waveform.periodic()) {
+    w.key("periods").number(s.periods);
+  } else {
+    w.key("duration_s").number(s.duration_s);
+  }
+  w.key("dt_s").number(r.dt_s);
+  w.key("record_every").integer(s.record_every);
+  w.key("steps").integer(r.steps);
+  w.key("wall_time_s").number(r.wall_time_s);
+  w.key("frozen").begin_array(io_detail::JsonLayout::Inline);
+  for (const auto& name : frozen_names(s.freeze)) w.string(name);
+  w.end_array();
   if (r.has_metrics) {
-    JsonObject mo(2);
-    mo.number("stroke_um", r.metrics.stroke_um);
-    mo.number("hysteresis_um", r.metrics.hysteresis_um);
-    mo.number("B_pp_T", r.metrics.B_pp_T);
-    mo.number("y_mean_um", r.metrics.y_mean_um);
-    mo.number("window_start_s", r.metrics.window_start_s);
-    mo.number("window_end_s", r.metrics.window_end_s);
+    w.key("metrics").begin_object();
+    w.numbers({{"stroke_um", r.metrics.stroke_um},
+               {"hysteresis_um", r.metrics.hysteresis_um},
+               {"B_pp_T", r.metrics.B_pp_T},
+               {"y_mean_um", r.metrics.y_mean_um},
+               {"window_start_s", r.metrics.window_start_s},
+               {"window_end_s", r.metrics.window_end_s}});
     if (r.step.valid) {
-      mo.number("step_y_initial_um", r.step.y_initial_um);
-      mo.number("step_y_final_um", r.step.y_final_um);
-      mo.number("step_rise_time_s", r.step.rise_time_s);
-      mo.number("step_overshoot_pct", r.step.overshoot_pct);
-      mo.number("step_settling_time_s", r.step.settling_time_s);
+      w.numbers({{"step_y_initial_um", r.step.y_initial_um},
+                 {"step_y_final_um", r.step.y_final_um},
+                 {"step_rise_time_s", r.step.rise_time_s},
+                 {"step_overshoot_pct", r.step.overshoot_pct},
+                 {"step_settling_time_s", r.step.settling_time_s}});
     }
-    o.raw("metrics", mo.str());
+    w.end_object();
   }
   if (!r.quantities.empty()) {
-    JsonObject qo(2);
+    w.key("quantities").begin_object();
     for (const auto& q : r.quantities) {
-      JsonObject one(4);
-      one.number("rms", q.rms);
-      one.number("peak", q.peak);
-      one.number("pp", q.pp);
-      one.number("mean", q.mean);
-      qo.raw(q.name, one.str());
+      w.key(q.name).begin_object();
+      w.numbers({{"rms", q.rms}, {"peak", q.peak}, {"pp", q.pp}, {"mean", q.mean}});
+      w.end_object();
     }
-    o.raw("quantities", qo.str());
+    w.end_object();
   }
-  o.number("thermal_expansion_um", r.thermal_expansion_um);
-  if (r.heating.rows() > 0) {
-    // Self-heating: the end state of the network and its energy balance (self_heating.csv).
-    JsonObject ho(2);
-    const auto last = r.heating.rows() - 1;
-    ho.number("thermal_step_s", r.heating.rows() > 1 ? r.heating.columns[0][1] : 0.0);
-    ho.number("coil_C", r.heating.column("coil_C")[last]);
-    ho.number("rods_C", r.heating.column("rods_C")[last]);
-    ho.number("housing_C", r.heating.column("housing_C")[last]);
-    // The first thermal step holds the virgin curve: the drift starts at the second.
-    ho.number("stroke_start_um",
-              r.heating.column("stroke_um")[std::min<std::size_t>(last, 2)]);
-    ho.number("stroke_last_um", r.heating.column("stroke_um")[last]);
-    ho.number("energy_in_J", r.energy_in_J);
-    ho.number("energy_stored_J", r.energy_stored_J);
-    ho.number("energy_out_J", r.energy_out_J);
-    o.raw("self_heating", ho.str());
-  }
+  w.key("thermal_expansion_um").number(r.thermal_expansion_um);
+  if (r.heating.rows() > 0) write_self_heating(w, r);
   if (!timeseries_csv_text.empty()) {
     // Pairs this file with the timeseries.csv written with it (write_files_atomic).
-    JsonObject to(2);
-    to.integer("bytes", static_cast<long>(timeseries_csv_text.size()));
-    to.string("fnv1a64", fnv1a64_hex(timeseries_csv_text));
-    o.raw("timeseries_csv", to.str());
+    w.key("timeseries_csv").begin_object();
+    w.key("bytes").integer(static_cast<long long>(timeseries_csv_text.size()));
+    w.key("fnv1a64").string(fnv1a64_hex(timeseries_csv_text));
+    w.end_object();
   }
-  return o.str() + "\n";
+  w.end_object();
+  return w.text();
 }
 
 std::vector<std::string> write_report_files(const std::string& dir, const std::string& stem,

@@ -3,8 +3,8 @@
 // package gmasim.report_figures from those CSVs).
 #include <fmt/format.h>
 
-#include <cstdlib>
 #include <filesystem>
+#include <system_error>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
@@ -45,13 +45,16 @@ std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
   std::string figures_note;
   bool figures = false;
   if (!python_exe.empty()) {
-    const std::string cmd =
-        fmt::format("PYTHONPATH='{}' MPLBACKEND=Agg '{}' -m gmasim.report_figures '{}' 1>&2",
-                    python_path, python_exe, dir.string());
-    const int rc = std::system(cmd.c_str());
+    PythonCommand c;
+    c.python = python_exe;
+    c.python_path = python_path;
+    c.module = "gmasim.report_figures";
+    c.args = {dir.string()};
+    c.stdout_to_stderr = true;  // our standard output is the command's summary
+    const int rc = run_python(c);
     figures = rc == 0;
     if (!figures)
-      figures_note = fmt::format("(figure rendering failed: `{}` exited with {})", cmd, rc);
+      figures_note = fmt::format("(figure rendering failed: `{}` exited with {})", c.text(), rc);
   } else {
     figures_note = "(figures not rendered: --no-figures)";
   }
@@ -82,12 +85,12 @@ std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
     for (double f : c.mode_frequencies_Hz)
       modes += fmt::format("{}{:.0f}", modes.empty() ? "" : ", ", f);
     md += fmt::format(
-        "- {:g} degC: first resonance in the band {} (paper 1270 Hz), -3 dB bandwidth {:.0f} Hz "
-        "(paper > 2000 Hz), modes of eq. 15 at the bias point: {} Hz\n",
+        "- {:g} degC: first resonance in the band {} (paper {:g} Hz), -3 dB bandwidth {:.0f} Hz "
+        "(paper > {:g} Hz), modes of eq. 15 at the bias point: {} Hz\n",
         c.temperature_C,
         c.first_resonance_Hz > 0 ? fmt::format("{:.0f} Hz", c.first_resonance_Hz)
                                  : std::string("none"),
-        c.bandwidth_3dB_Hz, modes);
+        r.frf.paper_first_resonance_Hz, c.bandwidth_3dB_Hz, r.frf.paper_bandwidth_Hz, modes);
   }
   md += "\n";
   md += fig(
@@ -105,8 +108,8 @@ std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
   md += fig("ablate",
             "Change of the output when one temperature law is frozen at 20 degC, 6 A, 70 degC");
   md += fmt::format(
-      "## Thermal expansion (eq. 21)\n\n{:.3f} um/degC (paper: model 0.662, measured 0.712).\n",
-      r.thermal.um_per_C);
+      "## Thermal expansion (eq. 21)\n\n{:.3f} um/degC (paper: model {:g}, measured {:g}).\n",
+      r.thermal.um_per_C, r.thermal.paper_model_um_per_C, r.thermal.paper_measured_um_per_C);
   write_file_atomic((dir / "report.md").string(), md);
   return md;
 }
@@ -114,13 +117,9 @@ std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
 std::vector<std::pair<std::string, std::string>> load_claim_notes(const std::string& path) {
   const std::string text = io_detail::read_text_file(path, "claim notes");
   std::vector<std::pair<std::string, std::string>> notes;
-  std::size_t pos = 0;
-  int line_no = 0;
+  std::size_t line_no = 0;
   bool in_note = false;
-  while (pos < text.size()) {
-    const std::size_t end = std::min(text.find('\n', pos), text.size());
-    const std::string_view line(text.data() + pos, end - pos);
-    pos = end + 1;
+  for (const std::string_view line : io_detail::split_lines(text)) {
     ++line_no;
     if (line.starts_with("### ")) {
       const std::string id(io_detail::trim(line.substr(4)));

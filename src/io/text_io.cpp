@@ -43,6 +43,20 @@ std::string read_text_file(const std::string& path, std::string_view what,
   return text;
 }
 
+std::vector<std::string_view> split_lines(std::string_view text, StripCR strip_cr) {
+  std::vector<std::string_view> lines;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    auto end = text.find('\n', start);
+    if (end == std::string_view::npos) end = text.size();
+    auto line = text.substr(start, end - start);
+    if (strip_cr == StripCR::Yes && line.ends_with('\r')) line.remove_suffix(1);
+    lines.push_back(line);
+    start = end + 1;
+  }
+  return lines;
+}
+
 std::string_view trim(std::string_view s) {
   const auto b = s.find_first_not_of(" \t\r");
   if (b == std::string_view::npos) return {};

@@ -19,6 +19,12 @@ enum class OnReadError {
 std::string read_text_file(const std::string& path, std::string_view what,
                            OnReadError on_read_error = OnReadError::Throw);
 
+// The lines of `text` without their '\n' (and, with StripCR::Yes, without a '\r' before it):
+// "a\nb\n" and "a\nb" are {"a", "b"}, "" is {}. Views into `text`; line i + 1 of a file
+// is element i. The one line splitter of model files, fitted models and claim notes.
+enum class StripCR { No, Yes };
+std::vector<std::string_view> split_lines(std::string_view text, StripCR strip_cr = StripCR::No);
+
 // `s` without leading and trailing spaces, tabs and carriage returns.
 std::string_view trim(std::string_view s);
 

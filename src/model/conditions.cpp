@@ -2,7 +2,9 @@
 // Each law has a freeze switch (ablation): a frozen law sees T = T_ref.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/model.hpp"
@@ -45,6 +47,31 @@ JaCoefficients ja_at(const Model& m, const JaReference& j, double T_C) {
 }
 
 }  // namespace
+
+Freeze parse_freeze(const std::vector<std::string>& names) {
+  Freeze f;
+  for (const auto& n : names) {
+    const auto* sw = std::find_if(std::begin(kFreezeSwitches), std::end(kFreezeSwitches),
+                                  [&](const FreezeSwitch& s) { return n == s.name; });
+    if (sw == std::end(kFreezeSwitches))
+      throw InputError(fmt::format("unknown law '{}' to freeze; known: {}", n, freeze_name_list()));
+    f.*(sw->flag) = true;
+  }
+  return f;
+}
+
+std::vector<std::string> frozen_names(const Freeze& f) {
+  std::vector<std::string> names;
+  for (const auto& s : kFreezeSwitches)
+    if (f.*(s.flag)) names.emplace_back(s.name);
+  return names;
+}
+
+std::string freeze_name_list() {
+  std::string list;
+  for (const auto& s : kFreezeSwitches) list += (list.empty() ? "" : ", ") + std::string(s.name);
+  return list;
+}
 
 Conditions make_conditions(const Model& m, double temperature_C, const Freeze& fz) {
   const auto& mat = m.material;

@@ -85,7 +85,6 @@ RunLength run_length(const SimulationSettings& s) {
   return L;
 }
 
-
 // The slower thermal clock of self-heating (gmasim/self_heating.hpp): accumulates the
 // losses of each thermal step, advances the network, recomputes the Conditions at the rods'
 // new temperature. The per-step work is allocation-free; the Conditions update once per
@@ -126,9 +125,9 @@ struct SelfHeatingRun {
     Hc_prev.assign(n, 0.0);
     H_prev.assign(n, 0.0);
     M_prev.assign(n, 0.0);
-    r.heating.names = {"t_s",      "coil_C",         "rods_C",      "housing_C", "P_copper_W",
-                       "P_eddy_W", "P_hysteresis_W", "P_ambient_W", "stroke_um", "E_in_J",
-                       "E_stored_J", "E_out_J"};
+    r.heating.names = {"t_s",        "coil_C",   "rods_C",         "housing_C",
+                       "P_copper_W", "P_eddy_W", "P_hysteresis_W", "P_ambient_W",
+                       "stroke_um",  "E_in_J",   "E_stored_J",     "E_out_J"};
     r.heating.columns.assign(r.heating.names.size(), {});
     const double rows = static_cast<double>(L.steps) / static_cast<double>(steps_per_interval) + 2;
     for (auto& col : r.heating.columns) col.reserve(static_cast<std::size_t>(rows));
@@ -141,10 +140,10 @@ struct SelfHeatingRun {
   }
 
   void push_row(Result& r, double t, double Pc, double Pe, double Ph, double Pa, double stroke) {
-    const double row[] = {t,  T.coil_C, T.rods_C, T.housing_C, Pc, Pe,
-                          Ph, Pa,       stroke,   r.energy_in_J, r.energy_stored_J,
-                          r.energy_out_J};
-    for (std::size_t j = 0; j < r.heating.columns.size(); ++j) r.heating.columns[j].push_back(row[j]);
+    const double row[] = {t,      T.coil_C,      T.rods_C,          T.housing_C,   Pc, Pe, Ph, Pa,
+                          stroke, r.energy_in_J, r.energy_stored_J, r.energy_out_J};
+    for (std::size_t j = 0; j < r.heating.columns.size(); ++j)
+      r.heating.columns[j].push_back(row[j]);
   }
 
   void begin(const Conditions& c, const State& st, Result& r) {
@@ -160,8 +159,8 @@ struct SelfHeatingRun {
 
   void after_step(const Model& m, const SimulationSettings& s, Conditions& c, const State& st,
                   double dt, bool last, Result& r) {
-    E_copper += copper_loss_J(i_prev, st.current_A,
-                              coil_resistance_ohm(*net, T_ref_C, T.coil_C), dt);
+    E_copper +=
+        copper_loss_J(i_prev, st.current_A, coil_resistance_ohm(*net, T_ref_C, T.coil_C), dt);
     i_prev = st.current_A;
     for (std::size_t i = 0; i < volume_m3.size(); ++i) {
       const RodState& rs = st.rods[i];
@@ -271,7 +270,8 @@ void validate(const SimulationSettings& s) {
   if (s.self_heating.enabled) {
     const auto& h = s.self_heating;
     require_nonnegative(h.thermal_step_s, "thermal step", "s");
-    if (!std::isnan(h.ambient_C)) require_in(h.ambient_C, -273.15, 1e4, "ambient temperature", "degC");
+    if (!std::isnan(h.ambient_C))
+      require_in(h.ambient_C, -273.15, 1e4, "ambient temperature", "degC");
     if (h.thermal_step_s > 0.0 && h.thermal_step_s < L.dt_s)
       throw InputError(fmt::format("thermal step {} s: shorter than the time step {} s",
                                    h.thermal_step_s, L.dt_s));

@@ -13,7 +13,7 @@ cat stdout.txt
 "$PY" "$SRC/tests/cli/check_identify.py" mpi/model_report/fit_report.json --gmasim "$GMASIM" --truth-model "$TRUTH" \
   --ranks 2
 "$GMASIM" model check mpi/model.toml
-for f in fit_report.md fit_report.json convergence.csv overlay_T70_I8_f100.csv plot_fit.py; do
+for f in fit_report.md fit_report.json convergence.csv overlay_T70_I8_f100.csv; do
   [[ -s mpi/model_report/$f ]] || { echo "FAIL: missing mpi/model_report/$f"; exit 1; }
 done
 [[ $(grep -c "gmasim identify: generation" stderr.txt) -ge 2 ]]  # progress from rank 0 only

@@ -60,9 +60,21 @@ check "step metrics" 0 "step +y .* rise \(10-90 %\)" "$B" simulate --waveform-ki
 if compgen -G "$(dirname "$B")/../python/gmasim/_gmasim*.so" >/dev/null; then
   check "plot" 0 "wrote .*frf.png" "$B" frf --method linear --points 8 --temperatures 20 --plot --out "$T/frfplot"
   [[ -s "$T/frfplot/frf.svg" ]] && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: frf.svg"; }
+  # identify draws its figures the same way (gmasim.command_figures identify REPORT_DIR).
+  "$B" identify synthesize --out "$T/iddata" --temperatures 20 --currents 8 --frequencies 10 \
+    --steps-per-period 100 --samples-per-period 50 >/dev/null
+  check "identify figures" 0 "weighted RMS" "$B" identify --data "$T/iddata/manifest.toml" \
+    --fit material.chi_m:8:50:log --out "$T/id/m.toml" --islands 1 --population 8 --generations 1 \
+    --migrate-every 1 --no-refine --no-profile --steps-per-period 100 --threads 1
+  ok "identify overlay and convergence figures" test -s "$T/id/m_report/overlay_T20_I8_f10.png" \
+    -a -s "$T/id/m_report/overlay_T20_I8_f10.svg" -a -s "$T/id/m_report/convergence.png"
 else
   echo "skip: --plot (no Python module in this build)"
 fi
+# The Freeze switches by their one set of names (kFreezeSwitches).
+check "simulate --freeze" 0 "stroke" "$B" simulate --periods 2 --temperature 70 --freeze mu_G,E_t --out "$T/fz"
+grep -q '"frozen": \["mu_G", "E_t"\]' "$T/fz/metrics.json" && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: frozen in metrics.json"; }
+check "unknown law to freeze" 2 "unknown law 'mu' to freeze; known: mu_G, rho_G, M, E_G, E_t, F_pm, geometry" "$B" simulate --freeze mu --out "$T/fz2"
 check "progress eta" 0 "simulate: 100000/100000 \(100 %\), .* s elapsed, ETA" "$B" simulate --periods 10 --progress --out "$T/prog"
 check "single-rod template" 0 "OK \(57 parameters, 1 rods" "$B" model check "$(dirname "$0")/../../models/single_rod.toml"
 check "help has units" 0 "Operating temperature \[degC\]" "$B" simulate --help
