@@ -214,7 +214,7 @@ def identify(out):
         t = o[t_key]
         a2.plot(t, o[measured], ".", ms=2.0, label="measured")
         a2.plot(t, o[simulated], "-", lw=1.0, label="simulated")
-        if np.any(cmp):
+        if np.any(cmp) and np.argmax(cmp) > 0:  # only when leading samples are skipped
             a2.axvspan(t[0], t[np.argmax(cmp)], color="0.9", label="not compared")
         a2.set_xlabel("time (s)" if t_key == "t_s" else "sample (-)")
         a2.set_ylabel(ylabel)
