@@ -361,7 +361,8 @@ ThermalExpansionResult thermal_expansion_coefficient(const Model& m);
 
 // ---------------------------------------------------------------------------------------
 // Reports: one table per result (CSV: one row per point, column names with units) and a
-// JSON document with the same data (src/experiments/report.cpp).
+// JSON document with the same data (src/experiments/report.cpp builds them; table_csv and
+// report_json of gmasim/io.hpp write them).
 // ---------------------------------------------------------------------------------------
 struct Cell {
   double number = 0.0;
@@ -386,10 +387,6 @@ struct Report {
   std::vector<std::pair<std::string, Cell>> meta;  // settings and summary numbers
   std::vector<Table> tables;
 };
-
-std::string table_csv(const Table& t);
-// {"experiment": ..., "meta": {...}, "tables": {"name": {"columns": [...], "rows": [{...}]}}}
-std::string report_json(const Report& r);
 
 Report sweep_report(const Model& m, const SweepRequest& req, const SweepResult& res);
 Report frf_report(const Model& m, const FrfRequest& req, const FrfResult& res);

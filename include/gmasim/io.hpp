@@ -76,6 +76,12 @@ void ensure_output_dir(const std::string& dir);
 
 std::string timeseries_csv(const TimeSeries& ts);
 
+// An experiment's report table as CSV (one row per point; a non-finite number is an empty
+// cell), and the whole report as one JSON document:
+// {"experiment": ..., "meta": {...}, "tables": {"name": {"columns": [...], "rows": [{...}]}}}
+std::string table_csv(const Table& t);
+std::string report_json(const Report& r);
+
 // Writes an experiment's report: DIR/<stem>.json (every table) and one CSV per table,
 // DIR/<stem>.csv for the first and DIR/<stem>_<table>.csv for the others, atomically.
 // Returns the paths written.
