@@ -13,12 +13,11 @@
 // eq. 2-3). When the fixed branches alone already tie every node to the reference (true
 // of the MDMA), the Laplacian is G = G0 + B D B^T with G0 constant, B the incidence of the
 // k rod branches and D = diag(1/R_rod). The Woodbury identity then reduces each step to a
-// k x k solve with matrices precomputed once (LowRank); otherwise the full n x n system is
+// k x k solve with matrices precomputed once (Circuit::lowrank); otherwise the full n x n system is
 // factorised every step. Both give the same fluxes (tested).
 #pragma once
 
-#include <Eigen/Cholesky>
-#include <Eigen/Core>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -35,24 +34,24 @@ struct CircuitBranch {
   double pm_mmf_At = 0.0;  // permanent-magnet MMF F_pm at T0 [A-turns], scaled by eq. (1)
 };
 
-// Precomputed pieces of the low-rank (Woodbury) solve, see above.
-struct LowRank {
-  bool enabled = false;
-  Eigen::MatrixXd W;            // G0^-1 B            (n x k)
-  Eigen::MatrixXd S;            // B^T G0^-1 B        (k x k)
-  Eigen::VectorXd psi_coil;     // G0^-1 b per ampere of coil current (fixed branches)
-  Eigen::VectorXd psi_pm;       // G0^-1 b per unit PM scale (fixed branches)
-  Eigen::VectorXd Bt_psi_coil;  // B^T psi_coil (k)
-  Eigen::VectorXd Bt_psi_pm;    // B^T psi_pm (k)
-};
+// The Eigen matrices of the nodal solve are private to src/circuit/netlist.cpp:
+// CircuitMatrices (the fixed part of the Laplacian and the precomputed pieces of the low-rank
+// solve, set by finalize_circuit) and NodalBuffers (a workspace's nodal matrix, its Cholesky
+// factorisation and the node potentials).
+struct CircuitMatrices;
+struct NodalBuffers;
 
 struct Circuit {
   std::vector<std::string> node_names;  // non-reference nodes, index = position
   std::string reference_node;
   std::vector<CircuitBranch> branches;
-  std::vector<int> rod_branch;      // rod index -> branch index
-  Eigen::MatrixXd fixed_laplacian;  // contribution of the fixed-reluctance branches
-  LowRank lowrank;
+  std::vector<int> rod_branch;  // rod index -> branch index
+  // Set by finalize_circuit: enabled when the fixed branches alone ground every node, so each
+  // solve takes the k x k low-rank (Woodbury) path.
+  struct LowRank {
+    bool enabled = false;
+  } lowrank;
+  std::shared_ptr<const CircuitMatrices> matrices;  // set by finalize_circuit, then immutable
 
   int node_count() const { return static_cast<int>(node_names.size()); }
   int branch_count() const { return static_cast<int>(branches.size()); }
@@ -63,14 +62,26 @@ struct Circuit {
 // the message.
 void finalize_circuit(Circuit& c, int rod_count, const std::string& where);
 
-// Buffers of the nodal solve, sized once.
-using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 8, 1>;
+// Owns a workspace's NodalBuffers and copies them with it, so that a State stays a copyable
+// value. Defined in src/circuit/netlist.cpp.
+class NodalBuffersPtr {
+ public:
+  NodalBuffersPtr();
+  ~NodalBuffersPtr();
+  NodalBuffersPtr(const NodalBuffersPtr& other);
+  NodalBuffersPtr& operator=(const NodalBuffersPtr& other);
+  NodalBuffersPtr(NodalBuffersPtr&& other) noexcept;
+  NodalBuffersPtr& operator=(NodalBuffersPtr&& other) noexcept;
+  NodalBuffers* get() const { return p_.get(); }
+  void reset(std::unique_ptr<NodalBuffers> p);
 
+ private:
+  std::unique_ptr<NodalBuffers> p_;
+};
+
+// Buffers of the nodal solve, sized once.
 struct CircuitWorkspace {
-  Eigen::MatrixXd G;
-  Eigen::VectorXd rhs;  // holds the node potentials psi after a solve
-  Eigen::LLT<Eigen::MatrixXd> llt;
-  SmallVector v, z;                // low-rank path: rod potential drops B^T psi, and D F + z
+  NodalBuffersPtr nodal;           // nodal matrix, factorisation, potentials (netlist.cpp)
   std::vector<double> reluctance;  // per branch, this step [1/H]
   std::vector<double> mmf;         // per branch, this step [A-turns]
   std::vector<double> phi;         // per branch, solved flux [Wb]

@@ -1,12 +1,51 @@
 #include <fmt/format.h>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
 #include <array>
+#include <utility>
 #include <vector>
 
 #include "gmasim/circuit.hpp"
 #include "gmasim/errors.hpp"
 
 namespace gmasim {
+
+// The fixed part of the nodal matrix and the precomputed pieces of the low-rank (Woodbury)
+// solve (gmasim/circuit.hpp).
+struct CircuitMatrices {
+  Eigen::MatrixXd fixed_laplacian;  // contribution of the fixed-reluctance branches
+  // Low-rank pieces, when Circuit::lowrank.enabled:
+  Eigen::MatrixXd W;            // G0^-1 B            (n x k)
+  Eigen::MatrixXd S;            // B^T G0^-1 B        (k x k)
+  Eigen::VectorXd psi_coil;     // G0^-1 b per ampere of coil current (fixed branches)
+  Eigen::VectorXd psi_pm;       // G0^-1 b per unit PM scale (fixed branches)
+  Eigen::VectorXd Bt_psi_coil;  // B^T psi_coil (k)
+  Eigen::VectorXd Bt_psi_pm;    // B^T psi_pm (k)
+};
+
+using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 8, 1>;
+
+// A workspace's Eigen buffers, sized once by CircuitWorkspace::resize.
+struct NodalBuffers {
+  Eigen::MatrixXd G;
+  Eigen::VectorXd rhs;  // holds the node potentials psi after a solve
+  Eigen::LLT<Eigen::MatrixXd> llt;
+  SmallVector v, z;  // low-rank path: rod potential drops B^T psi, and D F + z
+};
+
+NodalBuffersPtr::NodalBuffersPtr() = default;
+NodalBuffersPtr::~NodalBuffersPtr() = default;
+NodalBuffersPtr::NodalBuffersPtr(const NodalBuffersPtr& other)
+    : p_(other.p_ ? std::make_unique<NodalBuffers>(*other.p_) : nullptr) {}
+NodalBuffersPtr& NodalBuffersPtr::operator=(const NodalBuffersPtr& other) {
+  if (this != &other) p_ = other.p_ ? std::make_unique<NodalBuffers>(*other.p_) : nullptr;
+  return *this;
+}
+NodalBuffersPtr::NodalBuffersPtr(NodalBuffersPtr&& other) noexcept = default;
+NodalBuffersPtr& NodalBuffersPtr::operator=(NodalBuffersPtr&& other) noexcept = default;
+void NodalBuffersPtr::reset(std::unique_ptr<NodalBuffers> p) { p_ = std::move(p); }
+
 namespace {
 
 // Adds a branch of conductance g between its nodes to a nodal (Laplacian) matrix.
@@ -70,14 +109,17 @@ void finalize_circuit(Circuit& c, int rod_count, const std::string& where) {
                               "reference node '{}'",
                               c.node_names[static_cast<std::size_t>(i)], c.reference_node)));
 
-  c.fixed_laplacian = Eigen::MatrixXd::Zero(n, n);
+  auto matrices = std::make_shared<CircuitMatrices>();
+  auto& L = *matrices;
+  L.fixed_laplacian = Eigen::MatrixXd::Zero(n, n);
   for (const auto& br : c.branches) {
     if (br.rod >= 0) continue;
-    stamp_conductance(c.fixed_laplacian, br, 1.0 / br.fixed_reluctance_per_H);
+    stamp_conductance(L.fixed_laplacian, br, 1.0 / br.fixed_reluctance_per_H);
   }
+  c.matrices = matrices;
   // Low-rank pieces, when the fixed branches alone ground every node (G0 SPD).
-  c.lowrank = LowRank{};
-  Eigen::LLT<Eigen::MatrixXd> llt0(c.fixed_laplacian);
+  c.lowrank = Circuit::LowRank{};
+  Eigen::LLT<Eigen::MatrixXd> llt0(L.fixed_laplacian);
   if (llt0.info() != Eigen::Success || rod_count == 0) return;
   const int k = rod_count;
   Eigen::MatrixXd B = Eigen::MatrixXd::Zero(n, k);
@@ -100,27 +142,28 @@ void finalize_circuit(Circuit& c, int rod_count, const std::string& where) {
       b_pm(br.to) += br.pm_mmf_At * g;
     }
   }
-  auto& L = c.lowrank;
   L.W = llt0.solve(B);
   L.S = B.transpose() * L.W;
   L.psi_coil = llt0.solve(b_coil);
   L.psi_pm = llt0.solve(b_pm);
   L.Bt_psi_coil = B.transpose() * L.psi_coil;
   L.Bt_psi_pm = B.transpose() * L.psi_pm;
-  L.enabled = true;
+  c.lowrank.enabled = true;
 }
 
 void CircuitWorkspace::resize(const Circuit& c) {
   const int n = c.node_count();
-  G = Eigen::MatrixXd::Zero(n, n);
-  rhs = Eigen::VectorXd::Zero(n);
+  if (nodal.get() == nullptr) nodal.reset(std::make_unique<NodalBuffers>());
+  NodalBuffers& nb = *nodal.get();
+  nb.G = Eigen::MatrixXd::Zero(n, n);
+  nb.rhs = Eigen::VectorXd::Zero(n);
   // Sized by a factorisation of the identity, not by LLT(n): LLT(n) leaves its status and
   // norm uninitialised, and copying such a workspace (a State copy) loads an indeterminate
   // enum (UBSan, issue 8). compute() sets both; step() refactorises in place, no allocation.
-  llt.compute(Eigen::MatrixXd::Identity(n, n));
+  nb.llt.compute(Eigen::MatrixXd::Identity(n, n));
   const int k = static_cast<int>(c.rod_branch.size());
-  v = SmallVector::Zero(k);
-  z = SmallVector::Zero(k);
+  nb.v = SmallVector::Zero(k);
+  nb.z = SmallVector::Zero(k);
   reluctance.assign(c.branches.size(), 0.0);
   mmf.assign(c.branches.size(), 0.0);
   phi.assign(c.branches.size(), 0.0);
@@ -155,8 +198,8 @@ double potential_drop(const CircuitBranch& br, const Eigen::VectorXd& psi) {
 // Leaves z in ws.z and the rod potential drops B^T psi in ws.v. Fixed-size Eigen types for
 // small k (the hot path of the step); capacity-8 storage otherwise. Allocation-free.
 template <int K>
-bool rod_solve(const LowRank& L, std::span<const double> R, const double* mmf, double current_A,
-               double pm_scale, CircuitWorkspace& ws) {
+bool rod_solve(const CircuitMatrices& L, std::span<const double> R, const double* mmf,
+               double current_A, double pm_scale, NodalBuffers& ws) {
   constexpr int kMax = K == Eigen::Dynamic ? 8 : K;
   using Vec = Eigen::Matrix<double, K, 1, 0, kMax, 1>;
   using Mat = Eigen::Matrix<double, K, K, 0, kMax, kMax>;
@@ -180,8 +223,10 @@ bool rod_solve(const LowRank& L, std::span<const double> R, const double* mmf, d
 
 bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_H, double current_A,
                    double pm_scale, CircuitWorkspace& ws, bool all_branches) {
-  const LowRank& L = c.lowrank;
-  if (!L.enabled) return solve_circuit_full(c, rod_reluctance_per_H, current_A, pm_scale, ws);
+  if (!c.lowrank.enabled)
+    return solve_circuit_full(c, rod_reluctance_per_H, current_A, pm_scale, ws);
+  const CircuitMatrices& L = *c.matrices;
+  NodalBuffers& nb = *ws.nodal.get();
   const int k = static_cast<int>(c.rod_branch.size());
   std::array<double, 8> mmf{};
   for (int r = 0; r < k; ++r)
@@ -191,52 +236,53 @@ bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_
   bool ok = false;
   switch (k) {
     case 1:
-      ok = rod_solve<1>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, ws);
+      ok = rod_solve<1>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, nb);
       break;
     case 2:
-      ok = rod_solve<2>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, ws);
+      ok = rod_solve<2>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, nb);
       break;
     case 3:
-      ok = rod_solve<3>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, ws);
+      ok = rod_solve<3>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, nb);
       break;
     case 4:
-      ok = rod_solve<4>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, ws);
+      ok = rod_solve<4>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, nb);
       break;
     default:
-      ok = rod_solve<Eigen::Dynamic>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, ws);
+      ok = rod_solve<Eigen::Dynamic>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, nb);
   }
   if (!ok) return false;
   if (!all_branches) {  // the step needs only the rod fluxes: phi_r = (drop_r + F_r) / R_r
     for (int r = 0; r < k; ++r)
       set_flux(c, static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)]),
-               rod_reluctance_per_H, current_A, pm_scale, ws.v(r), ws);
+               rod_reluctance_per_H, current_A, pm_scale, nb.v(r), ws);
     return true;
   }
-  ws.rhs.noalias() = current_A * L.psi_coil + pm_scale * L.psi_pm;
-  ws.rhs.noalias() -= L.W * ws.z;
+  nb.rhs.noalias() = current_A * L.psi_coil + pm_scale * L.psi_pm;
+  nb.rhs.noalias() -= L.W * nb.z;
   for (std::size_t b = 0; b < c.branches.size(); ++b)
-    set_flux(c, b, rod_reluctance_per_H, current_A, pm_scale, potential_drop(c.branches[b], ws.rhs),
+    set_flux(c, b, rod_reluctance_per_H, current_A, pm_scale, potential_drop(c.branches[b], nb.rhs),
              ws);
   return true;
 }
 
 bool solve_circuit_full(const Circuit& c, std::span<const double> rod_reluctance_per_H,
                         double current_A, double pm_scale, CircuitWorkspace& ws) {
-  ws.G = c.fixed_laplacian;
-  ws.rhs.setZero();
+  NodalBuffers& nb = *ws.nodal.get();
+  nb.G = c.matrices->fixed_laplacian;
+  nb.rhs.setZero();
   for (const auto& br : c.branches) {
     const double g = 1.0 / branch_reluctance(br, rod_reluctance_per_H);
     const double F = branch_mmf(br, current_A, pm_scale, ws);
-    if (br.rod >= 0) stamp_conductance(ws.G, br, g);
+    if (br.rod >= 0) stamp_conductance(nb.G, br, g);
     // phi_b = (psi_from - psi_to + F)/R; KCL at `from` (outflow) and `to` (inflow).
-    if (br.from >= 0) ws.rhs(br.from) -= F * g;
-    if (br.to >= 0) ws.rhs(br.to) += F * g;
+    if (br.from >= 0) nb.rhs(br.from) -= F * g;
+    if (br.to >= 0) nb.rhs(br.to) += F * g;
   }
-  ws.llt.compute(ws.G);
-  if (ws.llt.info() != Eigen::Success) return false;
-  ws.llt.solveInPlace(ws.rhs);  // rhs now holds psi
+  nb.llt.compute(nb.G);
+  if (nb.llt.info() != Eigen::Success) return false;
+  nb.llt.solveInPlace(nb.rhs);  // rhs now holds psi
   for (std::size_t b = 0; b < c.branches.size(); ++b)
-    set_flux(c, b, rod_reluctance_per_H, current_A, pm_scale, potential_drop(c.branches[b], ws.rhs),
+    set_flux(c, b, rod_reluctance_per_H, current_A, pm_scale, potential_drop(c.branches[b], nb.rhs),
              ws);
   return true;
 }
