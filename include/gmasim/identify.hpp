@@ -286,23 +286,22 @@ struct SyntheticRequest {
 MeasurementSet synthesize_measurements(const Model& truth, const SyntheticRequest& r);
 
 // =======================================================================================
-// Communicator: a thin layer over MPI (or a single process)
+// Communicator: the processes of one identification (a single process, or MPI ranks)
 // =======================================================================================
+// Made by make_serial_communicator() or make_mpi_communicator(); the collectives identify()
+// runs over it (sum, max, broadcast, ring, gather) are internal (src/identify/communicator.hpp).
 class Communicator {
  public:
   virtual ~Communicator() = default;
   virtual int rank() const = 0;
   virtual int size() const = 0;
-  // Element-wise sum / max over ranks, in place; every rank gets the result.
-  virtual void allreduce_sum(double* data, std::size_t n) = 0;
-  virtual void allreduce_max(double* data, std::size_t n) = 0;
-  virtual void broadcast(double* data, std::size_t n, int root) = 0;
-  // Ring: sends `send` to rank+1, returns what rank-1 sent (the same size on every rank).
-  virtual std::vector<double> ring_shift(const std::vector<double>& send) = 0;
-  // Gathers one string per rank on root (others get an empty vector).
-  virtual std::vector<std::string> gather(const std::string& s, int root) = 0;
-  virtual void barrier() = 0;
+  // Ends every rank (MPI_Abort), or this process (exit) when it is alone.
   [[noreturn]] virtual void abort(int code) = 0;
+
+ protected:
+  Communicator() = default;
+  Communicator(const Communicator&) = default;
+  Communicator& operator=(const Communicator&) = default;
 };
 
 std::unique_ptr<Communicator> make_serial_communicator();
@@ -345,7 +344,7 @@ struct IdentifyOptions {
   std::function<void(const IdentifyProgress&)> progress;
   // Polled between epochs / iterations: true stops cleanly (SIGINT). May be null.
   const std::atomic<bool>* stop = nullptr;
-  Communicator* comm = nullptr;  // null: one process
+  Communicator* comm = nullptr;  // null: one process; else from make_*_communicator()
 };
 
 struct FittedParameter {

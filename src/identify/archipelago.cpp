@@ -100,7 +100,7 @@ unsigned long long fevals(const pagmo::archipelago& archi) {
 
 // The best champion over all islands and ranks (a collective call), kept in out if it
 // improves on out.best_f.
-void update_best(const pagmo::archipelago& archi, Communicator& comm, GaOutcome& out) {
+void update_best(const pagmo::archipelago& archi, Collective& comm, GaOutcome& out) {
   double f = std::numeric_limits<double>::infinity();
   std::vector<double> u = out.best_u;
   for (const auto& isl : archi) {
@@ -122,7 +122,7 @@ void update_best(const pagmo::archipelago& archi, Communicator& comm, GaOutcome&
 // gives at the stored point. One batch of evaluations, about one generation's cost; the
 // verdict is collective, so that no rank is left waiting in a collective call.
 void verify_restored(const Checkpoint& c, const pagmo::problem& prob, const IdentifyOptions& o,
-                     Communicator& comm, int ranks, std::size_t n) {
+                     Collective& comm, int ranks, std::size_t n) {
   auto fail = [&](const std::string& what) {
     throw InputError(located(o.resume_path, 0, fmt::format("cannot resume: {}", what)));
   };
@@ -166,7 +166,7 @@ void verify_restored(const Checkpoint& c, const pagmo::problem& prob, const Iden
 
 }  // namespace
 
-GaOutcome run_ga(const Objective& obj, const IdentifyOptions& o, Communicator& comm,
+GaOutcome run_ga(const Objective& obj, const IdentifyOptions& o, Collective& comm,
                  const std::vector<double>& start_u, double start_f) {
   using clock = std::chrono::steady_clock;
   const auto t_start = clock::now();

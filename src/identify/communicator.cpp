@@ -1,13 +1,14 @@
 // The thin communication layer of identify(): a single process, or MPI (OpenMPI) when the
 // library is built with GMASIM_WITH_MPI. Only the main thread calls MPI (MPI_THREAD_FUNNELED);
 // islands and evaluation threads never do.
+#include "identify/communicator.hpp"
+
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/identify.hpp"
 
 #ifdef GMASIM_WITH_MPI
 #include <mpi.h>
@@ -16,7 +17,9 @@
 namespace gmasim {
 namespace {
 
-class SerialCommunicator final : public Communicator {
+using identify_detail::Collective;
+
+class SerialCommunicator final : public Collective {
  public:
   int rank() const override { return 0; }
   int size() const override { return 1; }
@@ -34,7 +37,7 @@ void check(int rc, const char* what) {
   if (rc != MPI_SUCCESS) throw std::runtime_error(std::string("MPI error in ") + what);
 }
 
-class MpiCommunicator final : public Communicator {
+class MpiCommunicator final : public Collective {
  public:
   MpiCommunicator(int* argc, char*** argv) {
     int inited = 0;
@@ -124,6 +127,14 @@ class MpiCommunicator final : public Communicator {
 #endif
 
 }  // namespace
+
+Collective& identify_detail::collective(Communicator& c) {
+  auto* own = dynamic_cast<Collective*>(&c);
+  if (own == nullptr)
+    throw InputError(
+        "IdentifyOptions::comm: use make_serial_communicator() or make_mpi_communicator()");
+  return *own;
+}
 
 std::unique_ptr<Communicator> make_serial_communicator() {
   return std::make_unique<SerialCommunicator>();

@@ -20,7 +20,7 @@ namespace {
 // the crossing by two bisections and a linear interpolation. Returns the interval in u-space.
 std::pair<double, double> profile(const Objective& obj, BatchEvaluator& ev,
                                   const std::vector<double>& u, double chi_opt, double thr,
-                                  std::size_t j, const IdentifyOptions& o, Communicator& comm,
+                                  std::size_t j, const IdentifyOptions& o, Collective& comm,
                                   double& lowest, std::vector<double>& lowest_u) {
   constexpr double kSteps[] = {0.04, 0.12, 0.3, 0.6, 1.0};
   constexpr int kIterations = 20;  // warm-started; the stall rule ends converged solves early
@@ -96,7 +96,7 @@ FittedParameter fitted_parameter(const Objective& obj, std::size_t j, double val
 }
 
 void fill_covariance(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u,
-                     double f, const IdentifyOptions& o, Communicator& comm, IdentifyResult& out) {
+                     double f, const IdentifyOptions& o, Collective& comm, IdentifyResult& out) {
   const double h = o.fd_step;
   const std::size_t n = obj.dim(), m = obj.residual_count();
   const auto p = obj.to_params(u);

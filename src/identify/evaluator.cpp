@@ -51,7 +51,7 @@ std::vector<char> BatchEvaluator::run(const std::vector<std::vector<double>>& po
   return ok;
 }
 
-void global_best(Communicator& comm, double& f, std::vector<double>& u) {
+void global_best(Collective& comm, double& f, std::vector<double>& u) {
   if (comm.size() == 1) return;
   double neg = -f;
   comm.allreduce_max(&neg, 1);
@@ -63,13 +63,13 @@ void global_best(Communicator& comm, double& f, std::vector<double>& u) {
   f = fmin;
 }
 
-bool any_rank(Communicator& comm, bool flag) {
+bool any_rank(Collective& comm, bool flag) {
   double v = flag ? 1.0 : 0.0;
   comm.allreduce_max(&v, 1);
   return v > 0.5;
 }
 
-long sum_ranks(Communicator& comm, long v) {
+long sum_ranks(Collective& comm, long v) {
   double d = static_cast<double>(v);
   comm.allreduce_sum(&d, 1);
   return static_cast<long>(d);

@@ -17,7 +17,7 @@ IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, cons
                         const IdentifyOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   auto serial = make_serial_communicator();
-  Communicator& comm = o.comm ? *o.comm : *serial;
+  Collective& comm = collective(o.comm ? *o.comm : *serial);
 
   // ---- options ------------------------------------------------------------------------
   if (o.algorithm != "sga" && o.algorithm != "de" && o.algorithm != "sade" &&

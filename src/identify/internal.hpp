@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "gmasim/identify.hpp"
+#include "identify/communicator.hpp"
 
 namespace gmasim::identify_detail {
 
@@ -15,7 +16,7 @@ namespace gmasim::identify_detail {
 // over `threads` worker threads. Every rank gets every result, bit-identical.
 class BatchEvaluator {
  public:
-  BatchEvaluator(const Objective& obj, int threads, Communicator& comm)
+  BatchEvaluator(const Objective& obj, int threads, Collective& comm)
       : obj_(obj), threads_(threads < 1 ? 1 : threads), comm_(comm) {}
   // ok[i] = residuals(points[i]) succeeded; res[i] has residual_count() values.
   std::vector<char> run(const std::vector<std::vector<double>>& points,
@@ -25,14 +26,14 @@ class BatchEvaluator {
  private:
   const Objective& obj_;
   int threads_;
-  Communicator& comm_;
+  Collective& comm_;
   long evaluations_ = 0;
 };
 
 // Reduces (f, u) to the best over ranks (lowest f, then lowest rank); every rank gets it.
-void global_best(Communicator& comm, double& f, std::vector<double>& u);
-bool any_rank(Communicator& comm, bool flag);
-long sum_ranks(Communicator& comm, long v);
+void global_best(Collective& comm, double& f, std::vector<double>& u);
+bool any_rank(Collective& comm, bool flag);
+long sum_ranks(Collective& comm, long v);
 
 // ---- checkpoint -------------------------------------------------------------------------
 struct IslandPopulation {
@@ -82,7 +83,7 @@ struct GaOutcome {
   std::vector<HistoryEntry> history;
 };
 
-GaOutcome run_ga(const Objective& obj, const IdentifyOptions& o, Communicator& comm,
+GaOutcome run_ga(const Objective& obj, const IdentifyOptions& o, Collective& comm,
                  const std::vector<double>& start_u, double start_f);
 
 // ---- refinement and covariance ------------------------------------------------------------
@@ -97,7 +98,7 @@ struct RefineOutcome {
 // Levenberg-Marquardt from u0 within [0, 1]^n; `fixed` >= 0 holds that component constant
 // (profile likelihood); max_iterations < 0: o.refine_iterations.
 RefineOutcome refine_lm(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u0,
-                        const IdentifyOptions& o, Communicator& comm,
+                        const IdentifyOptions& o, Collective& comm,
                         const std::function<void(int, double)>& on_iteration, int fixed = -1,
                         int max_iterations = -1);
 
@@ -114,6 +115,6 @@ FittedParameter fitted_parameter(const Objective& obj, std::size_t j, double val
 // profile-likelihood intervals for the parameters at a bound or whose linearised interval
 // leaves the bounds.
 void fill_covariance(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u,
-                     double f, const IdentifyOptions& o, Communicator& comm, IdentifyResult& out);
+                     double f, const IdentifyOptions& o, Collective& comm, IdentifyResult& out);
 
 }  // namespace gmasim::identify_detail

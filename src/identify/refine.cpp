@@ -91,7 +91,7 @@ class FdCost final : public ceres::CostFunction {
 
 class Callback final : public ceres::IterationCallback {
  public:
-  Callback(const IdentifyOptions& o, Communicator& comm,
+  Callback(const IdentifyOptions& o, Collective& comm,
            const std::function<void(int, double)>& on_iteration)
       : o_(o), comm_(comm), on_iteration_(on_iteration) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
@@ -118,7 +118,7 @@ class Callback final : public ceres::IterationCallback {
 
  private:
   const IdentifyOptions& o_;
-  Communicator& comm_;
+  Collective& comm_;
   const std::function<void(int, double)>& on_iteration_;
   std::vector<double> accepted_;
 };
@@ -126,7 +126,7 @@ class Callback final : public ceres::IterationCallback {
 }  // namespace
 
 RefineOutcome refine_lm(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u0,
-                        const IdentifyOptions& o, Communicator& comm,
+                        const IdentifyOptions& o, Collective& comm,
                         const std::function<void(int, double)>& on_iteration, int fixed,
                         int max_iterations) {
   const std::size_t n = obj.dim();
