@@ -247,35 +247,55 @@ Conditions make_conditions(const Model& m, double temperature_C, const Freeze& f
 // ---------------------------------------------------------------------------------------
 // State and step.
 // ---------------------------------------------------------------------------------------
+// Which stage writes each field ("computed by"): make_state() sets every field; then step()
+// (src/model/step.cpp) writes them in the order of its numbered stages:
+//   1. the rods' reluctances (eq. 2-3) and the nodal solve of the circuit (eq. 23);
+//   2. per rod the static field (eq. 7), the eddy lag (eq. 7) and JA (eq. 9); with the
+//      consistent magnetic state, stages 1-2 are one Newton solve (consistent_magnetic_update);
+//   3. per rod the strain, modulus and force (eq. 11-14, 17), then the oscillators
+//      (eq. 15-18), then the output stage;
+//   end: the outputs (eq. 20, the sensors) and the clock.
+// rk4_reference_step() writes the same fields by its own integration; quasi_static_step()
+// writes every field but t_s as one increment of make_state's ramp does (stages 1-2 without
+// eddy lag, then the force and the static equilibrium x = F / K). Nothing else writes a State,
+// except the run loops that reset t_s to k dt (no drift from repeated addition) and
+// settle_at_bias's anhysteretic start (M_irr = M = M_an, src/experiments/frf.cpp).
 struct RodState {
   // integrated state
-  double H_A_per_m = 0;     // eddy-filtered field (eq. 7)
-  double Mirr_A_per_m = 0;  // irreversible magnetisation (eq. 9)
-  double x_m = 0, v_m_per_s = 0;
+  double H_A_per_m = 0;     // eddy-filtered field (eq. 7); stage 2: the lag (consistent: Newton)
+  double Mirr_A_per_m = 0;  // irreversible magnetisation (eq. 9); stage 2: ja_step
+  double x_m = 0, v_m_per_s = 0;  // stage 3: oscillator_step (eq. 15); make_state: x = F / K
   // kept for the next step (hold values, warm starts)
-  double Hc_A_per_m = 0;      // static field of eq. (7) at the end of the last step
-  double H_prev_A_per_m = 0;  // H one step earlier (consistent state: Newton's first guess)
-  double M_A_per_m = 0;       // total magnetisation consistent with (H, M_irr)
-  double M_prev_A_per_m = 0;
-  double F_N = 0;  // force at the end of the last step
+  double Hc_A_per_m = 0;      // static field of eq. (7) at the end of the last step; stage 2
+  double H_prev_A_per_m = 0;  // H one step earlier (consistent state: Newton's first guess);
+                              // stage 2, consistent state only
+  double M_A_per_m = 0;       // total magnetisation consistent with (H, M_irr); stage 2: ja_step
+  double M_prev_A_per_m = 0;  // M one step earlier (stage 1's extrapolation); stage 2
+  double F_N = 0;             // force at the end of the last step (eq. 14); stage 3
   // reported
-  // mu_r: eq. (3) (printed) or the JA differential permeability 1 + dM/dH (consistent);
-  // B_T: the flux density the circuit assigns to the rod, phi / A (stored in step()).
-  double mu_r = 1, E_Pa = 0, lambda = 0, tau_s = 0, phi_Wb = 0, k_rod_N_per_m = 0,
-         k_load_N_per_m = 0, B_T = 0;
+  double mu_r = 1;    // eq. (3) at the extrapolated M, stage 1 (printed); the JA differential
+                      // permeability 1 + dM/dH, stage 2 (consistent)
+  double E_Pa = 0;    // Delta-E modulus (eq. 13); stage 3
+  double lambda = 0;  // magnetostriction (eq. 11-12); stage 3
+  double tau_s = 0;   // eddy time constant mu kappa (eq. 7); stage 2
+  double phi_Wb = 0;  // the rod branch's flux from the circuit (eq. 23); stage 2
+  double k_rod_N_per_m = 0;   // axial stiffness (eq. 17); stage 3
+  double k_load_N_per_m = 0;  // load-chain stiffness (eq. 18); stage 3
+  double B_T = 0;  // the flux density the circuit assigns to the rod, phi / A; end of step()
 };
 
 struct State {
-  double t_s = 0;
-  double current_A = 0;
+  double t_s = 0;        // end of the last step; end of step(): t_s + dt
+  double current_A = 0;  // coil current at t_s; end of step(): StepInput::current_A
   double y_m = 0;        // the output the sensor reads: z with an output stage, else y_stack (+ x_T
-                         // if the option says so)
-  double y_stack_m = 0;  // x1 + x2 + x3 (eq. 20)
-  double z_m = 0, z_v_m_per_s = 0;  // output stage (if any): displacement and velocity
-  double B_T = 0;                   // flux density seen by the induction coil
+                         // if the option says so); end of step()
+  double y_stack_m = 0;  // x1 + x2 + x3 (eq. 20); end of step()
+  double z_m = 0, z_v_m_per_s = 0;  // output stage (if any): displacement and velocity; stage 3
+  double B_T = 0;  // flux density seen by the induction coil (sensor branches); end of step()
   std::vector<RodState> rods;
-  CircuitWorkspace circuit;
-  std::vector<double> rod_reluctance;
+  CircuitWorkspace circuit;  // stage 1: the rod branches' fluxes phi (eq. 23), the consistent
+                             // state's linearised rod MMFs (rod_extra_mmf)
+  std::vector<double> rod_reluctance;  // per rod, eq. (2) (consistent: linearised); stage 1
 };
 
 // Sizes every buffer, and places the actuator at rest in its quasi-static equilibrium
