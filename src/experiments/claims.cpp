@@ -1,7 +1,7 @@
 // The extractors of the claims (data/claims.toml, docs/claims.md): for each kind, the C++
 // that computes our value from a `gmasim reproduce` study, and the scoring of a claim by its
 // tolerance rule. The claims themselves (numbers, tolerances, conditions) are data; the
-// loader is src/io/claims_loader.cpp.
+// loader is src/experiments/claims_loader.cpp.
 #include "gmasim/claims.hpp"
 
 #include <fmt/format.h>

@@ -10,9 +10,9 @@
 #include <filesystem>
 #include <sstream>
 
+#include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
 #include "internal.hpp"
-#include "io/text_io.hpp"
 
 namespace gmasim::identify_detail {
 namespace {

@@ -12,12 +12,12 @@
 #include <set>
 #include <string_view>
 
+#include "common/text_io.hpp"
+#include "common/toml_io.hpp"
 #include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/identify.hpp"
 #include "gmasim/io.hpp"
-#include "io/text_io.hpp"
-#include "io/toml_io.hpp"
 
 namespace gmasim {
 namespace {

@@ -12,12 +12,12 @@
 #include <string>
 #include <string_view>
 
+#include "common/text_io.hpp"
+#include "common/toml_io.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/identify.hpp"
 #include "gmasim/io.hpp"
 #include "gmasim/validate.hpp"
-#include "io/text_io.hpp"
-#include "io/toml_io.hpp"
 
 namespace gmasim {
 namespace {

@@ -7,12 +7,12 @@
 #include <ctime>
 #include <string_view>
 
+#include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/identify.hpp"
 #include "gmasim/io.hpp"
 #include "io/json.hpp"
 #include "io/schema.hpp"
-#include "io/text_io.hpp"
 
 namespace gmasim {
 namespace {

@@ -9,11 +9,11 @@
 #include <set>
 #include <utility>
 
+#include "common/text_io.hpp"
+#include "common/toml_io.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
 #include "io/schema.hpp"
-#include "io/text_io.hpp"
-#include "io/toml_io.hpp"
 
 namespace gmasim {
 

@@ -10,11 +10,11 @@
 #include <map>
 #include <stdexcept>
 
+#include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
 #include "gmasim/validate.hpp"
 #include "io/schema.hpp"
-#include "io/text_io.hpp"
 
 namespace gmasim {
 

@@ -18,10 +18,10 @@
 #include <utility>
 #include <vector>
 
+#include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
 #include "io/json.hpp"
-#include "io/text_io.hpp"
 
 namespace gmasim {
 

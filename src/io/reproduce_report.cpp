@@ -6,10 +6,10 @@
 #include <filesystem>
 #include <system_error>
 
+#include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
 #include "gmasim/reproduce.hpp"
-#include "text_io.hpp"
 
 namespace gmasim {
 namespace {

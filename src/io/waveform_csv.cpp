@@ -5,9 +5,9 @@
 #include <string_view>
 #include <vector>
 
+#include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
-#include "io/text_io.hpp"
 
 namespace gmasim {
 

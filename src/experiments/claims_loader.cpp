@@ -11,10 +11,10 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "common/text_io.hpp"
+#include "common/toml_io.hpp"
 #include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
-#include "io/text_io.hpp"
-#include "io/toml_io.hpp"
 
 namespace gmasim {
 

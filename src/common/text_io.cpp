@@ -1,4 +1,4 @@
-#include "io/text_io.hpp"
+#include "common/text_io.hpp"
 
 #include <fmt/format.h>
 

@@ -1,9 +1,9 @@
-#include "io/toml_io.hpp"
+#include "common/toml_io.hpp"
 
 #include <fmt/format.h>
 
+#include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
-#include "io/text_io.hpp"
 
 namespace gmasim::io_detail {
 
