@@ -277,7 +277,8 @@ TEST(Records, RelativeStrainFitsOnlyWithItsOffsetRule) {
   r.samples_per_period = 50;
   r.noise_pct = 0.0;
   r.with_flux = false;
-  const ModelSpec spec = load_model_spec(std::string(GMASIM_SOURCE_DIR) + "/models/single_rod.toml");
+  const ModelSpec spec =
+      load_model_spec(std::string(GMASIM_SOURCE_DIR) + "/models/single_rod.toml");
   FitSpec fit;
   fit.parameters.push_back({"rod.ja.k0", 1000.0, 9000.0, ParamScale::Log, false, 0.0, 1});
   auto rms_at_truth = [&](OffsetMode written, OffsetMode declared, double shift) {
@@ -359,12 +360,12 @@ TEST(Records, BadRecordsAreRefusedWithFileLineAndRule) {
       {"field too large", qs + "2e7,1\n", 3, "field_A_per_m = 2e+07: must be in"},
       {"current too large", "# temperature_C = 20\ncurrent_A,displacement_um\n1e4,1\n", 3,
        "current_A = 10000: must be in"},
-      {"quasi-static with a frequency", "# temperature_C = 20\n# frequency_Hz = 10\n" +
-                                            qs.substr(21) + qs_rows(10),
-       2, "a quasi-static record (no t_s column) has no time"},
-      {"flat quasi-static drive", "# temperature_C = 20\ncurrent_A,displacement_um\n" +
-                                      std::string("1,1\n1,2\n1,3\n1,4\n"),
-       0, "the current_A column does not vary"},
+      {"quasi-static with a frequency",
+       "# temperature_C = 20\n# frequency_Hz = 10\n" + qs.substr(21) + qs_rows(10), 2,
+       "a quasi-static record (no t_s column) has no time"},
+      {"flat quasi-static drive",
+       "# temperature_C = 20\ncurrent_A,displacement_um\n" + std::string("1,1\n1,2\n1,3\n1,4\n"), 0,
+       "the current_A column does not vary"},
       {"compare_from_sample on a timed record",
        "# temperature_C = 20\n# compare_from_sample = 2\nt_s,current_A,displacement_um\n"
        "0,0,0\n1,1,1\n2,2,2\n3,3,3\n",
@@ -391,8 +392,8 @@ TEST(Records, BadRecordsAreRefusedWithFileLineAndRule) {
        4, "this record's drive is field_A_per_m"},
   };
   for (const auto& c : cases) {
-    const std::string path = dir.write(std::string("bad_") + std::to_string(c.line) + ".csv",
-                                       c.text);
+    const std::string path =
+        dir.write(std::string("bad_") + std::to_string(c.line) + ".csv", c.text);
     const std::string msg = input_error([&] { (void)load_measurement_csv(path); });
     EXPECT_THAT(msg, HasSubstr(c.message)) << c.name;
     if (c.line > 0) {
@@ -405,7 +406,8 @@ TEST(Records, BadRecordsAreRefusedWithFileLineAndRule) {
   set.items.push_back(load_measurement_csv(path));
   FitSpec fit;
   fit.parameters.push_back({"rod1.ja.k0", 1000.0, 9000.0, ParamScale::Log, false, 0.0, 1});
-  const std::string msg = input_error(
-      [&] { (void)Objective(builtin_model_spec(), set, fit, ObjectiveSettings{}); });
-  EXPECT_THAT(msg, HasSubstr("rod = 'rod9' is not a rod of the model (its rods: rod1, rod2, rod3)"));
+  const std::string msg =
+      input_error([&] { (void)Objective(builtin_model_spec(), set, fit, ObjectiveSettings{}); });
+  EXPECT_THAT(msg,
+              HasSubstr("rod = 'rod9' is not a rod of the model (its rods: rod1, rod2, rod3)"));
 }

@@ -51,6 +51,10 @@ struct ModelSpec {
   double get(const std::string& dotted) const;        // throws InputError if unknown
   void set(const std::string& dotted, double value);  // throws InputError if unknown
   long line_of(const std::string& dotted) const;
+  // The full key a dotted name resolves to: the name itself, or the unique
+  // "<name>_<unit suffix>" ("rod1.ja.k0" -> "rod1.ja.k0_A_per_m"); throws InputError if
+  // unknown or ambiguous, as get() does.
+  std::string key_of(const std::string& dotted) const;
 };
 
 // ---------------------------------------------------------------------------------------

@@ -61,24 +61,6 @@ struct SineMetrics {
   double stroke_um = 0, hysteresis_um = 0, B_pp_T = 0;
 };
 
-// Resolves a dotted name to the model's full key, with the library's prefix rule.
-std::string resolve_key(const ModelSpec& spec, const std::string& name) {
-  if (spec.params.count(name)) return name;
-  const std::string prefix = name + "_";
-  std::vector<std::string> matches;
-  for (auto it = spec.params.lower_bound(prefix);
-       it != spec.params.end() && it->first.starts_with(prefix); ++it) {
-    if (it->first.find('.', prefix.size()) == std::string::npos) matches.push_back(it->first);
-  }
-  if (matches.size() == 1) return matches.front();
-  (void)spec.get(name);  // throws the library's "unknown/ambiguous parameter" message
-  throw InputError(fmt::format("unknown parameter '{}'", name));
-}
-
-double step_for(const ObjectiveSettings& s, double period_s) {
-  return identify_detail::objective_step(s, period_s);
-}
-
 // Conditions and the state at rest per (temperature, initial current): runs that share both
 // (every frequency and amplitude of a biased sine starting at its -3 A minimum) share one
 // make_state(), whose quasi-static ramp costs about as much as 300 steps.
@@ -109,7 +91,7 @@ SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings
   const Waveform w = biased_sine(run.pp, run.f, run.min);
   const double per = w.period_s();
   const long n_per =
-      std::max(8L, checked_ceil_count(per / step_for(s, per), kMaxSteps, "steps per period"));
+      std::max(8L, checked_ceil_count(per / identify_detail::objective_step(s, per), kMaxSteps, "steps per period"));
   const double dt = per / static_cast<double>(n_per);
   const long periods = std::max(1L, checked_count(s.target_periods, 1e4, "target periods"));
   const long total = periods * n_per;
@@ -319,7 +301,7 @@ Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const F
   for (const auto& fp : fit.parameters) {
     std::string key;
     try {
-      key = resolve_key(start, fp.name);
+      key = start.key_of(fp.name);
     } catch (const InputError& e) {
       throw InputError(located(fit.source, fp.line, e.what()));
     }
@@ -455,7 +437,7 @@ Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const F
   // evaluation fails only for its parameter values, never for the settings (issue 8) ----
   for (const SineRun& run : I.sine_runs) {
     const double per = 1.0 / run.f;
-    const double n_per = std::max(8.0, std::ceil(per / step_for(settings, per) - 1e-9));
+    const double n_per = std::max(8.0, std::ceil(per / identify_detail::objective_step(settings, per) - 1e-9));
     (void)checked_count(n_per * std::round(settings.target_periods), kMaxSteps,
                         fmt::format("steps of the {:g} Hz target simulation", run.f));
   }

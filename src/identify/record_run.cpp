@@ -1,6 +1,8 @@
 // Simulating one measurement record (docs/data.md, "What is simulated and compared"):
 // current- or field-driven, timed or quasi-static, optionally pre-cycled; the response is
 // the actuator output or one rod's strain, with the record's offset rule applied after.
+#include "identify/record_run.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -10,7 +12,6 @@
 
 #include "gmasim/errors.hpp"
 #include "gmasim/validate.hpp"
-#include "identify/record_run.hpp"
 
 namespace gmasim::identify_detail {
 namespace {
@@ -93,17 +94,16 @@ class Driver {
     }
     if (std::fabs(fb) <= tol_A_per_m) return b;
     if ((fb > 0.0) == (fa > 0.0))
-      throw DivergenceError(st.t_s, m_.rods[rod_].name, "field_A_per_m [A/m] of the record",
-                            target,
-                            fmt::format("no coil current within +-{:g} A produces it",
-                                        kMaxCurrent_A));
+      throw DivergenceError(
+          st.t_s, m_.rods[rod_].name, "field_A_per_m [A/m] of the record", target,
+          fmt::format("no coil current within +-{:g} A produces it", kMaxCurrent_A));
     auto tol = [&](double lo, double hi) {
       return std::fabs(hi - lo) <= 1e-13 * std::max(1.0, std::fabs(lo));
     };
     std::uintmax_t iters = 60;
     const auto [lo, hi] = boost::math::tools::toms748_solve(
-        [&](double v) { return field_error(st, v, target, dt); }, std::min(a, b),
-        std::max(a, b), a < b ? fa : fb, a < b ? fb : fa, tol, iters);
+        [&](double v) { return field_error(st, v, target, dt); }, std::min(a, b), std::max(a, b),
+        a < b ? fa : fb, a < b ? fb : fa, tol, iters);
     const double root = 0.5 * (lo + hi);
     if (std::fabs(b - a) > 0.0) dI_dH_ = (b - a) / (fb - fa);  // secant: next guess
     return root;
@@ -144,9 +144,9 @@ std::size_t record_rod(const Model& m, const Measurement& meas) {
     if (m.rods[i].name == name) return i;
     names += (i ? ", " : "") + m.rods[i].name;
   }
-  throw InputError(located(meas.path, 0,
-                           fmt::format("rod = '{}' is not a rod of the model (its rods: {})", name,
-                                       names)));
+  throw InputError(
+      located(meas.path, 0,
+              fmt::format("rod = '{}' is not a rod of the model (its rods: {})", name, names)));
 }
 
 double record_initial_current(const Measurement& meas) {
@@ -175,8 +175,8 @@ double record_step_count(const Measurement& meas, const ObjectiveSettings& s) {
 }
 
 void run_record(const Model& m, const Conditions& c, State st, const Measurement& meas,
-                const ObjectiveSettings& s, std::vector<double>& response,
-                std::vector<double>* B_T, std::vector<double>* H_A_per_m) {
+                const ObjectiveSettings& s, std::vector<double>& response, std::vector<double>* B_T,
+                std::vector<double>* H_A_per_m) {
   const auto& ts = meas.t_s;
   const std::size_t n = ts.size();
   const auto& cond = meas.condition;
@@ -187,36 +187,35 @@ void run_record(const Model& m, const Conditions& c, State st, const Measurement
   if (B_T) B_T->resize(n);
   if (H_A_per_m) H_A_per_m->resize(n);
   auto field = [&](const State& x) { return x.rods[rod].Hc_A_per_m; };
+  auto store = [&](std::size_t i, const State& x) {  // sample i from the state x
+    response[i] = probe.response(x);
+    if (B_T) (*B_T)[i] = x.B_T;
+    if (H_A_per_m) (*H_A_per_m)[i] = field(x);
+  };
   const long passes = 1 + cond.precycles;
+  // Moves quasi-statically from the drive value `from` to `to` in equal increments of at
+  // most (drive range) / quasi_static_increments.
+  const double inc = std::max(peak_to_peak(meas.drive), 1e-300) / s.quasi_static_increments;
+  auto travel = [&](double from, double to) {
+    const long k_n = std::max(1L, checked_ceil_count(std::fabs(to - from) / inc - 1e-9, kMaxSteps,
+                                                     meas.path + ": quasi-static increments"));
+    for (long k = 1; k <= k_n; ++k)
+      driver.move(st, from + (to - from) * static_cast<double>(k) / static_cast<double>(k_n), 0.0);
+  };
+  // A field record starts at rest at zero current and ramps quasi-statically to its first
+  // field, as a current record starts at rest at its first current (make_state).
+  if (meas.drive_kind == DriveInput::Field && field(st) != meas.drive.front())
+    travel(field(st), meas.drive.front());
 
   if (cond.quasi_static) {
-    const double inc = peak_to_peak(meas.drive) / s.quasi_static_increments;
-    // Moves from the drive value `from` to `to` in equal increments of at most inc.
-    auto travel = [&](double from, double to) {
-      const long k_n =
-          std::max(1L, checked_ceil_count(std::fabs(to - from) / inc - 1e-9, kMaxSteps,
-                                           meas.path + ": quasi-static increments"));
-      for (long k = 1; k <= k_n; ++k)
-        driver.move(st, from + (to - from) * static_cast<double>(k) / static_cast<double>(k_n),
-                    0.0);
-    };
-    double at = 0.0;
-    if (meas.drive_kind == DriveInput::Field) {  // from rest at zero current to the first field
-      at = st.rods[rod].Hc_A_per_m;
-      if (at != meas.drive.front()) travel(at, meas.drive.front());
-    }
-    at = meas.drive.front();
+    double at = meas.drive.front();
     for (long pass = 0; pass < passes; ++pass) {
       if (pass > 0) travel(at, meas.drive.front());
       at = meas.drive.front();
       for (std::size_t i = 0; i < n; ++i) {
         if (i > 0) travel(at, meas.drive[i]);
         at = meas.drive[i];
-        if (pass + 1 == passes) {
-          response[i] = probe.response(st);
-          if (B_T) (*B_T)[i] = st.B_T;
-          if (H_A_per_m) (*H_A_per_m)[i] = field(st);
-        }
+        if (pass + 1 == passes) store(i, st);
       }
     }
     return;
@@ -232,30 +231,13 @@ void run_record(const Model& m, const Conditions& c, State st, const Measurement
   const long nsteps = std::max(1L, checked_ceil_count((t1 - t0) / dt_target, kMaxSteps,
                                                       meas.path + ": steps over the record"));
   const double dt = (t1 - t0) / static_cast<double>(nsteps);
-  if (meas.drive_kind == DriveInput::Field) {
-    // From rest at zero current to the first field, quasi-statically (the record starts
-    // there at rest, as a current record starts at rest at its first current).
-    const double from = st.rods[rod].Hc_A_per_m, to = drive(t0);
-    const double inc = std::max(peak_to_peak(meas.drive), 1e-300) / s.quasi_static_increments;
-    const long k_n = std::max(1L, checked_ceil_count(std::fabs(to - from) / inc, kMaxSteps,
-                                                     meas.path + ": ramp to the first field"));
-    for (long k = 1; k <= k_n; ++k)
-      driver.move(st, from + (to - from) * static_cast<double>(k) / static_cast<double>(k_n),
-                  0.0);
-  }
   st.t_s = t0;
   for (long pass = 0; pass < passes; ++pass) {
     const bool last = pass + 1 == passes;
     std::size_t j = 0;
     table.j = 1;
-    while (j < n && ts[j] <= t0) {
-      if (last) {
-        response[j] = probe.response(st);
-        if (B_T) (*B_T)[j] = st.B_T;
-        if (H_A_per_m) (*H_A_per_m)[j] = field(st);
-      }
-      ++j;
-    }
+    for (; j < n && ts[j] <= t0; ++j)
+      if (last) store(j, st);
     double r_prev = probe.si(st), B_prev = st.B_T, H_prev = field(st), t_prev = t0;
     st.t_s = t0;
     for (long k = 1; k <= nsteps; ++k) {
@@ -275,11 +257,7 @@ void run_record(const Model& m, const Conditions& c, State st, const Measurement
       H_prev = field(st);
       t_prev = t;
     }
-    for (; last && j < n; ++j) {
-      response[j] = probe.response(st);
-      if (B_T) (*B_T)[j] = st.B_T;
-      if (H_A_per_m) (*H_A_per_m)[j] = field(st);
-    }
+    for (; last && j < n; ++j) store(j, st);
   }
 }
 

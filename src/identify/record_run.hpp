@@ -30,8 +30,8 @@ double record_step_count(const Measurement& meas, const ObjectiveSettings& s);
 // and the record rod's applied field H_c (eq. 7) [A/m] at every sample. Offsets are not
 // applied here (apply_offset). Throws DivergenceError / InputError.
 void run_record(const Model& m, const Conditions& c, State st, const Measurement& meas,
-                const ObjectiveSettings& s, std::vector<double>& response,
-                std::vector<double>* B_T, std::vector<double>* H_A_per_m = nullptr);
+                const ObjectiveSettings& s, std::vector<double>& response, std::vector<double>* B_T,
+                std::vector<double>* H_A_per_m = nullptr);
 
 // Shifts `simulated` by the record's offset rule so that simulated - measured is the
 // residual: FirstSample aligns the first samples, Fitted removes the least-squares constant

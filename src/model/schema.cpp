@@ -371,6 +371,8 @@ std::string resolve(const ModelSpec& spec, const std::string& dotted) {
 
 }  // namespace
 
+std::string ModelSpec::key_of(const std::string& dotted) const { return resolve(*this, dotted); }
+
 double ModelSpec::get(const std::string& dotted) const {
   return params.at(resolve(*this, dotted)).value;
 }
