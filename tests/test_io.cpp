@@ -131,10 +131,10 @@ TEST(ModelFile, BuiltinParses) {
   EXPECT_EQ(spec.element_names, (std::vector<std::string>{"M1", "M2", "M3", "M4", "s", "dh"}));
   EXPECT_EQ(spec.sleeve_names, (std::vector<std::string>{"t1", "t2"}));
   EXPECT_EQ(spec.chains.at("rod3"), (std::vector<std::string>{"s", "dh"}));
-  EXPECT_EQ(spec.options.at("options.stress_sign"), "compression_negative");
-  EXPECT_EQ(spec.options.at("options.thermal_expansion_in_output"), "false");
-  EXPECT_EQ(spec.options.at("options.geometry_thermal_expansion"), "true");
-  EXPECT_EQ(spec.options.at("meta.name"), "MDMA");
+  EXPECT_EQ(spec.options.stress_sign, gmasim::StressSign::CompressionNegative);
+  EXPECT_FALSE(spec.options.thermal_expansion_in_output);
+  EXPECT_TRUE(spec.options.geometry_thermal_expansion);
+  EXPECT_EQ(spec.meta.at("meta.name"), "MDMA");
 
   const std::string text = builtin_text();
   const auto& k0 = spec.params.at("rod1.ja.k0_A_per_m");
@@ -242,7 +242,7 @@ TEST(ModelFile, ProvenanceIgnoresHashInsideStrings) {
       replace_once(builtin_text(), "name = \"MDMA\"  # the prototype of section 4.1",
                    "name = \"MD#MA\"  # the 'real' # prototype"),
       "hash.toml");
-  EXPECT_EQ(spec.options.at("meta.name"), "MD#MA");
+  EXPECT_EQ(spec.meta.at("meta.name"), "MD#MA");
 }
 
 TEST(ModelFile, LoadFromFileUsesPathAsSource) {

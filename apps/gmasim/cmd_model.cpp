@@ -1,4 +1,4 @@
-// gmasim model show / model check.
+// gmasim model show / params / save / check.
 #include <fmt/format.h>
 
 #include <memory>
@@ -6,9 +6,76 @@
 #include "commands.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
+#include "gmasim/parameters.hpp"
 #include "gmasim/simulate.hpp"
 
 namespace gmasim::cli {
+namespace {
+
+int run_show(const ModelArgs& a, bool doc) {
+  const ModelSpec spec = load_model_spec_args(a);
+  (void)compile(spec);  // show only valid models
+  fmt::print("# {}\n", model_label(a));
+  fmt::print("{:<48} {:>14}  {:<10} {}\n", "parameter", "value", "unit",
+             doc ? "meaning" : "provenance");
+  for (const auto& row : describe_model(spec))
+    fmt::print("{:<48} {:>14}  {:<10} {}\n", row.name, row.value, row.unit,
+               doc ? row.doc : row.provenance);
+  return 0;
+}
+
+// The parameter table itself (gmasim/parameters.hpp), as text or as docs/parameters.md.
+int run_params(bool markdown) {
+  if (markdown) {
+    fmt::print("{}", parameters_markdown());
+    return 0;
+  }
+  fmt::print("{:<54} {:<9} {:<16} {}\n", "key", "unit", "rule", "meaning");
+  for (const auto& g : parameter_groups())
+    for (const auto& p : parameter_table())
+      if (p.group == g.group)
+        fmt::print("{:<54} {:<9} {:<16} {}\n", fmt::format("{}.{}", g.path, p.key), p.unit,
+                   rule_text(p.rule), p.doc);
+  for (const auto& o : option_table()) {
+    std::string words;
+    for (const auto& c : o.choices) words += (words.empty() ? "" : "|") + std::string(c.word);
+    fmt::print("{:<54} {:<9} {:<16} {}\n", fmt::format("options.{}", o.key), "option", words,
+               o.doc);
+  }
+  return 0;
+}
+
+int run_check(const std::string& path) {
+  try {
+    const Model m = compile(load_model_spec(path));
+    (void)make_conditions(m, m.T_ref_C);
+    fmt::print("{}: OK ({} parameters, {} rods, {} circuit nodes, {} branches)\n", path,
+               m.spec.params.size(), m.rods.size(), m.circuit.node_count(),
+               m.circuit.branch_count());
+    const MagneticStateCheck k = check_magnetic_state(m);
+    fmt::print(
+        "magnetic state over {} runs (20/70/150 degC x 6/12 A x 10/400 Hz), "
+        "options.magnetic_state "
+        "= {}:\n"
+        "  max |B| of the induction coil          {:.4f} T\n"
+        "  max |phi/A| of a rod                   {:.4f} T   ({})\n"
+        "  max |phi/A - mu0 (H + M)| of a rod     {:.3g} T   ({:.3g} of mu0 (|H| + M_s^T); "
+        "{})\n",
+        k.runs, m.options.magnetic_state == MagneticState::Consistent ? "consistent" : "printed",
+        k.max_B_sensor_T, k.max_B_rod_T, k.where_B_rod, k.max_inconsistency_T,
+        k.max_inconsistency_rel, k.where_inconsistency);
+    if (!k.divergence.empty()) {
+      fmt::print(stderr, "diverged: {}\n", k.divergence);
+      return 3;
+    }
+    return 0;
+  } catch (const InputError& e) {
+    fmt::print(stderr, "{}: INVALID\n{}\n", path, e.what());
+    return 2;
+  }
+}
+
+}  // namespace
 
 Runner add_model(CLI::App& app) {
   auto* sub = app.add_subcommand("model", "Inspect and validate model files");
@@ -17,9 +84,18 @@ Runner add_model(CLI::App& app) {
   auto save_model_args = std::make_shared<ModelArgs>();
   auto save_out = std::make_shared<std::string>();
   auto check_path = std::make_shared<std::string>();
+  auto show_doc = std::make_shared<bool>(false);
+  auto params_markdown = std::make_shared<bool>(false);
   auto* show =
       sub->add_subcommand("show", "List every parameter with its value, unit and provenance");
   add_model_options(show, *show_model);
+  show->add_flag("--doc", *show_doc,
+                 "Show each parameter's meaning (the parameter table) instead of its provenance");
+  auto* params = sub->add_subcommand(
+      "params",
+      "The parameter table: every key a model file may hold, its unit, rule, meaning, default "
+      "and the Model field it lands in (docs/parameters.md)");
+  params->add_flag("--markdown", *params_markdown, "Print docs/parameters.md (Markdown)");
   auto* save = sub->add_subcommand(
       "save",
       "Write a model file with --set changes applied (each changed value keeps its line and "
@@ -29,15 +105,8 @@ Runner add_model(CLI::App& app) {
   auto* check = sub->add_subcommand("check", "Validate a model file and explain each problem");
   check->add_option("file", *check_path, "Model file (TOML)")->required();
   return [=]() -> int {
-    if (show->parsed()) {
-      const ModelSpec spec = load_model_spec_args(*show_model);
-      (void)compile(spec);  // show only valid models
-      fmt::print("# {}\n", model_label(*show_model));
-      fmt::print("{:<48} {:>14}  {:<10} {}\n", "parameter", "value", "unit", "provenance");
-      for (const auto& row : describe_model(spec))
-        fmt::print("{:<48} {:>14}  {:<10} {}\n", row.name, row.value, row.unit, row.provenance);
-      return 0;
-    }
+    if (show->parsed()) return run_show(*show_model, *show_doc);
+    if (params->parsed()) return run_params(*params_markdown);
     if (save->parsed()) {
       const ModelSpec spec = load_model_spec_args(*save_model_args);
       save_model(spec, *save_out, "gmasim model save --set");
@@ -45,36 +114,7 @@ Runner add_model(CLI::App& app) {
                  save_model_args->sets.size(), save_model_args->sets.size() == 1 ? "" : "s");
       return 0;
     }
-    if (check->parsed()) {
-      try {
-        const Model m = compile(load_model_spec(*check_path));
-        (void)make_conditions(m, m.T_ref_C);
-        fmt::print("{}: OK ({} parameters, {} rods, {} circuit nodes, {} branches)\n", *check_path,
-                   m.spec.params.size(), m.rods.size(), m.circuit.node_count(),
-                   m.circuit.branch_count());
-        const MagneticStateCheck k = check_magnetic_state(m);
-        fmt::print(
-            "magnetic state over {} runs (20/70/150 degC x 6/12 A x 10/400 Hz), "
-            "options.magnetic_state "
-            "= {}:\n"
-            "  max |B| of the induction coil          {:.4f} T\n"
-            "  max |phi/A| of a rod                   {:.4f} T   ({})\n"
-            "  max |phi/A - mu0 (H + M)| of a rod     {:.3g} T   ({:.3g} of mu0 (|H| + M_s^T); "
-            "{})\n",
-            k.runs,
-            m.options.magnetic_state == MagneticState::Consistent ? "consistent" : "printed",
-            k.max_B_sensor_T, k.max_B_rod_T, k.where_B_rod, k.max_inconsistency_T,
-            k.max_inconsistency_rel, k.where_inconsistency);
-        if (!k.divergence.empty()) {
-          fmt::print(stderr, "diverged: {}\n", k.divergence);
-          return 3;
-        }
-        return 0;
-      } catch (const InputError& e) {
-        fmt::print(stderr, "{}: INVALID\n{}\n", *check_path, e.what());
-        return 2;
-      }
-    }
+    if (check->parsed()) return run_check(*check_path);
     return -1;
   };
 }

@@ -31,8 +31,7 @@ Model load_model(const std::string& path);
 // Applies "name=value" assignments (the --set flag of every command; Python
 // Model.with_params): a number to a parameter by its dotted name (or a unique suffix of it,
 // under ModelSpec::set's rules), or a word to an option ("options.magnetic_state=printed",
-// whose allowed values compile() checks). `flag` names the source in messages. Throws
-// InputError.
+// under ModelSpec::set_option's). `flag` names the source in messages. Throws InputError.
 ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assignments,
                             std::string_view flag = "--set");
 
@@ -43,10 +42,12 @@ ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assi
 std::string model_toml(const ModelSpec& spec, const std::string& why);
 void save_model(const ModelSpec& spec, const std::string& path, const std::string& why);
 
-// One row per parameter: dotted name, value, unit, provenance; and the options.
+// One row per parameter, option, meta text and structure key, in file order: dotted name,
+// value, unit, provenance (the line's comment), line, and meaning (the parameter table's doc).
 struct ParamRow {
   std::string name, value, unit, provenance;
   long line;
+  std::string doc;
 };
 std::vector<ParamRow> describe_model(const ModelSpec& spec);
 

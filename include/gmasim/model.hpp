@@ -8,54 +8,11 @@
 #include <vector>
 
 #include "gmasim/circuit.hpp"
+#include "gmasim/parameters.hpp"
 #include "gmasim/physics/jiles_atherton.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 
 namespace gmasim {
-
-// ---------------------------------------------------------------------------------------
-// ModelSpec: what the TOML file says, validated field by field, with provenance.
-// ---------------------------------------------------------------------------------------
-struct ParamValue {
-  double value = 0.0;
-  std::string unit;        // from the schema, e.g. "A/m"
-  std::string provenance;  // the trailing comment of the TOML line ("Table 4", ...)
-  long line = 0;           // source line in the model file
-};
-
-struct SpecBranch {
-  std::string name, from, to;
-  std::vector<std::string> series;  // names in [circuit.reluctances], summed
-  std::string rod;                  // or the rod whose eq. (2) reluctance this is
-  long line = 0;
-};
-
-struct ModelSpec {
-  std::string source;  // file path, or "models/mdma.toml (built-in)"
-  std::string text;    // the TOML text it was parsed from (model_toml() edits it)
-  // Every numeric parameter by its dotted TOML name ("rod1.ja.k0_A_per_m").
-  std::map<std::string, ParamValue> params;
-  // Every string/boolean option by dotted name ("options.eq10_temperature_scale").
-  std::map<std::string, std::string> options;
-  std::map<std::string, long> option_lines;
-  std::vector<std::string> rods;  // stack.rods, in order
-  std::string reference_node;
-  std::vector<std::string> nodes;  // circuit.nodes: the non-reference nodes
-  long nodes_line = 0;
-  std::vector<SpecBranch> branches;
-  std::vector<std::string> flux_sensor_branches;           // sensor.flux_branches
-  std::vector<std::string> element_names;                  // mechanics.elements.*
-  std::vector<std::string> sleeve_names;                   // mechanics.sleeves.*
-  std::map<std::string, std::vector<std::string>> chains;  // rod -> load chain (eq. 18/27/28)
-
-  double get(const std::string& dotted) const;        // throws InputError if unknown
-  void set(const std::string& dotted, double value);  // throws InputError if unknown
-  long line_of(const std::string& dotted) const;
-  // The full key a dotted name resolves to: the name itself, or the unique
-  // "<name>_<unit suffix>" ("rod1.ja.k0" -> "rod1.ja.k0_A_per_m"); throws InputError if
-  // unknown or ambiguous, as get() does.
-  std::string key_of(const std::string& dotted) const;
-};
 
 // ---------------------------------------------------------------------------------------
 // Options: the readings READING-NOTES leaves open (docs/model.md).
@@ -79,14 +36,70 @@ enum class MagneticState { Printed, Consistent };
 //                of the magnetisation alone (classical magnetoelastic scaling, docs/model.md).
 enum class Eq11Saturation { Temperature, Reference };
 
+// Parsed once, by the loader or ModelSpec::set_option, from the words of the option table
+// (gmasim/parameters.hpp). The defaults are the built-in model's readings (a test holds them
+// to models/mdma.toml); a model file must state every option.
 struct Options {
   StressSign stress_sign = StressSign::CompressionNegative;
   Eq10Scale eq10_scale = Eq10Scale::RoomReferenced;
-  ShapeLaw shape_law = ShapeLaw::Printed;
-  MagneticState magnetic_state = MagneticState::Printed;
-  Eq11Saturation eq11_saturation = Eq11Saturation::Temperature;
+  ShapeLaw shape_law = ShapeLaw::MeanField;
+  MagneticState magnetic_state = MagneticState::Consistent;
+  Eq11Saturation eq11_saturation = Eq11Saturation::Reference;
   bool thermal_expansion_in_output = false;
   bool geometry_thermal_expansion = true;
+  bool operator==(const Options&) const = default;
+};
+
+// ---------------------------------------------------------------------------------------
+// ModelSpec: what the TOML file says, validated field by field, with provenance.
+// ---------------------------------------------------------------------------------------
+struct ParamValue {
+  double value = 0.0;
+  std::string unit;               // its row's unit (gmasim/parameters.hpp), e.g. "A/m"
+  std::string provenance;         // the trailing comment of the TOML line ("Table 4", ...)
+  long line = 0;                  // source line in the model file (0: a default of its row)
+  const ParamDef* def = nullptr;  // its row of the parameter table
+};
+
+struct SpecBranch {
+  std::string name, from, to;
+  std::vector<std::string> series;  // names in [circuit.reluctances], summed
+  std::string rod;                  // or the rod whose eq. (2) reluctance this is
+  long line = 0;
+};
+
+struct ModelSpec {
+  std::string source;  // file path, or "models/mdma.toml (built-in)"
+  std::string text;    // the TOML text it was parsed from (model_toml() edits it)
+  // Every numeric parameter by its dotted TOML name ("rod1.ja.k0_A_per_m").
+  std::map<std::string, ParamValue> params;
+  Options options;  // [options], parsed (gmasim/parameters.hpp, option_table())
+  std::map<std::string, std::string> meta;  // [meta] texts by dotted name ("meta.name")
+  // Source lines of the options, the meta texts, structure keys and optional tables'
+  // headers, by dotted name ("options.magnetic_state", "stack.rods", "[thermal_network]").
+  std::map<std::string, long> option_lines;
+  std::vector<std::string> rods;  // stack.rods, in order
+  std::string reference_node;
+  std::vector<std::string> nodes;  // circuit.nodes: the non-reference nodes
+  long nodes_line = 0;
+  std::vector<SpecBranch> branches;
+  std::vector<std::string> flux_sensor_branches;           // sensor.flux_branches
+  std::vector<std::string> element_names;                  // mechanics.elements.*
+  std::vector<std::string> sleeve_names;                   // mechanics.sleeves.*
+  std::map<std::string, std::vector<std::string>> chains;  // rod -> load chain (eq. 18/27/28)
+
+  double get(const std::string& dotted) const;  // throws InputError if unknown
+  // Sets a number after checking it against its row's rule and the cross-field rules that
+  // involve it; throws InputError (and leaves the spec unchanged) if unknown or refused.
+  void set(const std::string& dotted, double value);
+  // Sets an option ("options.magnetic_state" or "magnetic_state") from its word; throws
+  // InputError naming the allowed words, or the rule between options it breaks.
+  void set_option(const std::string& name, const std::string& word);
+  long line_of(const std::string& dotted) const;
+  // The full key a dotted name resolves to: the name itself, or the unique
+  // "<name>_<unit suffix>" ("rod1.ja.k0" -> "rod1.ja.k0_A_per_m"); throws InputError if
+  // unknown or ambiguous, as get() does.
+  std::string key_of(const std::string& dotted) const;
 };
 
 // One switch per temperature law: a frozen law is evaluated at the reference
@@ -137,7 +150,7 @@ struct JaReference {
 
 struct RodModel {
   std::string name;
-  double length_m, r_outer_m, r_inner_m, mass_kg;
+  double length_m, outer_diameter_m, inner_diameter_m, mass_kg;  // at T_ref
   double k_f, k_j;           // eq. (7) flux-leakage and eddy-current factors
   double damping_N_s_per_m;  // c_i of eq. (25)
   JaReference ja;
@@ -176,8 +189,18 @@ struct ThermalNetworkModel {
   double coil_resistance_ohm = 0;  // at T_ref_C
   double coil_alpha_per_K = 0;     // R(T) = R (1 + alpha (T - T_ref))
   double coil_C_J_per_K = 0, rods_C_J_per_K = 0, housing_C_J_per_K = 0;  // heat capacities
+  double rod_specific_heat_J_per_kg_K = 0;  // rods_C_J_per_K = this x the rods' mass (compile)
   double G_coil_rods_W_per_K = 0, G_coil_housing_W_per_K = 0, G_rods_housing_W_per_K = 0,
          G_housing_ambient_W_per_K = 0;  // thermal conductances
+};
+
+// The lengths and expansion coefficients of eq. (21) ([thermal_expansion]); compile() forms
+// Model::xT_*_m_per_K from them.
+struct ThermalExpansionModel {
+  double rod_length_m = 0;  // 0: the longest rod
+  double magnetizer_length_m = 0, magnetizer_alpha_per_K = 0;
+  double output_rod_length_m = 0, output_rod_alpha_per_K = 0;
+  double sleeve_length_m = 0, sleeve_alpha_per_K = 0;
 };
 
 struct ChainLink {  // one member of a rod's load chain
@@ -202,7 +225,8 @@ struct Model {
   std::vector<std::vector<ChainLink>> chains;  // per rod
   OutputStageModel output_stage;
   ThermalNetworkModel thermal_network;
-  // eq. (21) alpha*l products of the stack [m/K]
+  ThermalExpansionModel thermal_expansion;
+  // eq. (21) alpha*l products of the stack [m/K], from thermal_expansion and the rods
   double xT_rod_m_per_K = 0, xT_magnetizer_m_per_K = 0, xT_output_rod_m_per_K = 0,
          xT_sleeve_m_per_K = 0;
 

@@ -15,11 +15,11 @@ adds plotting helpers (``gmasim.plots``). Units are SI and named in every key
 """
 from ._gmasim import *  # noqa: F401,F403
 from ._gmasim import (FREEZE_LAWS, DivergenceError, InputError, Model, Stepper, ablate, claims,  # noqa: F401
-                      compensate, frf, params_vs_temperature, simulate, sweep, thermal_expansion,
-                      track)
+                      compensate, frf, parameter_table, params_vs_temperature, simulate, sweep,
+                      thermal_expansion, track)
 from ._gmasim import __git_describe__, __version__  # noqa: F401
 from . import plots  # noqa: F401
 
 __all__ = ["Model", "Stepper", "simulate", "sweep", "frf", "track", "compensate", "ablate",
-           "params_vs_temperature",
+           "params_vs_temperature", "parameter_table",
            "thermal_expansion", "claims", "plots", "InputError", "DivergenceError", "FREEZE_LAWS"]

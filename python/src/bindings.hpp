@@ -14,4 +14,5 @@ pybind11::dict series_dict(const TimeSeries& ts);
 pybind11::dict metrics_dict(const Metrics& m);
 void bind_experiments(pybind11::module_& mod);  // experiments.cpp
 void bind_stepper(pybind11::module_& mod);      // stepper.cpp: Stepper, __version__
+void bind_parameters(pybind11::module_& mod);   // parameters.cpp: parameter_table()
 }  // namespace gmasim::py_bind

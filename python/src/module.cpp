@@ -24,7 +24,8 @@ py::array_t<double> to_numpy(const std::vector<double>& v) {
 
 py::dict series_dict(const TimeSeries& ts) {
   py::dict d;
-  for (std::size_t i = 0; i < ts.names.size(); ++i) d[py::str(ts.names[i])] = to_numpy(ts.columns[i]);
+  for (std::size_t i = 0; i < ts.names.size(); ++i)
+    d[py::str(ts.names[i])] = to_numpy(ts.columns[i]);
   return d;
 }
 
@@ -48,8 +49,9 @@ using namespace gmasim::py_bind;
 py::dict simulate_py(const Model& m, double temperature_C, double current_pp_A, double frequency_Hz,
                      double periods, double current_min_A, double dt_s, int record_every,
                      const std::string& kind, py::object waveform, double duration_s,
-                     const std::vector<std::string>& freeze, const std::vector<std::string>& quantities,
-                     bool self_heating, double thermal_step_s, py::object ambient_C) {
+                     const std::vector<std::string>& freeze,
+                     const std::vector<std::string>& quantities, bool self_heating,
+                     double thermal_step_s, py::object ambient_C) {
   SimulationSettings s;
   s.self_heating.enabled = self_heating;
   s.self_heating.thermal_step_s = thermal_step_s;
@@ -68,10 +70,12 @@ py::dict simulate_py(const Model& m, double temperature_C, double current_pp_A, 
     w.table_current_A = tup.second;
     w.table_source = "<python>";
     if (w.table_t_s.size() < 2 || w.table_t_s.size() != w.table_current_A.size())
-      throw InputError("waveform: need two equally long arrays (t_s, current_A) of at least 2 samples");
+      throw InputError(
+          "waveform: need two equally long arrays (t_s, current_A) of at least 2 samples");
     for (std::size_t i = 1; i < w.table_t_s.size(); ++i)
       if (!(w.table_t_s[i] > w.table_t_s[i - 1]))
-        throw InputError("waveform: time must increase strictly (sample " + std::to_string(i) + ")");
+        throw InputError("waveform: time must increase strictly (sample " + std::to_string(i) +
+                         ")");
     s.waveform = w;
   } else if (kind == "sine") {
     s.waveform = biased_sine(current_pp_A, frequency_Hz, current_min_A);
@@ -118,55 +122,72 @@ py::dict simulate_py(const Model& m, double temperature_C, double current_pp_A, 
 }  // namespace
 
 PYBIND11_MODULE(_gmasim, mod) {
-  mod.doc() = "gmasim: temperature-dependent giant magnetostrictive actuator simulator (MCTD model)";
+  mod.doc() =
+      "gmasim: temperature-dependent giant magnetostrictive actuator simulator (MCTD model)";
   py::register_exception<InputError>(mod, "InputError", PyExc_ValueError);
   py::register_exception<DivergenceError>(mod, "DivergenceError", PyExc_ArithmeticError);
 
   py::class_<Model, std::shared_ptr<Model>>(mod, "Model", "A compiled, immutable model")
-      .def(py::init([](const std::string& path) { return std::make_shared<Model>(load_model(path)); }),
+      .def(py::init(
+               [](const std::string& path) { return std::make_shared<Model>(load_model(path)); }),
            py::arg("path") = std::string(), "Load a model file (TOML); empty path = built-in MDMA")
       .def_property_readonly("source", [](const Model& m) { return m.spec.source; })
-      .def_property_readonly("rods", [](const Model& m) {
-        std::vector<std::string> r;
-        for (const auto& rod : m.rods) r.push_back(rod.name);
-        return r;
-      })
-      .def("params", [](const Model& m) {
-        py::dict d;
-        for (const auto& [name, p] : m.spec.params) d[py::str(name)] = py::make_tuple(p.value, p.unit, p.provenance);
-        return d;
-      }, "Every numeric parameter: name -> (value, unit, provenance)")
-      .def("get", [](const Model& m, const std::string& name) { return m.spec.get(name); }, py::arg("name"))
-      .def("with_params", [](const Model& m, const py::dict& values) {
-        ModelSpec spec = m.spec;
-        for (const auto& [k, v] : values) {
-          const std::string name = py::str(k);
-          if (py::isinstance<py::str>(v)) {
-            spec = apply_assignments(std::move(spec), {name + "=" + v.cast<std::string>()},
-                                     "with_params");
-          } else {
-            spec.set(name, v.cast<double>());
-          }
-        }
-        return std::make_shared<Model>(compile(spec));
-      }, py::arg("values"),
-         "A new model with some parameters changed: {dotted name: number in the file's units} "
-         "or {'options.<name>': 'word'}; the same rules as the CLI's --set")
-      .def("toml", [](const Model& m, const std::string& why) { return model_toml(m.spec, why); },
-           py::arg("why") = "Python Model.toml",
-           "The model file text: the source file with each changed value replaced on its line "
-           "and a 'set: <why>; was <old>' comment")
-      .def("save", [](const Model& m, const std::string& path, const std::string& why) {
-        save_model(m.spec, path, why);
-      }, py::arg("path"), py::arg("why") = "Python Model.save",
-         "Write the model file (see toml()) atomically; Model(path) loads it back unchanged");
+      .def_property_readonly("rods",
+                             [](const Model& m) {
+                               std::vector<std::string> r;
+                               for (const auto& rod : m.rods) r.push_back(rod.name);
+                               return r;
+                             })
+      .def(
+          "params",
+          [](const Model& m) {
+            py::dict d;
+            for (const auto& [name, p] : m.spec.params)
+              d[py::str(name)] = py::make_tuple(p.value, p.unit, p.provenance);
+            return d;
+          },
+          "Every numeric parameter: name -> (value, unit, provenance)")
+      .def(
+          "get", [](const Model& m, const std::string& name) { return m.spec.get(name); },
+          py::arg("name"))
+      .def(
+          "with_params",
+          [](const Model& m, const py::dict& values) {
+            ModelSpec spec = m.spec;
+            for (const auto& [k, v] : values) {
+              const std::string name = py::str(k);
+              if (py::isinstance<py::str>(v)) {
+                spec = apply_assignments(std::move(spec), {name + "=" + v.cast<std::string>()},
+                                         "with_params");
+              } else {
+                spec.set(name, v.cast<double>());
+              }
+            }
+            return std::make_shared<Model>(compile(spec));
+          },
+          py::arg("values"),
+          "A new model with some parameters changed: {dotted name: number in the file's units} "
+          "or {'options.<name>': 'word'}; the same rules as the CLI's --set")
+      .def(
+          "toml", [](const Model& m, const std::string& why) { return model_toml(m.spec, why); },
+          py::arg("why") = "Python Model.toml",
+          "The model file text: the source file with each changed value replaced on its line "
+          "and a 'set: <why>; was <old>' comment")
+      .def(
+          "save",
+          [](const Model& m, const std::string& path, const std::string& why) {
+            save_model(m.spec, path, why);
+          },
+          py::arg("path"), py::arg("why") = "Python Model.save",
+          "Write the model file (see toml()) atomically; Model(path) loads it back unchanged");
 
   mod.def("simulate", &simulate_py, py::arg("model"), py::arg("temperature_C") = 20.0,
           py::arg("current_pp_A") = 8.0, py::arg("frequency_Hz") = 10.0, py::arg("periods") = 3.0,
           py::arg("current_min_A") = -3.0, py::arg("dt_s") = 0.0, py::arg("record_every") = 1,
           py::arg("kind") = "sine", py::arg("waveform") = py::none(), py::arg("duration_s") = 0.0,
-          py::arg("freeze") = std::vector<std::string>{}, py::arg("quantities") = std::vector<std::string>{},
-          py::arg("self_heating") = false, py::arg("thermal_step_s") = 0.0, py::arg("ambient_C") = py::none(),
+          py::arg("freeze") = std::vector<std::string>{},
+          py::arg("quantities") = std::vector<std::string>{}, py::arg("self_heating") = false,
+          py::arg("thermal_step_s") = 0.0, py::arg("ambient_C") = py::none(),
           "Time-domain run. Returns {'series': {column: ndarray}, 'metrics': {...}, ...}; with "
           "self_heating=True also 'heating' (one row per thermal step: node temperatures, losses, "
           "stroke) and the energy balance (energy_in_J = energy_stored_J + energy_out_J)");
@@ -176,4 +197,5 @@ PYBIND11_MODULE(_gmasim, mod) {
   mod.attr("FREEZE_LAWS") = py::tuple(laws);
   gmasim::py_bind::bind_experiments(mod);
   gmasim::py_bind::bind_stepper(mod);
+  gmasim::py_bind::bind_parameters(mod);
 }

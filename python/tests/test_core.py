@@ -41,6 +41,22 @@ def test_with_params_changes_the_model(mdma):
     assert mdma.with_params({"rod1.ja.k0": 2500.0}).get("rod1.ja.k0_A_per_m") == 2500.0
 
 
+def test_parameter_table_describes_every_parameter(mdma):
+    rows = gmasim.parameter_table()
+    by_key = {(r["table"], r["key"]): r for r in rows}
+    ms = by_key[("material", "Ms_A_per_m")]
+    assert ms["unit"] == "A/m" and ms["rule"] == "> 0" and "eq. (4)" in ms["doc"]
+    assert ms["lands_in"] == "Material::Ms_A_per_m" and ms["default"] is None
+    assert by_key[("thermal_network", "coil_alpha_per_K")]["default"] == pytest.approx(3.93e-3)
+    assert by_key[("options", "magnetic_state")]["rule"] == ["printed", "consistent"]
+    # every number of the model has a row of its key with its unit
+    for name, (value, unit, provenance) in mdma.params().items():
+        key = name.rsplit(".", 1)[1]
+        if name.startswith("circuit.reluctances_per_H."):
+            key = "*"
+        assert unit in {r["unit"] for r in rows if r["key"] == key}, name
+
+
 def test_arbitrary_waveform(mdma):
     t = np.linspace(0, 0.02, 201)
     i = 1.0 + 2.0 * np.sin(2 * np.pi * 100 * t)

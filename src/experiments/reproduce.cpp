@@ -25,8 +25,7 @@ ReproduceResult run_reproduce(const Model& m, const ReproduceOptions& o,
   ReproduceResult r;
   r.model_source = m.spec.source;
   auto opt = [&](const char* k) {
-    auto it = m.spec.options.find(std::string("options.") + k);
-    return it == m.spec.options.end() ? std::string("?") : it->second;
+    return std::string(option_word(*find_option_def(k), m.options));
   };
   r.model_readings =
       fmt::format("eq. 10: shape law {}, temperature scale {}; stress sign {}",

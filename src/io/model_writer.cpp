@@ -89,13 +89,12 @@ ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assi
     const std::string name(io_detail::trim(std::string_view(a).substr(0, eq)));
     const std::string value(io_detail::trim(std::string_view(a).substr(eq + 1)));
     if (name.starts_with("options.")) {
-      const auto it = spec.options.find(name);
-      if (it == spec.options.end())
+      if (!find_option_def(name))
         throw InputError(fmt::format("{} '{}': the model has no option '{}'", flag, shown, name));
       if (value.empty() || value.find_first_of(" \t\"'#") != std::string::npos)
         throw InputError(
             fmt::format("{} '{}': an option value is one word (no spaces or quotes)", flag, shown));
-      it->second = value;  // its allowed values are checked by compile()
+      spec.set_option(name, value);
       continue;
     }
     double v = 0;
@@ -133,15 +132,17 @@ std::string model_toml(const ModelSpec& spec, const std::string& why) {
     replace_value(lines, was.line, leaf_of(name), schema::toml_float(pv.value), comment,
                   spec.source);
   }
-  for (const auto& [name, value] : spec.options) {
-    const auto it = original.options.find(name);
-    if (it == original.options.end() || it->second == value) continue;
+  for (const auto& def : option_table()) {
+    const std::string name = "options." + std::string(def.key);
+    const std::string value(option_word(def, spec.options));
+    const std::string was(option_word(def, original.options));
+    if (value == was) continue;
     const long line_no = spec.line_of(name);
     const std::string& line = lines.at(static_cast<std::size_t>(std::max(1L, line_no) - 1));
     const auto span = schema::value_span(line, leaf_of(name));
     const bool quoted = span && span->begin < line.size() && line[span->begin] == '"';
     replace_value(lines, line_no, leaf_of(name), quoted ? "\"" + value + "\"" : value,
-                  fmt::format("set: {}; was {}", why, it->second), spec.source);
+                  fmt::format("set: {}; was {}", why, was), spec.source);
   }
   // Defaulted keys: below their table's header if the file has one, else in a new table at
   // the end (bottom-up, so earlier line numbers stay valid).

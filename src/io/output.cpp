@@ -238,7 +238,7 @@ std::string metrics_json(const Result& r, const SimulationSettings& s, const Mod
     w.string(r.error);
   }
   w.key("model").string(m.spec.source);
-  if (const auto it = m.spec.options.find("meta.name"); it != m.spec.options.end())
+  if (const auto it = m.spec.meta.find("meta.name"); it != m.spec.meta.end())
     w.key("model_name").string(it->second);
   w.key("temperature_C").number(s.temperature_C);
   w.key("waveform");

@@ -73,134 +73,164 @@ std::string freeze_name_list() {
   return list;
 }
 
-Conditions make_conditions(const Model& m, double temperature_C, const Freeze& fz) {
-  const auto& mat = m.material;
-  const std::string& src = m.spec.source;
+namespace {
+
+void check_temperature(const Model& m, double temperature_C) {
   if (!std::isfinite(temperature_C))
     throw InputError(fmt::format("temperature {} degC: must be a finite number", temperature_C));
   if (temperature_C < -kZeroCelsiusInK)
     throw InputError(
         fmt::format("temperature {} degC: below absolute zero (-273.15 degC)", temperature_C));
-  if (temperature_C >= mat.Tc_C)
+  if (temperature_C >= m.material.Tc_C)
     throw InputError(
         fmt::format("temperature {} degC: at or above the Curie temperature T_c = {} degC of {} "
                     "(material.Tc_C); the model holds only below T_c",
-                    temperature_C, mat.Tc_C, src));
+                    temperature_C, m.material.Tc_C, m.spec.source));
+}
 
+// The temperature offsets the laws see: T - T_r, or 0 for a frozen law (and for the
+// geometry when thermal expansion of the geometry is off).
+struct Offsets {
+  double dT, dT_geom;
+  double of(bool frozen) const { return frozen ? 0.0 : dT; }
+};
+
+// Eq. (19): the sleeves' stiffness at E_t^T, with expanded lengths and areas.
+void sleeve_conditions(const Model& m, const Offsets& d, Conditions& c) {
+  for (const auto& s : m.sleeves) {
+    std::array<double, 3> l{}, a{};
+    for (std::size_t i = 0; i < 3; ++i) {
+      l[i] = expanded_length(s.lengths_m[i], s.alpha_thermal_per_K, d.dT_geom);
+      const double g = 1.0 + s.alpha_thermal_per_K * d.dT_geom;
+      a[i] = s.areas_m2[i] * g * g;
+    }
+    c.sleeve_stiffness_N_per_m.push_back(sleeve_stiffness(c.Et_Pa, l, a));
+  }
+}
+
+// A rod's geometry at T (l^T, r^T, A^T) and its prestress.
+void rod_geometry(const Model& m, const RodModel& rod, const Offsets& d, RodConditions& rc) {
+  const double g = 1.0 + m.material.alpha_thermal_per_K * d.dT_geom;
+  rc.length_m = rod.length_m * g;
+  rc.r_outer_m = 0.5 * rod.outer_diameter_m * g;
+  rc.r_inner_m = 0.5 * rod.inner_diameter_m * g;
+  rc.area_m2 = kPi * (rc.r_outer_m * rc.r_outer_m - rc.r_inner_m * rc.r_inner_m);
+  rc.k_f = rod.k_f;
+  rc.k_j = rod.k_j;
+  const double sign = m.options.stress_sign == StressSign::CompressionNegative ? -1.0 : 1.0;
+  rc.sigma_p_Pa = m.preload_N / rc.area_m2;
+  rc.sigma_Pa = sign * rc.sigma_p_Pa;
+}
+
+// Eq. (3)-(6), (8), (10), (13) of one rod at T: saturation, stress terms, the Delta-E
+// constants, the JA coefficients, the resistivity and the eddy geometry.
+void rod_material(const Model& m, const RodModel& rod, const Conditions& c, const Offsets& d,
+                  RodConditions& rc) {
+  const auto& mat = m.material;
+  const auto& fz = c.freeze;
+  const std::string& src = m.spec.source;
+  const double T = c.temperature_C;
+  auto MsT = [&](bool frozen) {  // eq. (4)
+    return saturation_magnetisation(mat.Ms_A_per_m, d.of(frozen), mat.Tc_C - m.T_ref_C,
+                                    mat.x_exponent);
+  };
+  rc.MsT_mu = MsT(fz.permeability);
+  rc.MsT_ja = MsT(fz.magnetisation);
+  rc.MsT_E = MsT(fz.modulus);
+  rc.Ms_strain_A_per_m =
+      m.options.eq11_saturation == Eq11Saturation::Temperature ? rc.MsT_ja : mat.Ms_A_per_m;
+  const double L0 = Lambda0(rc.sigma_Pa, mat.lambda_s, mat.sigma_lambda_Pa);  // eq. (6)
+  rc.S_mu_J_per_m3 =
+      stress_energy_term(rc.sigma_Pa, mat.lambda_s, L0, mat.beta_per_K, d.of(fz.permeability));
+  const double S_E =
+      stress_energy_term(rc.sigma_Pa, mat.lambda_s, L0, mat.beta_per_K, d.of(fz.modulus));
+  rc.dE = delta_e_terms(mat.Es_Pa, mat.lambda_s, rc.sigma_Pa, mat.sigma_lambda_Pa, mat.beta_per_K,
+                        d.of(fz.modulus), rc.MsT_E, mat.chi_m, S_E);
+  // Eq. (3) must give a positive susceptibility at M = 0 (where it is smallest).
+  const double inv_chi0 = inverse_susceptibility(0.0, mat.chi_m, rc.S_mu_J_per_m3, rc.MsT_mu);
+  if (!(inv_chi0 > 0.0))
+    throw InputError(
+        fmt::format("{}: at {} degC the stress terms of eq. (3) exceed 1/chi_m in rod '{}' "
+                    "(1/chi = {:.4g} at M = 0); check preload.force_N, material.lambda_s, "
+                    "material.sigma_lambda_Pa, options.stress_sign",
+                    src, T, rod.name, inv_chi0));
+  rc.ja = ja_at(m, rod.ja, fz.magnetisation ? m.T_ref_C : T);  // eq. (10)
+  // Consistent magnetic state: eq. (3)'s stress and temperature terms act in the JA
+  // effective field (magnetic.hpp, magnetoelastic_coupling); frozen with mu_G.
+  rc.alpha_sigma = magnetoelastic_coupling(rc.S_mu_J_per_m3, rc.MsT_mu);
+  if (m.options.magnetic_state == MagneticState::Consistent) rc.ja.alpha += rc.alpha_sigma;
+  if (!(rc.ja.a_A_per_m > 0 && rc.ja.k_A_per_m > 0 && rc.ja.c >= 0 && rc.ja.c < 1 &&
+        std::isfinite(rc.ja.alpha)))
+    throw InputError(fmt::format(
+        "{}: eq. (10) at {} degC gives unphysical JA coefficients in rod '{}' (a = {:.4g} A/m, k "
+        "= {:.4g} A/m, c = {:.4g}, alpha = {:.4g})",
+        src, T, rod.name, rc.ja.a_A_per_m, rc.ja.k_A_per_m, rc.ja.c, rc.ja.alpha));
+  rc.rho_ohm_m =
+      resistivity(mat.rho0_ohm_m, mat.drho_dT_ohm_m_per_K, d.of(fz.resistivity));  // eq. (8)
+  if (!(rc.rho_ohm_m > 0))
+    throw InputError(fmt::format("{}: eq. (8) gives a non-positive resistivity {} ohm m at {} degC",
+                                 src, rc.rho_ohm_m, T));
+  rc.eddy_geometry_s_m_per_H =
+      eddy_time_constant(1.0, rc.r_outer_m, rc.r_inner_m, rod.k_j, rc.rho_ohm_m);
+}
+
+// Eq. (24)-(28): rod i's oscillator mass, damping and the fixed part of its load compliance,
+// summed over its load chain.
+void rod_chain(const Model& m, std::size_t i, const Conditions& c, RodConditions& rc) {
+  double m_load = 0.0, inv_c = 0.0, inv_k_fixed = 0.0;
+  rc.chain_rod_count = 0;
+  rc.chain_rods.fill(-1);
+  for (const auto& link : m.chains[i]) {
+    const auto idx = static_cast<std::size_t>(link.index);
+    switch (link.kind) {
+      case ChainLink::Element:
+        m_load += m.elements[idx].mass_kg;
+        inv_c += 1.0 / m.elements[idx].damping_N_s_per_m;
+        inv_k_fixed += 1.0 / m.elements[idx].stiffness_N_per_m;
+        break;
+      case ChainLink::Sleeve:
+        m_load += m.sleeves[idx].mass_kg;
+        inv_c += 1.0 / m.sleeves[idx].damping_N_s_per_m;
+        inv_k_fixed += 1.0 / c.sleeve_stiffness_N_per_m[idx];
+        break;
+      case ChainLink::Rod:
+        m_load += m.rods[idx].mass_kg;
+        inv_c += 1.0 / m.rods[idx].damping_N_s_per_m;
+        rc.chain_rods[static_cast<std::size_t>(rc.chain_rod_count++)] = link.index;
+        break;
+    }
+  }
+  rc.mass_osc_kg = oscillator_mass(m.rods[i].mass_kg, m_load);
+  rc.damping_osc_N_s_per_m = m.rods[i].damping_N_s_per_m + 1.0 / inv_c;
+  rc.fixed_compliance_m_per_N = inv_k_fixed;
+}
+
+}  // namespace
+
+Conditions make_conditions(const Model& m, double temperature_C, const Freeze& fz) {
+  check_temperature(m, temperature_C);
   Conditions c;
   c.temperature_C = temperature_C;
   c.freeze = fz;
   const double Tr = m.T_ref_C;
   const double dT = temperature_C - Tr;
-  auto dT_if = [&](bool frozen) { return frozen ? 0.0 : dT; };
-  const double dT_geom = (m.options.geometry_thermal_expansion && !fz.geometry) ? dT : 0.0;
+  const Offsets d{dT, (m.options.geometry_thermal_expansion && !fz.geometry) ? dT : 0.0};
 
-  c.pm_scale = pm_mmf(1.0, m.alpha_pm1_per_K, m.alpha_pm2_per_K2, dT_if(fz.pm_mmf));  // eq. (1)
+  c.pm_scale = pm_mmf(1.0, m.alpha_pm1_per_K, m.alpha_pm2_per_K2, d.of(fz.pm_mmf));  // eq. (1)
   c.Et_Pa = sleeve_modulus(m.Et_Pa, m.dEt_dT_Pa_per_C, fz.sleeve_modulus ? Tr : temperature_C);
   if (!(c.Et_Pa > 0.0))
     throw InputError(fmt::format(
         "temperature {} degC: eq. (19) gives a non-positive sleeve modulus E_t^T = {} Pa",
         temperature_C, c.Et_Pa));
-  for (const auto& s : m.sleeves) {  // eq. (19)
-    std::array<double, 3> l{}, a{};
-    for (int i = 0; i < 3; ++i) {
-      l[static_cast<std::size_t>(i)] =
-          expanded_length(s.lengths_m[static_cast<std::size_t>(i)], s.alpha_thermal_per_K, dT_geom);
-      const double g = 1.0 + s.alpha_thermal_per_K * dT_geom;
-      a[static_cast<std::size_t>(i)] = s.areas_m2[static_cast<std::size_t>(i)] * g * g;
-    }
-    c.sleeve_stiffness_N_per_m.push_back(sleeve_stiffness(c.Et_Pa, l, a));
-  }
+  sleeve_conditions(m, d, c);
   c.thermal_expansion_m = thermal_expansion(m.xT_rod_m_per_K, m.xT_magnetizer_m_per_K,
                                             m.xT_output_rod_m_per_K, m.xT_sleeve_m_per_K,
                                             fz.geometry ? 0.0 : dT);  // eq. (21)
-
-  const double Tc_minus_Tr = mat.Tc_C - Tr;
-  auto MsT = [&](bool frozen) {  // eq. (4)
-    return saturation_magnetisation(mat.Ms_A_per_m, dT_if(frozen), Tc_minus_Tr, mat.x_exponent);
-  };
-  const double sign = m.options.stress_sign == StressSign::CompressionNegative ? -1.0 : 1.0;
-
   for (std::size_t i = 0; i < m.rods.size(); ++i) {
-    const auto& rod = m.rods[i];
     RodConditions rc{};
-    const double g = 1.0 + mat.alpha_thermal_per_K * dT_geom;
-    rc.length_m = rod.length_m * g;
-    rc.r_outer_m = rod.r_outer_m * g;
-    rc.r_inner_m = rod.r_inner_m * g;
-    rc.area_m2 = kPi * (rc.r_outer_m * rc.r_outer_m - rc.r_inner_m * rc.r_inner_m);
-    rc.k_f = rod.k_f;
-    rc.k_j = rod.k_j;
-    rc.sigma_p_Pa = m.preload_N / rc.area_m2;
-    rc.sigma_Pa = sign * rc.sigma_p_Pa;
-    rc.MsT_mu = MsT(fz.permeability);
-    rc.MsT_ja = MsT(fz.magnetisation);
-    rc.MsT_E = MsT(fz.modulus);
-    rc.Ms_strain_A_per_m =
-        m.options.eq11_saturation == Eq11Saturation::Temperature ? rc.MsT_ja : mat.Ms_A_per_m;
-    const double L0 = Lambda0(rc.sigma_Pa, mat.lambda_s, mat.sigma_lambda_Pa);  // eq. (6)
-    rc.S_mu_J_per_m3 =
-        stress_energy_term(rc.sigma_Pa, mat.lambda_s, L0, mat.beta_per_K, dT_if(fz.permeability));
-    const double S_E =
-        stress_energy_term(rc.sigma_Pa, mat.lambda_s, L0, mat.beta_per_K, dT_if(fz.modulus));
-    rc.dE = delta_e_terms(mat.Es_Pa, mat.lambda_s, rc.sigma_Pa, mat.sigma_lambda_Pa, mat.beta_per_K,
-                          dT_if(fz.modulus), rc.MsT_E, mat.chi_m, S_E);
-    // Eq. (3) must give a positive susceptibility at M = 0 (where it is smallest).
-    const double inv_chi0 = inverse_susceptibility(0.0, mat.chi_m, rc.S_mu_J_per_m3, rc.MsT_mu);
-    if (!(inv_chi0 > 0.0))
-      throw InputError(
-          fmt::format("{}: at {} degC the stress terms of eq. (3) exceed 1/chi_m in rod '{}' "
-                      "(1/chi = {:.4g} at M = 0); check preload.force_N, material.lambda_s, "
-                      "material.sigma_lambda_Pa, options.stress_sign",
-                      src, temperature_C, rod.name, inv_chi0));
-    const double Tja = fz.magnetisation ? Tr : temperature_C;
-    rc.ja = ja_at(m, rod.ja, Tja);  // eq. (10)
-    // Consistent magnetic state: eq. (3)'s stress and temperature terms act in the JA
-    // effective field (magnetic.hpp, magnetoelastic_coupling); frozen with mu_G.
-    rc.alpha_sigma = magnetoelastic_coupling(rc.S_mu_J_per_m3, rc.MsT_mu);
-    if (m.options.magnetic_state == MagneticState::Consistent) rc.ja.alpha += rc.alpha_sigma;
-    if (!(rc.ja.a_A_per_m > 0 && rc.ja.k_A_per_m > 0 && rc.ja.c >= 0 && rc.ja.c < 1 &&
-          std::isfinite(rc.ja.alpha)))
-      throw InputError(fmt::format(
-          "{}: eq. (10) at {} degC gives unphysical JA coefficients in rod '{}' (a = {:.4g} A/m, k "
-          "= {:.4g} A/m, c = {:.4g}, alpha = {:.4g})",
-          src, temperature_C, rod.name, rc.ja.a_A_per_m, rc.ja.k_A_per_m, rc.ja.c, rc.ja.alpha));
-    rc.rho_ohm_m =
-        resistivity(mat.rho0_ohm_m, mat.drho_dT_ohm_m_per_K, dT_if(fz.resistivity));  // eq. (8)
-    if (!(rc.rho_ohm_m > 0))
-      throw InputError(
-          fmt::format("{}: eq. (8) gives a non-positive resistivity {} ohm m at {} degC", src,
-                      rc.rho_ohm_m, temperature_C));
-    rc.eddy_geometry_s_m_per_H =
-        eddy_time_constant(1.0, rc.r_outer_m, rc.r_inner_m, rod.k_j, rc.rho_ohm_m);
-
-    // Eq. (24)-(28): oscillator mass, damping and the fixed part of the load compliance.
-    double m_load = 0.0, inv_c = 0.0, inv_k_fixed = 0.0;
-    rc.chain_rod_count = 0;
-    rc.chain_rods.fill(-1);
-    for (const auto& link : m.chains[i]) {
-      const auto idx = static_cast<std::size_t>(link.index);
-      switch (link.kind) {
-        case ChainLink::Element:
-          m_load += m.elements[idx].mass_kg;
-          inv_c += 1.0 / m.elements[idx].damping_N_s_per_m;
-          inv_k_fixed += 1.0 / m.elements[idx].stiffness_N_per_m;
-          break;
-        case ChainLink::Sleeve:
-          m_load += m.sleeves[idx].mass_kg;
-          inv_c += 1.0 / m.sleeves[idx].damping_N_s_per_m;
-          inv_k_fixed += 1.0 / c.sleeve_stiffness_N_per_m[idx];
-          break;
-        case ChainLink::Rod:
-          m_load += m.rods[idx].mass_kg;
-          inv_c += 1.0 / m.rods[idx].damping_N_s_per_m;
-          rc.chain_rods[static_cast<std::size_t>(rc.chain_rod_count++)] = link.index;
-          break;
-      }
-    }
-    rc.mass_osc_kg = oscillator_mass(rod.mass_kg, m_load);
-    rc.damping_osc_N_s_per_m = rod.damping_N_s_per_m + 1.0 / inv_c;
-    rc.fixed_compliance_m_per_N = inv_k_fixed;
+    rod_geometry(m, m.rods[i], d, rc);
+    rod_material(m, m.rods[i], c, d, rc);
+    rod_chain(m, i, c, rc);
     c.rods.push_back(rc);
   }
   return c;

@@ -44,7 +44,7 @@ grep -q '| first resonant frequency |' "$T/r/report.md" && pass=$((pass + 1)) ||
 check "set on simulate" 0 "with --set material.Ms_A_per_m=7e5" "$B" simulate --set material.Ms_A_per_m=7e5 --periods 1 --out "$T/set"
 check "set unknown" 2 "unknown parameter 'nope'" "$B" sweep --set nope=1 --out "$T/set2"
 check "set nan" 2 "'nan' is not a finite number" "$B" frf --set material.Ms_A_per_m=nan --out "$T/set2"
-check "set bad option" 2 "options.magnetic_state = 'weird': must be printed or consistent" "$B" track --set options.magnetic_state=weird --out "$T/set2"
+check "set bad option" 2 "options.magnetic_state = .weird.: must be one of: printed, consistent" "$B" track --set options.magnetic_state=weird --out "$T/set2"
 check "set rule" 2 "rod1.length_m = -1 m: must be > 0" "$B" ablate --set rod1.length_m=-1 --out "$T/set2"
 check "model save" 0 "with 2 changes" "$B" model save --set material.Ms_A_per_m=7e5 --set options.magnetic_state=printed --out "$T/saved.toml"
 check "saved model loads" 0 "Ms_A_per_m +700000 .*set: gmasim model save" "$B" model show --model "$T/saved.toml"

@@ -1,0 +1,500 @@
+// The parameter table (gmasim/parameters.hpp): the one place that says which numbers and
+// options a model file holds, their units, rules and meaning, and where each lands in
+// Model. To add a parameter: a row here, its line in the model files, and the Model field.
+#include "gmasim/parameters.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <type_traits>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/model.hpp"
+
+namespace gmasim {
+namespace {
+
+// ---- where a value lands: a reference into the Model for instance i ---------------------
+template <auto P>
+double& in_model(Model& m, std::size_t) {
+  return m.*P;
+}
+template <auto P>
+double& in_material(Model& m, std::size_t) {
+  return m.material.*P;
+}
+template <auto P>
+double& in_rod(Model& m, std::size_t i) {
+  return m.rods[i].*P;
+}
+template <auto P>
+double& in_ja(Model& m, std::size_t i) {
+  return m.rods[i].ja.*P;
+}
+template <auto P>
+double& in_element(Model& m, std::size_t i) {
+  return m.elements[i].*P;
+}
+template <auto P>
+double& in_output_stage(Model& m, std::size_t) {
+  return m.output_stage.*P;
+}
+template <auto P>
+double& in_sleeve(Model& m, std::size_t i) {
+  return m.sleeves[i].*P;
+}
+template <std::size_t K>
+double& in_sleeve_length(Model& m, std::size_t i) {
+  return m.sleeves[i].lengths_m[K];
+}
+template <std::size_t K>
+double& in_sleeve_area(Model& m, std::size_t i) {
+  return m.sleeves[i].areas_m2[K];
+}
+template <auto P>
+double& in_branch(Model& m, std::size_t i) {
+  return m.circuit.branches[i].*P;
+}
+template <auto P>
+double& in_expansion(Model& m, std::size_t) {
+  return m.thermal_expansion.*P;
+}
+template <auto P>
+double& in_network(Model& m, std::size_t) {
+  return m.thermal_network.*P;
+}
+
+// The land function and its text, from one spelling: LAND(in_rod, RodModel, length_m).
+#define LAND(fn, Struct, field) &fn<&Struct::field>, #Struct "::" #field
+
+using G = Group;
+using R = Rule;
+using Cross = CrossRule;
+
+constexpr GroupDef kGroups[] = {
+    {G::Reference, "reference", TableRule::Required, "The reference temperature of the laws"},
+    {G::Material, "material", TableRule::Required, "Terfenol-D, shared by the rods"},
+    {G::Preload, "preload", TableRule::Required, "The disk-spring preload through the rod stack"},
+    {G::Magnet, "magnet", TableRule::Defaulted,
+     "Temperature coefficients of the permanent magnet's MMF, eq. (1)"},
+    {G::Rod, "<rod>", TableRule::Required, "One Terfenol-D rod of stack.rods"},
+    {G::RodJa, "<rod>.ja", TableRule::Required,
+     "The rod's Jiles-Atherton constants at T_ref (Table 4), eq. (9)-(10)"},
+    {G::Reluctance, "circuit.reluctances_per_H", TableRule::Required,
+     "Named fixed reluctances; a branch's `series` sums them"},
+    {G::Branch, "circuit.branches.<name>", TableRule::KeysOptional,
+     "The sources of a branch of [[circuit.branches]] (absent: 0)"},
+    {G::Element, "mechanics.elements.<name>", TableRule::Required,
+     "A member of a load chain with constant mass, stiffness and damping (magnetizer, output "
+     "rod, disk spring)"},
+    {G::OutputStage, "mechanics.output_stage", TableRule::Optional,
+     "The output head and sensor on a compliant mount (absent: the sensor reads the stack)"},
+    {G::SleeveModulus, "mechanics.sleeve_modulus", TableRule::Defaulted,
+     "The sleeves' modulus law E_t^T = E_t - dE_t/dT T, eq. (19)"},
+    {G::Sleeve, "mechanics.sleeves.<name>", TableRule::Required,
+     "A three-section sleeve of eq. (19) in a load chain"},
+    {G::ThermalExpansion, "thermal_expansion", TableRule::Defaulted,
+     "The stack's thermal expansion, eq. (21)"},
+    {G::ThermalNetwork, "thermal_network", TableRule::Defaulted,
+     "The lumped thermal network of self-heating (coil, rods, housing, ambient)"},
+};
+
+constexpr std::string_view kNoMagnet =
+    "default: no permanent-magnet temperature coefficient (or no magnet)";
+constexpr std::string_view kNoMagnetizer = "default: no magnetizer in the stack";
+constexpr std::string_view kNoOutputRod = "default: no output rod in the stack";
+constexpr std::string_view kNoSleeve = "default: no sleeve in the stack";
+
+// The rows, by group in file order. A row's default makes the key optional (Defaulted
+// tables only).
+const ParamDef kParams[] = {
+    // [reference]
+    {G::Reference, "T_ref_C", "degC", R::AboveAbsoluteZero,
+     "reference temperature: T_0 of eq. (1), (8), T_r of eq. (4), (10); Table 4 holds here",
+     LAND(in_model, Model, T_ref_C)},
+    // [material]
+    {G::Material, "Ms_A_per_m", "A/m", R::Positive,
+     "saturation magnetisation M_s at T_ref, eq. (4)", LAND(in_material, Material, Ms_A_per_m)},
+    {G::Material, "lambda_s", "-", R::Positive, "saturation magnetostriction, eq. (6), (11), (13)",
+     LAND(in_material, Material, lambda_s)},
+    {G::Material, "sigma_lambda_Pa", "Pa", R::Positive,
+     "stress scale sigma_lambda of eq. (6), (13)", LAND(in_material, Material, sigma_lambda_Pa)},
+    {G::Material, "Es_Pa", "Pa", R::Positive, "Young's modulus at saturation E_s, eq. (13)",
+     LAND(in_material, Material, Es_Pa)},
+    {G::Material,
+     "Tc_C",
+     "degC",
+     R::Any,
+     "Curie temperature T_c, eq. (4), (10)",
+     LAND(in_material, Material, Tc_C),
+     std::nullopt,
+     {},
+     Cross{Cross::Above, "reference.T_ref_C"}},
+    {G::Material, "rho0_ohm_m", "ohm m", R::Positive, "resistivity at T_0, eq. (8)",
+     LAND(in_material, Material, rho0_ohm_m)},
+    {G::Material, "drho_dT_ohm_m_per_K", "ohm m/K", R::Any, "resistivity slope, eq. (8)",
+     LAND(in_material, Material, drho_dT_ohm_m_per_K)},
+    {G::Material, "beta_per_K", "1/K", R::Any, "temperature coefficient beta of eq. (3), (13)",
+     LAND(in_material, Material, beta_per_K)},
+    {G::Material, "chi_m", "-", R::Positive, "initial susceptibility chi_m of eq. (3), (5), (13)",
+     LAND(in_material, Material, chi_m)},
+    {G::Material, "x", "-", R::Positive, "critical exponent x of M_s^T, eq. (4)",
+     LAND(in_material, Material, x_exponent)},
+    {G::Material, "alpha_thermal_per_K", "1/K", R::NonNegative,
+     "thermal expansion coefficient of the rods, eq. (21) and l^T, A^T",
+     LAND(in_material, Material, alpha_thermal_per_K)},
+    // [preload]
+    {G::Preload, "force_N", "N", R::NonNegative,
+     "preload F_pre; each rod's prestress is F_pre / A_i, eq. (3), (6), (11), (13)",
+     LAND(in_model, Model, preload_N)},
+    // [magnet]
+    {G::Magnet, "alpha_pm1_per_K", "1/K", R::Any, "first-order coefficient of F_pm^T, eq. (1)",
+     LAND(in_model, Model, alpha_pm1_per_K), 0.0, kNoMagnet},
+    {G::Magnet, "alpha_pm2_per_K2", "1/K^2", R::Any, "second-order coefficient of F_pm^T, eq. (1)",
+     LAND(in_model, Model, alpha_pm2_per_K2), 0.0, kNoMagnet},
+    // [<rod>]
+    {G::Rod, "outer_diameter_m", "m", R::Positive, "outer diameter 2 r_1, eq. (2), (7), (14)",
+     LAND(in_rod, RodModel, outer_diameter_m)},
+    {G::Rod,
+     "inner_diameter_m",
+     "m",
+     R::NonNegative,
+     "inner diameter 2 r_2 (0: a cylinder)",
+     LAND(in_rod, RodModel, inner_diameter_m),
+     std::nullopt,
+     {},
+     Cross{Cross::Below, "outer_diameter_m"}},
+    {G::Rod, "length_m", "m", R::Positive, "length l_i, eq. (2), (17)",
+     LAND(in_rod, RodModel, length_m)},
+    {G::Rod, "mass_kg", "kg", R::Positive, "mass m_i, eq. (24)", LAND(in_rod, RodModel, mass_kg)},
+    {G::Rod, "k_f", "-", R::Positive, "flux-leakage factor k_f of eq. (7)",
+     LAND(in_rod, RodModel, k_f)},
+    {G::Rod, "k_j", "-", R::Positive, "eddy-current factor k_j of eq. (7)",
+     LAND(in_rod, RodModel, k_j)},
+    {G::Rod, "damping_N_s_per_m", "N s/m", R::Positive, "damping c_i, eq. (25)",
+     LAND(in_rod, RodModel, damping_N_s_per_m)},
+    // [<rod>.ja]
+    {G::RodJa, "a0_A_per_m", "A/m", R::Positive, "anhysteretic shape a at T_ref, eq. (9)-(10)",
+     LAND(in_ja, JaReference, a0_A_per_m)},
+    {G::RodJa, "alpha0", "-", R::Any, "inter-domain coupling alpha at T_ref, eq. (9)-(10)",
+     LAND(in_ja, JaReference, alpha0)},
+    {G::RodJa, "c0", "-", R::UnitInterval, "reversibility c at T_ref, eq. (9)-(10)",
+     LAND(in_ja, JaReference, c0)},
+    {G::RodJa, "k0_A_per_m", "A/m", R::Positive, "pinning k at T_ref, eq. (9)-(10)",
+     LAND(in_ja, JaReference, k0_A_per_m)},
+    {G::RodJa, "beta1", "-", R::Positive, "exponent beta_1 of alpha^T and c^T, eq. (10)",
+     LAND(in_ja, JaReference, beta1)},
+    {G::RodJa, "beta2", "-", R::Positive, "exponent beta_2 of k^T, eq. (10)",
+     LAND(in_ja, JaReference, beta2)},
+    {G::RodJa, "beta3", "-", R::Positive, "exponent beta_3 of the printed a^T, eq. (10)",
+     LAND(in_ja, JaReference, beta3)},
+    // [circuit.reluctances_per_H]
+    {G::Reluctance, "*", "1/H", R::Positive,
+     "a fixed reluctance of Table 1 (any name); summed over a branch's series, eq. (23)", nullptr,
+     "CircuitBranch::fixed_reluctance_per_H (the sum over `series`)"},
+    // [[circuit.branches]]
+    {G::Branch, "coil_turns", "turns", R::NonNegative,
+     "turns N of the coil in the branch: MMF N I, eq. (22)-(23)",
+     LAND(in_branch, CircuitBranch, coil_turns)},
+    {G::Branch, "pm_mmf_At", "A-turns", R::Any,
+     "permanent-magnet MMF F_pm at T_0 in the branch, eq. (1), (22)",
+     LAND(in_branch, CircuitBranch, pm_mmf_At)},
+    // [mechanics.elements.<name>]
+    {G::Element, "mass_kg", "kg", R::NonNegative, "mass, summed into m_lr of eq. (27)",
+     LAND(in_element, ChainElementModel, mass_kg)},
+    {G::Element, "stiffness_N_per_m", "N/m", R::Positive, "stiffness, in series in eq. (18)",
+     LAND(in_element, ChainElementModel, stiffness_N_per_m)},
+    {G::Element, "damping_N_s_per_m", "N s/m", R::Positive, "damping, in series in eq. (28)",
+     LAND(in_element, ChainElementModel, damping_N_s_per_m)},
+    // [mechanics.output_stage]
+    {G::OutputStage, "mass_kg", "kg", R::Positive, "mass of the output head",
+     LAND(in_output_stage, OutputStageModel, mass_kg)},
+    {G::OutputStage, "stiffness_N_per_m", "N/m", R::Positive, "stiffness of its mount",
+     LAND(in_output_stage, OutputStageModel, stiffness_N_per_m)},
+    {G::OutputStage, "damping_N_s_per_m", "N s/m", R::NonNegative, "damping of its mount",
+     LAND(in_output_stage, OutputStageModel, damping_N_s_per_m)},
+    // [mechanics.sleeve_modulus]
+    {G::SleeveModulus, "Et_Pa", "Pa", R::Positive, "E_t, the modulus law's 0 degC value, eq. (19)",
+     LAND(in_model, Model, Et_Pa), 200e9, "default: steel; used only by [mechanics.sleeves]"},
+    {G::SleeveModulus, "dEt_dT_Pa_per_C", "Pa/degC", R::Any, "its slope dE_t/dT, eq. (19)",
+     LAND(in_model, Model, dEt_dT_Pa_per_C), 0.0, "default: temperature-independent"},
+    // [mechanics.sleeves.<name>]
+    {G::Sleeve, "mass_kg", "kg", R::Positive, "mass m_t, eq. (27)",
+     LAND(in_sleeve, SleeveModel, mass_kg)},
+    {G::Sleeve, "damping_N_s_per_m", "N s/m", R::Positive, "damping c_t, eq. (28)",
+     LAND(in_sleeve, SleeveModel, damping_N_s_per_m)},
+    {G::Sleeve, "alpha_thermal_per_K", "1/K", R::NonNegative,
+     "thermal expansion coefficient of its l^T, A^T",
+     LAND(in_sleeve, SleeveModel, alpha_thermal_per_K)},
+    {G::Sleeve, "l1_m", "m", R::Positive, "length of section 1, eq. (19)", &in_sleeve_length<0>,
+     "SleeveModel::lengths_m[0]"},
+    {G::Sleeve, "l2_m", "m", R::Positive, "length of section 2, eq. (19)", &in_sleeve_length<1>,
+     "SleeveModel::lengths_m[1]"},
+    {G::Sleeve, "l3_m", "m", R::Positive, "length of section 3, eq. (19)", &in_sleeve_length<2>,
+     "SleeveModel::lengths_m[2]"},
+    {G::Sleeve, "A1_m2", "m^2", R::Positive, "area of section 1, eq. (19)", &in_sleeve_area<0>,
+     "SleeveModel::areas_m2[0]"},
+    {G::Sleeve, "A2_m2", "m^2", R::Positive, "area of section 2, eq. (19)", &in_sleeve_area<1>,
+     "SleeveModel::areas_m2[1]"},
+    {G::Sleeve, "A3_m2", "m^2", R::Positive, "area of section 3, eq. (19)", &in_sleeve_area<2>,
+     "SleeveModel::areas_m2[2]"},
+    // [thermal_expansion]
+    {G::ThermalExpansion, "rod_length_m", "m", R::NonNegative,
+     "expanding length of the rods, eq. (21) (0: the longest rod)",
+     LAND(in_expansion, ThermalExpansionModel, rod_length_m), 0.0,
+     "default: 0 = the longest rod of stack.rods"},
+    {G::ThermalExpansion, "magnetizer_length_m", "m", R::NonNegative,
+     "length of the magnetizers, eq. (21)",
+     LAND(in_expansion, ThermalExpansionModel, magnetizer_length_m), 0.0, kNoMagnetizer},
+    {G::ThermalExpansion, "magnetizer_alpha_per_K", "1/K", R::NonNegative,
+     "their expansion coefficient, eq. (21)",
+     LAND(in_expansion, ThermalExpansionModel, magnetizer_alpha_per_K), 0.0, kNoMagnetizer},
+    {G::ThermalExpansion, "output_rod_length_m", "m", R::NonNegative,
+     "length of the output rod, eq. (21)",
+     LAND(in_expansion, ThermalExpansionModel, output_rod_length_m), 0.0, kNoOutputRod},
+    {G::ThermalExpansion, "output_rod_alpha_per_K", "1/K", R::NonNegative,
+     "its expansion coefficient, eq. (21)",
+     LAND(in_expansion, ThermalExpansionModel, output_rod_alpha_per_K), 0.0, kNoOutputRod},
+    {G::ThermalExpansion, "sleeve_length_m", "m", R::NonNegative,
+     "length of the sleeve, eq. (21) (subtracted)",
+     LAND(in_expansion, ThermalExpansionModel, sleeve_length_m), 0.0, kNoSleeve},
+    {G::ThermalExpansion, "sleeve_alpha_per_K", "1/K", R::NonNegative,
+     "its expansion coefficient, eq. (21)",
+     LAND(in_expansion, ThermalExpansionModel, sleeve_alpha_per_K), 0.0, kNoSleeve},
+    // [thermal_network]
+    {G::ThermalNetwork, "coil_resistance_ohm", "ohm", R::Positive,
+     "coil resistance at T_ref: copper loss I^2 R(T)",
+     LAND(in_network, ThermalNetworkModel, coil_resistance_ohm), 1.5,
+     "default: estimate for the MDMA coil (720 turns of ~0.8 mm copper), at reference.T_ref_C"},
+    {G::ThermalNetwork, "coil_alpha_per_K", "1/K", R::NonNegative,
+     "temperature coefficient of the coil resistance, R(T) = R (1 + alpha (T - T_ref))",
+     LAND(in_network, ThermalNetworkModel, coil_alpha_per_K), 3.93e-3,
+     "default: copper, handbook value"},
+    {G::ThermalNetwork, "coil_heat_capacity_J_per_K", "J/K", R::Positive,
+     "heat capacity of the coil node", LAND(in_network, ThermalNetworkModel, coil_C_J_per_K), 80.0,
+     "default: estimate, ~0.2 kg of copper x 385 J/(kg K)"},
+    {G::ThermalNetwork, "rod_specific_heat_J_per_kg_K", "J/(kg K)", R::Positive,
+     "specific heat of Terfenol-D; times the rods' mass, the rods node's heat capacity",
+     LAND(in_network, ThermalNetworkModel, rod_specific_heat_J_per_kg_K), 350.0,
+     "default: Terfenol-D, ~0.35 kJ/(kg K) (manufacturer data)"},
+    {G::ThermalNetwork, "housing_heat_capacity_J_per_K", "J/K", R::Positive,
+     "heat capacity of the housing node", LAND(in_network, ThermalNetworkModel, housing_C_J_per_K),
+     450.0, "default: estimate, ~1 kg of steel x 460 J/(kg K)"},
+    {G::ThermalNetwork, "coil_to_rods_W_per_K", "W/K", R::Positive,
+     "thermal conductance coil - rods", LAND(in_network, ThermalNetworkModel, G_coil_rods_W_per_K),
+     0.5, "default: estimate, conduction across the coil former and air gap"},
+    {G::ThermalNetwork, "coil_to_housing_W_per_K", "W/K", R::Positive,
+     "thermal conductance coil - housing",
+     LAND(in_network, ThermalNetworkModel, G_coil_housing_W_per_K), 1.0,
+     "default: estimate, coil potted to the housing"},
+    {G::ThermalNetwork, "rods_to_housing_W_per_K", "W/K", R::Positive,
+     "thermal conductance rods - housing",
+     LAND(in_network, ThermalNetworkModel, G_rods_housing_W_per_K), 0.5,
+     "default: estimate, conduction through the magnetizers and end caps"},
+    {G::ThermalNetwork, "housing_to_ambient_W_per_K", "W/K", R::Positive,
+     "thermal conductance housing - ambient",
+     LAND(in_network, ThermalNetworkModel, G_housing_ambient_W_per_K), 0.4,
+     "default: estimate, natural convection ~10 W/(m^2 K) over ~0.04 m^2"},
+};
+
+#undef LAND
+
+// ---- options ----------------------------------------------------------------------------
+template <auto P>
+void set_option(Options& o, int v) {
+  using T = std::remove_reference_t<decltype(o.*P)>;
+  o.*P = static_cast<T>(v);
+}
+template <auto P>
+int get_option(const Options& o) {
+  return static_cast<int>(o.*P);
+}
+#define OPTION(field) &set_option<&Options::field>, &get_option<&Options::field>, "Options::" #field
+
+constexpr OptionChoice kBoolean[] = {{"false", 0, "off"}, {"true", 1, "on"}};
+constexpr OptionChoice kStressSign[] = {
+    {"compression_negative", static_cast<int>(StressSign::CompressionNegative),
+     "the Zheng/Zhou form of eq. (6): compression is negative"},
+    {"compression_positive", static_cast<int>(StressSign::CompressionPositive),
+     "sigma in eq. (3), (6), (13) is the compressive magnitude, as eq. (11)-(12) use sigma_p"},
+};
+constexpr OptionChoice kEq10Scale[] = {
+    {"room_referenced", static_cast<int>(Eq10Scale::RoomReferenced),
+     "p(T) = p0 f(T)/f(T_ref), T and T_c in K: Table 4 holds at T_ref for every law"},
+    {"kelvin", static_cast<int>(Eq10Scale::Kelvin), "T/T_c in K: Table 4 holds at 0 K"},
+    {"celsius", static_cast<int>(Eq10Scale::Celsius), "T/T_c in degC, the literal print"},
+};
+constexpr OptionChoice kShapeLaw[] = {
+    {"printed", static_cast<int>(ShapeLaw::Printed), "a^T = a0 exp(-T/(beta3 T_c)), as printed"},
+    {"mean_field", static_cast<int>(ShapeLaw::MeanField),
+     "a^T = a0 T/T_ref (kelvin), mean-field theory; needs room_referenced"},
+};
+constexpr OptionChoice kMagneticState[] = {
+    {"printed", static_cast<int>(MagneticState::Printed), "eq. (2), (3), (7) as printed"},
+    {"consistent", static_cast<int>(MagneticState::Consistent),
+     "each rod carries the flux of its own state, B = mu0 (H + M)"},
+};
+constexpr OptionChoice kEq11Saturation[] = {
+    {"temperature", static_cast<int>(Eq11Saturation::Temperature),
+     "M normalised by M_s^T, as printed"},
+    {"reference", static_cast<int>(Eq11Saturation::Reference),
+     "M normalised by M_s at T_ref: the strain follows the magnetisation"},
+};
+
+const OptionDef kOptions[] = {
+    {"stress_sign", false, kStressSign, OPTION(stress_sign),
+     "the sign convention of the prestress in eq. (3), (6), (13)"},
+    {"eq10_temperature_scale", false, kEq10Scale, OPTION(eq10_scale),
+     "the temperature scale of T/T_c in eq. (10) and where Table 4 holds"},
+    {"eq10_shape_law", false, kShapeLaw, OPTION(shape_law), "the law of the JA shape a^T"},
+    {"magnetic_state", false, kMagneticState, OPTION(magnetic_state),
+     "how a rod's flux, field and magnetisation relate (docs/model.md, \"Magnetic state\")"},
+    {"eq11_saturation", false, kEq11Saturation, OPTION(eq11_saturation),
+     "the M_s that normalises M in eq. (11)"},
+    {"thermal_expansion_in_output", true, kBoolean, OPTION(thermal_expansion_in_output),
+     "add the thermal expansion x_T of eq. (21) to the output (section 4.4.2 removes it)"},
+    {"geometry_thermal_expansion", true, kBoolean, OPTION(geometry_thermal_expansion),
+     "use l^T, A^T, r^T in eq. (2), (7), (17), (19)"},
+};
+
+#undef OPTION
+
+bool is_rod(const ModelSpec& spec, std::string_view name) {
+  return std::find(spec.rods.begin(), spec.rods.end(), name) != spec.rods.end();
+}
+
+// Whether table path `table` ("rod2.ja") is an instance of `path` ("<rod>.ja").
+bool path_matches(const ModelSpec& spec, std::string_view path, std::string_view table) {
+  const auto open = path.find('<');
+  if (open == std::string_view::npos) return path == table;
+  const auto close = path.find('>', open);
+  const std::string_view prefix = path.substr(0, open), suffix = path.substr(close + 1);
+  if (table.size() <= prefix.size() + suffix.size() || !table.starts_with(prefix) ||
+      !table.ends_with(suffix))
+    return false;
+  const std::string_view name =
+      table.substr(prefix.size(), table.size() - prefix.size() - suffix.size());
+  if (name.find('.') != std::string_view::npos) return false;
+  return path.substr(open, close - open + 1) != "<rod>" || is_rod(spec, name);
+}
+
+}  // namespace
+
+std::string_view rule_text(Rule r) {
+  switch (r) {
+    case Rule::Any:
+      return "any";
+    case Rule::Positive:
+      return "> 0";
+    case Rule::NonNegative:
+      return ">= 0";
+    case Rule::UnitInterval:
+      return "[0, 1)";
+    case Rule::AboveAbsoluteZero:
+      return "> -273.15 degC";
+  }
+  return "?";
+}
+
+std::span<const GroupDef> parameter_groups() { return kGroups; }
+std::span<const ParamDef> parameter_table() { return kParams; }
+std::span<const OptionDef> option_table() { return kOptions; }
+
+const GroupDef& group_def(Group g) {
+  for (const auto& d : kGroups)
+    if (d.group == g) return d;
+  throw std::logic_error("group_def: a group without a row");
+}
+
+const ParamDef* find_param_def(const ModelSpec& spec, std::string_view dotted) {
+  const auto dot = dotted.rfind('.');
+  if (dot == std::string_view::npos) return nullptr;
+  const std::string_view table = dotted.substr(0, dot), key = dotted.substr(dot + 1);
+  for (const auto& g : kGroups) {
+    if (!path_matches(spec, g.path, table)) continue;
+    for (const auto& p : kParams)
+      if (p.group == g.group && (p.key == key || (p.key == "*" && !key.empty()))) return &p;
+    return nullptr;
+  }
+  return nullptr;
+}
+
+const OptionDef* find_option_def(std::string_view key) {
+  if (key.starts_with("options.")) key.remove_prefix(8);
+  for (const auto& o : kOptions)
+    if (o.key == key) return &o;
+  return nullptr;
+}
+
+std::string_view option_word(const OptionDef& def, const Options& o) {
+  const int v = def.reads(o);
+  for (const auto& c : def.choices)
+    if (c.value == v) return c.word;
+  return "?";
+}
+
+std::optional<std::string> set_option_word(const OptionDef& def, Options& o,
+                                           std::string_view word) {
+  for (const auto& c : def.choices) {
+    if (c.word == word) {
+      def.lands(o, c.value);
+      return std::nullopt;
+    }
+  }
+  std::string words;
+  for (const auto& c : def.choices) words += (words.empty() ? "" : ", ") + std::string(c.word);
+  return fmt::format("options.{} = \"{}\": must be one of: {}", def.key, word, words);
+}
+
+std::optional<OptionProblem> check_options(const Options& o) {
+  // One reference temperature per reading (issue 7): a^T proportional to T vanishes at 0 K,
+  // so Table 4's a0 can only be the T_ref value, and then k, alpha and c must be too.
+  if (o.shape_law == ShapeLaw::MeanField && o.eq10_scale != Eq10Scale::RoomReferenced) {
+    const std::string_view sc = o.eq10_scale == Eq10Scale::Kelvin ? "kelvin" : "celsius";
+    return OptionProblem{
+        "options.eq10_shape_law",
+        fmt::format("options.eq10_shape_law = 'mean_field' with eq10_temperature_scale = "
+                    "'{}': mixes reference temperatures (a^T = a0 T/T_ref takes Table 4 at "
+                    "T_ref, '{}' takes k0, alpha0, c0 at {}); use eq10_temperature_scale = "
+                    "'room_referenced' (docs/model.md)",
+                    sc, sc, sc == "kelvin" ? "0 K" : "0 degC")};
+  }
+  return std::nullopt;
+}
+
+std::string parameters_markdown() {
+  std::string md =
+      "# Model parameters\n\n"
+      "Generated by `gmasim model params --markdown` from the parameter table "
+      "(src/model/parameters.cpp); do not edit. Every number of a model file, its unit, "
+      "rule, meaning and where `compile()` puts it in `Model`. Besides its rule, every number "
+      "must be finite and, unless 0, between 1e-30 and 1e30 in magnitude.\n";
+  for (const auto& g : kGroups) {
+    const char* presence = g.table == TableRule::Required    ? "required"
+                           : g.table == TableRule::Optional  ? "optional (all keys, or none)"
+                           : g.table == TableRule::Defaulted ? "optional, every key defaulted"
+                                                             : "optional keys (absent: 0)";
+    md += fmt::format("\n## [{}]\n\n{}; {}.\n\n", g.path, g.doc, presence);
+    md += "| key | unit | rule | meaning | default | lands in |\n|---|---|---|---|---|---|\n";
+    for (const auto& p : kParams) {
+      if (p.group != g.group) continue;
+      std::string rule(rule_text(p.rule));
+      if (p.cross.kind != CrossRule::None)
+        rule += fmt::format(", {} {}", p.cross.kind == CrossRule::Below ? "<" : ">", p.cross.other);
+      md += fmt::format("| `{}` | {} | {} | {} | {} | `{}` |\n", p.key, p.unit, rule, p.doc,
+                        p.default_value ? fmt::format("{:g}", *p.default_value) : "", p.lands_in);
+    }
+  }
+  md += "\n## [options]\n\nEvery option is required: a model file states its reading.\n\n";
+  md += "| key | values | meaning | lands in |\n|---|---|---|---|\n";
+  for (const auto& o : kOptions) {
+    std::string values;
+    for (const auto& c : o.choices)
+      values += fmt::format("{}`{}`{}", values.empty() ? "" : "; ", c.word,
+                            o.boolean ? "" : fmt::format(": {}", c.doc));
+    md += fmt::format("| `{}` | {} | {} | `{}` |\n", o.key, values, o.doc, o.lands_in);
+  }
+  return md;
+}
+
+}  // namespace gmasim
