@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <utility>
 #include <pagmo/algorithm.hpp>
 #include <pagmo/algorithms/cmaes.hpp>
 #include <pagmo/algorithms/de.hpp>
@@ -25,6 +24,7 @@
 #include <pagmo/topologies/ring.hpp>
 #include <pagmo/topology.hpp>
 #include <pagmo/types.hpp>
+#include <utility>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
@@ -358,10 +358,7 @@ class GaRun {
     const auto blocks = comm_.gather(block, 0);
     if (rank_ != 0) return;
     Checkpoint c;
-    c.fp_parameters = fp_.parameters;
-    c.fp_data = fp_.data;
-    c.fp_settings = fp_.settings;
-    c.fp_layout = fp_.layout;
+    c.fp = fp_;
     c.algorithm = o_.algorithm;
     c.ranks = ranks_;
     c.islands = o_.islands;

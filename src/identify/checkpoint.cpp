@@ -115,10 +115,10 @@ void read_header(LineReader& in, Checkpoint& c) {
   const double version = in.nums(head.substr(std::strlen(kMagic)), 1)[0];
   if (version != 1.0) in.fail(fmt::format("version {:g} is not supported (expected 1)", version));
   c.version = 1;
-  c.fp_parameters = in.expect("fp_parameters");
-  c.fp_data = in.expect("fp_data");
-  c.fp_settings = in.expect("fp_settings");
-  c.fp_layout = in.expect("fp_layout");
+  c.fp.parameters = in.expect("fp_parameters");
+  c.fp.data = in.expect("fp_data");
+  c.fp.settings = in.expect("fp_settings");
+  c.fp.layout = in.expect("fp_layout");
   c.algorithm = in.expect("algorithm");
   // Limits: far above any run (the CLI's own limits), far below a forged count.
   c.ranks = static_cast<int>(in.integer("ranks", 1, 4096));
@@ -245,8 +245,8 @@ std::string islands_text(const std::vector<IslandPopulation>& islands) {
 
 std::string checkpoint_text(const Checkpoint& c, const std::vector<std::string>& rank_blocks) {
   std::string s = fmt::format("{} {}\n", kMagic, c.version);
-  s += fmt::format("fp_parameters {}\nfp_data {}\nfp_settings {}\nfp_layout {}\n", c.fp_parameters,
-                   c.fp_data, c.fp_settings, c.fp_layout);
+  s += fmt::format("fp_parameters {}\nfp_data {}\nfp_settings {}\nfp_layout {}\n", c.fp.parameters,
+                   c.fp.data, c.fp.settings, c.fp.layout);
   s += fmt::format("algorithm {}\nranks {}\nislands {}\npopulation {}\ndim {}\nseed {}\n",
                    c.algorithm, c.ranks, c.islands, c.population, c.dim, c.seed);
   s += fmt::format("generation {}\nevaluations {}\nwall_s {:.17g}\n", c.generation, c.evaluations,
@@ -295,14 +295,14 @@ void check_compatible(const Checkpoint& c, const Fingerprints& fp, const std::st
                                          "with the same data, fit spec, model and flags",
                                          what)));
   };
-  if (c.fp_parameters != fp.parameters) fail("other fitted parameters or bounds");
-  if (c.fp_data != fp.data) fail("other measurement data");
-  if (c.fp_settings != fp.settings) fail("other objective settings or targets");
-  if (c.fp_layout != fp.layout) {
+  if (c.fp.parameters != fp.parameters) fail("other fitted parameters or bounds");
+  if (c.fp.data != fp.data) fail("other measurement data");
+  if (c.fp.settings != fp.settings) fail("other objective settings or targets");
+  if (c.fp.layout != fp.layout) {
     fail(
         fmt::format("another algorithm layout ({} ; now {}: algorithm, ranks, islands, "
                     "population, migration, seed)",
-                    c.fp_layout, fp.layout));
+                    c.fp.layout, fp.layout));
   }
 }
 
