@@ -3,68 +3,31 @@
 // responses (offset = first_sample | fitted) and pre-cycled starts; quasi_static_step.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <unistd.h>
 
-#include <atomic>
+#include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <functional>
 #include <string>
 #include <vector>
 
+#include "alloc_counter.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/identify.hpp"
 #include "gmasim/io.hpp"
+#include "test_util.hpp"
 
-namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using namespace gmasim;
 
-namespace gmasim_test {
-extern std::atomic<bool> g_counting;
-extern std::atomic<long> g_allocations;
-}  // namespace gmasim_test
 using gmasim_test::g_allocations;
 using gmasim_test::g_counting;
+using gmasim_test::input_error;
+using gmasim_test::TempDir;
 
 namespace {
 
 const Model& builtin() {
   static const Model m = compile(builtin_model_spec());
   return m;
-}
-
-class RecTempDir {
- public:
-  RecTempDir() {
-    static int counter = 0;
-    path_ = fs::path(::testing::TempDir()) /
-            ("gmasim_records_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~RecTempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  std::string write(const std::string& name, const std::string& text) const {
-    const auto p = path_ / name;
-    std::ofstream(p) << text;
-    return p.string();
-  }
-
- private:
-  fs::path path_;
-};
-
-std::string input_error(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no InputError thrown";
-  return "";
 }
 
 // A biased sine as a measured current table: `periods` periods of n samples at f (0: as a
@@ -305,7 +268,7 @@ TEST(Records, RelativeStrainFitsOnlyWithItsOffsetRule) {
 }
 
 TEST(Records, CsvRoundTripOfEveryNewKey) {
-  RecTempDir dir;
+  TempDir dir;
   SyntheticRequest r;
   r.temperatures_C = {45};
   r.currents_pp_A = {8};
@@ -337,7 +300,7 @@ TEST(Records, CsvRoundTripOfEveryNewKey) {
 
 // Every new key and column is checked, with the file:line of the culprit.
 TEST(Records, BadRecordsAreRefusedWithFileLineAndRule) {
-  RecTempDir dir;
+  TempDir dir;
   auto qs_rows = [](int n) {
     std::string s;
     for (int k = 0; k < n; ++k)

@@ -263,25 +263,20 @@ int run_synthesize(SynthArgs& a) {
   return 0;
 }
 
-}  // namespace
-
-Runner add_identify(CLI::App& app) {
-  auto a = std::make_shared<IdentifyArgs>();
-  auto s = std::make_shared<SynthArgs>();
-  auto* sub = app.add_subcommand(
-      "identify",
-      "Identify model parameters from measurements: multi-island GA (pagmo2; MPI ranks under "
-      "mpirun) + Levenberg-Marquardt; writes a calibrated model file and a fit report");
-  sub->require_subcommand(0, 1);
-  auto& o = a->opt;
-  sub->add_option("--data", a->data, "Measurement manifest (TOML, docs/data.md)");
-  sub->add_option("--fit", a->fit,
+// identify: its inputs and outputs.
+void add_identify_files(CLI::App* sub, IdentifyArgs& a) {
+  sub->add_option("--data", a.data, "Measurement manifest (TOML, docs/data.md)");
+  sub->add_option("--fit", a.fit,
                   "Fit spec: TOML file ([[parameter]], [[target]]) or inline "
                   "'name:lower:upper[:log],...'");
-  sub->add_option("--out", a->out, "Calibrated model file to write (TOML)");
-  add_model_options(sub, a->model, "Start model (TOML); default: the built-in MDMA model");
-  sub->add_option("--report", a->report,
+  sub->add_option("--out", a.out, "Calibrated model file to write (TOML)");
+  add_model_options(sub, a.model, "Start model (TOML); default: the built-in MDMA model");
+  sub->add_option("--report", a.report,
                   "Fit report directory; default: <out>_report next to --out");
+}
+
+// identify: the global search (pagmo2 islands, MPI ranks).
+void add_search_options(CLI::App* sub, IdentifyOptions& o) {
   sub->add_option("--algorithm", o.algorithm,
                   "Island algorithm: sga (the paper's GA), de, sade, cmaes")
       ->check(CLI::IsMember({"sga", "de", "sade", "cmaes"}))
@@ -303,41 +298,130 @@ Runner add_identify(CLI::App& app) {
   sub->add_option("--threads", o.threads,
                   "Threads for the refinement's Jacobian batches (0: cores / ranks per node)")
       ->capture_default_str();
-  sub->add_flag("--no-refine", a->no_refine, "Skip the Levenberg-Marquardt refinement");
-  sub->add_flag("--no-profile", a->no_profile,
+}
+
+// identify: the Levenberg-Marquardt refinement and the intervals.
+void add_refine_options(CLI::App* sub, IdentifyArgs& a) {
+  sub->add_flag("--no-refine", a.no_refine, "Skip the Levenberg-Marquardt refinement");
+  sub->add_flag("--no-profile", a.no_profile,
                 "Linearised intervals only (no profile likelihood for parameters on a bound)");
-  sub->add_option("--refine-iterations", o.refine_iterations,
+  sub->add_option("--refine-iterations", a.opt.refine_iterations,
                   "Levenberg-Marquardt iterations (max)")
       ->capture_default_str();
-  sub->add_option("--fd-step", o.fd_step,
+  sub->add_option("--fd-step", a.opt.fd_step,
                   "Finite-difference step of the Jacobian, fraction of each parameter's range")
       ->capture_default_str();
-  sub->add_option("--dt", o.objective.dt_s,
-                  "Simulation time step [s]; 0: period / --steps-per-period")
+}
+
+// identify: how each candidate is simulated and compared.
+void add_objective_options(CLI::App* sub, ObjectiveSettings& s) {
+  sub->add_option("--dt", s.dt_s, "Simulation time step [s]; 0: period / --steps-per-period")
       ->capture_default_str();
-  sub->add_option("--steps-per-period", o.objective.steps_per_period,
+  sub->add_option("--steps-per-period", s.steps_per_period,
                   "Time steps per period of periodic conditions and targets")
       ->capture_default_str();
-  sub->add_option("--quasi-static-increments", o.objective.quasi_static_increments,
+  sub->add_option("--quasi-static-increments", s.quasi_static_increments,
                   "Quasi-static records: increments of the drive over its whole range")
       ->capture_default_str();
-  sub->add_option("--flux-weight", o.objective.flux_weight,
+  sub->add_option("--flux-weight", s.flux_weight,
                   "Weight of the flux_T residuals of files that have them (0: ignore flux)")
       ->capture_default_str();
-  sub->add_option("--target-periods", o.objective.target_periods,
+  sub->add_option("--target-periods", s.target_periods,
                   "Periods simulated for scalar targets (the last is measured)")
       ->capture_default_str();
-  sub->add_option("--checkpoint", o.checkpoint_path, "Checkpoint file (written atomically)");
-  sub->add_option("--checkpoint-every", o.checkpoint_every, "Generations between checkpoints")
+}
+
+// identify: checkpoints, MPI, plots and progress.
+void add_run_options(CLI::App* sub, IdentifyArgs& a) {
+  sub->add_option("--checkpoint", a.opt.checkpoint_path, "Checkpoint file (written atomically)");
+  sub->add_option("--checkpoint-every", a.opt.checkpoint_every, "Generations between checkpoints")
       ->capture_default_str();
-  sub->add_option("--resume", o.resume_path, "Continue from a checkpoint (same data, spec, flags)");
-  sub->add_option("--mpi", a->mpi, "MPI: auto (when launched by mpirun/srun), on, off")
+  sub->add_option("--resume", a.opt.resume_path,
+                  "Continue from a checkpoint (same data, spec, flags)");
+  sub->add_option("--mpi", a.mpi, "MPI: auto (when launched by mpirun/srun), on, off")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
-  sub->add_flag("--no-plots", a->no_plots,
+  sub->add_flag("--no-plots", a.no_plots,
                 "Do not draw overlay_*.png and convergence.png (gmasim.command_figures); the "
                 "CSV overlays are written");
-  sub->add_flag("--quiet", a->quiet, "No progress on stderr, no summary");
+  sub->add_flag("--quiet", a.quiet, "No progress on stderr, no summary");
+}
+
+// identify synthesize: the conditions, the record length and the noise.
+void add_synthetic_conditions(CLI::App* syn, SynthArgs& s) {
+  syn->add_option("--temperatures", s.req.temperatures_C, "Temperatures [degC]")
+      ->delimiter(',')
+      ->capture_default_str();
+  syn->add_option("--currents", s.req.currents_pp_A, "Current peak-to-peak values [A]")
+      ->delimiter(',')
+      ->capture_default_str();
+  syn->add_option("--frequencies", s.req.frequencies_Hz, "Frequencies [Hz]")
+      ->delimiter(',')
+      ->capture_default_str();
+  syn->add_option("--current-min", s.req.current_min_A, "Current minimum [A] (Fig. 11)")
+      ->capture_default_str();
+  syn->add_option("--periods", s.req.periods, "Record length [periods]; the first is not compared")
+      ->capture_default_str();
+  syn->add_option("--samples-per-period", s.req.samples_per_period, "Samples per period")
+      ->capture_default_str();
+  syn->add_option("--noise", s.req.noise_pct,
+                  "Displacement noise: Gaussian sigma in % of each condition's p-p")
+      ->capture_default_str();
+  syn->add_option("--flux-noise", s.req.flux_noise_pct, "Flux noise: sigma in % of p-p")
+      ->capture_default_str();
+  syn->add_flag("--no-flux", s.no_flux, "Do not write the flux_T column");
+  syn->add_option("--seed", s.req.seed, "Noise seed")->capture_default_str();
+}
+
+// identify synthesize: the simulation and the record format (docs/data.md).
+void add_synthetic_records(CLI::App* syn, SynthArgs& s) {
+  syn->add_option("--dt", s.req.objective.dt_s, "Simulation time step [s]; 0: period / steps")
+      ->capture_default_str();
+  syn->add_option("--steps-per-period", s.req.objective.steps_per_period,
+                  "Time steps per period (use the same value for identify)")
+      ->capture_default_str();
+  syn->add_flag("--quasi-static", s.req.quasi_static,
+                "Quasi-static records: the sine's samples as equilibria, no t_s column (one "
+                "record per temperature x current; --frequencies is ignored)");
+  syn->add_option("--drive", s.drive,
+                  "Drive column: current (current_A) or field (field_A_per_m: the rod's applied "
+                  "field that the current produced)")
+      ->check(CLI::IsMember({"current", "field"}))
+      ->capture_default_str();
+  syn->add_option("--response", s.response,
+                  "Response column: displacement (displacement_um) or strain (strain_ppm of "
+                  "the rod)")
+      ->check(CLI::IsMember({"displacement", "strain"}))
+      ->capture_default_str();
+  syn->add_option("--rod", s.req.rod, "Rod of the field / strain columns (default: the first)");
+  syn->add_option("--offset", s.offset,
+                  "Response reference: absolute, first_sample (written relative to the first "
+                  "sample) or fitted (shifted by --response-offset)")
+      ->check(CLI::IsMember({"absolute", "first_sample", "fitted"}))
+      ->capture_default_str();
+  syn->add_option("--response-offset", s.req.response_offset,
+                  "Constant added to the response with --offset fitted [um or ppm]")
+      ->capture_default_str();
+  syn->add_option("--precycles", s.req.precycles,
+                  "Pre-cycles written into each record (then every period is compared)")
+      ->capture_default_str();
+}
+
+}  // namespace
+
+Runner add_identify(CLI::App& app) {
+  auto a = std::make_shared<IdentifyArgs>();
+  auto s = std::make_shared<SynthArgs>();
+  auto* sub = app.add_subcommand(
+      "identify",
+      "Identify model parameters from measurements: multi-island GA (pagmo2; MPI ranks under "
+      "mpirun) + Levenberg-Marquardt; writes a calibrated model file and a fit report");
+  sub->require_subcommand(0, 1);
+  add_identify_files(sub, *a);
+  add_search_options(sub, a->opt);
+  add_refine_options(sub, *a);
+  add_objective_options(sub, a->opt.objective);
+  add_run_options(sub, *a);
 
   auto* syn = sub->add_subcommand(
       "synthesize",
@@ -345,58 +429,8 @@ Runner add_identify(CLI::App& app) {
       "temperature x current x frequency, with Gaussian noise");
   syn->add_option("--out", s->out, "Output directory")->required();
   add_model_options(syn, s->model);
-  syn->add_option("--temperatures", s->req.temperatures_C, "Temperatures [degC]")
-      ->delimiter(',')
-      ->capture_default_str();
-  syn->add_option("--currents", s->req.currents_pp_A, "Current peak-to-peak values [A]")
-      ->delimiter(',')
-      ->capture_default_str();
-  syn->add_option("--frequencies", s->req.frequencies_Hz, "Frequencies [Hz]")
-      ->delimiter(',')
-      ->capture_default_str();
-  syn->add_option("--current-min", s->req.current_min_A, "Current minimum [A] (Fig. 11)")
-      ->capture_default_str();
-  syn->add_option("--periods", s->req.periods, "Record length [periods]; the first is not compared")
-      ->capture_default_str();
-  syn->add_option("--samples-per-period", s->req.samples_per_period, "Samples per period")
-      ->capture_default_str();
-  syn->add_option("--noise", s->req.noise_pct,
-                  "Displacement noise: Gaussian sigma in % of each condition's p-p")
-      ->capture_default_str();
-  syn->add_option("--flux-noise", s->req.flux_noise_pct, "Flux noise: sigma in % of p-p")
-      ->capture_default_str();
-  syn->add_flag("--no-flux", s->no_flux, "Do not write the flux_T column");
-  syn->add_option("--seed", s->req.seed, "Noise seed")->capture_default_str();
-  syn->add_option("--dt", s->req.objective.dt_s, "Simulation time step [s]; 0: period / steps")
-      ->capture_default_str();
-  syn->add_option("--steps-per-period", s->req.objective.steps_per_period,
-                  "Time steps per period (use the same value for identify)")
-      ->capture_default_str();
-  syn->add_flag("--quasi-static", s->req.quasi_static,
-                "Quasi-static records: the sine's samples as equilibria, no t_s column (one "
-                "record per temperature x current; --frequencies is ignored)");
-  syn->add_option("--drive", s->drive,
-                  "Drive column: current (current_A) or field (field_A_per_m: the rod's applied "
-                  "field that the current produced)")
-      ->check(CLI::IsMember({"current", "field"}))
-      ->capture_default_str();
-  syn->add_option("--response", s->response,
-                  "Response column: displacement (displacement_um) or strain (strain_ppm of "
-                  "the rod)")
-      ->check(CLI::IsMember({"displacement", "strain"}))
-      ->capture_default_str();
-  syn->add_option("--rod", s->req.rod, "Rod of the field / strain columns (default: the first)");
-  syn->add_option("--offset", s->offset,
-                  "Response reference: absolute, first_sample (written relative to the first "
-                  "sample) or fitted (shifted by --response-offset)")
-      ->check(CLI::IsMember({"absolute", "first_sample", "fitted"}))
-      ->capture_default_str();
-  syn->add_option("--response-offset", s->req.response_offset,
-                  "Constant added to the response with --offset fitted [um or ppm]")
-      ->capture_default_str();
-  syn->add_option("--precycles", s->req.precycles,
-                  "Pre-cycles written into each record (then every period is compared)")
-      ->capture_default_str();
+  add_synthetic_conditions(syn, *s);
+  add_synthetic_records(syn, *s);
 
   return [a, s, sub, syn]() -> int {
     if (syn->parsed()) return run_synthesize(*s);

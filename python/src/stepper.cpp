@@ -115,31 +115,17 @@ class PyStepper {
   bool busy_ = false;
 };
 
-}  // namespace
-
-void bind_stepper(py::module_& mod) {
-  mod.attr("__version__") = GMASIM_VERSION;
-  mod.attr("__git_describe__") = GMASIM_GIT_DESCRIBE;
-
-  py::class_<PyStepper>(mod, "Stepper", R"doc(
-The actuator stepped sample by sample (real-time loops, co-simulation, your own controller).
-
-    s = gmasim.Stepper(gmasim.Model(), temperature_C=20.0, dt_s=1e-5, current_A=0.0)
-    y_um = s.step(1.5)        # one step of dt_s; 1.5 A is the coil current at its end
-    y = s.run(currents_A)     # one step per sample, the GIL released; ndarray of y_um
-
-Stepping a sample at a time reproduces gmasim.simulate with the same dt_s and currents bit
-for bit (t = k dt_s). Errors: gmasim.InputError (a bad number, the Curie point), and
-gmasim.DivergenceError, after which step() refuses until reset().)doc")
-      .def(py::init([](std::shared_ptr<Model> model, double temperature_C, double dt_s,
-                       double current_A, const std::vector<std::string>& freeze) {
-             return std::make_unique<PyStepper>(std::move(model), temperature_C, dt_s, current_A,
-                                                freeze);
-           }),
-           py::arg("model"), py::arg("temperature_C") = 20.0, py::arg("dt_s") = 1e-5,
-           py::arg("current_A") = 0.0, py::arg("freeze") = std::vector<std::string>{},
-           "The actuator at temperature_C [degC] at rest under current_A [A], stepped by dt_s "
-           "[s] (0 < dt_s <= 1e-3). freeze: temperature laws held at 20 degC, as in simulate().")
+// Stepper's constructor and methods.
+void def_stepper_methods(py::class_<PyStepper>& cls) {
+  cls.def(py::init([](std::shared_ptr<Model> model, double temperature_C, double dt_s,
+                      double current_A, const std::vector<std::string>& freeze) {
+            return std::make_unique<PyStepper>(std::move(model), temperature_C, dt_s, current_A,
+                                               freeze);
+          }),
+          py::arg("model"), py::arg("temperature_C") = 20.0, py::arg("dt_s") = 1e-5,
+          py::arg("current_A") = 0.0, py::arg("freeze") = std::vector<std::string>{},
+          "The actuator at temperature_C [degC] at rest under current_A [A], stepped by dt_s "
+          "[s] (0 < dt_s <= 1e-3). freeze: temperature laws held at 20 degC, as in simulate().")
       .def("step", &PyStepper::step, py::arg("current_A"),
            "One step of dt_s to coil current current_A [A] (|I| <= 1000 A); returns y [um].")
       .def("run", &PyStepper::run, py::arg("currents_A"),
@@ -158,9 +144,13 @@ gmasim.DivergenceError, after which step() refuses until reset().)doc")
           "t_s and steps carry on.")
       .def("outputs", &PyStepper::outputs,
            "Every quantity simulate() records, under its column names (y_um, B_T, rod1_F_N, "
-           "...), plus temperature_C, dt_s and steps.")
-      .def_property_readonly(
-          "t_s", [](const PyStepper& s) { return s.get().t_s(); }, "Time since creation/reset [s]")
+           "...), plus temperature_C, dt_s and steps.");
+}
+
+// Stepper's read-only properties and its repr.
+void def_stepper_properties(py::class_<PyStepper>& cls) {
+  cls.def_property_readonly(
+         "t_s", [](const PyStepper& s) { return s.get().t_s(); }, "Time since creation/reset [s]")
       .def_property_readonly(
           "y_um", [](const PyStepper& s) { return s.get().y_m() * 1e6; },
           "Output displacement [um]")
@@ -203,6 +193,26 @@ gmasim.DivergenceError, after which step() refuses until reset().)doc")
                ", dt_s=" + py::repr(py::float_(st.dt_s())).cast<std::string>() +
                ", t_s=" + py::repr(py::float_(st.t_s())).cast<std::string>() + ")";
       });
+}
+
+}  // namespace
+
+void bind_stepper(py::module_& mod) {
+  mod.attr("__version__") = GMASIM_VERSION;
+  mod.attr("__git_describe__") = GMASIM_GIT_DESCRIBE;
+
+  py::class_<PyStepper> cls(mod, "Stepper", R"doc(
+The actuator stepped sample by sample (real-time loops, co-simulation, your own controller).
+
+    s = gmasim.Stepper(gmasim.Model(), temperature_C=20.0, dt_s=1e-5, current_A=0.0)
+    y_um = s.step(1.5)        # one step of dt_s; 1.5 A is the coil current at its end
+    y = s.run(currents_A)     # one step per sample, the GIL released; ndarray of y_um
+
+Stepping a sample at a time reproduces gmasim.simulate with the same dt_s and currents bit
+for bit (t = k dt_s). Errors: gmasim.InputError (a bad number, the Curie point), and
+gmasim.DivergenceError, after which step() refuses until reset().)doc");
+  def_stepper_methods(cls);
+  def_stepper_properties(cls);
 }
 
 }  // namespace gmasim::py_bind

@@ -58,24 +58,10 @@ void stamp_conductance(Eigen::MatrixXd& G, const CircuitBranch& br, double g) {
   }
 }
 
-}  // namespace
-
-void finalize_circuit(Circuit& c, int rod_count, const std::string& where) {
-  const int n = c.node_count();
-  if (n == 0) throw InputError(located(where, 0, "circuit has no nodes besides the reference"));
+// Checks every branch (two distinct nodes; a rod index in range and in one branch only; a
+// positive reluctance otherwise) and maps each rod to its branch (c.rod_branch).
+void map_rod_branches(Circuit& c, int rod_count, const std::string& where) {
   c.rod_branch.assign(static_cast<std::size_t>(rod_count), -1);
-  // Union-find over nodes with the reference as index n: every node must connect to it.
-  std::vector<int> parent(static_cast<std::size_t>(n + 1));
-  for (int i = 0; i <= n; ++i) parent[static_cast<std::size_t>(i)] = i;
-  auto find = [&](int i) {
-    while (parent[static_cast<std::size_t>(i)] != i) {
-      parent[static_cast<std::size_t>(i)] =
-          parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
-      i = parent[static_cast<std::size_t>(i)];
-    }
-    return i;
-  };
-  auto idx = [n](int node) { return node < 0 ? n : node; };
   for (std::size_t b = 0; b < c.branches.size(); ++b) {
     const auto& br = c.branches[b];
     if (br.from == br.to)
@@ -96,11 +82,29 @@ void finalize_circuit(Circuit& c, int rod_count, const std::string& where) {
                   fmt::format("circuit branch '{}' has reluctance {} 1/H; it must be > 0", br.name,
                               br.fixed_reluctance_per_H)));
     }
-    parent[static_cast<std::size_t>(find(idx(br.from)))] = find(idx(br.to));
   }
   for (int r = 0; r < rod_count; ++r)
     if (c.rod_branch[static_cast<std::size_t>(r)] < 0)
       throw InputError(located(where, 0, fmt::format("rod index {} is in no circuit branch", r)));
+}
+
+// Every node must be joined to the reference by a path of branches (union-find over the
+// nodes, the reference as index n).
+void check_connected(const Circuit& c, const std::string& where) {
+  const int n = c.node_count();
+  std::vector<int> parent(static_cast<std::size_t>(n + 1));
+  for (int i = 0; i <= n; ++i) parent[static_cast<std::size_t>(i)] = i;
+  auto find = [&](int i) {
+    while (parent[static_cast<std::size_t>(i)] != i) {
+      parent[static_cast<std::size_t>(i)] =
+          parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+      i = parent[static_cast<std::size_t>(i)];
+    }
+    return i;
+  };
+  auto idx = [n](int node) { return node < 0 ? n : node; };
+  for (const auto& br : c.branches)
+    parent[static_cast<std::size_t>(find(idx(br.from)))] = find(idx(br.to));
   for (int i = 0; i < n; ++i)
     if (find(i) != find(n))
       throw InputError(
@@ -108,20 +112,14 @@ void finalize_circuit(Circuit& c, int rod_count, const std::string& where) {
                   fmt::format("circuit node '{}' is floating: no path of branches joins it to the "
                               "reference node '{}'",
                               c.node_names[static_cast<std::size_t>(i)], c.reference_node)));
+}
 
-  auto matrices = std::make_shared<CircuitMatrices>();
-  auto& L = *matrices;
-  L.fixed_laplacian = Eigen::MatrixXd::Zero(n, n);
-  for (const auto& br : c.branches) {
-    if (br.rod >= 0) continue;
-    stamp_conductance(L.fixed_laplacian, br, 1.0 / br.fixed_reluctance_per_H);
-  }
-  c.matrices = matrices;
-  // Low-rank pieces, when the fixed branches alone ground every node (G0 SPD).
-  c.lowrank = Circuit::LowRank{};
-  Eigen::LLT<Eigen::MatrixXd> llt0(L.fixed_laplacian);
-  if (llt0.info() != Eigen::Success || rod_count == 0) return;
-  const int k = rod_count;
+// The low-rank (Woodbury) pieces from G0 = the fixed branches' Laplacian (factorised in
+// llt0): B has a column per rod (+1 at its branch's from node, -1 at its to node), b the
+// fixed branches' coil and PM sources.
+void set_lowrank_pieces(const Circuit& c, const Eigen::LLT<Eigen::MatrixXd>& llt0, int k,
+                        CircuitMatrices& L) {
+  const auto n = static_cast<Eigen::Index>(c.node_count());
   Eigen::MatrixXd B = Eigen::MatrixXd::Zero(n, k);
   Eigen::VectorXd b_coil = Eigen::VectorXd::Zero(n), b_pm = Eigen::VectorXd::Zero(n);
   for (int r = 0; r < k; ++r) {
@@ -148,6 +146,29 @@ void finalize_circuit(Circuit& c, int rod_count, const std::string& where) {
   L.psi_pm = llt0.solve(b_pm);
   L.Bt_psi_coil = B.transpose() * L.psi_coil;
   L.Bt_psi_pm = B.transpose() * L.psi_pm;
+}
+
+}  // namespace
+
+void finalize_circuit(Circuit& c, int rod_count, const std::string& where) {
+  const int n = c.node_count();
+  if (n == 0) throw InputError(located(where, 0, "circuit has no nodes besides the reference"));
+  map_rod_branches(c, rod_count, where);
+  check_connected(c, where);
+
+  auto matrices = std::make_shared<CircuitMatrices>();
+  auto& L = *matrices;
+  L.fixed_laplacian = Eigen::MatrixXd::Zero(n, n);
+  for (const auto& br : c.branches) {
+    if (br.rod >= 0) continue;
+    stamp_conductance(L.fixed_laplacian, br, 1.0 / br.fixed_reluctance_per_H);
+  }
+  c.matrices = matrices;
+  // Low-rank pieces, when the fixed branches alone ground every node (G0 SPD).
+  c.lowrank = Circuit::LowRank{};
+  Eigen::LLT<Eigen::MatrixXd> llt0(L.fixed_laplacian);
+  if (llt0.info() != Eigen::Success || rod_count == 0) return;
+  set_lowrank_pieces(c, llt0, rod_count, L);
   c.lowrank.enabled = true;
 }
 

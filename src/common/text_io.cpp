@@ -103,104 +103,137 @@ std::string shown(char c) {
   return fmt::format("byte 0x{:02x}", static_cast<unsigned>(u));
 }
 
-}  // namespace
+// The scan of guard_toml_text, one character at a time: the line, whether a string is open
+// (and which kind), and the [ and { nesting inside values.
+class TomlGuard {
+ public:
+  TomlGuard(std::string_view text, const std::string& source)
+      : text_(text), n_(text.size()), source_(source) {}
 
-void guard_toml_text(std::string_view text, const std::string& source) {
+  void run() {
+    for (i_ = 0; i_ < n_; ++i_) {
+      const char c = text_[i_];
+      if (c == '\0') fail("NUL byte: not a text file");
+      if (c == '\n') {
+        new_line();
+        continue;
+      }
+      if (str_ != Str::None) {
+        string_char(c);
+        continue;
+      }
+      if (line_start_ && depth_ == 0) {
+        if (c == ' ' || c == '\t' || c == '\r') continue;
+        line_start_ = false;
+        if (c == '[') {
+          table_header();
+          continue;
+        }
+        if (!(is_bare_key_char(c) || c == '"' || c == '\'' || c == '#'))
+          fail(fmt::format("expected a key, a [table] or a comment; a key cannot start with {}",
+                           shown(c)));
+      }
+      line_start_ = false;
+      value_char(c);
+    }
+  }
+
+ private:
   enum class Str { None, Basic, Literal, MlBasic, MlLiteral };
-  Str str = Str::None;
-  int depth = 0;  // [ and { nesting inside values
-  long line = 1;
-  bool line_start = true;
-  auto fail = [&](const std::string& why) { throw InputError(located(source, line, why)); };
-  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);  // UTF-8 byte-order mark
-  const std::size_t n = text.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const char c = text[i];
-    if (c == '\0') fail("NUL byte: not a text file");
-    if (c == '\n') {
-      ++line;
-      line_start = true;
-      if (str == Str::Basic || str == Str::Literal) str = Str::None;  // toml++ reports it
-      continue;
+
+  [[noreturn]] void fail(const std::string& why) const {
+    throw InputError(located(source_, line_, why));
+  }
+
+  void new_line() {
+    ++line_;
+    line_start_ = true;
+    if (str_ == Str::Basic || str_ == Str::Literal) str_ = Str::None;  // toml++ reports it
+  }
+
+  // Inside a string: an escape (basic strings) or the closing quote(s).
+  void string_char(char c) {
+    const bool basic = str_ == Str::Basic || str_ == Str::MlBasic;
+    if (basic && c == '\\') {
+      if (i_ + 1 < n_ && text_[i_ + 1] != '\n') ++i_;  // skip the escaped character
+      return;
     }
-    if (str == Str::Basic || str == Str::MlBasic) {
-      if (c == '\\') {
-        if (i + 1 < n && text[i + 1] != '\n') ++i;  // skip the escaped character
-        continue;
-      }
-      if (c == '"') {
-        if (str == Str::Basic)
-          str = Str::None;
-        else if (text.substr(i, 3) == "\"\"\"") {
-          str = Str::None;
-          i += 2;
-        }
-      }
-      continue;
+    if (c != (basic ? '"' : '\'')) return;
+    if (str_ == Str::Basic || str_ == Str::Literal) {
+      str_ = Str::None;
+    } else if (text_.substr(i_, 3) == (basic ? "\"\"\"" : "'''")) {
+      str_ = Str::None;
+      i_ += 2;
     }
-    if (str == Str::Literal || str == Str::MlLiteral) {
-      if (c == '\'') {
-        if (str == Str::Literal)
-          str = Str::None;
-        else if (text.substr(i, 3) == "'''") {
-          str = Str::None;
-          i += 2;
-        }
-      }
-      continue;
+  }
+
+  // A table header at the start of a line: [key] or [[key]].
+  void table_header() {
+    std::size_t j = i_ + 1;
+    if (j < n_ && text_[j] == '[') ++j;
+    while (j < n_ && (text_[j] == ' ' || text_[j] == '\t')) ++j;
+    if (j >= n_ || !(is_bare_key_char(text_[j]) || text_[j] == '"' || text_[j] == '\''))
+      fail(fmt::format(
+          "malformed table header: a key cannot start with {}",
+          j >= n_ || text_[j] == '\n' ? std::string("the end of the line") : shown(text_[j])));
+    // The rest of the header (quoted keys may hold brackets) is toml++'s to check.
+    skip_to_line_end();
+  }
+
+  void skip_to_line_end() {
+    while (i_ + 1 < n_ && text_[i_ + 1] != '\n') ++i_;
+  }
+
+  // A string opens at a quote: multi-line after three of them.
+  void open_string(std::string_view triple, Str single, Str multi) {
+    if (text_.substr(i_, 3) == triple) {
+      str_ = multi;
+      i_ += 2;
+    } else {
+      str_ = single;
     }
-    if (line_start && depth == 0) {
-      if (c == ' ' || c == '\t' || c == '\r') continue;
-      line_start = false;
-      if (c == '[') {  // a table header: [key] or [[key]]
-        std::size_t j = i + 1;
-        if (j < n && text[j] == '[') ++j;
-        while (j < n && (text[j] == ' ' || text[j] == '\t')) ++j;
-        if (j >= n || !(is_bare_key_char(text[j]) || text[j] == '"' || text[j] == '\''))
-          fail(fmt::format(
-              "malformed table header: a key cannot start with {}",
-              j >= n || text[j] == '\n' ? std::string("the end of the line") : shown(text[j])));
-        // The rest of the header (quoted keys may hold brackets) is toml++'s to check.
-        while (i + 1 < n && text[i + 1] != '\n') ++i;
-        continue;
-      }
-      if (!(is_bare_key_char(c) || c == '"' || c == '\'' || c == '#'))
-        fail(fmt::format("expected a key, a [table] or a comment; a key cannot start with {}",
-                         shown(c)));
-    }
-    line_start = false;
+  }
+
+  // A character outside strings, after a line's first one.
+  void value_char(char c) {
     switch (c) {
       case '#':
-        while (i + 1 < n && text[i + 1] != '\n') ++i;
+        skip_to_line_end();
         break;
       case '"':
-        if (text.substr(i, 3) == "\"\"\"") {
-          str = Str::MlBasic;
-          i += 2;
-        } else {
-          str = Str::Basic;
-        }
+        open_string("\"\"\"", Str::Basic, Str::MlBasic);
         break;
       case '\'':
-        if (text.substr(i, 3) == "'''") {
-          str = Str::MlLiteral;
-          i += 2;
-        } else {
-          str = Str::Literal;
-        }
+        open_string("'''", Str::Literal, Str::MlLiteral);
         break;
       case '[':
       case '{':
-        ++depth;
+        ++depth_;
         break;
       case ']':
       case '}':
-        if (depth > 0) --depth;
+        if (depth_ > 0) --depth_;
         break;
       default:
         break;
     }
   }
+
+  const std::string_view text_;
+  const std::size_t n_;
+  const std::string& source_;
+  std::size_t i_ = 0;
+  Str str_ = Str::None;
+  int depth_ = 0;  // [ and { nesting inside values
+  long line_ = 1;
+  bool line_start_ = true;
+};
+
+}  // namespace
+
+void guard_toml_text(std::string_view text, const std::string& source) {
+  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);  // UTF-8 byte-order mark
+  TomlGuard(text, source).run();
 }
 
 }  // namespace gmasim::io_detail

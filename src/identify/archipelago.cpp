@@ -24,6 +24,7 @@
 #include <pagmo/topologies/ring.hpp>
 #include <pagmo/topology.hpp>
 #include <pagmo/types.hpp>
+#include <utility>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
@@ -98,11 +99,12 @@ unsigned long long fevals(const pagmo::archipelago& archi) {
   return n;
 }
 
-// The best champion over all islands and ranks (a collective call), kept in out if it
-// improves on out.best_f.
-void update_best(const pagmo::archipelago& archi, Collective& comm, GaOutcome& out) {
+// The best champion of this rank's islands, (f, u); u is `fallback` when no champion's
+// fitness is below +inf.
+std::pair<double, std::vector<double>> best_champion(const pagmo::archipelago& archi,
+                                                     std::vector<double> fallback) {
   double f = std::numeric_limits<double>::infinity();
-  std::vector<double> u = out.best_u;
+  std::vector<double> u = std::move(fallback);
   for (const auto& isl : archi) {
     const auto pop = isl.get_population();
     if (pop.champion_f()[0] < f) {
@@ -110,10 +112,33 @@ void update_best(const pagmo::archipelago& archi, Collective& comm, GaOutcome& o
       u = pop.champion_x();
     }
   }
+  return {f, std::move(u)};
+}
+
+// The best champion over all islands and ranks (a collective call), kept in out if it
+// improves on out.best_f.
+void update_best(const pagmo::archipelago& archi, Collective& comm, GaOutcome& out) {
+  auto [f, u] = best_champion(archi, out.best_u);
   global_best(comm, f, u);
   if (f < out.best_f) {
     out.best_f = f;
     out.best_u = u;
+  }
+}
+
+// The ring of ranks (a collective call): this rank's best champion goes to the next rank,
+// and the one received replaces the worst individual of island 0 if it is better.
+void exchange_champions(pagmo::archipelago& archi, Collective& comm, std::size_t n) {
+  const auto [f, u] = best_champion(archi, std::vector<double>(n, 0.0));
+  std::vector<double> msg{f};
+  msg.insert(msg.end(), u.begin(), u.end());
+  const std::vector<double> in = comm.ring_shift(msg);
+  auto& isl = *archi.begin();
+  pagmo::population pop = isl.get_population();
+  const auto w = pop.worst_idx();
+  if (in[0] < pop.get_f()[w][0]) {
+    pop.set_xf(w, pagmo::vector_double(in.begin() + 1, in.end()), {in[0]});
+    isl.set_population(pop);
   }
 }
 
@@ -164,169 +189,211 @@ void verify_restored(const Checkpoint& c, const pagmo::problem& prob, const Iden
   }
 }
 
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+// One rank's global search: its archipelago, the seeds of its islands, and the outcome so
+// far. run() is run_ga().
+class GaRun {
+ public:
+  GaRun(const Objective& obj, const IdentifyOptions& o, Collective& comm)
+      : o_(o),
+        comm_(comm),
+        rank_(comm.rank()),
+        ranks_(comm.size()),
+        n_(obj.dim()),
+        fp_(fingerprints(obj, o, ranks_)),
+        prob_{GmaProblem{std::make_shared<const Objective>(obj)}} {}
+
+  GaOutcome run(const std::vector<double>& start_u, double start_f) {
+    out_.best_u = start_u;
+    out_.best_f = start_f;
+    const std::vector<std::vector<IslandPopulation>> restored = resume();
+    build_islands(start_u, start_f, restored);
+    record_start();
+    t_epoch_ = Clock::now();
+    while (out_.generation < o_.generations) {
+      if (run_epoch()) {
+        out_.interrupted = true;
+        break;
+      }
+    }
+    out_.wall_s = seconds_since(t_start_);
+    return out_;
+  }
+
+ private:
+  // With o.resume_path: the outcome so far from the checkpoint (checked against this run,
+  // its fitness values against the model), and every rank's islands; else nothing.
+  std::vector<std::vector<IslandPopulation>> resume() {
+    if (o_.resume_path.empty()) return {};
+    Checkpoint c = read_checkpoint(o_.resume_path);
+    check_compatible(c, fp_, o_.resume_path);
+    verify_restored(c, prob_, o_, comm_, ranks_, n_);
+    out_.resumed = true;
+    out_.generation = c.generation;
+    out_.evaluations = c.evaluations;
+    wall_before_ = c.wall_s;
+    if (c.best_f <= out_.best_f) {
+      out_.best_f = c.best_f;
+      out_.best_u = c.best_u;
+    }
+    out_.history = c.history;
+    return std::move(c.rank_islands);
+  }
+
+  // This rank's islands on a ring, each running the algorithm for the first epoch's
+  // generations.
+  void build_islands(const std::vector<double>& start_u, double start_f,
+                     const std::vector<std::vector<IslandPopulation>>& restored) {
+    const auto migrants = static_cast<pagmo::pop_size_t>(o_.migrants);
+    current_gen_ = static_cast<unsigned>(
+        std::min(o_.migrate_every, std::max(1, o_.generations - out_.generation)));
+    for (int i = 0; i < o_.islands; ++i) {
+      const unsigned s = mix_seed(o_.seed, rank_, i, out_.generation);
+      seeds_.push_back(s);
+      archi_.push_back(pagmo::thread_island{}, make_algorithm(o_.algorithm, current_gen_, n_, s),
+                       island_population(i, s, start_u, start_f, restored),
+                       pagmo::fair_replace{migrants}, pagmo::select_best{migrants});
+    }
+  }
+
+  // Island i's population: as the checkpoint holds it, or a random one (evaluated over
+  // threads) with the start model in place of island 0's worst individual.
+  pagmo::population island_population(
+      int i, unsigned seed, const std::vector<double>& start_u, double start_f,
+      const std::vector<std::vector<IslandPopulation>>& restored) const {
+    if (!out_.resumed) {
+      pagmo::population pop{prob_, pagmo::bfe{pagmo::thread_bfe{}},
+                            static_cast<pagmo::pop_size_t>(o_.population), seed};
+      if (i == 0) pop.set_xf(pop.worst_idx(), start_u, {start_f});  // seed the start model
+      return pop;
+    }
+    pagmo::population pop{prob_, 0u, seed};
+    const auto& ip = restored[static_cast<std::size_t>(rank_)][static_cast<std::size_t>(i)];
+    for (std::size_t k = 0; k < ip.x.size(); ++k) pop.push_back(ip.x[k], {ip.f[k]});
+    return pop;
+  }
+
+  // The evaluations of the initial populations (all ranks), the best so far, and the
+  // history's generation 0 (a resumed run has its counts and history from the checkpoint).
+  void record_start() {
+    if (!out_.resumed) {
+      out_.evaluations = sum_ranks(comm_, static_cast<long>(fevals(archi_)));
+      out_.run_evaluations = out_.evaluations;
+    }
+    update_best(archi_, comm_, out_);
+    if (!out_.resumed) {
+      const double wall = seconds_since(t_start_);
+      out_.history.push_back({"ga", 0, out_.evaluations, out_.best_f, wall,
+                              wall > 0 ? static_cast<double>(out_.evaluations) / wall : 0.0});
+    }
+  }
+
+  // One epoch of up to migrate_every generations, then the champions over the ring of ranks
+  // (every mpi_every generations), the best so far, the history and the checkpoint. True
+  // when a stop was requested on any rank.
+  bool run_epoch() {
+    const int gens = std::min(o_.migrate_every, o_.generations - out_.generation);
+    const int prev_gen = out_.generation;
+    const long epoch_evals = evolve(gens);
+    const int X = o_.mpi_every > 0 ? o_.mpi_every : o_.migrate_every;
+    if (ranks_ > 1 && out_.generation / X != prev_gen / X) exchange_champions(archi_, comm_, n_);
+    // Best so far over all islands and ranks.
+    update_best(archi_, comm_, out_);
+    record_epoch(epoch_evals);
+    const bool stop = any_rank(comm_, o_.stop && o_.stop->load());
+    const bool due = o_.checkpoint_every > 0 &&
+                     out_.generation / o_.checkpoint_every != prev_gen / o_.checkpoint_every;
+    if (!o_.checkpoint_path.empty() && (due || stop || out_.generation >= o_.generations))
+      write_checkpoint();
+    return stop;
+  }
+
+  // `gens` generations on every island; returns the evaluations of all ranks.
+  long evolve(int gens) {
+    if (static_cast<unsigned>(gens) != current_gen_) {
+      int i = 0;
+      for (auto& isl : archi_) {
+        isl.set_algorithm(make_algorithm(o_.algorithm, static_cast<unsigned>(gens), n_,
+                                         mix_seed(o_.seed, rank_, i++, out_.generation)));
+      }
+      current_gen_ = static_cast<unsigned>(gens);
+    }
+    const auto before = fevals(archi_);
+    archi_.evolve(1);  // each island: immigrants from its ring neighbour, `gens` generations
+    archi_.wait_check();
+    out_.generation += gens;
+    const long epoch_evals = sum_ranks(comm_, static_cast<long>(fevals(archi_) - before));
+    out_.evaluations += epoch_evals;
+    out_.run_evaluations += epoch_evals;
+    return epoch_evals;
+  }
+
+  // The epoch's history entry, and the progress report on rank 0.
+  void record_epoch(long epoch_evals) {
+    const auto now = Clock::now();
+    const double dt = std::chrono::duration<double>(now - t_epoch_).count();
+    t_epoch_ = now;
+    HistoryEntry h;
+    h.phase = "ga";
+    h.step = out_.generation;
+    h.evaluations = out_.evaluations;
+    h.best_rms_pct = out_.best_f;
+    h.wall_s = wall_before_ + std::chrono::duration<double>(now - t_start_).count();
+    h.evals_per_s = dt > 0 ? static_cast<double>(epoch_evals) / dt : 0.0;
+    out_.history.push_back(h);
+    if (rank_ == 0 && o_.progress) {
+      o_.progress({"ga", out_.generation, o_.generations, out_.best_f, out_.evaluations,
+                   h.evals_per_s, h.wall_s});
+    }
+  }
+
+  // Every rank's islands, gathered to rank 0 (a collective call), which writes the file.
+  void write_checkpoint() {
+    const std::string block = islands_text(snapshot(archi_, seeds_));
+    const auto blocks = comm_.gather(block, 0);
+    if (rank_ != 0) return;
+    Checkpoint c;
+    c.fp = fp_;
+    c.algorithm = o_.algorithm;
+    c.ranks = ranks_;
+    c.islands = o_.islands;
+    c.population = o_.population;
+    c.dim = static_cast<int>(n_);
+    c.seed = o_.seed;
+    c.generation = out_.generation;
+    c.evaluations = out_.evaluations;
+    c.wall_s = wall_before_ + seconds_since(t_start_);
+    c.best_f = out_.best_f;
+    c.best_u = out_.best_u;
+    c.history = out_.history;
+    write_file_atomic(o_.checkpoint_path, checkpoint_text(c, blocks));
+  }
+
+  const Clock::time_point t_start_ = Clock::now();
+  const IdentifyOptions& o_;
+  Collective& comm_;
+  const int rank_, ranks_;
+  const std::size_t n_;
+  const Fingerprints fp_;
+  const pagmo::problem prob_;
+  GaOutcome out_;
+  double wall_before_ = 0.0;  // GA wall time of the run(s) before a resume
+  pagmo::archipelago archi_{pagmo::topology{pagmo::ring{}}};
+  std::vector<unsigned> seeds_;
+  unsigned current_gen_ = 0;  // generations per evolve() of the islands' algorithms
+  Clock::time_point t_epoch_;
+};
+
 }  // namespace
 
 GaOutcome run_ga(const Objective& obj, const IdentifyOptions& o, Collective& comm,
                  const std::vector<double>& start_u, double start_f) {
-  using clock = std::chrono::steady_clock;
-  const auto t_start = clock::now();
-  const int rank = comm.rank(), ranks = comm.size();
-  const std::size_t n = obj.dim();
-  const auto P = static_cast<pagmo::pop_size_t>(o.population);
-  const int K = o.migrate_every;
-  const int X = o.mpi_every > 0 ? o.mpi_every : o.migrate_every;
-  const Fingerprints fp = fingerprints(obj, o, ranks);
-  const pagmo::problem prob{GmaProblem{std::make_shared<const Objective>(obj)}};
-
-  GaOutcome out;
-  out.best_u = start_u;
-  out.best_f = start_f;
-  double wall_before = 0.0;  // GA wall time of the run(s) before a resume
-  std::vector<std::vector<IslandPopulation>> restored;
-  if (!o.resume_path.empty()) {
-    Checkpoint c = read_checkpoint(o.resume_path);
-    check_compatible(c, fp, o.resume_path);
-    verify_restored(c, prob, o, comm, ranks, n);
-    out.resumed = true;
-    out.generation = c.generation;
-    out.evaluations = c.evaluations;
-    wall_before = c.wall_s;
-    if (c.best_f <= out.best_f) {
-      out.best_f = c.best_f;
-      out.best_u = c.best_u;
-    }
-    out.history = c.history;
-    restored = std::move(c.rank_islands);
-  }
-
-  // ---- the archipelago of this rank --------------------------------------------------
-  pagmo::archipelago archi{pagmo::topology{pagmo::ring{}}};
-  std::vector<unsigned> seeds;
-  const auto migrants = static_cast<pagmo::pop_size_t>(o.migrants);
-  const unsigned first_gen =
-      static_cast<unsigned>(std::min(K, std::max(1, o.generations - out.generation)));
-  for (int i = 0; i < o.islands; ++i) {
-    const unsigned s = mix_seed(o.seed, rank, i, out.generation);
-    seeds.push_back(s);
-    pagmo::population pop{prob, 0u, s};
-    if (out.resumed) {
-      const auto& ip = restored[static_cast<std::size_t>(rank)][static_cast<std::size_t>(i)];
-      for (std::size_t k = 0; k < ip.x.size(); ++k) pop.push_back(ip.x[k], {ip.f[k]});
-    } else {
-      pop = pagmo::population{prob, pagmo::bfe{pagmo::thread_bfe{}}, P, s};
-      if (i == 0) pop.set_xf(pop.worst_idx(), start_u, {start_f});  // seed the start model
-    }
-    archi.push_back(pagmo::thread_island{}, make_algorithm(o.algorithm, first_gen, n, s), pop,
-                    pagmo::fair_replace{migrants}, pagmo::select_best{migrants});
-  }
-  if (!out.resumed) {
-    out.evaluations = sum_ranks(comm, static_cast<long>(fevals(archi)));
-    out.run_evaluations = out.evaluations;
-  }
-  update_best(archi, comm, out);
-  if (!out.resumed) {
-    const double wall = std::chrono::duration<double>(clock::now() - t_start).count();
-    out.history.push_back({"ga", 0, out.evaluations, out.best_f, wall,
-                           wall > 0 ? static_cast<double>(out.evaluations) / wall : 0.0});
-  }
-
-  auto write_checkpoint = [&]() {
-    const std::string block = islands_text(snapshot(archi, seeds));
-    const auto blocks = comm.gather(block, 0);
-    if (rank != 0) return;
-    Checkpoint c;
-    c.fp_parameters = fp.parameters;
-    c.fp_data = fp.data;
-    c.fp_settings = fp.settings;
-    c.fp_layout = fp.layout;
-    c.algorithm = o.algorithm;
-    c.ranks = ranks;
-    c.islands = o.islands;
-    c.population = o.population;
-    c.dim = static_cast<int>(n);
-    c.seed = o.seed;
-    c.generation = out.generation;
-    c.evaluations = out.evaluations;
-    c.wall_s = wall_before + std::chrono::duration<double>(clock::now() - t_start).count();
-    c.best_f = out.best_f;
-    c.best_u = out.best_u;
-    c.history = out.history;
-    write_file_atomic(o.checkpoint_path, checkpoint_text(c, blocks));
-  };
-
-  // ---- epochs of K generations ---------------------------------------------------------
-  unsigned current_gen = first_gen;
-  auto t_epoch = clock::now();
-  while (out.generation < o.generations) {
-    const int gens = std::min(K, o.generations - out.generation);
-    if (static_cast<unsigned>(gens) != current_gen) {
-      int i = 0;
-      for (auto& isl : archi) {
-        isl.set_algorithm(make_algorithm(o.algorithm, static_cast<unsigned>(gens), n,
-                                         mix_seed(o.seed, rank, i++, out.generation)));
-      }
-      current_gen = static_cast<unsigned>(gens);
-    }
-    const auto before = fevals(archi);
-    archi.evolve(1);  // each island: immigrants from its ring neighbour, `gens` generations
-    archi.wait_check();
-    const int prev_gen = out.generation;
-    out.generation += gens;
-    const long epoch_evals = sum_ranks(comm, static_cast<long>(fevals(archi) - before));
-    out.evaluations += epoch_evals;
-    out.run_evaluations += epoch_evals;
-
-    // Champions over the ring of ranks.
-    if (ranks > 1 && out.generation / X != prev_gen / X) {
-      double f = std::numeric_limits<double>::infinity();
-      std::vector<double> u(n, 0.0);
-      for (const auto& isl : archi) {
-        const auto pop = isl.get_population();
-        if (pop.champion_f()[0] < f) {
-          f = pop.champion_f()[0];
-          u = pop.champion_x();
-        }
-      }
-      std::vector<double> msg{f};
-      msg.insert(msg.end(), u.begin(), u.end());
-      const std::vector<double> in = comm.ring_shift(msg);
-      auto& isl = *archi.begin();
-      pagmo::population pop = isl.get_population();
-      const auto w = pop.worst_idx();
-      if (in[0] < pop.get_f()[w][0]) {
-        pop.set_xf(w, pagmo::vector_double(in.begin() + 1, in.end()), {in[0]});
-        isl.set_population(pop);
-      }
-    }
-    // Best so far over all islands and ranks.
-    update_best(archi, comm, out);
-    const auto now = clock::now();
-    const double dt = std::chrono::duration<double>(now - t_epoch).count();
-    t_epoch = now;
-    HistoryEntry h;
-    h.phase = "ga";
-    h.step = out.generation;
-    h.evaluations = out.evaluations;
-    h.best_rms_pct = out.best_f;
-    h.wall_s = wall_before + std::chrono::duration<double>(now - t_start).count();
-    h.evals_per_s = dt > 0 ? static_cast<double>(epoch_evals) / dt : 0.0;
-    out.history.push_back(h);
-    if (rank == 0 && o.progress) {
-      o.progress({"ga", out.generation, o.generations, out.best_f, out.evaluations, h.evals_per_s,
-                  h.wall_s});
-    }
-    const bool stop = any_rank(comm, o.stop && o.stop->load());
-    const bool due = o.checkpoint_every > 0 &&
-                     out.generation / o.checkpoint_every != prev_gen / o.checkpoint_every;
-    if (!o.checkpoint_path.empty() && (due || stop || out.generation >= o.generations))
-      write_checkpoint();
-    if (stop) {
-      out.interrupted = true;
-      break;
-    }
-  }
-  out.wall_s = std::chrono::duration<double>(clock::now() - t_start).count();
-  return out;
+  return GaRun(obj, o, comm).run(start_u, start_f);
 }
 
 }  // namespace gmasim::identify_detail

@@ -108,6 +108,79 @@ struct LineReader {
   }
 };
 
+// The magic line, the fingerprints, the layout and the search state up to best_u.
+void read_header(LineReader& in, Checkpoint& c) {
+  const std::string head = in.next();
+  if (head.rfind(kMagic, 0) != 0) in.fail("not a gmasim identify checkpoint");
+  const double version = in.nums(head.substr(std::strlen(kMagic)), 1)[0];
+  if (version != 1.0) in.fail(fmt::format("version {:g} is not supported (expected 1)", version));
+  c.version = 1;
+  c.fp.parameters = in.expect("fp_parameters");
+  c.fp.data = in.expect("fp_data");
+  c.fp.settings = in.expect("fp_settings");
+  c.fp.layout = in.expect("fp_layout");
+  c.algorithm = in.expect("algorithm");
+  // Limits: far above any run (the CLI's own limits), far below a forged count.
+  c.ranks = static_cast<int>(in.integer("ranks", 1, 4096));
+  c.islands = static_cast<int>(in.integer("islands", 1, 4096));
+  c.population = static_cast<int>(in.integer("population", 1, 1e6));
+  c.dim = static_cast<int>(in.integer("dim", 1, 10000));
+  c.seed = static_cast<unsigned>(in.integer("seed", 0, 4294967295.0));
+  c.generation = static_cast<int>(in.integer("generation", 0, 1e9));
+  c.evaluations = in.integer("evaluations", 0, 1e15);
+  c.wall_s = in.finite("wall_s", 0.0);
+  c.best_f = in.finite("best_f", 0.0);  // a weighted RMS [%]: finite, >= 0
+  c.best_u = in.nums(in.expect("best_u"), static_cast<std::size_t>(c.dim));
+  in.unit_vector(c.best_u, "best_u");
+}
+
+// "phase step evaluations best_rms_pct wall_s evals_per_s"
+HistoryEntry read_history_entry(LineReader& in) {
+  const std::string l = in.next();
+  const auto sp = l.find(' ');
+  if (sp == std::string::npos) in.fail("bad history line");
+  const auto v = in.nums(l.substr(sp + 1), 5);
+  for (double x : v)
+    if (!(std::isfinite(x) && x >= 0.0))
+      in.fail(fmt::format("history: {:g} is not a finite value >= 0", x));
+  // The step and the evaluation count become integers: in range first (found by
+  // fuzz_checkpoint: 1.1e88 converted to int).
+  if (!(v[0] <= 1e9 && v[1] <= 1e15 && v[0] == std::floor(v[0]) && v[1] == std::floor(v[1])))
+    in.fail(fmt::format("history: step {:g} / evaluations {:g}: not a count in range", v[0], v[1]));
+  const std::string phase = l.substr(0, sp);
+  if (phase != "ga" && phase != "refine")
+    in.fail(fmt::format("history: unknown phase '{}'", phase));
+  return {phase, static_cast<int>(v[0]), static_cast<long>(v[1]), v[2], v[3], v[4]};
+}
+
+// Island i: "island i seed S size P", then P lines "fitness x_1 .. x_dim".
+IslandPopulation read_island(LineReader& in, int i, int population, int dim) {
+  const std::string il = in.next();
+  long v[3] = {0, 0, 0};
+  if (std::sscanf(il.c_str(), "island %ld seed %ld size %ld", &v[0], &v[1], &v[2]) != 3)
+    in.fail(fmt::format("expected 'island N seed S size P', got '{}'", il));
+  if (static_cast<int>(v[0]) != i) in.fail(fmt::format("expected island {}", i));
+  // Every island holds the whole population: an empty or short island cannot be
+  // restored (pagmo's algorithms need the population they were configured for).
+  if (v[2] != population)
+    in.fail(fmt::format("island {} has {} individuals; the population is {}", i, v[2], population));
+  if (v[1] < 0 || v[1] > 4294967295L)
+    in.fail(fmt::format("island {}: seed {} out of range", i, v[1]));
+  IslandPopulation ip;
+  ip.seed = static_cast<unsigned>(v[1]);
+  const auto size = static_cast<std::size_t>(v[2]);
+  for (std::size_t k = 0; k < size; ++k) {
+    const auto row = in.nums(in.next(), static_cast<std::size_t>(dim) + 1);
+    if (!(std::isfinite(row[0]) && row[0] >= 0.0))
+      in.fail(fmt::format("island {} individual {}: fitness {:g} is not a finite value >= 0", i, k,
+                          row[0]));
+    ip.f.push_back(row[0]);
+    ip.x.emplace_back(row.begin() + 1, row.end());
+    in.unit_vector(ip.x.back(), "individual");
+  }
+  return ip;
+}
+
 }  // namespace
 
 Fingerprints fingerprints(const Objective& obj, const IdentifyOptions& o, int ranks) {
@@ -172,8 +245,8 @@ std::string islands_text(const std::vector<IslandPopulation>& islands) {
 
 std::string checkpoint_text(const Checkpoint& c, const std::vector<std::string>& rank_blocks) {
   std::string s = fmt::format("{} {}\n", kMagic, c.version);
-  s += fmt::format("fp_parameters {}\nfp_data {}\nfp_settings {}\nfp_layout {}\n", c.fp_parameters,
-                   c.fp_data, c.fp_settings, c.fp_layout);
+  s += fmt::format("fp_parameters {}\nfp_data {}\nfp_settings {}\nfp_layout {}\n", c.fp.parameters,
+                   c.fp.data, c.fp.settings, c.fp.layout);
   s += fmt::format("algorithm {}\nranks {}\nislands {}\npopulation {}\ndim {}\nseed {}\n",
                    c.algorithm, c.ranks, c.islands, c.population, c.dim, c.seed);
   s += fmt::format("generation {}\nevaluations {}\nwall_s {:.17g}\n", c.generation, c.evaluations,
@@ -202,77 +275,13 @@ Checkpoint read_checkpoint(const std::string& path) {
   for (std::string l; std::getline(ss, l);) in.lines.push_back(l);
 
   Checkpoint c;
-  const std::string head = in.next();
-  if (head.rfind(kMagic, 0) != 0) in.fail("not a gmasim identify checkpoint");
-  const double version = in.nums(head.substr(std::strlen(kMagic)), 1)[0];
-  if (version != 1.0) in.fail(fmt::format("version {:g} is not supported (expected 1)", version));
-  c.version = 1;
-  c.fp_parameters = in.expect("fp_parameters");
-  c.fp_data = in.expect("fp_data");
-  c.fp_settings = in.expect("fp_settings");
-  c.fp_layout = in.expect("fp_layout");
-  c.algorithm = in.expect("algorithm");
-  // Limits: far above any run (the CLI's own limits), far below a forged count.
-  c.ranks = static_cast<int>(in.integer("ranks", 1, 4096));
-  c.islands = static_cast<int>(in.integer("islands", 1, 4096));
-  c.population = static_cast<int>(in.integer("population", 1, 1e6));
-  c.dim = static_cast<int>(in.integer("dim", 1, 10000));
-  c.seed = static_cast<unsigned>(in.integer("seed", 0, 4294967295.0));
-  c.generation = static_cast<int>(in.integer("generation", 0, 1e9));
-  c.evaluations = in.integer("evaluations", 0, 1e15);
-  c.wall_s = in.finite("wall_s", 0.0);
-  c.best_f = in.finite("best_f", 0.0);  // a weighted RMS [%]: finite, >= 0
-  c.best_u = in.nums(in.expect("best_u"), static_cast<std::size_t>(c.dim));
-  in.unit_vector(c.best_u, "best_u");
+  read_header(in, c);
   const long nh = in.integer("history", 0, 1e7);
-  for (long k = 0; k < nh; ++k) {
-    const std::string l = in.next();
-    const auto sp = l.find(' ');
-    if (sp == std::string::npos) in.fail("bad history line");
-    const auto v = in.nums(l.substr(sp + 1), 5);
-    for (double x : v)
-      if (!(std::isfinite(x) && x >= 0.0))
-        in.fail(fmt::format("history: {:g} is not a finite value >= 0", x));
-    // The step and the evaluation count become integers: in range first (found by
-    // fuzz_checkpoint: 1.1e88 converted to int).
-    if (!(v[0] <= 1e9 && v[1] <= 1e15 && v[0] == std::floor(v[0]) && v[1] == std::floor(v[1])))
-      in.fail(fmt::format("history: step {:g} / evaluations {:g}: not a count in range", v[0],
-                          v[1]));
-    const std::string phase = l.substr(0, sp);
-    if (phase != "ga" && phase != "refine")
-      in.fail(fmt::format("history: unknown phase '{}'", phase));
-    c.history.push_back({phase, static_cast<int>(v[0]), static_cast<long>(v[1]), v[2], v[3], v[4]});
-  }
+  for (long k = 0; k < nh; ++k) c.history.push_back(read_history_entry(in));
   for (int r = 0; r < c.ranks; ++r) {
     if (in.integer("rank", 0, 4096) != r) in.fail(fmt::format("expected rank {}", r));
     std::vector<IslandPopulation> isl;
-    for (int i = 0; i < c.islands; ++i) {
-      const std::string il = in.next();
-      long v[3] = {0, 0, 0};
-      if (std::sscanf(il.c_str(), "island %ld seed %ld size %ld", &v[0], &v[1], &v[2]) != 3)
-        in.fail(fmt::format("expected 'island N seed S size P', got '{}'", il));
-      if (static_cast<int>(v[0]) != i) in.fail(fmt::format("expected island {}", i));
-      // Every island holds the whole population: an empty or short island cannot be
-      // restored (pagmo's algorithms need the population they were configured for).
-      if (v[2] != c.population)
-        in.fail(fmt::format("island {} has {} individuals; the population is {}", i, v[2],
-                            c.population));
-      if (v[1] < 0 || v[1] > 4294967295L)
-        in.fail(fmt::format("island {}: seed {} out of range", i, v[1]));
-      IslandPopulation ip;
-      ip.seed = static_cast<unsigned>(v[1]);
-      const auto size = static_cast<std::size_t>(v[2]);
-      for (std::size_t k = 0; k < size; ++k) {
-        const auto row = in.nums(in.next(), static_cast<std::size_t>(c.dim) + 1);
-        if (!(std::isfinite(row[0]) && row[0] >= 0.0))
-          in.fail(fmt::format("island {} individual {}: fitness {:g} is not a finite value >= 0", i,
-                              k, row[0]));
-        ip.f.push_back(row[0]);
-        ip.x.emplace_back(row.begin() + 1, row.end());
-        in.unit_vector(ip.x.back(), "individual");
-      }
-      isl.push_back(std::move(ip));
-    }
+    for (int i = 0; i < c.islands; ++i) isl.push_back(read_island(in, i, c.population, c.dim));
     c.rank_islands.push_back(std::move(isl));
   }
   if (in.next() != "end") in.fail("missing 'end' line");
@@ -286,14 +295,14 @@ void check_compatible(const Checkpoint& c, const Fingerprints& fp, const std::st
                                          "with the same data, fit spec, model and flags",
                                          what)));
   };
-  if (c.fp_parameters != fp.parameters) fail("other fitted parameters or bounds");
-  if (c.fp_data != fp.data) fail("other measurement data");
-  if (c.fp_settings != fp.settings) fail("other objective settings or targets");
-  if (c.fp_layout != fp.layout) {
+  if (c.fp.parameters != fp.parameters) fail("other fitted parameters or bounds");
+  if (c.fp.data != fp.data) fail("other measurement data");
+  if (c.fp.settings != fp.settings) fail("other objective settings or targets");
+  if (c.fp.layout != fp.layout) {
     fail(
         fmt::format("another algorithm layout ({} ; now {}: algorithm, ranks, islands, "
                     "population, migration, seed)",
-                    c.fp_layout, fp.layout));
+                    c.fp.layout, fp.layout));
   }
 }
 

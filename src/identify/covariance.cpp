@@ -81,132 +81,135 @@ std::pair<double, double> profile(const Objective& obj, BatchEvaluator& ev,
   return {edge[0], edge[1]};
 }
 
-}  // namespace
-
-FittedParameter fitted_parameter(const Objective& obj, std::size_t j, double value) {
-  const auto& spec = obj.fit().parameters[j];
-  FittedParameter fp;
-  fp.name = obj.names()[j];
-  fp.unit = obj.units()[j];
-  fp.scale = spec.scale;
-  fp.lower = spec.lower;
-  fp.upper = spec.upper;
-  fp.value = value;
+// Parameter j at u before its interval is known: an infinite standard error, and the
+// bounds as its (linearised) interval.
+FittedParameter unbounded_parameter(const Objective& obj, std::size_t j, double value, double uj) {
+  FittedParameter fp = fitted_parameter(obj, j, value);
+  fp.at_bound = uj < 1e-6 || uj > 1.0 - 1e-6;
+  fp.std_error = std::numeric_limits<double>::infinity();
+  fp.ci_method = "linearised";
+  fp.wald_low = -std::numeric_limits<double>::infinity();
+  fp.wald_high = std::numeric_limits<double>::infinity();
+  fp.determined = false;
+  fp.ci_low = fp.lower;
+  fp.ci_high = fp.upper;
   return fp;
 }
 
-void fill_covariance(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u,
-                     double f, const IdentifyOptions& o, Collective& comm, IdentifyResult& out) {
-  const double h = o.fd_step;
-  const std::size_t n = obj.dim(), m = obj.residual_count();
-  const auto p = obj.to_params(u);
-  const auto dtheta = obj.theta_per_unit();
-  out.parameters.clear();
-  for (std::size_t j = 0; j < n; ++j) {
-    FittedParameter fp = fitted_parameter(obj, j, p[j]);
-    fp.at_bound = u[j] < 1e-6 || u[j] > 1.0 - 1e-6;
-    fp.std_error = std::numeric_limits<double>::infinity();
-    fp.ci_method = "linearised";
-    fp.wald_low = -std::numeric_limits<double>::infinity();
-    fp.wald_high = std::numeric_limits<double>::infinity();
-    fp.determined = false;
-    fp.ci_low = fp.lower;
-    fp.ci_high = fp.upper;
-    out.parameters.push_back(fp);
-  }
-  out.correlation.assign(n, std::vector<double>(n, 0.0));
-  out.residual_count = m;
-  std::vector<double> r, Jv;
-  if (!jacobian(obj, ev, u, h, r, Jv)) {
-    out.covariance_ok = false;
-    out.covariance_note = "the model cannot be evaluated at the optimum";
-    return;
-  }
+// The Jacobian of the residuals (m x n, row-major, per unit of u) per unit of theta.
+Eigen::MatrixXd jacobian_in_theta(const std::vector<double>& Jv, std::size_t m, std::size_t n,
+                                  const std::vector<double>& dtheta) {
   const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> Ju(
       Jv.data(), static_cast<Eigen::Index>(m), static_cast<Eigen::Index>(n));
   Eigen::MatrixXd J = Ju;
   for (std::size_t j = 0; j < n; ++j) J.col(static_cast<Eigen::Index>(j)) /= dtheta[j];
-  double ss = 0.0;
-  for (double v : r) ss += v * v;
-  const double dof = static_cast<double>(m) - static_cast<double>(n);
-  const double s2 = dof > 0 ? ss / dof : 0.0;
-  out.residual_sigma = std::sqrt(s2);
+  return J;
+}
 
-  // Column scaling for conditioning; pseudo-inverse with a relative eigenvalue cut.
+// cov = s^2 (J^T J)^+ in theta, through the column-scaled J^T J (for conditioning) and its
+// pseudo-inverse with a relative eigenvalue cut.
+struct Covariance {
+  Eigen::MatrixXd cov;
+  Eigen::VectorXd d;            // the column scaling 1 / sqrt((J^T J)_jj); 0: a zero column
+  Eigen::VectorXd null_weight;  // each parameter's weight in the cut (null) eigenvectors
+  int rank_deficiency = 0;      // eigenvalues cut
+  double condition = 0.0;       // condition number of the column-scaled J^T J
+};
+
+Covariance scaled_covariance(const Eigen::MatrixXd& J, double s2) {
+  const Eigen::Index n = J.cols();
+  Covariance c;
   Eigen::MatrixXd A = J.transpose() * J;
-  Eigen::VectorXd d(static_cast<Eigen::Index>(n));
-  for (Eigen::Index j = 0; j < d.size(); ++j) d(j) = A(j, j) > 0 ? 1.0 / std::sqrt(A(j, j)) : 0.0;
-  const Eigen::MatrixXd As = d.asDiagonal() * A * d.asDiagonal();
+  c.d.resize(n);
+  for (Eigen::Index j = 0; j < n; ++j) c.d(j) = A(j, j) > 0 ? 1.0 / std::sqrt(A(j, j)) : 0.0;
+  const Eigen::MatrixXd As = c.d.asDiagonal() * A * c.d.asDiagonal();
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(As);
   const Eigen::VectorXd lam = es.eigenvalues();
   const Eigen::MatrixXd V = es.eigenvectors();
   const double lmax = lam.maxCoeff();
   const double cut = 1e-12 * std::max(lmax, 1e-300);
-  Eigen::MatrixXd inv =
-      Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
-  Eigen::VectorXd null_weight = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
-  int rank_deficiency = 0;
+  Eigen::MatrixXd inv = Eigen::MatrixXd::Zero(n, n);
+  c.null_weight = Eigen::VectorXd::Zero(n);
   for (Eigen::Index k = 0; k < lam.size(); ++k) {
     if (lam(k) > cut) {
       inv += V.col(k) * V.col(k).transpose() / lam(k);
     } else {
-      ++rank_deficiency;
-      null_weight += V.col(k).cwiseAbs2();
+      ++c.rank_deficiency;
+      c.null_weight += V.col(k).cwiseAbs2();
     }
   }
-  const Eigen::MatrixXd cov = s2 * (d.asDiagonal() * inv * d.asDiagonal());
-  out.covariance_ok = true;
-  const double cond =
+  c.cov = s2 * (c.d.asDiagonal() * inv * c.d.asDiagonal());
+  c.condition =
       lam.minCoeff() > 0 ? lmax / lam.minCoeff() : std::numeric_limits<double>::infinity();
-  out.covariance_note = fmt::format(
+  return c;
+}
+
+std::string covariance_note(std::size_t m, std::size_t n, double residual_sigma,
+                            const Covariance& c) {
+  std::string note = fmt::format(
       "{} residuals, {} parameters; residual variance from the fit (m - n degrees of freedom: "
       "RMS sqrt(m / (m - n)) = {:.4g} %); condition number of the column-scaled J^T J {}",
-      m, n, out.residual_sigma * std::sqrt(static_cast<double>(m)),
-      std::isfinite(cond) ? fmt::format("{:.3g}", cond) : std::string("infinite (singular)"));
-  if (rank_deficiency > 0) {
-    out.covariance_note += fmt::format(
+      m, n, residual_sigma * std::sqrt(static_cast<double>(m)),
+      std::isfinite(c.condition) ? fmt::format("{:.3g}", c.condition)
+                                 : std::string("infinite (singular)"));
+  if (c.rank_deficiency > 0) {
+    note += fmt::format(
         "; J^T J is rank-deficient by {}: some parameter "
         "combinations are not determined by the data",
-        rank_deficiency);
+        c.rank_deficiency);
   }
+  return note;
+}
+
+// The linearised 95 % interval of a parameter of standard deviation sd in theta (1.96 sd;
+// multiplicative for a log parameter); it is the parameter's interval when it is narrower
+// than the bounds.
+void set_linearised_interval(FittedParameter& fp, double sd) {
+  if (fp.scale == ParamScale::Log) {
+    const double a = fp.value * std::exp(-1.96 * sd), b = fp.value * std::exp(1.96 * sd);
+    fp.wald_low = std::min(a, b);
+    fp.wald_high = std::max(a, b);
+    fp.std_error = std::fabs(fp.value) * sd;
+    fp.determined = std::isfinite(sd) && 2.0 * 1.96 * sd < std::fabs(std::log(fp.upper / fp.lower));
+  } else {
+    fp.wald_low = fp.value - 1.96 * sd;
+    fp.wald_high = fp.value + 1.96 * sd;
+    fp.std_error = sd;
+    fp.determined = std::isfinite(sd) && 2.0 * 1.96 * sd < fp.upper - fp.lower;
+  }
+  if (fp.determined) {
+    fp.ci_low = fp.wald_low;
+    fp.ci_high = fp.wald_high;
+  }
+}
+
+// Intervals and correlations of the parameters outside the null space of J^T J (the others
+// keep their infinite interval).
+void set_linearised_intervals(const Covariance& c, IdentifyResult& out) {
+  const std::size_t n = out.parameters.size();
   for (std::size_t j = 0; j < n; ++j) {
     const auto jj = static_cast<Eigen::Index>(j);
-    auto& fp = out.parameters[j];
-    if (d(jj) == 0.0 || null_weight(jj) > 1e-2) continue;  // not determined: infinite interval
-    const double sd = std::sqrt(std::max(cov(jj, jj), 0.0));
-    if (fp.scale == ParamScale::Log) {
-      const double a = fp.value * std::exp(-1.96 * sd), b = fp.value * std::exp(1.96 * sd);
-      fp.wald_low = std::min(a, b);
-      fp.wald_high = std::max(a, b);
-      fp.std_error = std::fabs(fp.value) * sd;
-      fp.determined =
-          std::isfinite(sd) && 2.0 * 1.96 * sd < std::fabs(std::log(fp.upper / fp.lower));
-    } else {
-      fp.wald_low = fp.value - 1.96 * sd;
-      fp.wald_high = fp.value + 1.96 * sd;
-      fp.std_error = sd;
-      fp.determined = std::isfinite(sd) && 2.0 * 1.96 * sd < fp.upper - fp.lower;
-    }
-    if (fp.determined) {
-      fp.ci_low = fp.wald_low;
-      fp.ci_high = fp.wald_high;
-    }
+    if (c.d(jj) == 0.0 || c.null_weight(jj) > 1e-2) continue;  // not determined
+    set_linearised_interval(out.parameters[j], std::sqrt(std::max(c.cov(jj, jj), 0.0)));
     for (std::size_t k = 0; k < n; ++k) {
       const auto kk = static_cast<Eigen::Index>(k);
-      const double den = std::sqrt(cov(jj, jj) * cov(kk, kk));
-      out.correlation[j][k] = den > 0 ? cov(jj, kk) / den : 0.0;
+      const double den = std::sqrt(c.cov(jj, jj) * c.cov(kk, kk));
+      out.correlation[j][k] = den > 0 ? c.cov(jj, kk) / den : 0.0;
     }
   }
+}
 
-  // Profile likelihood where the linearisation cannot hold: a parameter on a bound (the
-  // optimum is not stationary there) or whose linearised interval leaves the bounds.
-  if (!o.profile || !(dof > 0)) return;
+// Profile likelihood where the linearisation cannot hold: a parameter on a bound (the
+// optimum is not stationary there) or whose linearised interval leaves the bounds.
+void set_profile_intervals(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u,
+                           double f, double dof, const IdentifyOptions& o, Collective& comm,
+                           IdentifyResult& out) {
   const double chi_opt = f * f;
   const double thr = 3.841458820694124 * chi_opt / dof;  // chi^2_1(95 %) s^2
   double lowest = chi_opt;
   std::vector<double> lowest_u = u;
   std::vector<std::string> profiled;
-  for (std::size_t j = 0; j < n; ++j) {
+  for (std::size_t j = 0; j < out.parameters.size(); ++j) {
     auto& fp = out.parameters[j];
     const bool leaves = !(fp.wald_low >= fp.lower && fp.wald_high <= fp.upper);
     if (!fp.at_bound && !leaves) continue;
@@ -235,6 +238,49 @@ void fill_covariance(const Objective& obj, BatchEvaluator& ev, const std::vector
         "one; rerun with more generations or islands",
         std::sqrt(lowest), f));
   }
+}
+
+}  // namespace
+
+FittedParameter fitted_parameter(const Objective& obj, std::size_t j, double value) {
+  const auto& spec = obj.fit().parameters[j];
+  FittedParameter fp;
+  fp.name = obj.names()[j];
+  fp.unit = obj.units()[j];
+  fp.scale = spec.scale;
+  fp.lower = spec.lower;
+  fp.upper = spec.upper;
+  fp.value = value;
+  return fp;
+}
+
+void fill_covariance(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u,
+                     double f, const IdentifyOptions& o, Collective& comm, IdentifyResult& out) {
+  const std::size_t n = obj.dim(), m = obj.residual_count();
+  const auto p = obj.to_params(u);
+  out.parameters.clear();
+  for (std::size_t j = 0; j < n; ++j)
+    out.parameters.push_back(unbounded_parameter(obj, j, p[j], u[j]));
+  out.correlation.assign(n, std::vector<double>(n, 0.0));
+  out.residual_count = m;
+  std::vector<double> r, Jv;
+  if (!jacobian(obj, ev, u, o.fd_step, r, Jv)) {
+    out.covariance_ok = false;
+    out.covariance_note = "the model cannot be evaluated at the optimum";
+    return;
+  }
+  const Eigen::MatrixXd J = jacobian_in_theta(Jv, m, n, obj.theta_per_unit());
+  double ss = 0.0;
+  for (double v : r) ss += v * v;
+  const double dof = static_cast<double>(m) - static_cast<double>(n);
+  const double s2 = dof > 0 ? ss / dof : 0.0;
+  out.residual_sigma = std::sqrt(s2);
+  const Covariance c = scaled_covariance(J, s2);
+  out.covariance_ok = true;
+  out.covariance_note = covariance_note(m, n, out.residual_sigma, c);
+  set_linearised_intervals(c, out);
+  if (!o.profile || !(dof > 0)) return;
+  set_profile_intervals(obj, ev, u, f, dof, o, comm, out);
 }
 
 }  // namespace gmasim::identify_detail

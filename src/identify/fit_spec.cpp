@@ -171,6 +171,117 @@ ClaimFitTarget resolve_claim(const toml::table& t, const std::string& src,
   return *ft;
 }
 
+// The target's kind: the claim's, or `kind = "..."`.
+const KindName& target_kind(const toml::table& t, const std::string& src, long line,
+                            const ClaimFitTarget* from) {
+  const auto kind = from ? std::optional<std::string>(from->kind) : t["kind"].value<std::string>();
+  const KindName* kn = kind ? find_kind(*kind) : nullptr;
+  if (!kn) {
+    throw InputError(located(src, line,
+                             fmt::format("[[target]]: kind must be one of {}{}", kind_list(),
+                                         kind ? fmt::format(" (got '{}')", *kind) : "")));
+  }
+  return *kn;
+}
+
+// The numbers of one [[target]] table: written in it, or given by the claim it names
+// (`from`; such a number must not be written again).
+class TargetFields {
+ public:
+  TargetFields(const toml::table& t, const std::string& src, long line, const KindName& kind,
+               const ClaimFitTarget* from, const std::string& claim_id)
+      : t_(t), src_(src), line_(line), kind_(kind), from_(from), claim_id_(claim_id) {}
+
+  double required(std::string_view key) const {
+    bool found = false;
+    const double v = given(key, found);
+    if (!found) {
+      throw InputError(located(
+          src_, line_,
+          fmt::format("[[target]] {}: missing {}{}", kind_.name, key,
+                      from_ ? fmt::format(" (claim '{}' does not give it)", claim_id_) : "")));
+    }
+    return v;
+  }
+  double optional(std::string_view key, double def) const {
+    bool found = false;
+    const double v = given(key, found);
+    return found ? v : def;
+  }
+  // Throws "src:line: [[target]] <kind>: <msg>".
+  [[noreturn]] void fail(const std::string& msg) const {
+    throw InputError(located(src_, line_, fmt::format("[[target]] {}: {}", kind_.name, msg)));
+  }
+
+ private:
+  // What the claim gives: its value and condition (NaN: the claim does not give it).
+  double from_claim(std::string_view key) const {
+    if (!from_) return std::numeric_limits<double>::quiet_NaN();
+    const ClaimCondition& c = from_->condition;
+    if (key == "value") return from_->value;
+    if (key == "temperature_C") return c.temperature_C;
+    if (key == "reference_temperature_C") return c.reference_temperature_C;
+    if (key == "current_pp_A") return c.current_pp_A;
+    if (key == "frequency_Hz") return c.frequency_Hz;
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  double given(std::string_view key, bool& found) const {
+    const double c = from_claim(key);
+    const double v = number(t_, key, src_, found);
+    if (!std::isnan(c)) {
+      if (found) {
+        throw InputError(located(src_, line_of(*t_.get(key)),
+                                 fmt::format("[[target]] {}: {} comes from claim '{}' ({:g}); "
+                                             "leave it out",
+                                             kind_.name, key, claim_id_, c)));
+      }
+      found = true;
+      return c;
+    }
+    return v;
+  }
+
+  const toml::table& t_;
+  const std::string& src_;
+  long line_;
+  const KindName& kind_;
+  const ClaimFitTarget* from_;
+  const std::string& claim_id_;
+};
+
+// A target computed from a biased-sine run: its current and frequency, in range.
+void read_sine_condition(const TargetFields& in, FitTarget& g) {
+  g.current_pp_A = in.required("current_pp_A");
+  g.frequency_Hz = in.required("frequency_Hz");
+  g.current_min_A = in.optional("current_min_A", -3.0);
+  if (!(g.current_pp_A > 0.0) || !(g.frequency_Hz > 0.0))
+    in.fail("current_pp_A and frequency_Hz must be > 0");
+  auto range = [&](const char* key, double v, double lo, double hi, const char* unit) {
+    if (!(std::isfinite(v) && v >= lo && v <= hi))
+      in.fail(fmt::format("{} = {:g} {}: must be in [{:g}, {:g}]", key, v, unit, lo, hi));
+  };
+  range("current_pp_A", g.current_pp_A, 0.0, 2.0 * kMaxCurrent_A, "A");
+  range("frequency_Hz", g.frequency_Hz, 0.0, kMaxFrequency_Hz, "Hz");
+  range("current_min_A", g.current_min_A, -kMaxCurrent_A, kMaxCurrent_A, "A");
+}
+
+// The relative weight and the scale of the error (default |value|).
+void read_weight_and_scale(const TargetFields& in, FitTarget& g) {
+  g.weight = in.optional("weight", 1.0);
+  if (!(g.weight > 0.0)) in.fail("weight must be > 0");
+  // Relative weights: an extreme one scales every other residual to nothing (issue 8).
+  if (!(g.weight >= 1e-6 && g.weight <= 1e6))
+    in.fail(fmt::format("weight = {:g}: must be in [1e-6, 1e6]", g.weight));
+  g.scale = in.optional("scale", 0.0);
+  if (g.scale < 0.0) in.fail("scale must be > 0");
+  if (g.scale == 0.0) g.scale = std::fabs(g.value);
+  if (!(g.scale > 0.0)) {
+    in.fail(
+        "value 0 needs an explicit scale (the error is 100 (sim - value) / "
+        "scale %)");
+  }
+}
+
 FitTarget read_target(const toml::table& t, const std::string& src, const ClaimsData* claims) {
   check_keys(t,
              {"kind", "claim", "label", "temperature_C", "reference_temperature_C", "current_pp_A",
@@ -184,111 +295,26 @@ FitTarget read_target(const toml::table& t, const std::string& src, const Claims
     from = resolve_claim(t, src, claims ? *claims : builtin_claims());
     claim_id = *t["claim"].value<std::string>();
   }
-  const auto kind = from ? std::optional<std::string>(from->kind) : t["kind"].value<std::string>();
-  const KindName* kn = kind ? find_kind(*kind) : nullptr;
-  if (!kn) {
-    throw InputError(located(src, g.line,
-                             fmt::format("[[target]]: kind must be one of {}{}", kind_list(),
-                                         kind ? fmt::format(" (got '{}')", *kind) : "")));
-  }
-  g.kind = kn->kind;
-  // What a claim gives: its value and condition (NaN: the claim does not give it).
-  auto from_claim = [&](std::string_view key) {
-    if (!from) return std::numeric_limits<double>::quiet_NaN();
-    const ClaimCondition& c = from->condition;
-    if (key == "value") return from->value;
-    if (key == "temperature_C") return c.temperature_C;
-    if (key == "reference_temperature_C") return c.reference_temperature_C;
-    if (key == "current_pp_A") return c.current_pp_A;
-    if (key == "frequency_Hz") return c.frequency_Hz;
-    return std::numeric_limits<double>::quiet_NaN();
-  };
-  bool f = false;
-  auto given = [&](std::string_view key, bool& found) {
-    const double c = from_claim(key);
-    const double v = number(t, key, src, found);
-    if (!std::isnan(c)) {
-      if (found) {
-        throw InputError(located(src, line_of(*t.get(key)),
-                                 fmt::format("[[target]] {}: {} comes from claim '{}' ({:g}); "
-                                             "leave it out",
-                                             kn->name, key, claim_id, c)));
-      }
-      found = true;
-      return c;
-    }
-    return v;
-  };
-  auto req = [&](std::string_view key) {
-    const double v = given(key, f);
-    if (!f) {
-      throw InputError(located(
-          src, g.line,
-          fmt::format("[[target]] {}: missing {}{}", kn->name, key,
-                      from ? fmt::format(" (claim '{}' does not give it)", claim_id) : "")));
-    }
-    return v;
-  };
-  auto opt = [&](std::string_view key, double def) {
-    const double v = given(key, f);
-    return f ? v : def;
-  };
-  g.value = req("value");
-  g.temperature_C = req("temperature_C");
-  if (kn->sine) {
-    g.current_pp_A = req("current_pp_A");
-    g.frequency_Hz = req("frequency_Hz");
-    g.current_min_A = opt("current_min_A", -3.0);
-    if (!(g.current_pp_A > 0.0) || !(g.frequency_Hz > 0.0)) {
-      throw InputError(located(src, g.line,
-                               fmt::format("[[target]] {}: current_pp_A and "
-                                           "frequency_Hz must be > 0",
-                                           kn->name)));
-    }
-    auto range = [&](const char* key, double v, double lo, double hi, const char* unit) {
-      if (!(std::isfinite(v) && v >= lo && v <= hi))
-        throw InputError(located(src, g.line,
-                                 fmt::format("[[target]] {}: {} = {:g} {}: must be in [{:g}, {:g}]",
-                                             kn->name, key, v, unit, lo, hi)));
-    };
-    range("current_pp_A", g.current_pp_A, 0.0, 2.0 * kMaxCurrent_A, "A");
-    range("frequency_Hz", g.frequency_Hz, 0.0, kMaxFrequency_Hz, "Hz");
-    range("current_min_A", g.current_min_A, -kMaxCurrent_A, kMaxCurrent_A, "A");
+  const KindName& kn = target_kind(t, src, g.line, from ? &*from : nullptr);
+  g.kind = kn.kind;
+  const TargetFields in(t, src, g.line, kn, from ? &*from : nullptr, claim_id);
+  g.value = in.required("value");
+  g.temperature_C = in.required("temperature_C");
+  if (kn.sine) {
+    read_sine_condition(in, g);
   } else {
-    g.bias_A = opt("bias_A", 1.0);
+    g.bias_A = in.optional("bias_A", 1.0);
     if (!(std::fabs(g.bias_A) <= kMaxCurrent_A))
-      throw InputError(located(src, g.line,
-                               fmt::format("[[target]] {}: bias_A = {:g} A: must be in [-{:g}, "
-                                           "{:g}]",
-                                           kn->name, g.bias_A, kMaxCurrent_A, kMaxCurrent_A)));
+      in.fail(fmt::format("bias_A = {:g} A: must be in [-{:g}, {:g}]", g.bias_A, kMaxCurrent_A,
+                          kMaxCurrent_A));
   }
-  if (kn->needs_reference) g.reference_temperature_C = opt("reference_temperature_C", 20.0);
-  g.weight = opt("weight", 1.0);
-  if (!(g.weight > 0.0))
-    throw InputError(
-        located(src, g.line, fmt::format("[[target]] {}: weight must be > 0", kn->name)));
-  // Relative weights: an extreme one scales every other residual to nothing (issue 8).
-  if (!(g.weight >= 1e-6 && g.weight <= 1e6))
-    throw InputError(located(
-        src, g.line,
-        fmt::format("[[target]] {}: weight = {:g}: must be in [1e-6, 1e6]", kn->name, g.weight)));
-  g.scale = opt("scale", 0.0);
-  if (g.scale < 0.0)
-    throw InputError(
-        located(src, g.line, fmt::format("[[target]] {}: scale must be > 0", kn->name)));
-  if (g.scale == 0.0) g.scale = std::fabs(g.value);
-  if (!(g.scale > 0.0)) {
-    throw InputError(located(src, g.line,
-                             fmt::format("[[target]] {}: value 0 needs an explicit "
-                                         "scale (the error is 100 (sim - value) / "
-                                         "scale %)",
-                                         kn->name)));
-  }
+  if (kn.needs_reference) g.reference_temperature_C = in.optional("reference_temperature_C", 20.0);
+  read_weight_and_scale(in, g);
   const auto label = t["label"].value<std::string>();
   g.label = label ? *label
-                  : (kn->sine ? fmt::format("{} {:g}C {:g}A {:g}Hz", kn->name, g.temperature_C,
-                                            g.current_pp_A, g.frequency_Hz)
-                              : fmt::format("{} {:g}C {:g}A", kn->name, g.temperature_C, g.bias_A));
+                  : (kn.sine ? fmt::format("{} {:g}C {:g}A {:g}Hz", kn.name, g.temperature_C,
+                                           g.current_pp_A, g.frequency_Hz)
+                             : fmt::format("{} {:g}C {:g}A", kn.name, g.temperature_C, g.bias_A));
   if (from && !label) g.label = fmt::format("{} ({})", claim_id, g.label);
   return g;
 }

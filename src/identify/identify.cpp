@@ -13,13 +13,12 @@ namespace gmasim {
 
 using namespace identify_detail;
 
-IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, const FitSpec& fit,
-                        const IdentifyOptions& o) {
-  const auto t0 = std::chrono::steady_clock::now();
-  auto serial = make_serial_communicator();
-  Collective& comm = collective(o.comm ? *o.comm : *serial);
+namespace {
 
-  // ---- options ------------------------------------------------------------------------
+using Clock = std::chrono::steady_clock;
+
+// The options no other part checks before the search needs them.
+void check_options(const IdentifyOptions& o) {
   if (o.algorithm != "sga" && o.algorithm != "de" && o.algorithm != "sade" &&
       o.algorithm != "cmaes")
     throw InputError(fmt::format("--algorithm {}: must be sga, de, sade or cmaes", o.algorithm));
@@ -39,6 +38,89 @@ IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, cons
   if (o.refine_iterations < 0) throw InputError("--refine-iterations: must be >= 0");
   if (!(o.fd_step > 0.0 && o.fd_step < 0.1)) throw InputError("--fd-step: must be in (0, 0.1)");
   if (o.mpi_every < 0) throw InputError("--mpi-every: must be >= 0");
+}
+
+// The start model must evaluate: a search from a model that cannot be simulated under
+// these settings would penalise every candidate alike and end "successfully" with nothing
+// determined (issue 8). A candidate that fails later is penalised; the start is not.
+void check_start_evaluates(const Objective& obj, const std::vector<double>& u_start,
+                           double f_start) {
+  if (f_start < Objective::kPenalty) return;
+  const std::string why = obj.failure_reason(u_start);
+  throw InputError(fmt::format("the start model cannot be evaluated: {}{}",
+                               why.empty() ? "its error is not finite" : why,
+                               "; fix the start model or the settings before searching"));
+}
+
+// Levenberg-Marquardt from the GA's best (u, f), which it replaces when it is better; its
+// iterations continue the GA's history in res.
+void refine_champion(const Objective& obj, BatchEvaluator& ev, const GaOutcome& ga,
+                     const IdentifyOptions& o, Collective& comm, Clock::time_point t0,
+                     std::vector<double>& u, double& f, IdentifyResult& res) {
+  const double wall_before = ga.history.empty() ? 0.0 : ga.history.back().wall_s - ga.wall_s;
+  const long ga_evals = ga.evaluations;
+  if (o.refine && !res.interrupted && o.refine_iterations > 0) {
+    auto on_iter = [&](int it, double rms) {
+      HistoryEntry h;
+      h.phase = "refine";
+      h.step = it;
+      h.evaluations = ga_evals + ev.evaluations();
+      h.best_rms_pct = rms;
+      h.wall_s = wall_before + std::chrono::duration<double>(Clock::now() - t0).count();
+      res.history.push_back(h);
+      if (comm.rank() == 0 && o.progress)
+        o.progress({"refine", it, o.refine_iterations, rms, h.evaluations, 0.0, h.wall_s});
+    };
+    RefineOutcome ro = refine_lm(obj, ev, u, o, comm, on_iter);
+    res.refine_summary = ro.summary;
+    res.interrupted = ro.interrupted;
+    if (ro.f < f) {  // never worse than the GA champion
+      f = ro.f;
+      u = ro.u;
+    }
+  } else if (!o.refine || o.refine_iterations == 0) {
+    res.refine_summary = "no refinement (--no-refine)";
+  } else {
+    res.refine_summary = "interrupted before the refinement";
+  }
+}
+
+// The fitted parameters at the optimum (u, f) with their intervals; after an interruption
+// the values without intervals (a clean, fast stop).
+void set_parameters(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u,
+                    double f, const IdentifyOptions& o, Collective& comm, IdentifyResult& res) {
+  if (!res.interrupted) {
+    IdentifyOptions oc = o;
+    if (!o.refine || o.refine_iterations == 0) {
+      // Not refined: the point is not a minimum, a profile around it would mean nothing.
+      oc.profile = false;
+      res.notes.push_back(
+          "not refined: the intervals are linearised at the GA champion, which "
+          "is not a minimum; refine for meaningful intervals");
+    }
+    fill_covariance(obj, ev, u, f, oc, comm, res);
+    return;
+  }
+  const auto p = obj.to_params(u);
+  for (std::size_t j = 0; j < obj.dim(); ++j) {
+    FittedParameter fp = fitted_parameter(obj, j, p[j]);
+    fp.std_error = std::nan("");
+    fp.ci_low = fp.ci_high = fp.wald_low = fp.wald_high = std::nan("");
+    fp.determined = false;
+    fp.ci_method = "none";
+    res.parameters.push_back(fp);
+  }
+  res.covariance_note = "interrupted: no confidence intervals";
+}
+
+}  // namespace
+
+IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, const FitSpec& fit,
+                        const IdentifyOptions& o) {
+  const auto t0 = Clock::now();
+  auto serial = make_serial_communicator();
+  Collective& comm = collective(o.comm ? *o.comm : *serial);
+  check_options(o);
 
   const Objective obj(start, data, fit, o.objective);
   const int threads = o.threads > 0
@@ -56,18 +138,10 @@ IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, cons
   const std::vector<double> u_start = obj.start_unit();
   const double f_start = obj.rms_pct(u_start);
   res.start_rms_pct = f_start;
-  // The start model must evaluate: a search from a model that cannot be simulated under
-  // these settings would penalise every candidate alike and end "successfully" with nothing
-  // determined (issue 8). A candidate that fails later is penalised; the start is not.
-  if (f_start >= Objective::kPenalty) {
-    const std::string why = obj.failure_reason(u_start);
-    throw InputError(fmt::format("the start model cannot be evaluated: {}{}",
-                                 why.empty() ? "its error is not finite" : why,
-                                 "; fix the start model or the settings before searching"));
-  }
+  check_start_evaluates(obj, u_start, f_start);
 
-  // ---- global search ------------------------------------------------------------------
-  GaOutcome ga = run_ga(obj, o, comm, u_start, f_start);
+  // ---- global search, local refinement ------------------------------------------------
+  const GaOutcome ga = run_ga(obj, o, comm, u_start, f_start);
   res.history = ga.history;
   res.generations_done = ga.generation;
   res.resumed = ga.resumed;
@@ -76,63 +150,13 @@ IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, cons
   res.ga_evals_per_s = ga.wall_s > 0 ? static_cast<double>(ga.run_evaluations) / ga.wall_s : 0.0;
   std::vector<double> u = ga.best_u;
   double f = ga.best_f;
-
-  // ---- local refinement ---------------------------------------------------------------
-  const double wall_before = ga.history.empty() ? 0.0 : ga.history.back().wall_s - ga.wall_s;
-  const long ga_evals = ga.evaluations;
-  if (o.refine && !res.interrupted && o.refine_iterations > 0) {
-    auto on_iter = [&](int it, double rms) {
-      HistoryEntry h;
-      h.phase = "refine";
-      h.step = it;
-      h.evaluations = ga_evals + ev.evaluations();
-      h.best_rms_pct = rms;
-      h.wall_s = wall_before +
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      res.history.push_back(h);
-      if (comm.rank() == 0 && o.progress)
-        o.progress({"refine", it, o.refine_iterations, rms, h.evaluations, 0.0, h.wall_s});
-    };
-    RefineOutcome ro = refine_lm(obj, ev, u, o, comm, on_iter);
-    res.refine_summary = ro.summary;
-    res.interrupted = ro.interrupted;
-    if (ro.f < f) {  // never worse than the GA champion
-      f = ro.f;
-      u = ro.u;
-    }
-  } else if (!o.refine || o.refine_iterations == 0) {
-    res.refine_summary = "no refinement (--no-refine)";
-  } else {
-    res.refine_summary = "interrupted before the refinement";
-  }
+  refine_champion(obj, ev, ga, o, comm, t0, u, f, res);
 
   // ---- result -------------------------------------------------------------------------
   res.unit_optimum = u;
   res.rms_pct = f;
   res.spec = obj.spec_at(u);
-  if (!res.interrupted) {
-    IdentifyOptions oc = o;
-    if (!o.refine || o.refine_iterations == 0) {
-      // Not refined: the point is not a minimum, a profile around it would mean nothing.
-      oc.profile = false;
-      res.notes.push_back(
-          "not refined: the intervals are linearised at the GA champion, which "
-          "is not a minimum; refine for meaningful intervals");
-    }
-    fill_covariance(obj, ev, u, f, oc, comm, res);
-  } else {
-    // Interrupted: the values without intervals (a clean, fast stop).
-    const auto p = obj.to_params(u);
-    for (std::size_t j = 0; j < obj.dim(); ++j) {
-      FittedParameter fp = fitted_parameter(obj, j, p[j]);
-      fp.std_error = std::nan("");
-      fp.ci_low = fp.ci_high = fp.wald_low = fp.wald_high = std::nan("");
-      fp.determined = false;
-      fp.ci_method = "none";
-      res.parameters.push_back(fp);
-    }
-    res.covariance_note = "interrupted: no confidence intervals";
-  }
+  set_parameters(obj, ev, u, f, o, comm, res);
   const auto p_start = obj.to_params(u_start);
   for (std::size_t j = 0; j < res.parameters.size(); ++j) {
     res.parameters[j].start = p_start[j];
@@ -143,7 +167,7 @@ IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, cons
     res.targets = obj.target_fits(u);
   }
   res.evaluations = ga.evaluations + ev.evaluations() + 1;
-  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  res.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
   return res;
 }
 

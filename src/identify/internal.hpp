@@ -42,9 +42,15 @@ struct IslandPopulation {
   std::vector<double> f;
 };
 
+// Hashes of what a checkpoint's search depends on: the fitted parameters and bounds, the
+// data, the objective settings and targets, and the layout (algorithm, ranks, islands, ...).
+struct Fingerprints {
+  std::string parameters, data, settings, layout;
+};
+
 struct Checkpoint {
   int version = 1;
-  std::string fp_parameters, fp_data, fp_settings, fp_layout;  // fingerprints
+  Fingerprints fp;  // of the run that wrote it
   std::string algorithm;
   int ranks = 1, islands = 0, population = 0, dim = 0;
   unsigned seed = 0;
@@ -57,9 +63,6 @@ struct Checkpoint {
   std::vector<std::vector<IslandPopulation>> rank_islands;  // [rank][island]
 };
 
-struct Fingerprints {
-  std::string parameters, data, settings, layout;
-};
 Fingerprints fingerprints(const Objective& obj, const IdentifyOptions& o, int ranks);
 
 // Text of one rank's islands (gathered to rank 0), and the whole file.

@@ -159,6 +159,109 @@ void write_history(JsonWriter& w, const HistoryEntry& h) {
   w.end_object();
 }
 
+// The fit report's head: command, inputs, the error, the search and its cost.
+std::string markdown_summary(const IdentifyResult& r, const FitProvenance& p) {
+  std::string s = "# gmasim identify: fit report\n\n";
+  if (!p.command.empty()) s += fmt::format("Command: `{}`\n\n", p.command);
+  s += fmt::format("- data: {}\n- fit spec: {}\n- start model: {}\n", data_label(r, p),
+                   p.fit.empty() ? "-" : p.fit, p.start_model);
+  s += fmt::format(
+      "- **weighted RMS error {:.4g} %** of peak-to-peak (start {:.4g} %, after the "
+      "GA {:.4g} %)\n",
+      r.rms_pct, r.start_rms_pct, r.ga_rms_pct);
+  s += fmt::format("- {}: {} rank(s) x {} islands x {} individuals, {} generations{}{}\n",
+                   r.algorithm, r.ranks, r.islands, r.population, r.generations_done,
+                   r.resumed ? " (resumed from a checkpoint)" : "",
+                   r.interrupted ? ", **interrupted: best so far**" : "");
+  s += fmt::format("- refinement: {}\n", r.refine_summary);
+  s += fmt::format("- {} model evaluations, {:.1f} s wall, GA {:.1f} evaluations/s\n\n",
+                   r.evaluations, r.wall_s, r.ga_evals_per_s);
+  return s;
+}
+
+// The parameters table with the intervals, and how they were computed.
+std::string markdown_parameters(const IdentifyResult& r) {
+  std::string s = "## Parameters\n\n";
+  s += "95 % confidence intervals from the Jacobian of the normalised residuals at the optimum "
+       "(central differences; cov = s^2 (J^T J)^-1 with s^2 from the residuals; log-scale "
+       "parameters have multiplicative intervals). A parameter whose linearised interval is "
+       "wider than its bounds is *not determined*: the data do not constrain it within the "
+       "bounds, and its reported interval is the bounds. For a parameter on a bound, or whose "
+       "linearised interval leaves the bounds, the linearisation cannot hold and the interval "
+       "is the profile likelihood instead (u_j held at trial values, the others re-fitted, "
+       "the range where the sum of squares stays within 3.84 s^2 of its minimum).\n\n";
+  s += "| parameter | unit | start | fitted | 95 % CI | linearised | std. error | bounds | |\n";
+  s += "|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& fp : r.parameters) {
+    std::string flag = fp.determined ? "" : "not determined";
+    if (fp.at_bound) flag += flag.empty() ? "at a bound" : ", at a bound";
+    s += fmt::format("| {} | {} | {:.6g} | {:.6g} | {} | {} | {:.3g} | [{:.4g}, {:.4g}]{} | {} |\n",
+                     fp.name, fp.unit, fp.start, fp.value,
+                     fp.determined || std::isnan(fp.ci_low)
+                         ? ci_text(fp)
+                         : fmt::format("[{:.6g}, {:.6g}] = bounds", fp.ci_low, fp.ci_high),
+                     wald_text(fp), fp.std_error, fp.lower, fp.upper,
+                     fp.scale == ParamScale::Log ? " log" : "", flag);
+  }
+  s += fmt::format("\n{}\n\n", r.covariance_note);
+  return s;
+}
+
+std::string markdown_correlation(const IdentifyResult& r) {
+  std::string s = "## Correlation matrix\n\n|   |";
+  for (std::size_t j = 0; j < r.parameters.size(); ++j) s += fmt::format(" {} |", j + 1);
+  s += "\n|---|";
+  for (std::size_t j = 0; j < r.parameters.size(); ++j) s += "---|";
+  s += "\n";
+  for (std::size_t j = 0; j < r.correlation.size(); ++j) {
+    s += fmt::format("| {} {} |", j + 1, r.parameters[j].name);
+    for (double c : r.correlation[j]) s += fmt::format(" {:+.2f} |", c);
+    s += "\n";
+  }
+  s += "\n|correlation| close to 1 means the data determine only a combination of the two "
+       "parameters.\n\n";
+  return s;
+}
+
+// Each condition's fit (in the record's response unit), and where its overlay is.
+std::string markdown_conditions(const IdentifyResult& r) {
+  std::string s =
+      "## Conditions\n\np-p, RMS and max err are in the record's response unit: um of "
+      "displacement_um, ppm of strain_ppm. f = 0: not periodic (or quasi-static).\n\n"
+      "| condition | T [degC] | f [Hz] | I p-p [A] | weight | p-p | RMS | RMS [%] | max err | "
+      "flux RMS [%] |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto& c : r.conditions) {
+    if (c.failed) {
+      s += fmt::format("| {} | {:g} | {:g} | {:g} | {:g} | - | failed: {} | | | |\n", c.label,
+                       c.condition.temperature_C, c.condition.frequency_Hz,
+                       c.condition.current_pp_A, c.weight, c.error);
+      continue;
+    }
+    s += fmt::format(
+        "| {} | {:g} | {:g} | {:g} | {:g} | {:.3f} {} | {:.4f} {} | {:.3f} | {:.4f} {} | {} |\n",
+        c.label, c.condition.temperature_C, c.condition.frequency_Hz, c.condition.current_pp_A,
+        c.weight, c.pp_um, c.response_unit, c.rms_um, c.response_unit, c.rms_pct, c.max_err_um,
+        c.response_unit, c.flux_rms_pct >= 0 ? fmt::format("{:.3f}", c.flux_rms_pct) : "-");
+  }
+  s += "\nOverlays (measured vs simulated): `overlay_<condition>.csv`, drawn into "
+       "`overlay_<condition>.png` by `python3 -m gmasim.command_figures identify <this "
+       "directory>`.\n\n";
+  return s;
+}
+
+std::string markdown_targets(const IdentifyResult& r) {
+  std::string s =
+      "## Scalar targets\n\n| target | kind | value | simulated | error [%] | weight |\n"
+      "|---|---|---|---|---|---|\n";
+  for (const auto& t : r.targets) {
+    s += fmt::format("| {} | {} | {:.6g} | {} | {} | {:g} |\n", t.label, t.kind, t.value,
+                     t.failed ? "failed" : fmt::format("{:.6g}", t.simulated),
+                     t.failed ? "-" : fmt::format("{:+.3f}", t.error_pct), t.weight);
+  }
+  s += "\n";
+  return s;
+}
+
 }  // namespace
 
 std::string fitted_model_toml(const std::string& start_text, const ModelSpec& start,
@@ -291,92 +394,11 @@ std::string fit_report_json(const IdentifyResult& r, const FitProvenance& p) {
 }
 
 std::string fit_report_markdown(const IdentifyResult& r, const FitProvenance& p) {
-  std::string s = "# gmasim identify: fit report\n\n";
-  if (!p.command.empty()) s += fmt::format("Command: `{}`\n\n", p.command);
-  s += fmt::format("- data: {}\n- fit spec: {}\n- start model: {}\n", data_label(r, p),
-                   p.fit.empty() ? "-" : p.fit, p.start_model);
-  s += fmt::format(
-      "- **weighted RMS error {:.4g} %** of peak-to-peak (start {:.4g} %, after the "
-      "GA {:.4g} %)\n",
-      r.rms_pct, r.start_rms_pct, r.ga_rms_pct);
-  s += fmt::format("- {}: {} rank(s) x {} islands x {} individuals, {} generations{}{}\n",
-                   r.algorithm, r.ranks, r.islands, r.population, r.generations_done,
-                   r.resumed ? " (resumed from a checkpoint)" : "",
-                   r.interrupted ? ", **interrupted: best so far**" : "");
-  s += fmt::format("- refinement: {}\n", r.refine_summary);
-  s += fmt::format("- {} model evaluations, {:.1f} s wall, GA {:.1f} evaluations/s\n\n",
-                   r.evaluations, r.wall_s, r.ga_evals_per_s);
-
-  s += "## Parameters\n\n";
-  s += "95 % confidence intervals from the Jacobian of the normalised residuals at the optimum "
-       "(central differences; cov = s^2 (J^T J)^-1 with s^2 from the residuals; log-scale "
-       "parameters have multiplicative intervals). A parameter whose linearised interval is "
-       "wider than its bounds is *not determined*: the data do not constrain it within the "
-       "bounds, and its reported interval is the bounds. For a parameter on a bound, or whose "
-       "linearised interval leaves the bounds, the linearisation cannot hold and the interval "
-       "is the profile likelihood instead (u_j held at trial values, the others re-fitted, "
-       "the range where the sum of squares stays within 3.84 s^2 of its minimum).\n\n";
-  s += "| parameter | unit | start | fitted | 95 % CI | linearised | std. error | bounds | |\n";
-  s += "|---|---|---|---|---|---|---|---|---|\n";
-  for (const auto& fp : r.parameters) {
-    std::string flag = fp.determined ? "" : "not determined";
-    if (fp.at_bound) flag += flag.empty() ? "at a bound" : ", at a bound";
-    s += fmt::format("| {} | {} | {:.6g} | {:.6g} | {} | {} | {:.3g} | [{:.4g}, {:.4g}]{} | {} |\n",
-                     fp.name, fp.unit, fp.start, fp.value,
-                     fp.determined || std::isnan(fp.ci_low)
-                         ? ci_text(fp)
-                         : fmt::format("[{:.6g}, {:.6g}] = bounds", fp.ci_low, fp.ci_high),
-                     wald_text(fp), fp.std_error, fp.lower, fp.upper,
-                     fp.scale == ParamScale::Log ? " log" : "", flag);
-  }
-  s += fmt::format("\n{}\n\n", r.covariance_note);
-  if (!r.correlation.empty()) {
-    s += "## Correlation matrix\n\n|   |";
-    for (std::size_t j = 0; j < r.parameters.size(); ++j) s += fmt::format(" {} |", j + 1);
-    s += "\n|---|";
-    for (std::size_t j = 0; j < r.parameters.size(); ++j) s += "---|";
-    s += "\n";
-    for (std::size_t j = 0; j < r.correlation.size(); ++j) {
-      s += fmt::format("| {} {} |", j + 1, r.parameters[j].name);
-      for (double c : r.correlation[j]) s += fmt::format(" {:+.2f} |", c);
-      s += "\n";
-    }
-    s += "\n|correlation| close to 1 means the data determine only a combination of the two "
-         "parameters.\n\n";
-  }
-  if (!r.conditions.empty()) {
-    s += "## Conditions\n\np-p, RMS and max err are in the record's response unit: um of "
-         "displacement_um, ppm of strain_ppm. f = 0: not periodic (or quasi-static).\n\n"
-         "| condition | T [degC] | f [Hz] | I p-p [A] | weight | p-p | RMS | RMS [%] | max err | "
-         "flux RMS [%] |\n|---|---|---|---|---|---|---|---|---|---|\n";
-    for (const auto& c : r.conditions) {
-      if (c.failed) {
-        s += fmt::format("| {} | {:g} | {:g} | {:g} | {:g} | - | failed: {} | | | |\n", c.label,
-                         c.condition.temperature_C, c.condition.frequency_Hz,
-                         c.condition.current_pp_A, c.weight, c.error);
-        continue;
-      }
-      s += fmt::format(
-          "| {} | {:g} | {:g} | {:g} | {:g} | {:.3f} {} | {:.4f} {} | {:.3f} | {:.4f} {} | {} |\n",
-          c.label, c.condition.temperature_C, c.condition.frequency_Hz, c.condition.current_pp_A,
-          c.weight, c.pp_um, c.response_unit, c.rms_um, c.response_unit, c.rms_pct, c.max_err_um,
-          c.response_unit,
-          c.flux_rms_pct >= 0 ? fmt::format("{:.3f}", c.flux_rms_pct) : "-");
-    }
-    s += "\nOverlays (measured vs simulated): `overlay_<condition>.csv`, drawn into "
-         "`overlay_<condition>.png` by `python3 -m gmasim.command_figures identify <this "
-         "directory>`.\n\n";
-  }
-  if (!r.targets.empty()) {
-    s += "## Scalar targets\n\n| target | kind | value | simulated | error [%] | weight |\n"
-         "|---|---|---|---|---|---|\n";
-    for (const auto& t : r.targets) {
-      s += fmt::format("| {} | {} | {:.6g} | {} | {} | {:g} |\n", t.label, t.kind, t.value,
-                       t.failed ? "failed" : fmt::format("{:.6g}", t.simulated),
-                       t.failed ? "-" : fmt::format("{:+.3f}", t.error_pct), t.weight);
-    }
-    s += "\n";
-  }
+  std::string s = markdown_summary(r, p);
+  s += markdown_parameters(r);
+  if (!r.correlation.empty()) s += markdown_correlation(r);
+  if (!r.conditions.empty()) s += markdown_conditions(r);
+  if (!r.targets.empty()) s += markdown_targets(r);
   s += "## Convergence\n\n`convergence.csv` (and `convergence.png`): best weighted RMS error "
        "against generations (GA) and iterations (refinement).\n";
   if (!r.notes.empty()) {

@@ -19,17 +19,10 @@ std::string model_line(const ReproduceResult& r) {
                      r.model_source, r.model_readings, r.wall_time_s);
 }
 
-}  // namespace
-
-std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
-                                    const std::string& dir_s, const std::string& python_exe,
-                                    const std::string& python_path) {
-  namespace fs = std::filesystem;
-  ensure_output_dir(dir_s);
-  const fs::path dir(dir_s);
+// Every experiment's report tables (dir/data/*.csv|json), the loops, and the claims.
+void write_study_data(const Model& m, const ReproduceResult& r, const std::filesystem::path& dir) {
   const std::string data = (dir / "data").string();
   ensure_output_dir(data);
-
   write_report_files(data, "sweep_10Hz", sweep_report(m, r.sweep_10Hz_request, r.sweep_10Hz));
   write_report_files(data, "sweep_dynamic",
                      sweep_report(m, r.sweep_dynamic_request, r.sweep_dynamic));
@@ -38,32 +31,63 @@ std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
   write_report_files(data, "ablate", ablate_report(m, r.ablate_request, r.ablate));
   write_report_files(data, "params", params_report(m, r.params_request, r.params));
   write_report_files(data, "thermal", thermal_report(m, r.thermal));
-  write_file_atomic((fs::path(data) / "loops_8A_10Hz.csv").string(), timeseries_csv(r.loops));
+  write_file_atomic((std::filesystem::path(data) / "loops_8A_10Hz.csv").string(),
+                    timeseries_csv(r.loops));
   write_report_files(dir.string(), "claims", claims_report(r.claims));
+}
 
-  // Figures, rendered from the CSVs above by the Python package.
-  std::string figures_note;
-  bool figures = false;
-  if (!python_exe.empty()) {
+// The figures, rendered from the CSVs by the Python package (python_exe empty: not
+// rendered), and how report.md shows one: the image, or its caption and why it is missing.
+class Figures {
+ public:
+  Figures(const std::string& dir, const std::string& python_exe, const std::string& python_path) {
+    if (python_exe.empty()) {
+      note_ = "(figures not rendered: --no-figures)";
+      return;
+    }
     PythonCommand c;
     c.python = python_exe;
     c.python_path = python_path;
     c.module = "gmasim.report_figures";
-    c.args = {dir.string()};
+    c.args = {dir};
     c.stdout_to_stderr = true;  // our standard output is the command's summary
     const int rc = run_python(c);
-    figures = rc == 0;
-    if (!figures)
-      figures_note = fmt::format("(figure rendering failed: `{}` exited with {})", c.text(), rc);
-  } else {
-    figures_note = "(figures not rendered: --no-figures)";
+    rendered_ = rc == 0;
+    if (!rendered_)
+      note_ = fmt::format("(figure rendering failed: `{}` exited with {})", c.text(), rc);
   }
-  auto fig = [&](const std::string& stem, const std::string& caption) {
-    return figures ? fmt::format("![{0}](figures/{1}.png)\n\n*{0}* ([SVG](figures/{1}.svg))\n\n",
-                                 caption, stem)
-                   : fmt::format("*{}* {}\n\n", caption, figures_note);
-  };
 
+  std::string operator()(const std::string& stem, const std::string& caption) const {
+    return rendered_ ? fmt::format("![{0}](figures/{1}.png)\n\n*{0}* ([SVG](figures/{1}.svg))\n\n",
+                                   caption, stem)
+                     : fmt::format("*{}* {}\n\n", caption, note_);
+  }
+
+ private:
+  bool rendered_ = false;
+  std::string note_;
+};
+
+// One line per FRF curve: first resonance, bandwidth and modes beside the paper's.
+std::string frf_lines(const ReproduceResult& r) {
+  std::string md;
+  for (const auto& c : r.frf.curves) {
+    std::string modes;
+    for (double f : c.mode_frequencies_Hz)
+      modes += fmt::format("{}{:.0f}", modes.empty() ? "" : ", ", f);
+    md += fmt::format(
+        "- {:g} degC: first resonance in the band {} (paper {:g} Hz), -3 dB bandwidth {:.0f} Hz "
+        "(paper > {:g} Hz), modes of eq. 15 at the bias point: {} Hz\n",
+        c.temperature_C,
+        c.first_resonance_Hz > 0 ? fmt::format("{:.0f} Hz", c.first_resonance_Hz)
+                                 : std::string("none"),
+        r.frf.paper_first_resonance_Hz, c.bandwidth_3dB_Hz, r.frf.paper_bandwidth_Hz, modes);
+  }
+  return md;
+}
+
+// report.md: the claims, then each experiment with its figures and data files.
+std::string report_markdown(const ReproduceResult& r, const Figures& fig) {
   std::string md;
   md += "# gmasim reproduction of the MCTD paper\n\n";
   md += model_line(r);
@@ -80,18 +104,7 @@ std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
       "Data: `data/sweep_10Hz.csv`, `data/sweep_dynamic.csv` (100/200/400 Hz), "
       "`data/loops_8A_10Hz.csv`.\n\n";
   md += "## Frequency response (Fig. 15)\n\n";
-  for (const auto& c : r.frf.curves) {
-    std::string modes;
-    for (double f : c.mode_frequencies_Hz)
-      modes += fmt::format("{}{:.0f}", modes.empty() ? "" : ", ", f);
-    md += fmt::format(
-        "- {:g} degC: first resonance in the band {} (paper {:g} Hz), -3 dB bandwidth {:.0f} Hz "
-        "(paper > {:g} Hz), modes of eq. 15 at the bias point: {} Hz\n",
-        c.temperature_C,
-        c.first_resonance_Hz > 0 ? fmt::format("{:.0f} Hz", c.first_resonance_Hz)
-                                 : std::string("none"),
-        r.frf.paper_first_resonance_Hz, c.bandwidth_3dB_Hz, r.frf.paper_bandwidth_Hz, modes);
-  }
+  md += frf_lines(r);
   md += "\n";
   md += fig(
       "frf",
@@ -110,6 +123,19 @@ std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
   md += fmt::format(
       "## Thermal expansion (eq. 21)\n\n{:.3f} um/degC (paper: model {:g}, measured {:g}).\n",
       r.thermal.um_per_C, r.thermal.paper_model_um_per_C, r.thermal.paper_measured_um_per_C);
+  return md;
+}
+
+}  // namespace
+
+std::string write_reproduce_outputs(const Model& m, const ReproduceResult& r,
+                                    const std::string& dir_s, const std::string& python_exe,
+                                    const std::string& python_path) {
+  ensure_output_dir(dir_s);
+  const std::filesystem::path dir(dir_s);
+  write_study_data(m, r, dir);
+  const Figures figures(dir.string(), python_exe, python_path);
+  const std::string md = report_markdown(r, figures);
   write_file_atomic((dir / "report.md").string(), md);
   return md;
 }

@@ -8,7 +8,7 @@ PY=/usr/bin/python3
 rm -rf "$WORK"
 mkdir -p "$WORK"
 cd "$WORK"
-TRUTH="$SRC/tests/data/identify_fixture.toml"  # the calibrated printed reading (tests/test_identify.cpp)
+TRUTH="$SRC/tests/data/identify_fixture.toml"  # the calibrated printed reading (tests/identify_fixture.hpp)
 "$GMASIM" identify synthesize --model "$TRUTH" --out data --steps-per-period 200 --samples-per-period 100 \
   --noise 1 --seed 2 >/dev/null
 FIT="$SRC/examples/identify_synthetic/fit.toml"

@@ -1,0 +1,59 @@
+// Helpers shared by the test files: a temporary directory per test and the message of an
+// expected InputError.
+#pragma once
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <system_error>
+
+#include "gmasim/errors.hpp"
+
+namespace gmasim_test {
+
+// A fresh directory below the test temp dir, removed with everything in it at the end of
+// the scope.
+class TempDir {
+ public:
+  TempDir() {
+    static int counter = 0;
+    path_ = std::filesystem::path(::testing::TempDir()) /
+            ("gmasim_test_" + std::to_string(::getpid()) + "_" + std::to_string(++counter));
+    std::filesystem::remove_all(path_);
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  const std::filesystem::path& path() const { return path_; }
+  // Writes `content` to the file `name` in the directory; returns its path.
+  std::string write(const std::string& name, const std::string& content) const {
+    const std::filesystem::path p = path_ / name;
+    std::ofstream(p, std::ios::binary) << content;
+    return p.string();
+  }
+
+ private:
+  std::filesystem::path path_;
+};
+
+// The message of the InputError thrown by `f` (the test fails if none is thrown).
+inline std::string input_error(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const gmasim::InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InputError thrown";
+  return "";
+}
+
+}  // namespace gmasim_test
