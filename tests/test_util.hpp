@@ -5,11 +5,13 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <string>
 #include <system_error>
+#include <vector>
 
 #include "gmasim/errors.hpp"
 
@@ -39,6 +41,14 @@ class TempDir {
     const std::filesystem::path p = path_ / name;
     std::ofstream(p, std::ios::binary) << content;
     return p.string();
+  }
+  // The names of the files in the directory, sorted.
+  std::vector<std::string> entries() const {
+    std::vector<std::string> names;
+    for (const auto& e : std::filesystem::directory_iterator(path_))
+      names.push_back(e.path().filename());
+    std::sort(names.begin(), names.end());
+    return names;
   }
 
  private:
