@@ -5,180 +5,25 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include <set>
 #include <span>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/identify.hpp"
 #include "gmasim/validate.hpp"
-#include "identify/objective_runs.hpp"
-#include "identify/record_run.hpp"
+#include "identify/objective_impl.hpp"
 
 namespace gmasim {
-namespace {
-
-using identify_detail::ResonanceRun;
-using identify_detail::SineMetrics;
-using identify_detail::SineRun;
-using identify_detail::StartCache;
-
-struct Param {
-  std::string key, unit;
-  ParamScale scale = ParamScale::Linear;
-  double lo = 0, hi = 0;
-  double tlo = 0, thi = 0;  // theta bounds: p, or ln|p|
-  double sign = 1.0;
-};
-
-struct CondData {
-  std::size_t index = 0;          // in data.items
-  std::size_t compare_begin = 0;  // first compared sample
-  double pp_um = 0, y_scale = 0;
-  bool flux = false;
-  double ppB = 0, B_scale = 0;
-  std::size_t r_offset = 0, rB_offset = 0;
-};
-
-struct TargetData {
-  FitTarget t;
-  int run = -1, ref_run = -1, res_run = -1;
-  double r_scale = 0;
-  std::size_t r_index = 0;
-};
-
-}  // namespace
-
-// =======================================================================================
-struct Objective::Impl {
-  ModelSpec start;
-  MeasurementSet data;
-  FitSpec fit;
-  ObjectiveSettings settings;
-  std::vector<Param> params;
-  std::vector<std::string> names, units, notes;
-  std::vector<double> start_u;
-  std::vector<CondData> conds;
-  std::vector<SineRun> sine_runs;
-  std::vector<ResonanceRun> res_runs;
-  std::vector<TargetData> targets;
-  std::size_t m = 0;
-
-  double to_param(std::size_t j, double u) const {
-    const Param& p = params[j];
-    const double th = p.tlo + u * (p.thi - p.tlo);
-    return p.scale == ParamScale::Log ? p.sign * std::exp(th) : th;
-  }
-  double to_u(std::size_t j, double v) const {
-    const Param& p = params[j];
-    const double th = p.scale == ParamScale::Log ? std::log(std::fabs(v)) : v;
-    return std::clamp((th - p.tlo) / (p.thi - p.tlo), 0.0, 1.0);
-  }
-
-  // Model at u; throws InputError if a value breaks a model rule.
-  Model model_at(const double* u) const {
-    ModelSpec spec = start;
-    for (std::size_t j = 0; j < params.size(); ++j) spec.set(params[j].key, to_param(j, u[j]));
-    return compile(spec);
-  }
-
-  // The records' residuals. Throws InputError / DivergenceError.
-  void record_residuals(const Model& model, StartCache& starts, double* r) const {
-    std::vector<double> y, B;
-    for (const auto& cd : conds) {
-      const Measurement& meas = data.items[cd.index];
-      const auto& [c, st] =
-          starts.get(meas.condition.temperature_C, identify_detail::record_initial_current(meas));
-      identify_detail::run_record(model, c, st, meas, settings, y, cd.flux ? &B : nullptr);
-      identify_detail::apply_offset(meas.condition.offset, meas.response, cd.compare_begin, y);
-      if (cd.flux)
-        identify_detail::apply_offset(meas.condition.flux_offset, meas.flux_T, cd.compare_begin, B);
-      const std::size_t n = meas.t_s.size();
-      for (std::size_t i = cd.compare_begin; i < n; ++i) {
-        r[cd.r_offset + i - cd.compare_begin] = cd.y_scale * (y[i] - meas.response[i]);
-        if (cd.flux) r[cd.rB_offset + i - cd.compare_begin] = cd.B_scale * (B[i] - meas.flux_T[i]);
-      }
-    }
-  }
-
-  // The simulations of the scalar targets. Throws InputError / DivergenceError.
-  void target_runs(const Model& model, StartCache& starts, std::vector<SineMetrics>& sm,
-                   std::vector<double>& res) const {
-    std::vector<double> I, yy, BB;
-    sm.resize(sine_runs.size());
-    for (std::size_t k = 0; k < sine_runs.size(); ++k)
-      sm[k] = identify_detail::run_sine(model, sine_runs[k], settings, I, yy, BB, starts);
-    res.resize(res_runs.size());
-    for (std::size_t k = 0; k < res_runs.size(); ++k)
-      res[k] = identify_detail::lowest_resonance_Hz(model, res_runs[k]);
-  }
-
-  bool residuals(const double* u, double* r, std::string* why = nullptr) const {
-    try {
-      const Model model = model_at(u);
-      StartCache starts(model);
-      record_residuals(model, starts, r);
-      if (!targets.empty()) {
-        std::vector<SineMetrics> sm;
-        std::vector<double> res;
-        target_runs(model, starts, sm, res);
-        for (const auto& td : targets) {
-          const double sim = target_value(td, sm, res);
-          r[td.r_index] = td.r_scale * (sim - td.t.value);
-        }
-      }
-    } catch (const InputError& e) {
-      if (why) *why = e.what();
-      return false;
-    } catch (const DivergenceError& e) {
-      if (why) *why = e.what();
-      return false;
-    }
-    for (std::size_t i = 0; i < m; ++i)
-      if (!std::isfinite(r[i])) {
-        if (why) *why = fmt::format("residual {} is not finite", i);
-        return false;
-      }
-    return true;
-  }
-
-  static double target_value(const TargetData& td, const std::vector<SineMetrics>& sm,
-                             const std::vector<double>& res) {
-    auto change = [&](auto get) {
-      const double ref = get(sm[static_cast<std::size_t>(td.ref_run)]);
-      return 100.0 * (get(sm[static_cast<std::size_t>(td.run)]) / ref - 1.0);
-    };
-    auto stroke = [](const SineMetrics& s) { return s.stroke_um; };
-    auto hyst = [](const SineMetrics& s) { return s.hysteresis_um; };
-    auto bpp = [](const SineMetrics& s) { return s.B_pp_T; };
-    switch (td.t.kind) {
-      case TargetKind::StrokeUm:
-        return sm[static_cast<std::size_t>(td.run)].stroke_um;
-      case TargetKind::HysteresisUm:
-        return sm[static_cast<std::size_t>(td.run)].hysteresis_um;
-      case TargetKind::BppT:
-        return sm[static_cast<std::size_t>(td.run)].B_pp_T;
-      case TargetKind::StrokeChangePct:
-        return change(stroke);
-      case TargetKind::HysteresisChangePct:
-        return change(hyst);
-      case TargetKind::BppChangePct:
-        return change(bpp);
-      case TargetKind::RetentionPct:
-        return 100.0 + change(stroke);
-      case TargetKind::ResonanceHz:
-      case TargetKind::FrfPeakHz:
-      case TargetKind::BandwidthHz:
-        return res[static_cast<std::size_t>(td.res_run)];
-    }
-    return 0.0;
-  }
-};
-
 // =======================================================================================
 // Construction: the settings, the parameters and their start point, the records, the
 // targets, the run lengths, the residual layout.
 namespace {
+
+using identify_detail::CondData;
+using identify_detail::Param;
+using identify_detail::ResonanceRun;
+using identify_detail::SineRun;
+using identify_detail::TargetData;
 
 void check_settings(const ObjectiveSettings& settings, const MeasurementSet& data,
                     const FitSpec& fit) {
@@ -477,133 +322,6 @@ ModelSpec Objective::spec_at(const std::vector<double>& u) const {
   for (std::size_t j = 0; j < impl_->params.size(); ++j)
     spec.set(impl_->params[j].key, impl_->to_param(j, u[j]));
   return spec;
-}
-
-// =======================================================================================
-// The fit report's view: per record and per target.
-namespace {
-
-// overlay_<label>.csv with the label's unsafe characters replaced, unique among `out`.
-std::string overlay_file(const std::string& label, const std::vector<ConditionFit>& out) {
-  std::string safe;
-  for (char ch : label) {
-    const bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
-                    (ch >= '0' && ch <= '9') || ch == '_' || ch == '-' || ch == '.';
-    safe += ok ? ch : '_';
-  }
-  std::string name = "overlay_" + safe;
-  for (int k = 2;
-       std::any_of(out.begin(), out.end(),
-                   [&](const ConditionFit& o) { return o.overlay_file == name + ".csv"; });
-       ++k)
-    name = fmt::format("overlay_{}_{}", safe, k);
-  return name + ".csv";
-}
-
-// The errors of a simulated record (y, B: offsets applied) and its overlay table.
-void fill_fit(ConditionFit& f, const Measurement& meas, const CondData& cd,
-              const std::vector<double>& y, const std::vector<double>& B) {
-  const bool has_flux = !meas.flux_T.empty();
-  double ss = 0.0, ssB = 0.0;
-  for (std::size_t i = cd.compare_begin; i < f.samples; ++i) {
-    const double d = y[i] - meas.response[i];
-    ss += d * d;
-    f.max_err_um = std::max(f.max_err_um, std::fabs(d));
-    if (has_flux) ssB += (B[i] - meas.flux_T[i]) * (B[i] - meas.flux_T[i]);
-  }
-  f.rms_um = std::sqrt(ss / static_cast<double>(f.compared));
-  f.rms_pct = 100.0 * f.rms_um / f.pp_um;
-  if (has_flux) {
-    const double ppB = peak_to_peak(std::span<const double>(meas.flux_T).subspan(cd.compare_begin));
-    if (ppB > 0.0) f.flux_rms_pct = 100.0 * std::sqrt(ssB / static_cast<double>(f.compared)) / ppB;
-  }
-  TimeSeries& ts = f.overlay;
-  // Timed current/displacement records keep their historical column names; the others
-  // name their own columns (sample index, field, strain).
-  const std::string unit = f.response_unit;
-  ts.names = {meas.condition.quasi_static ? "sample" : "t_s", std::string(meas.drive_column()),
-              "measured_" + unit, "simulated_" + unit, "compared"};
-  ts.columns = {meas.t_s, meas.drive, meas.response, y, std::vector<double>(f.samples, 0.0)};
-  for (std::size_t i = cd.compare_begin; i < f.samples; ++i) ts.columns[4][i] = 1.0;
-  if (has_flux) {
-    ts.names.insert(ts.names.end(), {"measured_flux_T", "simulated_flux_T"});
-    ts.columns.push_back(meas.flux_T);
-    ts.columns.push_back(B);
-  }
-}
-
-}  // namespace
-
-std::vector<ConditionFit> Objective::condition_fits(const std::vector<double>& u) const {
-  const Impl& I = *impl_;
-  std::vector<ConditionFit> out;
-  std::optional<Model> model;
-  std::string model_error;
-  try {
-    model.emplace(I.model_at(u.data()));
-  } catch (const InputError& e) {
-    model_error = e.what();
-  }
-  for (const auto& cd : I.conds) {
-    const Measurement& meas = I.data.items[cd.index];
-    ConditionFit f;
-    f.label = meas.condition.label;
-    f.path = meas.path;
-    f.overlay_file = overlay_file(f.label, out);
-    f.condition = meas.condition;
-    f.weight = meas.weight;
-    f.samples = meas.t_s.size();
-    f.compared = f.samples - cd.compare_begin;
-    f.pp_um = cd.pp_um;
-    f.response_unit = std::string(meas.response_unit());
-    std::vector<double> y, B;
-    const bool has_flux = !meas.flux_T.empty();
-    try {
-      if (!model) throw InputError(model_error);
-      simulate_measurement(*model, meas, I.settings, y, has_flux ? &B : nullptr);
-      identify_detail::apply_offset(meas.condition.offset, meas.response, cd.compare_begin, y);
-      if (has_flux)
-        identify_detail::apply_offset(meas.condition.flux_offset, meas.flux_T, cd.compare_begin, B);
-    } catch (const std::exception& e) {
-      f.failed = true;
-      f.error = e.what();
-      out.push_back(std::move(f));
-      continue;
-    }
-    fill_fit(f, meas, cd, y, B);
-    out.push_back(std::move(f));
-  }
-  return out;
-}
-
-std::vector<TargetFit> Objective::target_fits(const std::vector<double>& u) const {
-  const Impl& I = *impl_;
-  std::vector<TargetFit> out;
-  if (I.targets.empty()) return out;
-  std::vector<SineMetrics> sm(I.sine_runs.size());
-  std::vector<double> res(I.res_runs.size());
-  bool failed = false;
-  try {
-    const Model model = I.model_at(u.data());
-    StartCache starts(model);
-    I.target_runs(model, starts, sm, res);
-  } catch (const std::exception&) {
-    failed = true;
-  }
-  for (const auto& td : I.targets) {
-    TargetFit f;
-    f.label = td.t.label;
-    f.kind = target_kind_name(td.t.kind);
-    f.value = td.t.value;
-    f.weight = td.t.weight;
-    f.failed = failed;
-    if (!failed) {
-      f.simulated = Impl::target_value(td, sm, res);
-      f.error_pct = 100.0 * (f.simulated - f.value) / td.t.scale;
-    }
-    out.push_back(f);
-  }
-  return out;
 }
 
 }  // namespace gmasim
