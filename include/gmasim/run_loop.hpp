@@ -94,18 +94,22 @@ struct StepPoint {
   long substep = 1;   // Sampled: 1..substeps within its sample; other clocks: 1
 };
 
+// What run_loop() accepts as a drive and as a recorder (clang-format 14 does not know
+// concepts, hence the guard).
+// clang-format off
 template <class D>
-concept TimeDrive =
-    std::invocable<D&, double> && std::convertible_to < std::invoke_result_t<D&, double>,
-double > ;
+concept TimeDrive = requires(D& d, double t) {
+  { d(t) } -> std::convertible_to<double>;
+};
 template <class D>
-concept StateDrive = std::invocable<D&, const State&, const StepPoint&> &&
-                     std::convertible_to < std::invoke_result_t<D&, const State&, const StepPoint&>,
-double > ;
+concept StateDrive = requires(D& d, const State& s, const StepPoint& p) {
+  { d(s, p) } -> std::convertible_to<double>;
+};
 template <class D>
 concept StepDrive = TimeDrive<D> || StateDrive<D>;
 template <class R>
 concept StepRecorder = std::invocable<R&, const State&, const StepPoint&>;
+// clang-format on
 
 // A current held for the whole grid (the DC settling of the FRF bias point).
 struct HeldCurrent {
