@@ -286,8 +286,9 @@ Conditions make_conditions(const Model& m, double temperature_C, const Freeze& f
 // rk4_reference_step() writes the same fields by its own integration; quasi_static_step()
 // writes every field but t_s as one increment of make_state's ramp does (stages 1-2 without
 // eddy lag, then the force and the static equilibrium x = F / K). Nothing else writes a State,
-// except the run loops that reset t_s to k dt (no drift from repeated addition) and
-// settle_at_bias's anhysteretic start (M_irr = M = M_an, src/experiments/frf.cpp).
+// except run_loop() (gmasim/run_loop.hpp), which sets t_s to its grid's time after each step
+// (t0 + k dt: no drift from repeated addition), and settle_at_bias's anhysteretic start
+// (M_irr = M = M_an, src/experiments/frf.cpp).
 struct RodState {
   // integrated state
   double H_A_per_m = 0;     // eddy-filtered field (eq. 7); stage 2: the lag (consistent: Newton)

@@ -29,7 +29,9 @@ std::vector<AblationLaw> ablation_laws() {
   return laws;
 }
 
-AblateResult run_ablate(const Model& m, const AblateRequest& r) {
+namespace {
+
+void check_request(const Model& m, const AblateRequest& r) {
   if (r.frequencies_Hz.empty()) throw InputError("ablate: no frequency given");
   for (double f : r.frequencies_Hz)
     if (!(f > 0.0) || !std::isfinite(f))
@@ -48,16 +50,56 @@ AblateResult run_ablate(const Model& m, const AblateRequest& r) {
     s.periods = r.periods;
     validate(s);
   }
+}
 
+struct Run {  // only what the comparison needs (a full Result holds every column)
+  std::vector<double> t, y;
+  Metrics metrics;
+  bool diverged = false;
+  std::string error;
+};
+
+// The deviation of a frozen run from the full one over the full run's metrics window.
+AblationRow compare(const Run& full, const Run& fr, const std::string& law, double f) {
+  AblationRow row;
+  row.law = law;
+  row.frequency_Hz = f;
+  row.diverged = fr.diverged;
+  row.error = fr.error;
+  const double nan = std::nan("");
+  if (fr.diverged || fr.y.size() != full.y.size()) {
+    row.error_rms_um = row.error_peak_um = row.error_pct_of_stroke = nan;
+    row.stroke_um = row.hysteresis_um = row.stroke_change_pct = row.hysteresis_change_pct = nan;
+    return row;
+  }
+  const auto& t = full.t;
+  const double eps = 1e-9 * (full.metrics.window_end_s - full.metrics.window_start_s);
+  const auto b = static_cast<std::size_t>(
+      std::lower_bound(t.begin(), t.end(), full.metrics.window_start_s - eps) - t.begin());
+  const auto e = static_cast<std::size_t>(
+      std::lower_bound(t.begin(), t.end(), full.metrics.window_end_s - eps) - t.begin());
+  // Same waveform, same dt: the two runs share the time grid sample for sample.
+  std::vector<double> d(fr.y.size());
+  for (std::size_t k = b; k < e; ++k) d[k] = fr.y[k] - full.y[k];
+  const RmsPeak rp = rms_and_peak(d, b, e);
+  row.error_rms_um = rp.rms;
+  row.error_peak_um = rp.peak;
+  row.error_pct_of_stroke = rp.rms / full.metrics.stroke_um * 100.0;
+  row.stroke_um = fr.metrics.stroke_um;
+  row.hysteresis_um = fr.metrics.hysteresis_um;
+  row.stroke_change_pct = detail::change_pct(full.metrics.stroke_um, fr.metrics.stroke_um);
+  row.hysteresis_change_pct =
+      detail::change_pct(full.metrics.hysteresis_um, fr.metrics.hysteresis_um);
+  return row;
+}
+
+}  // namespace
+
+AblateResult run_ablate(const Model& m, const AblateRequest& r) {
+  check_request(m, r);
   const auto laws = ablation_laws();
   const std::size_t per_f = laws.size() + 1;  // the full model, then each law
   const std::size_t n = r.frequencies_Hz.size() * per_f;
-  struct Run {  // only what the comparison needs (a full Result holds every column)
-    std::vector<double> t, y;
-    Metrics metrics;
-    bool diverged = false;
-    std::string error;
-  };
   std::vector<Run> runs(n);
   detail::parallel_for(n, resolve_thread_count(r.threads, n),
                        [&](std::size_t i) {
@@ -79,47 +121,14 @@ AblateResult run_ablate(const Model& m, const AblateRequest& r) {
                        {});
 
   AblateResult res;
-  const double nan = std::nan("");
   for (std::size_t fi = 0; fi < r.frequencies_Hz.size(); ++fi) {
     const Run& full = runs[fi * per_f];
     if (full.diverged)
       throw DivergenceError(0.0, "", "full model at the ablation point", 0.0, full.error);
     res.full.push_back(full.metrics);
-    const auto& t = full.t;
-    const auto& yf = full.y;
-    const double eps = 1e-9 * (full.metrics.window_end_s - full.metrics.window_start_s);
-    const auto b = static_cast<std::size_t>(
-        std::lower_bound(t.begin(), t.end(), full.metrics.window_start_s - eps) - t.begin());
-    const auto e = static_cast<std::size_t>(
-        std::lower_bound(t.begin(), t.end(), full.metrics.window_end_s - eps) - t.begin());
-    for (std::size_t li = 0; li < laws.size(); ++li) {
-      const Run& fr = runs[fi * per_f + li + 1];
-      AblationRow row;
-      row.law = laws[li].name;
-      row.frequency_Hz = r.frequencies_Hz[fi];
-      row.diverged = fr.diverged;
-      row.error = fr.error;
-      if (fr.diverged || fr.y.size() != full.y.size()) {
-        row.error_rms_um = row.error_peak_um = row.error_pct_of_stroke = nan;
-        row.stroke_um = row.hysteresis_um = row.stroke_change_pct = row.hysteresis_change_pct = nan;
-        res.rows.push_back(row);
-        continue;
-      }
-      // Same waveform, same dt: the two runs share the time grid sample for sample.
-      const auto& yz = fr.y;
-      std::vector<double> d(yz.size());
-      for (std::size_t k = b; k < e; ++k) d[k] = yz[k] - yf[k];
-      const RmsPeak rp = rms_and_peak(d, b, e);
-      row.error_rms_um = rp.rms;
-      row.error_peak_um = rp.peak;
-      row.error_pct_of_stroke = rp.rms / full.metrics.stroke_um * 100.0;
-      row.stroke_um = fr.metrics.stroke_um;
-      row.hysteresis_um = fr.metrics.hysteresis_um;
-      row.stroke_change_pct = detail::change_pct(full.metrics.stroke_um, fr.metrics.stroke_um);
-      row.hysteresis_change_pct =
-          detail::change_pct(full.metrics.hysteresis_um, fr.metrics.hysteresis_um);
-      res.rows.push_back(row);
-    }
+    for (std::size_t li = 0; li < laws.size(); ++li)
+      res.rows.push_back(
+          compare(full, runs[fi * per_f + li + 1], laws[li].name, r.frequencies_Hz[fi]));
   }
   return res;
 }

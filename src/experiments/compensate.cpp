@@ -104,6 +104,73 @@ void validate_request(const Model& m, const CompensateRequest& r) {
   validate(s);
 }
 
+// The drive x in (0, x_hi] whose stroke at temperature T is the target (a root of
+// stroke(x) - target: bracketed from the reference drive, solved by TOMS 748), or x_hi when
+// even that falls short.
+CompensatePoint solve_point(const Model& m, const CompensateRequest& r, double T, double target,
+                            double x_ref, double x_hi) {
+  CompensatePoint p;
+  p.temperature_C = T;
+  int evals = 0;
+  auto stroke = [&](double x) {
+    ++evals;
+    const Run run = run_drive(m, r, p.temperature_C, x);
+    if (run.diverged) throw DivergenceError(run.error);
+    return run.metrics;
+  };
+  try {
+    p.uncompensated_stroke_um = stroke(x_ref).stroke_um;
+    Metrics top = stroke(x_hi);
+    double x = x_hi;
+    if (top.stroke_um < target) {
+      p.reachable = false;  // the point holds the largest drive
+    } else {
+      // Bracket: the reference drive brackets from one side or the other; else the
+      // search runs over (0, x_hi].
+      double a = 1e-3 * x_ref, b = x_hi;
+      double fa = std::nan(""), fb = top.stroke_um - target;
+      const double f_ref = p.uncompensated_stroke_um - target;
+      if (f_ref < 0.0) {
+        a = x_ref;
+        fa = f_ref;
+      } else {
+        b = x_ref;
+        fb = f_ref;
+        fa = stroke(a).stroke_um - target;
+      }
+      if (fb == 0.0) {
+        x = b;
+      } else if (fa >= 0.0) {
+        x = a;  // even the smallest drive reaches the target
+      } else {
+        // Stop when the bracket is narrower than the drive change that moves the stroke
+        // by the tolerance (secant slope of the bracket).
+        auto tol = [&](double lo, double hi) {
+          return hi - lo <= 1e-12 * hi || (hi - lo) * (fb - fa) / (b - a) < 0.5 * r.tolerance_um;
+        };
+        std::uintmax_t iters = 60;
+        const auto [lo, hi] = boost::math::tools::toms748_solve(
+            [&](double v) { return stroke(v).stroke_um - target; }, a, b, fa, fb, tol, iters);
+        x = 0.5 * (lo + hi);
+      }
+    }
+    const Metrics fin = stroke(x);
+    const Waveform w = drive(r, x);
+    p.current_pp_A = w.pp_A;
+    p.current_min_A = w.min_A;
+    p.current_max_A = w.min_A + w.pp_A;
+    p.gain = x / x_ref;
+    p.stroke_um = fin.stroke_um;
+    p.hysteresis_um = fin.hysteresis_um;
+    p.B_pp_T = fin.B_pp_T;
+  } catch (const DivergenceError& e) {
+    p.diverged = true;
+    p.error = e.what();
+  }
+  p.evaluations = evals;
+  return p;
+}
+
 constexpr std::pair<CompensationAdjust, const char*> kAdjustNames[] = {
     {CompensationAdjust::Amplitude, "amplitude"},
     {CompensationAdjust::Swing, "swing"},
@@ -143,67 +210,7 @@ CompensateResult run_compensate(const Model& m, const CompensateRequest& r,
   detail::parallel_for(
       r.temperatures_C.size(), res.threads,
       [&](std::size_t i) {
-        CompensatePoint& p = res.points[i];
-        p.temperature_C = r.temperatures_C[i];
-        const double target = res.target_stroke_um;
-        int evals = 0;
-        auto stroke = [&](double x) {
-          ++evals;
-          const Run run = run_drive(m, r, p.temperature_C, x);
-          if (run.diverged) throw DivergenceError(run.error);
-          return run.metrics;
-        };
-        try {
-          p.uncompensated_stroke_um = stroke(x_ref).stroke_um;
-          Metrics top = stroke(x_hi);
-          double x = x_hi;
-          if (top.stroke_um < target) {
-            p.reachable = false;  // the point holds the largest drive
-          } else {
-            // Bracket: the reference drive brackets from one side or the other; else the
-            // search runs over (0, x_hi].
-            double a = 1e-3 * x_ref, b = x_hi;
-            double fa = std::nan(""), fb = top.stroke_um - target;
-            const double f_ref = p.uncompensated_stroke_um - target;
-            if (f_ref < 0.0) {
-              a = x_ref;
-              fa = f_ref;
-            } else {
-              b = x_ref;
-              fb = f_ref;
-              fa = stroke(a).stroke_um - target;
-            }
-            if (fb == 0.0) {
-              x = b;
-            } else if (fa >= 0.0) {
-              x = a;  // even the smallest drive reaches the target
-            } else {
-              // Stop when the bracket is narrower than the drive change that moves the stroke
-              // by the tolerance (secant slope of the bracket).
-              auto tol = [&](double lo, double hi) {
-                return hi - lo <= 1e-12 * hi ||
-                       (hi - lo) * (fb - fa) / (b - a) < 0.5 * r.tolerance_um;
-              };
-              std::uintmax_t iters = 60;
-              const auto [lo, hi] = boost::math::tools::toms748_solve(
-                  [&](double v) { return stroke(v).stroke_um - target; }, a, b, fa, fb, tol, iters);
-              x = 0.5 * (lo + hi);
-            }
-          }
-          const Metrics fin = stroke(x);
-          const Waveform w = drive(r, x);
-          p.current_pp_A = w.pp_A;
-          p.current_min_A = w.min_A;
-          p.current_max_A = w.min_A + w.pp_A;
-          p.gain = x / x_ref;
-          p.stroke_um = fin.stroke_um;
-          p.hysteresis_um = fin.hysteresis_um;
-          p.B_pp_T = fin.B_pp_T;
-        } catch (const DivergenceError& e) {
-          p.diverged = true;
-          p.error = e.what();
-        }
-        p.evaluations = evals;
+        res.points[i] = solve_point(m, r, r.temperatures_C[i], res.target_stroke_um, x_ref, x_hi);
       },
       progress);
   res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

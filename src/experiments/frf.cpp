@@ -13,11 +13,12 @@
 #include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
-#include "gmasim/rod_laws.hpp"
 #include "gmasim/physics/jiles_atherton.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
+#include "gmasim/rod_laws.hpp"
+#include "gmasim/run_loop.hpp"
 #include "gmasim/validate.hpp"
 
 namespace gmasim {
@@ -65,9 +66,10 @@ ForceStiffness force_at(const Model& m, const RodConditions& rc, double M) {
   return {r.F_N, r.k_rod_N_per_m};
 }
 
+// DC steps of kSettleDt_s at current I for duration_s (rounded to whole steps), from s.t_s.
 void run_dc(const Model& m, const Conditions& c, State& s, double I, double duration_s) {
-  const long n = std::lround(duration_s / kSettleDt_s);
-  for (long k = 0; k < n; ++k) step(m, c, s, {I, kSettleDt_s});
+  run_loop(m, c, s, StepGrid::covering(s.t_s, duration_s, kSettleDt_s, "DC settling"),
+           HeldCurrent{I});
 }
 
 double unwrap_deg(double prev, double now) {
@@ -124,92 +126,75 @@ State settle_at_bias(const Model& m, const Conditions& c, double bias_A, BiasSta
 // ---------------------------------------------------------------------------------------
 // Linearisation
 // ---------------------------------------------------------------------------------------
-SmallSignalModel linearise(const Model& m, const Conditions& c, const State& s) {
-  const std::size_t n = s.rods.size();
-  SmallSignalModel L;
-  L.temperature_C = c.temperature_C;
-  L.bias_A = s.current_A;
-  L.n = static_cast<int>(n);
-  L.y0_m = s.y_m;
-  std::vector<double> M0(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    M0[i] = s.rods[i].M_A_per_m;
-    L.M0_A_per_m.push_back(M0[i]);
-    L.H0_A_per_m.push_back(s.rods[i].H_A_per_m);
-    L.x0_m.push_back(s.rods[i].x_m);
-  }
-  CircuitWorkspace ws;
-  ws.resize(m.circuit);
-  const double I0 = s.current_A;
+namespace {
 
-  if (m.output_stage.enabled) {
-    L.output_stage = true;
-    L.os_mass_kg = m.output_stage.mass_kg;
-    L.os_stiffness_N_per_m = m.output_stage.stiffness_N_per_m;
-    L.os_damping_N_s_per_m = m.output_stage.damping_N_s_per_m;
-  }
-  if (m.options.magnetic_state == MagneticState::Consistent) {
-    // The circuit seen from the rod branches: with rod reluctances R_p and extra rod MMFs e,
-    // the rod fluxes solve (R_p + S) phi = b I + e (netlist.cpp), whatever R_p; probe it.
-    L.consistent = true;
-    const auto N = static_cast<Eigen::Index>(n);
-    std::vector<double> Rp(n);
+// Consistent magnetic state: the circuit seen from the rod branches. With rod reluctances R_p
+// and extra rod MMFs e, the rod fluxes solve (R_p + S) phi = b I + e (netlist.cpp), whatever
+// R_p; probe it. Then per rod the port constants, chi and tau.
+void linearise_ports(const Model& m, const Conditions& c, const State& s, CircuitWorkspace& ws,
+                     SmallSignalModel& L) {
+  const std::size_t n = s.rods.size();
+  L.consistent = true;
+  const auto N = static_cast<Eigen::Index>(n);
+  std::vector<double> Rp(n);
+  for (std::size_t i = 0; i < n; ++i)
+    Rp[i] = c.rods[i].length_m / (kMu0 * s.rods[i].mu_r * c.rods[i].area_m2);
+  auto rod_flux = [&](double I) {
+    if (!solve_circuit(m.circuit, Rp, I, 0.0, ws, false))
+      throw DivergenceError(0.0, "", "nodal matrix of the circuit", 0.0, "not positive definite");
+    Eigen::VectorXd phi(N);
     for (std::size_t i = 0; i < n; ++i)
-      Rp[i] = c.rods[i].length_m / (kMu0 * s.rods[i].mu_r * c.rods[i].area_m2);
-    auto rod_flux = [&](double I) {
-      if (!solve_circuit(m.circuit, Rp, I, 0.0, ws, false))
-        throw DivergenceError(0.0, "", "nodal matrix of the circuit", 0.0, "not positive definite");
-      Eigen::VectorXd phi(N);
-      for (std::size_t i = 0; i < n; ++i)
-        phi(static_cast<Eigen::Index>(i)) =
-            ws.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
-      return phi;
-    };
-    Eigen::MatrixXd P(N, N);
-    for (std::size_t j = 0; j < n; ++j) {
-      std::fill(ws.rod_extra_mmf.begin(), ws.rod_extra_mmf.end(), 0.0);
-      ws.rod_extra_mmf[j] = 1.0;
-      P.col(static_cast<Eigen::Index>(j)) = rod_flux(0.0);
-    }
+      phi(static_cast<Eigen::Index>(i)) = ws.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
+    return phi;
+  };
+  Eigen::MatrixXd P(N, N);
+  for (std::size_t j = 0; j < n; ++j) {
     std::fill(ws.rod_extra_mmf.begin(), ws.rod_extra_mmf.end(), 0.0);
-    const Eigen::MatrixXd RS = P.inverse();  // R_p + S
-    const Eigen::VectorXd b = RS * rod_flux(1.0);
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto& rc = c.rods[i];
-      const auto& r = s.rods[i];
-      for (std::size_t j = 0; j < n; ++j)
-        L.port_S_per_H.push_back(RS(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) -
-                                 (i == j ? Rp[i] : 0.0));
-      L.port_b_At_per_A.push_back(b(static_cast<Eigen::Index>(i)));
-      L.kfl_m.push_back(rc.k_f * rc.length_m);
-      L.kappa_s_m_per_H.push_back(rc.eddy_geometry_s_m_per_H);
-      L.area_m2.push_back(rc.area_m2);
-      const double He = r.H_A_per_m + rc.ja.alpha * r.M_A_per_m;
-      const double dMan = anhysteretic_slope(He, rc.MsT_ja, rc.ja.a_A_per_m);
-      const double chi = rc.ja.c * dMan / (1.0 - rc.ja.alpha * rc.ja.c * dMan);
-      L.chi.push_back(chi);
-      L.tau_s.push_back(kMu0 * (1.0 + chi) * rc.eddy_geometry_s_m_per_H);
-    }
+    ws.rod_extra_mmf[j] = 1.0;
+    P.col(static_cast<Eigen::Index>(j)) = rod_flux(0.0);
   }
-  // Circuit: dHc/dI at fixed M (linear in I, so any step is exact), dHc/dM_j at fixed I.
-  if (!L.consistent) {
-    const double dI = 1e-2;
-    const auto Hp = static_fields(m, c, ws, I0 + dI, M0);
-    const auto Hm = static_fields(m, c, ws, I0 - dI, M0);
-    for (std::size_t i = 0; i < n; ++i) L.g_A_per_m_per_A.push_back((Hp[i] - Hm[i]) / (2 * dI));
+  std::fill(ws.rod_extra_mmf.begin(), ws.rod_extra_mmf.end(), 0.0);
+  const Eigen::MatrixXd RS = P.inverse();  // R_p + S
+  const Eigen::VectorXd b = RS * rod_flux(1.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& rc = c.rods[i];
+    const auto& r = s.rods[i];
+    for (std::size_t j = 0; j < n; ++j)
+      L.port_S_per_H.push_back(RS(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) -
+                               (i == j ? Rp[i] : 0.0));
+    L.port_b_At_per_A.push_back(b(static_cast<Eigen::Index>(i)));
+    L.kfl_m.push_back(rc.k_f * rc.length_m);
+    L.kappa_s_m_per_H.push_back(rc.eddy_geometry_s_m_per_H);
+    L.area_m2.push_back(rc.area_m2);
+    const double He = r.H_A_per_m + rc.ja.alpha * r.M_A_per_m;
+    const double dMan = anhysteretic_slope(He, rc.MsT_ja, rc.ja.a_A_per_m);
+    const double chi = rc.ja.c * dMan / (1.0 - rc.ja.alpha * rc.ja.c * dMan);
+    L.chi.push_back(chi);
+    L.tau_s.push_back(kMu0 * (1.0 + chi) * rc.eddy_geometry_s_m_per_H);
   }
-  L.G.assign(n * n, 0.0);
-  for (std::size_t j = 0; j < n && !L.consistent; ++j) {
+}
+
+// Printed magnetic state: the circuit's dHc/dI at fixed M (linear in I, so any step is
+// exact) and dHc/dM_j at fixed I; the eddy lag (eq. 7) and JA with M_irr pinned (eq. 9):
+// M = (1-c) M_irr + c M_an(H + alpha M).
+void linearise_circuit(const Model& m, const Conditions& c, const State& s, CircuitWorkspace& ws,
+                       const std::vector<double>& M0, SmallSignalModel& L) {
+  const std::size_t n = s.rods.size();
+  const double I0 = s.current_A;
+  const double dI = 1e-2;
+  const auto Hp = static_fields(m, c, ws, I0 + dI, M0);
+  const auto Hm = static_fields(m, c, ws, I0 - dI, M0);
+  for (std::size_t i = 0; i < n; ++i) L.g_A_per_m_per_A.push_back((Hp[i] - Hm[i]) / (2 * dI));
+  for (std::size_t j = 0; j < n; ++j) {
     const double dM = 1e-5 * c.rods[j].MsT_mu;
     auto Mp = M0, Mm = M0;
     Mp[j] += dM;
     Mm[j] -= dM;
-    const auto Hp = static_fields(m, c, ws, I0, Mp);
-    const auto Hm = static_fields(m, c, ws, I0, Mm);
-    for (std::size_t i = 0; i < n; ++i) L.G[i * n + j] = (Hp[i] - Hm[i]) / (2 * dM);
+    const auto Hpj = static_fields(m, c, ws, I0, Mp);
+    const auto Hmj = static_fields(m, c, ws, I0, Mm);
+    for (std::size_t i = 0; i < n; ++i) L.G[i * n + j] = (Hpj[i] - Hmj[i]) / (2 * dM);
   }
-  // Eddy lag (eq. 7) and JA with M_irr pinned (eq. 9): M = (1-c) M_irr + c M_an(H + alpha M).
-  for (std::size_t i = 0; i < n && !L.consistent; ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
     const auto& rc = c.rods[i];
     const auto& r = s.rods[i];
     L.tau_s.push_back(mu_at(m, i, rc, r.M_A_per_m) * rc.eddy_geometry_s_m_per_H);
@@ -217,7 +202,12 @@ SmallSignalModel linearise(const Model& m, const Conditions& c, const State& s) 
     const double dMan = anhysteretic_slope(He, rc.MsT_ja, rc.ja.a_A_per_m);
     L.chi.push_back(rc.ja.c * dMan / (1.0 - rc.ja.alpha * rc.ja.c * dMan));
   }
-  // Force and stiffness: F_net,i = F_i(M_i) - K_i(M) x0_i (eq. 14-18 about the bias).
+}
+
+// Force and stiffness: F_net,i = F_i(M_i) - K_i(M) x0_i (eq. 14-18 about the bias).
+void linearise_forces(const Model& m, const Conditions& c, const State& s,
+                      const std::vector<double>& M0, SmallSignalModel& L) {
+  const std::size_t n = s.rods.size();
   L.D_N_per_A_per_m.assign(n * n, 0.0);
   for (std::size_t j = 0; j < n; ++j) {
     const double dM = 1e-5 * c.rods[j].MsT_ja;
@@ -235,6 +225,39 @@ SmallSignalModel linearise(const Model& m, const Conditions& c, const State& s) 
       L.D_N_per_A_per_m[i * n + j] = d;
     }
   }
+}
+
+}  // namespace
+
+SmallSignalModel linearise(const Model& m, const Conditions& c, const State& s) {
+  const std::size_t n = s.rods.size();
+  SmallSignalModel L;
+  L.temperature_C = c.temperature_C;
+  L.bias_A = s.current_A;
+  L.n = static_cast<int>(n);
+  L.y0_m = s.y_m;
+  std::vector<double> M0(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    M0[i] = s.rods[i].M_A_per_m;
+    L.M0_A_per_m.push_back(M0[i]);
+    L.H0_A_per_m.push_back(s.rods[i].H_A_per_m);
+    L.x0_m.push_back(s.rods[i].x_m);
+  }
+  CircuitWorkspace ws;
+  ws.resize(m.circuit);
+  if (m.output_stage.enabled) {
+    L.output_stage = true;
+    L.os_mass_kg = m.output_stage.mass_kg;
+    L.os_stiffness_N_per_m = m.output_stage.stiffness_N_per_m;
+    L.os_damping_N_s_per_m = m.output_stage.damping_N_s_per_m;
+  }
+  L.G.assign(n * n, 0.0);
+  if (m.options.magnetic_state == MagneticState::Consistent) {
+    linearise_ports(m, c, s, ws, L);
+  } else {
+    linearise_circuit(m, c, s, ws, M0, L);
+  }
+  linearise_forces(m, c, s, M0, L);
   for (std::size_t i = 0; i < n; ++i) {
     L.mass_kg.push_back(c.rods[i].mass_osc_kg);
     L.damping_N_s_per_m.push_back(c.rods[i].damping_osc_N_s_per_m);
@@ -368,7 +391,9 @@ double find_bandwidth_3dB_Hz(const std::vector<double>& f, const std::vector<dou
 // ---------------------------------------------------------------------------------------
 // The experiment
 // ---------------------------------------------------------------------------------------
-FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progress) {
+namespace {
+
+void check_request(const FrfRequest& r) {
   if (r.temperatures_C.empty()) throw InputError("frf: no temperature given");
   if (!(r.f_min_Hz > 0.0) || !std::isfinite(r.f_min_Hz))
     throw InputError(fmt::format("frequency {} Hz: must be > 0", r.f_min_Hz));
@@ -401,9 +426,128 @@ FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progres
     // constants; the settling is checked again per frequency once those are known.
     const double per = std::max(static_cast<double>(r.min_steps_per_period),
                                 std::ceil(1.0 / (r.f_min_Hz * kMaxDt_s) - 1e-9));
-    (void)checked_count(per * (r.settle_periods + r.measure_periods), kMaxSteps,
-                        fmt::format("stepped-sine steps at {:g} Hz", r.f_min_Hz));
+    (void)StepGrid::uniform(0.0, 1.0 / (r.f_min_Hz * per),
+                            per * (r.settle_periods + r.measure_periods),
+                            fmt::format("stepped-sine steps at {:g} Hz", r.f_min_Hz));
   }
+}
+
+// The transient of switching the sine on decays with the slowest of the eddy lags and the
+// mechanical modes: 10 of those time constants (the transient is then below 5e-5 of its start).
+double settling_time_s(const SmallSignalModel& lin) {
+  double t_settle = 0.0;
+  for (std::size_t i = 0; i < lin.tau_s.size(); ++i) {
+    const double zw = lin.damping_N_s_per_m[i] / (2.0 * lin.mass_kg[i]);
+    t_settle = std::max({t_settle, 10.0 * lin.tau_s[i], 10.0 / zw});
+  }
+  if (lin.output_stage && lin.os_damping_N_s_per_m > 0)
+    t_settle = std::max(t_settle, 10.0 * 2.0 * lin.os_mass_kg / lin.os_damping_N_s_per_m);
+  return t_settle;
+}
+
+// One stepped-sine point: the sine switched on at the bias state, >= min_steps_per_period
+// steps per period with dt <= 10 us (whole steps per period); settled for settling_time_s and
+// at least settle_periods periods (low frequencies need few periods, high frequencies many),
+// then the first harmonic of y over measure_periods whole periods.
+cd stepped_sine_point(const Model& m, const Conditions& c, const State& bias,
+                      const SmallSignalModel& lin, const FrfRequest& r, double fr) {
+  const long per =
+      steps_to_resolve(1.0 / (fr * kMaxDt_s), r.min_steps_per_period, "steps per period");
+  const double dt = 1.0 / (fr * static_cast<double>(per));
+  const long settle =
+      steps_to_resolve(settling_time_s(lin) * fr, r.settle_periods, "settle periods");
+  const long measure = r.measure_periods;
+  const StepGrid grid =
+      StepGrid::uniform(0.0, dt, static_cast<double>(settle + measure) * static_cast<double>(per),
+                        fmt::format("stepped-sine steps at {:g} Hz", fr));
+  const double w = kTwoPi * fr;
+  std::vector<double> ts, ys, is;
+  ts.reserve(static_cast<std::size_t>(measure * per));
+  ys.reserve(ts.capacity());
+  is.reserve(ts.capacity());
+  const long first = settle * per;  // samples first+1 .. total: whole periods
+  State s = bias;
+  run_loop(
+      m, c, s, grid, [&](double t) { return r.bias_A + r.amplitude_A * std::sin(w * t); },
+      [&](const State& st, const StepPoint& p) {
+        if (p.k <= first) return;
+        ts.push_back(p.t_s);
+        ys.push_back(st.y_m - lin.y0_m);
+        is.push_back(st.current_A - r.bias_A);
+      });
+  return first_harmonic_ratio(ts, ys, is, fr);
+}
+
+// The bias point's curve: the bias output, the eddy lags, the modes, the static gain.
+FrfCurve bias_curve(const Model& m, const Conditions& c, const State& bias,
+                    const SmallSignalModel& lin, double T, const std::vector<double>& f) {
+  FrfCurve cv;
+  cv.temperature_C = T;
+  cv.f_Hz = f;
+  cv.y_bias_um = bias.y_m * 1e6;
+  for (const auto& rd : bias.rods) cv.eddy_tau_ms.push_back(rd.tau_s * 1e3);
+  for (const Mode& md : mechanical_modes(m, c, bias)) {
+    cv.mode_frequencies_Hz.push_back(md.frequency_Hz);
+    cv.mode_damping_ratios.push_back(md.damping_ratio);
+  }
+  cv.static_gain_um_per_A = std::abs(lin.response(0.0)) * 1e6;
+  return cv;
+}
+
+// Magnitudes and unwrapped phases of both methods, their mismatch, resonance and bandwidth.
+void fill_curve(FrfCurve& cv, const SmallSignalModel& lin, const cd* stepped,
+                const std::vector<double>& f, const FrfRequest& r) {
+  double prev_l = 0.0, prev_s = 0.0;
+  for (std::size_t fi = 0; fi < f.size(); ++fi) {
+    if (r.small_signal) {
+      const cd Y = lin.response(f[fi]);
+      cv.linear_mag_um_per_A.push_back(std::abs(Y) * 1e6);
+      const double ph = std::arg(Y) * 180.0 / kPi;
+      prev_l = fi == 0 ? ph : unwrap_deg(prev_l, ph);
+      cv.linear_phase_deg.push_back(prev_l);
+    }
+    if (r.stepped_sine) {
+      const cd Y = stepped[fi];
+      cv.stepped_mag_um_per_A.push_back(std::abs(Y) * 1e6);
+      const double ph = std::arg(Y) * 180.0 / kPi;
+      prev_s = fi == 0 ? ph : unwrap_deg(prev_s, ph);
+      cv.stepped_phase_deg.push_back(prev_s);
+    }
+    if (r.small_signal && r.stepped_sine) {
+      const cd d = stepped[fi] - lin.response(f[fi]);
+      cv.max_mismatch_pct =
+          std::max(cv.max_mismatch_pct, std::abs(d) / std::abs(lin.response(f[fi])) * 100.0);
+    }
+  }
+  if (r.stepped_sine) {
+    cv.stepped_first_resonance_Hz = find_resonance_Hz(f, cv.stepped_mag_um_per_A);
+    cv.stepped_bandwidth_3dB_Hz = find_bandwidth_3dB_Hz(f, cv.stepped_mag_um_per_A);
+  }
+  if (!r.small_signal) {
+    cv.first_resonance_Hz = cv.stepped_first_resonance_Hz;
+    cv.bandwidth_3dB_Hz = cv.stepped_bandwidth_3dB_Hz;
+    return;
+  }
+  // Resonance and bandwidth of the linear model on a dense grid (cheap to evaluate).
+  const std::vector<double> fd = log_grid(r.f_min_Hz, r.f_max_Hz, 4000);
+  std::vector<double> md(fd.size());
+  for (std::size_t k = 0; k < fd.size(); ++k) md[k] = std::abs(lin.response(fd[k]));
+  cv.first_resonance_Hz = find_resonance_Hz(fd, md);
+  cv.bandwidth_3dB_Hz = find_bandwidth_3dB_Hz(fd, md);
+  // The same search beyond the band, up to twice the highest mode.
+  double f_top = r.f_max_Hz;
+  for (double fm : cv.mode_frequencies_Hz) f_top = std::max(f_top, 2.0 * fm);
+  const std::vector<double> fe = log_grid(r.f_min_Hz, f_top, 8000);
+  std::vector<double> me(fe.size());
+  for (std::size_t k = 0; k < fe.size(); ++k) me[k] = std::abs(lin.response(fe[k]));
+  cv.linear_peak_extended_Hz = find_resonance_Hz(fe, me);
+  cv.linear_peak_search_max_Hz = f_top;
+}
+
+}  // namespace
+
+FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progress) {
+  check_request(r);
   std::vector<Conditions> conds;
   for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
 
@@ -420,17 +564,8 @@ FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progres
   for (std::size_t ti = 0; ti < nT; ++ti) {
     bias.push_back(settle_at_bias(m, conds[ti], r.bias_A, r.bias_state));
     lin.push_back(linearise(m, conds[ti], bias.back()));
-    FrfCurve cv;
-    cv.temperature_C = r.temperatures_C[ti];
-    cv.f_Hz = f;
-    cv.y_bias_um = bias.back().y_m * 1e6;
-    for (const auto& rd : bias.back().rods) cv.eddy_tau_ms.push_back(rd.tau_s * 1e3);
-    for (const Mode& md : mechanical_modes(m, conds[ti], bias.back())) {
-      cv.mode_frequencies_Hz.push_back(md.frequency_Hz);
-      cv.mode_damping_ratios.push_back(md.damping_ratio);
-    }
-    cv.static_gain_um_per_A = std::abs(lin.back().response(0.0)) * 1e6;
-    res.curves.push_back(cv);
+    res.curves.push_back(
+        bias_curve(m, conds[ti], bias.back(), lin.back(), r.temperatures_C[ti], f));
   }
 
   // Stepped sine: one work item per (temperature, frequency).
@@ -441,102 +576,14 @@ FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progres
         n, resolve_thread_count(r.threads, n),
         [&](std::size_t idx) {
           const std::size_t ti = idx / nf, fi = idx % nf;
-          const double fr = f[fi];
-          const Conditions& c = conds[ti];
-          State s = bias[ti];
-          // >= min_steps_per_period steps per period, dt <= 10 us; whole steps per period.
-          const long per = std::max<long>(
-              r.min_steps_per_period,
-              checked_ceil_count(1.0 / (fr * kMaxDt_s), kMaxSteps, "steps per period"));
-          const double dt = 1.0 / (fr * static_cast<double>(per));
-          // Settling: the transient of switching the sine on decays with the slowest of the
-          // eddy lags and the mechanical modes. Settle for 10 of those time constants (the
-          // transient is then below 5e-5 of its start) and at least settle_periods periods:
-          // low frequencies need few periods, high frequencies many.
-          double t_settle = 0.0;
-          for (std::size_t i = 0; i < lin[ti].tau_s.size(); ++i) {
-            const double zw = lin[ti].damping_N_s_per_m[i] / (2.0 * lin[ti].mass_kg[i]);
-            t_settle = std::max({t_settle, 10.0 * lin[ti].tau_s[i], 10.0 / zw});
-          }
-          if (lin[ti].output_stage && lin[ti].os_damping_N_s_per_m > 0)
-            t_settle =
-                std::max(t_settle, 10.0 * 2.0 * lin[ti].os_mass_kg / lin[ti].os_damping_N_s_per_m);
-          const long settle = std::max<long>(
-              r.settle_periods, checked_ceil_count(t_settle * fr, kMaxSteps, "settle periods"));
-          const long measure = r.measure_periods;
-          (void)checked_count(static_cast<double>(settle + measure) * static_cast<double>(per),
-                              kMaxSteps, fmt::format("stepped-sine steps at {:g} Hz", fr));
-          const double w = kTwoPi * fr;
-          std::vector<double> ts, ys, is;
-          ts.reserve(static_cast<std::size_t>(measure * per));
-          ys.reserve(ts.capacity());
-          is.reserve(ts.capacity());
-          const long total = (settle + measure) * per;
-          for (long k = 1; k <= total; ++k) {
-            const double t = static_cast<double>(k) * dt;
-            const double I = r.bias_A + r.amplitude_A * std::sin(w * t);
-            step(m, c, s, {I, dt});
-            if (k > settle * per) {  // samples settle*per+1 .. total: whole periods
-              ts.push_back(t);
-              ys.push_back(s.y_m - lin[ti].y0_m);
-              is.push_back(I - r.bias_A);
-            }
-          }
-          stepped[idx] = first_harmonic_ratio(ts, ys, is, fr);
+          stepped[idx] = stepped_sine_point(m, conds[ti], bias[ti], lin[ti], r, f[fi]);
         },
         progress);
   } else if (progress) {
     progress(nT, nT);
   }
-
-  for (std::size_t ti = 0; ti < nT; ++ti) {
-    FrfCurve& cv = res.curves[ti];
-    double prev_l = 0.0, prev_s = 0.0;
-    for (std::size_t fi = 0; fi < nf; ++fi) {
-      if (r.small_signal) {
-        const cd Y = lin[ti].response(f[fi]);
-        cv.linear_mag_um_per_A.push_back(std::abs(Y) * 1e6);
-        const double ph = std::arg(Y) * 180.0 / kPi;
-        prev_l = fi == 0 ? ph : unwrap_deg(prev_l, ph);
-        cv.linear_phase_deg.push_back(prev_l);
-      }
-      if (r.stepped_sine) {
-        const cd Y = stepped[ti * nf + fi];
-        cv.stepped_mag_um_per_A.push_back(std::abs(Y) * 1e6);
-        const double ph = std::arg(Y) * 180.0 / kPi;
-        prev_s = fi == 0 ? ph : unwrap_deg(prev_s, ph);
-        cv.stepped_phase_deg.push_back(prev_s);
-      }
-      if (r.small_signal && r.stepped_sine) {
-        const cd d = stepped[ti * nf + fi] - lin[ti].response(f[fi]);
-        cv.max_mismatch_pct =
-            std::max(cv.max_mismatch_pct, std::abs(d) / std::abs(lin[ti].response(f[fi])) * 100.0);
-      }
-    }
-    if (r.stepped_sine) {
-      cv.stepped_first_resonance_Hz = find_resonance_Hz(f, cv.stepped_mag_um_per_A);
-      cv.stepped_bandwidth_3dB_Hz = find_bandwidth_3dB_Hz(f, cv.stepped_mag_um_per_A);
-    }
-    if (r.small_signal) {
-      // Resonance and bandwidth of the linear model on a dense grid (cheap to evaluate).
-      const std::vector<double> fd = log_grid(r.f_min_Hz, r.f_max_Hz, 4000);
-      std::vector<double> md(fd.size());
-      for (std::size_t k = 0; k < fd.size(); ++k) md[k] = std::abs(lin[ti].response(fd[k]));
-      cv.first_resonance_Hz = find_resonance_Hz(fd, md);
-      cv.bandwidth_3dB_Hz = find_bandwidth_3dB_Hz(fd, md);
-      // The same search beyond the band, up to twice the highest mode.
-      double f_top = r.f_max_Hz;
-      for (double fm : cv.mode_frequencies_Hz) f_top = std::max(f_top, 2.0 * fm);
-      const std::vector<double> fe = log_grid(r.f_min_Hz, f_top, 8000);
-      std::vector<double> me(fe.size());
-      for (std::size_t k = 0; k < fe.size(); ++k) me[k] = std::abs(lin[ti].response(fe[k]));
-      cv.linear_peak_extended_Hz = find_resonance_Hz(fe, me);
-      cv.linear_peak_search_max_Hz = f_top;
-    } else {
-      cv.first_resonance_Hz = cv.stepped_first_resonance_Hz;
-      cv.bandwidth_3dB_Hz = cv.stepped_bandwidth_3dB_Hz;
-    }
-  }
+  for (std::size_t ti = 0; ti < nT; ++ti)
+    fill_curve(res.curves[ti], lin[ti], stepped.data() + ti * nf, f, r);
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   for (auto& cv : res.curves) cv.wall_time_s = wall;

@@ -30,10 +30,7 @@ double mean_of(const std::vector<double>& v, std::size_t b, std::size_t e) {
   return e > b ? s / static_cast<double>(e - b) : 0.0;
 }
 
-}  // namespace
-
-ParamsVsTemperatureResult run_params_vs_temperature(const Model& m,
-                                                    const ParamsVsTemperatureRequest& r) {
+void check_request(const ParamsVsTemperatureRequest& r) {
   if (r.temperatures_C.empty()) throw InputError("params-vs-temperature: no temperature given");
   if (!(r.frequency_Hz > 0.0) || !std::isfinite(r.frequency_Hz))
     throw InputError(fmt::format("frequency {} Hz: must be > 0", r.frequency_Hz));
@@ -59,50 +56,43 @@ ParamsVsTemperatureResult run_params_vs_temperature(const Model& m,
     s.periods = r.periods;
     validate(s);
   }
-  std::vector<Conditions> conds;
-  for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
+}
 
-  // Currents per temperature: the retention currents, plus the Fig. 19 point if it is not
-  // one of them.
-  std::vector<double> currents = r.retention_currents_pp_A;
-  std::size_t op = currents.size();
-  for (std::size_t k = 0; k < currents.size(); ++k)
-    if (currents[k] == r.current_pp_A) op = k;
-  if (op == currents.size()) currents.push_back(r.current_pp_A);
-  const std::size_t nc = currents.size(), n = r.temperatures_C.size() * nc;
+// One run: the metrics; at the Fig. 19 operating point (with_rods) also each rod's mean mu_r,
+// mean E_G and peak M over the metrics window.
+Run run_point(const Model& m, const ParamsVsTemperatureRequest& r, double T, double pp,
+              bool with_rods) {
+  SimulationSettings s;
+  s.temperature_C = T;
+  s.waveform = biased_sine(pp, r.frequency_Hz, r.current_min_A);
+  s.periods = r.periods;
+  const Result out = simulate(m, s);
+  Run run;
+  run.diverged = out.diverged;
+  run.error = out.error;
+  run.metrics = out.metrics;
+  if (!with_rods || out.diverged) return run;
+  const auto& t = out.series.column("t_s");
+  const double eps = 1e-9 / r.frequency_Hz;
+  const auto b = static_cast<std::size_t>(
+      std::lower_bound(t.begin(), t.end(), out.metrics.window_start_s - eps) - t.begin());
+  const auto e = static_cast<std::size_t>(
+      std::lower_bound(t.begin(), t.end(), out.metrics.window_end_s - eps) - t.begin());
+  for (const auto& rod : m.rods) {
+    RodStats st;
+    st.mu_r_mean = mean_of(out.series.column(rod.name + "_mu_r"), b, e);
+    st.E_mean_GPa = mean_of(out.series.column(rod.name + "_E_GPa"), b, e);
+    st.M_peak = rms_and_peak(out.series.column(rod.name + "_M_A_per_m"), b, e).peak;
+    run.rods.push_back(st);
+  }
+  return run;
+}
 
-  std::vector<Run> runs(n);
-  detail::parallel_for(
-      n, resolve_thread_count(r.threads, n),
-      [&](std::size_t i) {
-        const std::size_t ti = i / nc, ci = i % nc;
-        SimulationSettings s;
-        s.temperature_C = r.temperatures_C[ti];
-        s.waveform = biased_sine(currents[ci], r.frequency_Hz, r.current_min_A);
-        s.periods = r.periods;
-        const Result out = simulate(m, s);
-        Run& run = runs[i];
-        run.diverged = out.diverged;
-        run.error = out.error;
-        run.metrics = out.metrics;
-        if (ci != op || out.diverged) return;
-        const auto& t = out.series.column("t_s");
-        const double eps = 1e-9 / r.frequency_Hz;
-        const auto b = static_cast<std::size_t>(
-            std::lower_bound(t.begin(), t.end(), out.metrics.window_start_s - eps) - t.begin());
-        const auto e = static_cast<std::size_t>(
-            std::lower_bound(t.begin(), t.end(), out.metrics.window_end_s - eps) - t.begin());
-        for (const auto& rod : m.rods) {
-          RodStats st;
-          st.mu_r_mean = mean_of(out.series.column(rod.name + "_mu_r"), b, e);
-          st.E_mean_GPa = mean_of(out.series.column(rod.name + "_E_GPa"), b, e);
-          st.M_peak = rms_and_peak(out.series.column(rod.name + "_M_A_per_m"), b, e).peak;
-          run.rods.push_back(st);
-        }
-      },
-      {});
-
-  ParamsVsTemperatureResult res;
+// The Fig. 19 rows: per temperature and rod the laws and the run's means, with their changes
+// against the first temperature.
+void add_law_rows(const Model& m, const ParamsVsTemperatureRequest& r,
+                  const std::vector<Conditions>& conds, const std::vector<Run>& runs,
+                  std::size_t nc, std::size_t op, ParamsVsTemperatureResult& res) {
   const double nan = std::nan("");
   for (std::size_t ti = 0; ti < r.temperatures_C.size(); ++ti) {
     const Run& run = runs[ti * nc + op];
@@ -134,6 +124,36 @@ ParamsVsTemperatureResult run_params_vs_temperature(const Model& m,
     row.E_G_change_pct = detail::change_pct(first.E_G_mean_GPa, row.E_G_mean_GPa);
     row.E_t_change_pct = detail::change_pct(first.E_t_GPa, row.E_t_GPa);
   }
+}
+
+}  // namespace
+
+ParamsVsTemperatureResult run_params_vs_temperature(const Model& m,
+                                                    const ParamsVsTemperatureRequest& r) {
+  check_request(r);
+  std::vector<Conditions> conds;
+  for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
+
+  // Currents per temperature: the retention currents, plus the Fig. 19 point if it is not
+  // one of them.
+  std::vector<double> currents = r.retention_currents_pp_A;
+  std::size_t op = currents.size();
+  for (std::size_t k = 0; k < currents.size(); ++k)
+    if (currents[k] == r.current_pp_A) op = k;
+  if (op == currents.size()) currents.push_back(r.current_pp_A);
+  const std::size_t nc = currents.size(), n = r.temperatures_C.size() * nc;
+
+  std::vector<Run> runs(n);
+  detail::parallel_for(n, resolve_thread_count(r.threads, n),
+                       [&](std::size_t i) {
+                         const std::size_t ti = i / nc, ci = i % nc;
+                         runs[i] = run_point(m, r, r.temperatures_C[ti], currents[ci], ci == op);
+                       },
+                       {});
+
+  ParamsVsTemperatureResult res;
+  add_law_rows(m, r, conds, runs, nc, op, res);
+  const double nan = std::nan("");
   for (std::size_t ci = 0; ci < r.retention_currents_pp_A.size(); ++ci) {
     const Run& first = runs[ci];
     for (std::size_t ti = 0; ti < r.temperatures_C.size(); ++ti) {

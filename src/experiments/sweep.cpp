@@ -29,9 +29,7 @@ struct Job {
   double T, pp, f;
 };
 
-}  // namespace
-
-SweepResult run_sweep(const Model& m, const SweepRequest& r, const ProgressFn& progress) {
+void check_request(const Model& m, const SweepRequest& r) {
   check_list(r.temperatures_C, "temperature", "degC");
   check_list(r.currents_pp_A, "current peak-to-peak", "A");
   check_list(r.frequencies_Hz, "frequency", "Hz");
@@ -65,7 +63,38 @@ SweepResult run_sweep(const Model& m, const SweepRequest& r, const ProgressFn& p
     }
   for (double T : r.temperatures_C) (void)make_conditions(m, T, r.freeze);
   (void)make_conditions(m, r.reference_temperature_C, r.freeze);
+}
 
+// Relative changes of the grid's points (slots[0, grid)) against the reference run at equal
+// current and frequency.
+void add_changes(const SweepRequest& r, bool ref_in_grid, std::size_t grid,
+                 std::vector<SweepPoint>& slots) {
+  const std::size_t per_T = r.currents_pp_A.size() * r.frequencies_Hz.size();
+  auto reference = [&](std::size_t cf) -> const SweepPoint& {
+    if (!ref_in_grid) return slots[grid + cf];
+    for (std::size_t ti = 0; ti < r.temperatures_C.size(); ++ti)
+      if (r.temperatures_C[ti] == r.reference_temperature_C) return slots[ti * per_T + cf];
+    return slots[cf];  // unreachable
+  };
+  const double nan = std::nan("");
+  for (std::size_t i = 0; i < grid; ++i) {
+    SweepPoint& p = slots[i];
+    const SweepPoint& ref = reference(i % per_T);
+    if (p.diverged || ref.diverged) {
+      p.stroke_change_pct = p.hysteresis_change_pct = p.B_pp_change_pct = nan;
+      continue;
+    }
+    p.stroke_change_pct = detail::change_pct(ref.metrics.stroke_um, p.metrics.stroke_um);
+    p.hysteresis_change_pct =
+        detail::change_pct(ref.metrics.hysteresis_um, p.metrics.hysteresis_um);
+    p.B_pp_change_pct = detail::change_pct(ref.metrics.B_pp_T, p.metrics.B_pp_T);
+  }
+}
+
+}  // namespace
+
+SweepResult run_sweep(const Model& m, const SweepRequest& r, const ProgressFn& progress) {
+  check_request(m, r);
   // The work list: the grid, then the reference temperature if it is not in the grid.
   std::vector<Job> jobs;
   for (double T : r.temperatures_C)
@@ -105,27 +134,7 @@ SweepResult run_sweep(const Model& m, const SweepRequest& r, const ProgressFn& p
       progress);
   res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
-  // Relative changes against the reference run at equal current and frequency.
-  const std::size_t per_T = r.currents_pp_A.size() * r.frequencies_Hz.size();
-  auto reference = [&](std::size_t cf) -> const SweepPoint& {
-    if (!ref_in_grid) return slots[grid + cf];
-    for (std::size_t ti = 0; ti < r.temperatures_C.size(); ++ti)
-      if (r.temperatures_C[ti] == r.reference_temperature_C) return slots[ti * per_T + cf];
-    return slots[cf];  // unreachable
-  };
-  const double nan = std::nan("");
-  for (std::size_t i = 0; i < grid; ++i) {
-    SweepPoint& p = slots[i];
-    const SweepPoint& ref = reference(i % per_T);
-    if (p.diverged || ref.diverged) {
-      p.stroke_change_pct = p.hysteresis_change_pct = p.B_pp_change_pct = nan;
-      continue;
-    }
-    p.stroke_change_pct = detail::change_pct(ref.metrics.stroke_um, p.metrics.stroke_um);
-    p.hysteresis_change_pct =
-        detail::change_pct(ref.metrics.hysteresis_um, p.metrics.hysteresis_um);
-    p.B_pp_change_pct = detail::change_pct(ref.metrics.B_pp_T, p.metrics.B_pp_T);
-  }
+  add_changes(r, ref_in_grid, grid, slots);
   res.points.assign(slots.begin(), slots.begin() + static_cast<long>(grid));
   res.reference_points.assign(slots.begin() + static_cast<long>(grid), slots.end());
   return res;

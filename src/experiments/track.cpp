@@ -6,12 +6,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <random>
 
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
 #include "gmasim/physics/magnetic.hpp"
+#include "gmasim/run_loop.hpp"
 #include "gmasim/simulate.hpp"
 #include "gmasim/validate.hpp"
 
@@ -97,9 +99,7 @@ void check_positive_list(const std::vector<double>& v, const char* what, const c
         fmt::format("{} {} values: too many (limit {:g})", v.size(), what, kMaxListValues));
 }
 
-}  // namespace
-
-TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& progress) {
+void check_request(const TrackRequest& r) {
   if (r.temperatures_C.empty()) throw InputError("track: no temperature given");
   for (double T : r.temperatures_C) require_finite(T, "temperature", "degC");
   check_positive_list(r.amplitudes_um, "reference amplitude", "um");
@@ -145,10 +145,134 @@ TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& p
   if (!(r.dt_s >= 0.0) || !std::isfinite(r.dt_s))
     throw InputError(fmt::format("dt {} s: must be > 0 (or 0 for the automatic rule)", r.dt_s));
   check_feedforward(r.feedforward);
-  {
-    Pid probe(r.gains, r.sample_rate_Hz, -1.0, 1.0);  // validates the gains' reference rate
-    (void)probe;
+  Pid probe(r.gains, r.sample_rate_Hz, -1.0, 1.0);  // validates the gains' reference rate
+  (void)probe;
+}
+
+// The plant steps per controller sample: dt divides the sample period, dt <= 10 us and
+// dt <= T_ref/2000 (docs/model.md rule). Every run's length is checked here, before any run.
+long plant_substeps(const TrackRequest& r) {
+  const double Ts = 1.0 / r.sample_rate_Hz;
+  double f_max = 0.0;
+  for (double f : r.frequencies_Hz) f_max = std::max(f_max, f);
+  const double dt_target =
+      r.dt_s > 0.0 ? r.dt_s : std::min(kMaxDt_s, 1.0 / (kStepsPerPeriod * f_max));
+  const long sub = steps_to_resolve(Ts / dt_target, 1, "plant steps per PID sample");
+  double f_min = f_max;
+  for (double f : r.frequencies_Hz) f_min = std::min(f_min, f);
+  (void)StepGrid::sampled(0.0, Ts, r.periods / f_min / Ts, sub, "plant steps of the longest run");
+  return sub;
+}
+
+// The reference y_bias + A sin(w t) [um].
+struct Reference {
+  double y_bias_um, A_um, w_rad_per_s;
+  double at(double t) const { return y_bias_um + A_um * std::sin(w_rad_per_s * t); }
+};
+
+// The controller as the run loop's drive: at the first plant step of each sample it reads the
+// sensor (y at the sample time t_k, + white noise) and computes the current, held until
+// t_k+1. With the temperature feed-forward, i = bias + g (u + r'/K_ref). Logs each sample to
+// `example` if given.
+struct SampledController {
+  const TrackRequest& r;
+  const StepGrid& grid;
+  const Reference& ref;
+  Pid pid;
+  double g;
+  std::mt19937_64 rng;
+  TimeSeries* example;
+  std::normal_distribution<double> noise{0.0, 1.0};
+  double I = 0.0;
+
+  double operator()(const State& s, const StepPoint& p) {
+    if (p.substep != 1) return I;
+    const double tk = grid.sample_time(p.sample);
+    const double y_meas =
+        s.y_m * 1e6 + r.sensor_noise_um * (r.sensor_noise_um > 0.0 ? noise(rng) : 0.0);
+    const double u = pid.update(ref.at(tk) - y_meas);
+    const double K_ref = r.feedforward.static_gain_um_per_A;
+    const double ff = K_ref > 0.0 ? (ref.at(tk) - ref.y_bias_um) / K_ref : 0.0;
+    I = r.feedforward.enabled()
+            ? std::clamp(r.bias_A + g * (u + ff), -r.current_limit_A, r.current_limit_A)
+            : r.bias_A + u;
+    if (example) {
+      auto& col = example->columns;
+      col[0].push_back(tk);
+      col[1].push_back(ref.at(tk));
+      col[2].push_back(s.y_m * 1e6);
+      col[3].push_back(I);
+      col[4].push_back(ref.at(tk) - s.y_m * 1e6);
+    }
+    return I;
   }
+};
+
+// The tracking error and the current over (t_end - T, t_end]: one whole period.
+struct ErrorOverLastPeriod {
+  const Reference& ref;
+  double after_s;
+  double ss = 0.0, peak = 0.0, Imin = 1e300, Imax = -1e300;
+  long n = 0;
+
+  void operator()(const State& s, const StepPoint& p) {
+    if (!(p.t_s > after_s)) return;
+    const double e = ref.at(p.t_s) - s.y_m * 1e6;
+    ss += e * e;
+    peak = std::max(peak, std::fabs(e));
+    ++n;
+    Imin = std::min(Imin, s.current_A);
+    Imax = std::max(Imax, s.current_A);
+  }
+};
+
+// One closed-loop run: the actuator at rest under the bias, the reference centred on its
+// output there, `periods` periods of the reference.
+void track_point(const Model& m, const Conditions& c, const TrackRequest& r, const Job& j, long sub,
+                 std::uint64_t seed, TrackPoint& p, TimeSeries* example) {
+  p.temperature_C = j.T;
+  p.amplitude_um = j.A;
+  p.frequency_Hz = j.f;
+  const double Ts = 1.0 / r.sample_rate_Hz;
+  const double period = 1.0 / j.f;
+  const StepGrid grid = StepGrid::sampled(
+      0.0, Ts, static_cast<double>(std::lround(r.periods * period / Ts)), sub, "plant steps");
+  const double t_end = static_cast<double>(grid.samples()) * Ts;
+  // The PID's own limits are those of u = (i - bias) / g, so its anti-windup acts where the
+  // current clips.
+  const double g = r.feedforward.gain_at(j.T);
+  p.feedforward_gain = g;
+  try {
+    State s = make_state(m, c, r.bias_A);
+    p.y_bias_um = s.y_m * 1e6;
+    const Reference ref{p.y_bias_um, j.A, 2.0 * physics::kPi * j.f};
+    SampledController drive{r,
+                            grid,
+                            ref,
+                            Pid(r.gains, r.sample_rate_Hz, (-r.current_limit_A - r.bias_A) / g,
+                                (r.current_limit_A - r.bias_A) / g),
+                            g,
+                            std::mt19937_64(seed),
+                            example};
+    ErrorOverLastPeriod err{ref, (t_end - period) + 1e-12 * period};
+    run_loop(m, c, s, grid, drive, err);
+    p.error_rms_um = std::sqrt(err.ss / static_cast<double>(std::max(err.n, 1L)));
+    p.error_peak_um = err.peak;
+    p.error_rms_pct = p.error_rms_um / j.A * 100.0;
+    p.current_min_A = err.Imin;
+    p.current_max_A = err.Imax;
+    p.saturated = err.Imax >= r.current_limit_A - 1e-12 || err.Imin <= -r.current_limit_A + 1e-12;
+  } catch (const DivergenceError& e) {
+    p.diverged = true;
+    p.error = e.what();
+    p.error_rms_um = p.error_peak_um = p.error_rms_pct = std::nan("");
+  }
+}
+
+}  // namespace
+
+TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& progress) {
+  check_request(r);
   std::vector<Conditions> conds;
   for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
 
@@ -157,109 +281,24 @@ TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& p
     for (double A : r.amplitudes_um)
       for (double f : r.frequencies_Hz) jobs.push_back({T, A, f});
   const std::size_t per_T = r.amplitudes_um.size() * r.frequencies_Hz.size();
-
-  // Plant step: divides the sample period, <= 10 us and <= T_ref/2000 (docs/model.md rule).
-  const double Ts = 1.0 / r.sample_rate_Hz;
-  double f_max = 0.0;
-  for (double f : r.frequencies_Hz) f_max = std::max(f_max, f);
-  const double dt_target =
-      r.dt_s > 0.0 ? r.dt_s : std::min(kMaxDt_s, 1.0 / (kStepsPerPeriod * f_max));
-  const long sub =
-      std::max(1L, checked_ceil_count(Ts / dt_target, kMaxSteps, "plant steps per PID sample"));
-  const double dt = Ts / static_cast<double>(sub);
-  // Every run's length: samples of the PID and plant steps, checked before any run.
-  double f_min = f_max;
-  for (double f : r.frequencies_Hz) f_min = std::min(f_min, f);
-  const double samples_max = r.periods / f_min / Ts;
-  (void)checked_count(samples_max, kMaxSteps, "PID samples of the longest run");
-  (void)checked_count(samples_max * static_cast<double>(sub), kMaxSteps,
-                      "plant steps of the longest run");
+  const long sub = plant_substeps(r);
 
   TrackResult res;
-  res.plant_dt_s = dt;
+  res.plant_dt_s = 1.0 / r.sample_rate_Hz / static_cast<double>(sub);
   res.threads = resolve_thread_count(r.threads, jobs.size());
   res.points.resize(jobs.size());
   const auto wall0 = std::chrono::steady_clock::now();
   detail::parallel_for(
       jobs.size(), res.threads,
       [&](std::size_t idx) {
-        const Job& j = jobs[idx];
-        const Conditions& c = conds[idx / per_T];
-        TrackPoint& p = res.points[idx];
-        p.temperature_C = j.T;
-        p.amplitude_um = j.A;
-        p.frequency_Hz = j.f;
-        const double period = 1.0 / j.f;
-        const long samples = std::lround(r.periods * period / Ts);
-        const double t_end = static_cast<double>(samples) * Ts;
-        const double t_window = t_end - period;  // errors over the last period
-        std::mt19937_64 rng(r.noise_seed + idx);
-        std::normal_distribution<double> noise(0.0, 1.0);
-        // With the temperature feed-forward, i = bias + g (u + r'/K_ref): the PID's own limits
-        // are those of u = (i - bias) / g, so its anti-windup acts where the current clips.
-        const double g = r.feedforward.gain_at(j.T);
-        const double K_ref = r.feedforward.static_gain_um_per_A;
-        p.feedforward_gain = g;
-        Pid pid(r.gains, r.sample_rate_Hz, (-r.current_limit_A - r.bias_A) / g,
-                (r.current_limit_A - r.bias_A) / g);
-        const bool record = idx == 0;
-        TimeSeries ex;
-        if (record) {
+        TimeSeries ex;  // the first point's run, sample by sample
+        if (idx == 0) {
           ex.names = {"t_s", "reference_um", "y_um", "current_A", "error_um"};
           ex.columns.assign(ex.names.size(), {});
         }
-        double ss = 0.0, peak = 0.0, Imin = 1e300, Imax = -1e300;
-        long n_err = 0;
-        try {
-          State s = make_state(m, c, r.bias_A);
-          const double y_bias_um = s.y_m * 1e6;
-          p.y_bias_um = y_bias_um;
-          const double w = 2.0 * physics::kPi * j.f;
-          auto ref = [&](double t) { return y_bias_um + j.A * std::sin(w * t); };
-          double I = r.bias_A;
-          for (long k = 0; k < samples; ++k) {
-            const double tk = static_cast<double>(k) * Ts;
-            // Sensor: y sampled at t_k (+ white noise); controller output held until t_k+1.
-            const double y_meas =
-                s.y_m * 1e6 + r.sensor_noise_um * (r.sensor_noise_um > 0.0 ? noise(rng) : 0.0);
-            const double u = pid.update(ref(tk) - y_meas);
-            const double ff = K_ref > 0.0 ? (ref(tk) - y_bias_um) / K_ref : 0.0;
-            I = r.feedforward.enabled()
-                    ? std::clamp(r.bias_A + g * (u + ff), -r.current_limit_A, r.current_limit_A)
-                    : r.bias_A + u;
-            if (record) {
-              ex.columns[0].push_back(tk);
-              ex.columns[1].push_back(ref(tk));
-              ex.columns[2].push_back(s.y_m * 1e6);
-              ex.columns[3].push_back(I);
-              ex.columns[4].push_back(ref(tk) - s.y_m * 1e6);
-            }
-            for (long q = 1; q <= sub; ++q) {
-              const double t = tk + static_cast<double>(q) * dt;
-              step(m, c, s, {I, dt});
-              s.t_s = t;
-              if (t > t_window + 1e-12 * period) {  // (t_end - T, t_end]: one whole period
-                const double e = ref(t) - s.y_m * 1e6;
-                ss += e * e;
-                peak = std::max(peak, std::fabs(e));
-                ++n_err;
-                Imin = std::min(Imin, I);
-                Imax = std::max(Imax, I);
-              }
-            }
-          }
-          p.error_rms_um = std::sqrt(ss / static_cast<double>(std::max(n_err, 1L)));
-          p.error_peak_um = peak;
-          p.error_rms_pct = p.error_rms_um / j.A * 100.0;
-          p.current_min_A = Imin;
-          p.current_max_A = Imax;
-          p.saturated = Imax >= r.current_limit_A - 1e-12 || Imin <= -r.current_limit_A + 1e-12;
-        } catch (const DivergenceError& e) {
-          p.diverged = true;
-          p.error = e.what();
-          p.error_rms_um = p.error_peak_um = p.error_rms_pct = std::nan("");
-        }
-        if (record) res.example = std::move(ex);
+        track_point(m, conds[idx / per_T], r, jobs[idx], sub, r.noise_seed + idx, res.points[idx],
+                    idx == 0 ? &ex : nullptr);
+        if (idx == 0) res.example = std::move(ex);
       },
       progress);
   res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -11,6 +11,7 @@
 #include <cstdint>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/run_loop.hpp"
 #include "gmasim/validate.hpp"
 
 namespace gmasim::identify_detail {
@@ -32,39 +33,15 @@ struct TableDrive {
   }
 };
 
-// Moves the model by one step (dt > 0) or one quasi-static increment (dt = 0) to a drive
-// value of the record: a coil current, or the applied field H_c of one rod (eq. 7), for
-// which the coil current that produces it at the end of the step is found by bracketing
-// and TOMS 748 (each trial is the step itself, from a copy of the state).
-class Driver {
+// The coil current that gives one rod the applied field H_c (eq. 7) of a field record at the
+// end of a step (dt > 0) or of a quasi-static increment (dt = 0): found by bracketing and
+// TOMS 748, each trial being that step itself, from a copy of the state.
+class FieldSolver {
  public:
-  Driver(const Model& m, const Conditions& c, const Measurement& meas, std::size_t rod)
-      : m_(m), c_(c), field_(meas.drive_kind == DriveInput::Field), rod_(rod), path_(meas.path) {}
+  FieldSolver(const Model& m, const Conditions& c, const Measurement& meas, std::size_t rod)
+      : m_(m), c_(c), rod_(rod), path_(meas.path) {}
 
-  void move(State& st, double drive, double dt) {
-    if (!field_) {
-      advance(st, drive, dt);
-      return;
-    }
-    advance(st, current_for_field(st, drive, dt), dt);
-  }
-
- private:
-  void advance(State& s, double current_A, double dt) const {
-    if (dt > 0.0) {
-      step(m_, c_, s, {current_A, dt});
-    } else {
-      quasi_static_step(m_, c_, s, current_A);
-    }
-  }
-
-  double field_error(const State& st, double current_A, double target, double dt) {
-    trial_ = st;
-    advance(trial_, current_A, dt);
-    return trial_.rods[rod_].Hc_A_per_m - target;
-  }
-
-  double current_for_field(const State& st, double target, double dt) {
+  double current_for(const State& st, double target, double dt) {
     if (dI_dH_ == 0.0) {  // first call: the slope of the circuit from a 1 mA probe
       const double h0 = field_error(st, st.current_A, 0.0, dt);
       const double h1 = field_error(st, st.current_A + 1e-3, 0.0, dt);
@@ -97,6 +74,27 @@ class Driver {
       throw DivergenceError(
           st.t_s, m_.rods[rod_].name, "field_A_per_m [A/m] of the record", target,
           fmt::format("no coil current within +-{:g} A produces it", kMaxCurrent_A));
+    return solve(st, target, dt, a, fa, b, fb);
+  }
+
+ private:
+  void advance(State& s, double current_A, double dt) const {
+    if (dt > 0.0) {
+      step(m_, c_, s, {current_A, dt});
+    } else {
+      quasi_static_step(m_, c_, s, current_A);
+    }
+  }
+
+  double field_error(const State& st, double current_A, double target, double dt) {
+    trial_ = st;
+    advance(trial_, current_A, dt);
+    return trial_.rods[rod_].Hc_A_per_m - target;
+  }
+
+  // TOMS 748 inside the bracket [a, b]; the secant of the bracket is the next first guess.
+  double solve(const State& st, double target, double dt, double a, double fa, double b,
+               double fb) {
     auto tol = [&](double lo, double hi) {
       return std::fabs(hi - lo) <= 1e-13 * std::max(1.0, std::fabs(lo));
     };
@@ -111,7 +109,6 @@ class Driver {
 
   const Model& m_;
   const Conditions& c_;
-  bool field_;
   std::size_t rod_;
   std::string path_;
   State trial_;
@@ -174,91 +171,152 @@ double record_step_count(const Measurement& meas, const ObjectiveSettings& s) {
   return passes * std::max(1.0, std::ceil(span / dt - 1e-9));
 }
 
-void run_record(const Model& m, const Conditions& c, State st, const Measurement& meas,
-                const ObjectiveSettings& s, std::vector<double>& response, std::vector<double>* B_T,
-                std::vector<double>* H_A_per_m) {
-  const auto& ts = meas.t_s;
-  const std::size_t n = ts.size();
-  const auto& cond = meas.condition;
-  const std::size_t rod = record_rod(m, meas);
-  const Probe probe{meas.response_kind == ResponseOutput::Strain, rod, c.rods[rod].length_m};
-  Driver driver(m, c, meas, rod);
-  response.resize(n);
-  if (B_T) B_T->resize(n);
-  if (H_A_per_m) H_A_per_m->resize(n);
-  auto field = [&](const State& x) { return x.rods[rod].Hc_A_per_m; };
-  auto store = [&](std::size_t i, const State& x) {  // sample i from the state x
-    response[i] = probe.response(x);
-    if (B_T) (*B_T)[i] = x.B_T;
-    if (H_A_per_m) (*H_A_per_m)[i] = field(x);
-  };
-  const long passes = 1 + cond.precycles;
-  // Moves quasi-statically from the drive value `from` to `to` in equal increments of at
-  // most (drive range) / quasi_static_increments.
-  const double inc = std::max(peak_to_peak(meas.drive), 1e-300) / s.quasi_static_increments;
-  auto travel = [&](double from, double to) {
-    const long k_n = std::max(1L, checked_ceil_count(std::fabs(to - from) / inc - 1e-9, kMaxSteps,
-                                                     meas.path + ": quasi-static increments"));
-    for (long k = 1; k <= k_n; ++k)
-      driver.move(st, from + (to - from) * static_cast<double>(k) / static_cast<double>(k_n), 0.0);
-  };
-  // A field record starts at rest at zero current and ramps quasi-statically to its first
-  // field, as a current record starts at rest at its first current (make_state).
-  if (meas.drive_kind == DriveInput::Field && field(st) != meas.drive.front())
-    travel(field(st), meas.drive.front());
+namespace {
 
-  if (cond.quasi_static) {
-    double at = meas.drive.front();
+// One simulation of a record: what it drives, what it measures, where the samples go.
+class RecordRun {
+ public:
+  RecordRun(const Model& m, const Conditions& c, const Measurement& meas,
+            const ObjectiveSettings& s, std::vector<double>& response, std::vector<double>* B_T,
+            std::vector<double>* H_A_per_m)
+      : m_(m),
+        c_(c),
+        meas_(meas),
+        s_(s),
+        rod_(record_rod(m, meas)),
+        probe_{meas.response_kind == ResponseOutput::Strain, rod_, c.rods[rod_].length_m},
+        solver_(m, c, meas, rod_),
+        field_drive_(meas.drive_kind == DriveInput::Field),
+        response_(response),
+        B_T_(B_T),
+        H_(H_A_per_m),
+        // Quasi-static moves: equal increments of at most (drive range) / increments.
+        inc_(std::max(peak_to_peak(meas.drive), 1e-300) / s.quasi_static_increments),
+        increments_what_(meas.path + ": quasi-static increments") {
+    const std::size_t n = meas.t_s.size();
+    response_.resize(n);
+    if (B_T_) B_T_->resize(n);
+    if (H_) H_->resize(n);
+  }
+
+  void run(State& st) {
+    // A field record starts at rest at zero current and ramps quasi-statically to its first
+    // field, as a current record starts at rest at its first current (make_state).
+    if (field_drive_ && field(st) != meas_.drive.front())
+      travel(st, field(st), meas_.drive.front());
+    if (meas_.condition.quasi_static) {
+      run_quasi_static(st);
+    } else {
+      run_timed(st);
+    }
+  }
+
+ private:
+  double field(const State& x) const { return x.rods[rod_].Hc_A_per_m; }
+
+  void store(std::size_t i, const State& x) {  // sample i from the state x
+    response_[i] = probe_.response(x);
+    if (B_T_) (*B_T_)[i] = x.B_T;
+    if (H_) (*H_)[i] = field(x);
+  }
+
+  // The coil current of a drive value (a current, or a field the solver produces).
+  double current(const State& x, double drive, double dt) {
+    return field_drive_ ? solver_.current_for(x, drive, dt) : drive;
+  }
+
+  // Moves quasi-statically from the drive value `from` to `to` in equal increments.
+  void travel(State& st, double from, double to) {
+    const StepGrid g = StepGrid::quasi_static(
+        steps_to_resolve(std::fabs(to - from) / inc_ - 1e-9, 1, increments_what_),
+        increments_what_);
+    const double k_n = static_cast<double>(g.steps);
+    run_loop(m_, c_, st, g, [&](const State& x, const StepPoint& p) {
+      return current(x, from + (to - from) * static_cast<double>(p.k) / k_n, 0.0);
+    });
+  }
+
+  void run_quasi_static(State& st) {
+    const auto& drive = meas_.drive;
+    const long passes = 1 + meas_.condition.precycles;
+    double at = drive.front();
     for (long pass = 0; pass < passes; ++pass) {
-      if (pass > 0) travel(at, meas.drive.front());
-      at = meas.drive.front();
-      for (std::size_t i = 0; i < n; ++i) {
-        if (i > 0) travel(at, meas.drive[i]);
-        at = meas.drive[i];
+      if (pass > 0) travel(st, at, drive.front());
+      at = drive.front();
+      for (std::size_t i = 0; i < drive.size(); ++i) {
+        if (i > 0) travel(st, at, drive[i]);
+        at = drive[i];
         if (pass + 1 == passes) store(i, st);
       }
     }
-    return;
   }
 
-  const double t0 = ts.front(), t1 = ts.back();
-  const bool sine = cond.current_source == "sine";
-  const Waveform w =
-      sine ? biased_sine(cond.current_pp_A, cond.frequency_Hz, cond.current_min_A) : Waveform{};
-  TableDrive table{ts, meas.drive};
-  auto drive = [&](double t) { return sine ? w.current_at(t) : table(t); };
-  const double dt_target = objective_step(s, meas.periodic() ? 1.0 / cond.frequency_Hz : 0.0);
-  const long nsteps = std::max(1L, checked_ceil_count((t1 - t0) / dt_target, kMaxSteps,
-                                                      meas.path + ": steps over the record"));
-  const double dt = (t1 - t0) / static_cast<double>(nsteps);
-  st.t_s = t0;
-  for (long pass = 0; pass < passes; ++pass) {
-    const bool last = pass + 1 == passes;
-    std::size_t j = 0;
-    table.j = 1;
-    for (; j < n && ts[j] <= t0; ++j)
-      if (last) store(j, st);
-    double r_prev = probe.si(st), B_prev = st.B_T, H_prev = field(st), t_prev = t0;
+  // Steps spanning [t0, t1] exactly (the record's first and last time); the samples between
+  // two steps are interpolated linearly. Every pre-cycle repeats the record from t0.
+  void run_timed(State& st) {
+    const auto& ts = meas_.t_s;
+    const std::size_t n = ts.size();
+    const auto& cond = meas_.condition;
+    const double t0 = ts.front(), t1 = ts.back();
+    const bool sine = cond.current_source == "sine";
+    const Waveform w =
+        sine ? biased_sine(cond.current_pp_A, cond.frequency_Hz, cond.current_min_A) : Waveform{};
+    TableDrive table{ts, meas_.drive};
+    const double dt_target = objective_step(s_, meas_.periodic() ? 1.0 / cond.frequency_Hz : 0.0);
+    const std::string what = meas_.path + ": steps over the record";
+    const StepGrid grid =
+        StepGrid::spanning(t0, t1, steps_to_resolve((t1 - t0) / dt_target, 1, what), what);
+    auto drive = [&](const State& x, const StepPoint& p) {
+      return current(x, sine ? w.current_at(p.t_s) : table(p.t_s), p.dt_s);
+    };
+    const long passes = 1 + cond.precycles;
     st.t_s = t0;
-    for (long k = 1; k <= nsteps; ++k) {
-      const double t = k == nsteps ? t1 : t0 + static_cast<double>(k) * dt;
-      driver.move(st, drive(t), t - t_prev);
-      st.t_s = t;
-      const double r_now = probe.si(st);
-      while (last && j < n && ts[j] <= t) {
-        const double f = (ts[j] - t_prev) / (t - t_prev);
-        response[j] = (r_prev + f * (r_now - r_prev)) * 1e6;
-        if (B_T) (*B_T)[j] = B_prev + f * (st.B_T - B_prev);
-        if (H_A_per_m) (*H_A_per_m)[j] = H_prev + f * (field(st) - H_prev);
-        ++j;
-      }
-      r_prev = r_now;
-      B_prev = st.B_T;
-      H_prev = field(st);
-      t_prev = t;
+    for (long pass = 0; pass < passes; ++pass) {
+      const bool last = pass + 1 == passes;
+      std::size_t j = 0;
+      table.j = 1;
+      for (; j < n && ts[j] <= t0; ++j)
+        if (last) store(j, st);
+      double r_prev = probe_.si(st), B_prev = st.B_T, H_prev = field(st), t_prev = t0;
+      run_loop(m_, c_, st, grid, drive, [&](const State& x, const StepPoint& p) {
+        const double t = p.t_s, r_now = probe_.si(x);
+        while (last && j < n && ts[j] <= t) {
+          const double f = (ts[j] - t_prev) / (t - t_prev);
+          response_[j] = (r_prev + f * (r_now - r_prev)) * 1e6;
+          if (B_T_) (*B_T_)[j] = B_prev + f * (x.B_T - B_prev);
+          if (H_) (*H_)[j] = H_prev + f * (field(x) - H_prev);
+          ++j;
+        }
+        r_prev = r_now;
+        B_prev = x.B_T;
+        H_prev = field(x);
+        t_prev = t;
+      });
+      for (; last && j < n; ++j) store(j, st);
     }
-    for (; last && j < n; ++j) store(j, st);
   }
+
+  const Model& m_;
+  const Conditions& c_;
+  const Measurement& meas_;
+  const ObjectiveSettings& s_;
+  std::size_t rod_;
+  Probe probe_;
+  FieldSolver solver_;
+  bool field_drive_;
+  std::vector<double>& response_;
+  std::vector<double>* B_T_;
+  std::vector<double>* H_;
+  double inc_;
+  std::string increments_what_;
+};
+
+}  // namespace
+
+void run_record(const Model& m, const Conditions& c, State st, const Measurement& meas,
+                const ObjectiveSettings& s, std::vector<double>& response, std::vector<double>* B_T,
+                std::vector<double>* H_A_per_m) {
+  RecordRun(m, c, meas, s, response, B_T, H_A_per_m).run(st);
 }
 
 void apply_offset(OffsetMode mode, const std::vector<double>& measured, std::size_t begin,

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/run_loop.hpp"
 #include "gmasim/self_heating.hpp"
 #include "gmasim/simulate.hpp"
 #include "gmasim/validate.hpp"
@@ -50,10 +51,10 @@ void record(const Conditions& c, const State& s, TimeSeries& ts) {
   }
 }
 
-// The run's fixed time step and length (docs/model.md, "Time step"), after validate().
+// The run's grid (docs/model.md, "Time step"), after validate(): a uniform grid from t = 0.
 struct RunLength {
-  double dt_s = 0, duration_s = 0;
-  long steps = 0;
+  StepGrid grid;
+  double duration_s = 0;
 };
 
 RunLength run_length(const SimulationSettings& s) {
@@ -63,9 +64,7 @@ RunLength run_length(const SimulationSettings& s) {
   if (w.periodic()) {
     // Whole steps per period, so the last period's window is sampled exactly.
     const double per = w.period_s();
-    const double steps_per_period =
-        static_cast<double>(checked_ceil_count(per / dt, kMaxSteps, "steps per period"));
-    dt = per / steps_per_period;
+    dt = per / static_cast<double>(steps_to_resolve(per / dt, 0, "steps per period"));
     L.duration_s = s.periods * per;
   } else {
     L.duration_s = s.duration_s;
@@ -74,14 +73,13 @@ RunLength run_length(const SimulationSettings& s) {
     if (!(L.duration_s > 0.0))
       throw InputError(fmt::format("duration {} s: must be > 0", L.duration_s));
   }
-  L.dt_s = dt;
-  L.steps = checked_step_count(L.duration_s, dt, "simulation");
-  const double rows = static_cast<double>(L.steps) / s.record_every + 2.0;
+  L.grid = StepGrid::covering(0.0, L.duration_s, dt, "simulation");
+  const double rows = static_cast<double>(L.grid.steps) / s.record_every + 2.0;
   if (rows > kMaxRecordedRows)
     throw InputError(fmt::format(
         "simulation: {} steps recorded every {} give {:.4g} rows (limit {:g}); record less often "
         "(record_every, --record-every) or shorten the run",
-        L.steps, s.record_every, rows, kMaxRecordedRows));
+        L.grid.steps, s.record_every, rows, kMaxRecordedRows));
   return L;
 }
 
@@ -111,8 +109,8 @@ struct SelfHeatingRun {
       if (s.waveform.periodic())
         want = s.waveform.period_s() * std::ceil(0.1 / s.waveform.period_s() - 1e-9);
     }
-    steps_per_interval = std::max(1L, std::lround(want / L.dt_s));
-    interval_s = static_cast<double>(steps_per_interval) * L.dt_s;
+    steps_per_interval = std::max(1L, std::lround(want / L.grid.dt_s));
+    interval_s = static_cast<double>(steps_per_interval) * L.grid.dt_s;
     const double tau = fastest_time_constant_s(*net);
     if (interval_s > tau)
       throw InputError(fmt::format(
@@ -129,7 +127,8 @@ struct SelfHeatingRun {
                        "P_copper_W", "P_eddy_W", "P_hysteresis_W", "P_ambient_W",
                        "stroke_um",  "E_in_J",   "E_stored_J",     "E_out_J"};
     r.heating.columns.assign(r.heating.names.size(), {});
-    const double rows = static_cast<double>(L.steps) / static_cast<double>(steps_per_interval) + 2;
+    const double rows =
+        static_cast<double>(L.grid.steps) / static_cast<double>(steps_per_interval) + 2;
     for (auto& col : r.heating.columns) col.reserve(static_cast<std::size_t>(rows));
   }
 
@@ -195,6 +194,26 @@ struct SelfHeatingRun {
           "defined ({})",
           st.t_s, T.rods_C, e.what()));
     }
+  }
+};
+
+// What simulate() does after each step: self-heating (which may replace the Conditions the
+// loop reads), the decimated record, the step count and the progress callback.
+struct SimulationRecorder {
+  const Model& m;
+  const SimulationSettings& s;
+  Conditions& c;  // the object run_loop() reads at every step
+  SelfHeatingRun& heat;
+  Result& r;
+  long nsteps, report_every;
+
+  void operator()(const State& st, const StepPoint& p) {
+    const long k = p.k;
+    if (heat.enabled) heat.after_step(m, s, c, st, p.dt_s, k == nsteps, r);
+    if (k % s.record_every == 0 || k == nsteps) record(c, st, r.series);
+    r.steps = k;
+    if (s.progress && (k % report_every == 0 || k == nsteps))
+      s.progress(static_cast<std::size_t>(k), static_cast<std::size_t>(nsteps));
   }
 };
 
@@ -272,9 +291,9 @@ void validate(const SimulationSettings& s) {
     require_nonnegative(h.thermal_step_s, "thermal step", "s");
     if (!std::isnan(h.ambient_C))
       require_in(h.ambient_C, -273.15, 1e4, "ambient temperature", "degC");
-    if (h.thermal_step_s > 0.0 && h.thermal_step_s < L.dt_s)
+    if (h.thermal_step_s > 0.0 && h.thermal_step_s < L.grid.dt_s)
       throw InputError(fmt::format("thermal step {} s: shorter than the time step {} s",
-                                   h.thermal_step_s, L.dt_s));
+                                   h.thermal_step_s, L.grid.dt_s));
   }
 }
 
@@ -282,12 +301,12 @@ Result simulate(const Model& m, const SimulationSettings& s) {
   const auto& w = s.waveform;
   validate(s);
   const RunLength L = run_length(s);
-  const double duration = L.duration_s, dt = L.dt_s;
-  const long nsteps = L.steps;
+  const double duration = L.duration_s;
+  const long nsteps = L.grid.steps;
 
   Conditions c = make_conditions(m, s.temperature_C, s.freeze);
   Result r;
-  r.dt_s = dt;
+  r.dt_s = L.grid.dt_s;
   r.thermal_expansion_um = c.thermal_expansion_m * 1e6;
   make_columns(m, r.series, static_cast<std::size_t>(nsteps / s.record_every + 2));
   SelfHeatingRun heat(m, s, L, r);
@@ -296,17 +315,9 @@ Result simulate(const Model& m, const SimulationSettings& s) {
     State st = make_state(m, c, w.current_at(0.0));
     record(c, st, r.series);
     heat.begin(c, st, r);
-    const long report_every = std::max(1L, nsteps / 100);
-    for (long k = 1; k <= nsteps; ++k) {
-      const double t = static_cast<double>(k) * dt;
-      step(m, c, st, {w.current_at(t), dt});
-      st.t_s = t;  // avoid drift from repeated addition
-      if (heat.enabled) heat.after_step(m, s, c, st, dt, k == nsteps, r);
-      if (k % s.record_every == 0 || k == nsteps) record(c, st, r.series);
-      r.steps = k;
-      if (s.progress && (k % report_every == 0 || k == nsteps))
-        s.progress(static_cast<std::size_t>(k), static_cast<std::size_t>(nsteps));
-    }
+    run_loop(
+        m, c, st, L.grid, [&w](double t) { return w.current_at(t); },
+        SimulationRecorder{m, s, c, heat, r, nsteps, std::max(1L, nsteps / 100)});
   } catch (const DivergenceError& e) {
     r.diverged = true;
     r.error = e.what();

@@ -1,0 +1,182 @@
+// The identification objective's internals (gmasim/identify.hpp, Objective): its parameters,
+// records and targets, and the residual evaluation, shared by objective.cpp (construction,
+// evaluation) and objective_fits.cpp (the fit report's per-record and per-target view).
+#pragma once
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/identify.hpp"
+#include "identify/objective_runs.hpp"
+#include "identify/record_run.hpp"
+
+namespace gmasim {
+namespace identify_detail {
+
+struct Param {
+  std::string key, unit;
+  ParamScale scale = ParamScale::Linear;
+  double lo = 0, hi = 0;
+  double tlo = 0, thi = 0;  // theta bounds: p, or ln|p|
+  double sign = 1.0;
+};
+
+struct CondData {
+  std::size_t index = 0;          // in data.items
+  std::size_t compare_begin = 0;  // first compared sample
+  double pp_um = 0, y_scale = 0;
+  bool flux = false;
+  double ppB = 0, B_scale = 0;
+  std::size_t r_offset = 0, rB_offset = 0;
+};
+
+struct TargetData {
+  FitTarget t;
+  int run = -1, ref_run = -1, res_run = -1;
+  double r_scale = 0;
+  std::size_t r_index = 0;
+};
+
+}  // namespace identify_detail
+
+// The objective's data: built by the constructor (objective.cpp), read by the evaluations and
+// the fit report (objective_fits.cpp).
+struct Objective::Impl {
+  using CondData = identify_detail::CondData;
+  using Param = identify_detail::Param;
+  using ResonanceRun = identify_detail::ResonanceRun;
+  using SineMetrics = identify_detail::SineMetrics;
+  using SineRun = identify_detail::SineRun;
+  using StartCache = identify_detail::StartCache;
+  using TargetData = identify_detail::TargetData;
+
+  ModelSpec start;
+  MeasurementSet data;
+  FitSpec fit;
+  ObjectiveSettings settings;
+  std::vector<Param> params;
+  std::vector<std::string> names, units, notes;
+  std::vector<double> start_u;
+  std::vector<CondData> conds;
+  std::vector<SineRun> sine_runs;
+  std::vector<ResonanceRun> res_runs;
+  std::vector<TargetData> targets;
+  std::size_t m = 0;
+
+  double to_param(std::size_t j, double u) const {
+    const Param& p = params[j];
+    const double th = p.tlo + u * (p.thi - p.tlo);
+    return p.scale == ParamScale::Log ? p.sign * std::exp(th) : th;
+  }
+  double to_u(std::size_t j, double v) const {
+    const Param& p = params[j];
+    const double th = p.scale == ParamScale::Log ? std::log(std::fabs(v)) : v;
+    return std::clamp((th - p.tlo) / (p.thi - p.tlo), 0.0, 1.0);
+  }
+
+  // Model at u; throws InputError if a value breaks a model rule.
+  Model model_at(const double* u) const {
+    ModelSpec spec = start;
+    for (std::size_t j = 0; j < params.size(); ++j) spec.set(params[j].key, to_param(j, u[j]));
+    return compile(spec);
+  }
+
+  // The records' residuals. Throws InputError / DivergenceError.
+  void record_residuals(const Model& model, StartCache& starts, double* r) const {
+    std::vector<double> y, B;
+    for (const auto& cd : conds) {
+      const Measurement& meas = data.items[cd.index];
+      const auto& [c, st] =
+          starts.get(meas.condition.temperature_C, identify_detail::record_initial_current(meas));
+      identify_detail::run_record(model, c, st, meas, settings, y, cd.flux ? &B : nullptr);
+      identify_detail::apply_offset(meas.condition.offset, meas.response, cd.compare_begin, y);
+      if (cd.flux)
+        identify_detail::apply_offset(meas.condition.flux_offset, meas.flux_T, cd.compare_begin, B);
+      const std::size_t n = meas.t_s.size();
+      for (std::size_t i = cd.compare_begin; i < n; ++i) {
+        r[cd.r_offset + i - cd.compare_begin] = cd.y_scale * (y[i] - meas.response[i]);
+        if (cd.flux) r[cd.rB_offset + i - cd.compare_begin] = cd.B_scale * (B[i] - meas.flux_T[i]);
+      }
+    }
+  }
+
+  // The simulations of the scalar targets. Throws InputError / DivergenceError.
+  void target_runs(const Model& model, StartCache& starts, std::vector<SineMetrics>& sm,
+                   std::vector<double>& res) const {
+    std::vector<double> I, yy, BB;
+    sm.resize(sine_runs.size());
+    for (std::size_t k = 0; k < sine_runs.size(); ++k)
+      sm[k] = identify_detail::run_sine(model, sine_runs[k], settings, I, yy, BB, starts);
+    res.resize(res_runs.size());
+    for (std::size_t k = 0; k < res_runs.size(); ++k)
+      res[k] = identify_detail::lowest_resonance_Hz(model, res_runs[k]);
+  }
+
+  bool residuals(const double* u, double* r, std::string* why = nullptr) const {
+    try {
+      const Model model = model_at(u);
+      StartCache starts(model);
+      record_residuals(model, starts, r);
+      if (!targets.empty()) {
+        std::vector<SineMetrics> sm;
+        std::vector<double> res;
+        target_runs(model, starts, sm, res);
+        for (const auto& td : targets) {
+          const double sim = target_value(td, sm, res);
+          r[td.r_index] = td.r_scale * (sim - td.t.value);
+        }
+      }
+    } catch (const InputError& e) {
+      if (why) *why = e.what();
+      return false;
+    } catch (const DivergenceError& e) {
+      if (why) *why = e.what();
+      return false;
+    }
+    for (std::size_t i = 0; i < m; ++i)
+      if (!std::isfinite(r[i])) {
+        if (why) *why = fmt::format("residual {} is not finite", i);
+        return false;
+      }
+    return true;
+  }
+
+  static double target_value(const TargetData& td, const std::vector<SineMetrics>& sm,
+                             const std::vector<double>& res) {
+    auto change = [&](auto get) {
+      const double ref = get(sm[static_cast<std::size_t>(td.ref_run)]);
+      return 100.0 * (get(sm[static_cast<std::size_t>(td.run)]) / ref - 1.0);
+    };
+    auto stroke = [](const SineMetrics& s) { return s.stroke_um; };
+    auto hyst = [](const SineMetrics& s) { return s.hysteresis_um; };
+    auto bpp = [](const SineMetrics& s) { return s.B_pp_T; };
+    switch (td.t.kind) {
+      case TargetKind::StrokeUm:
+        return sm[static_cast<std::size_t>(td.run)].stroke_um;
+      case TargetKind::HysteresisUm:
+        return sm[static_cast<std::size_t>(td.run)].hysteresis_um;
+      case TargetKind::BppT:
+        return sm[static_cast<std::size_t>(td.run)].B_pp_T;
+      case TargetKind::StrokeChangePct:
+        return change(stroke);
+      case TargetKind::HysteresisChangePct:
+        return change(hyst);
+      case TargetKind::BppChangePct:
+        return change(bpp);
+      case TargetKind::RetentionPct:
+        return 100.0 + change(stroke);
+      case TargetKind::ResonanceHz:
+      case TargetKind::FrfPeakHz:
+      case TargetKind::BandwidthHz:
+        return res[static_cast<std::size_t>(td.res_run)];
+    }
+    return 0.0;
+  }
+};
+
+}  // namespace gmasim

@@ -1,0 +1,101 @@
+// The simulations of the identification objective besides its records (objective_runs.hpp),
+// and simulate_measurement().
+#include "identify/objective_runs.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "gmasim/experiments.hpp"
+#include "gmasim/physics/magnetic.hpp"
+#include "gmasim/validate.hpp"
+#include "identify/record_run.hpp"
+
+namespace gmasim {
+namespace identify_detail {
+
+const std::pair<Conditions, State>& StartCache::get(double T, double I0) {
+  for (const auto& e : entries_)
+    if (e.T == T && e.I0 == I0) return e.cs;
+  Conditions c = make_conditions(m_, T);
+  State st = make_state(m_, c, I0);
+  entries_.push_back({T, I0, {std::move(c), std::move(st)}});
+  return entries_.back().cs;
+}
+
+SineGrid sine_target_grid(const SineRun& run, const ObjectiveSettings& s) {
+  const double per = 1.0 / run.f;
+  SineGrid g;
+  g.per_period = steps_to_resolve(per / objective_step(s, per), 8, "steps per period");
+  const long periods = std::max(1L, checked_count(s.target_periods, 1e4, "target periods"));
+  g.grid = StepGrid::uniform(0.0, per / static_cast<double>(g.per_period),
+                             static_cast<double>(periods) * static_cast<double>(g.per_period),
+                             fmt::format("steps of the {:g} Hz target simulation", run.f));
+  return g;
+}
+
+SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings& s,
+                     std::vector<double>& I, std::vector<double>& y, std::vector<double>& B,
+                     StartCache& starts) {
+  const Waveform w = biased_sine(run.pp, run.f, run.min);
+  const SineGrid g = sine_target_grid(run, s);
+  const long n_per = g.per_period, total = g.grid.steps;
+  const auto& [c, st0] = starts.get(run.T, w.current_at(0.0));
+  State st = st0;
+  I.assign(static_cast<std::size_t>(n_per), 0.0);
+  y.assign(static_cast<std::size_t>(n_per), 0.0);
+  B.assign(static_cast<std::size_t>(n_per), 0.0);
+  const long first = total - n_per;  // record samples k in [first, total)
+  auto rec = [&](const State& x, long k) {
+    if (k < first || k >= total) return;
+    const auto i = static_cast<std::size_t>(k - first);
+    I[i] = x.current_A;
+    y[i] = x.y_m * 1e6;
+    B[i] = x.B_T;
+  };
+  rec(st, 0);
+  run_loop(
+      m, c, st, g.grid, [&w](double t) { return w.current_at(t); },
+      [&](const State& x, const StepPoint& p) { rec(x, p.k); });
+  SineMetrics r;
+  r.stroke_um = peak_to_peak(y);
+  r.B_pp_T = peak_to_peak(B);
+  r.hysteresis_um = hysteresis_width(I, y, 0, y.size());
+  return r;
+}
+
+double lowest_resonance_Hz(const Model& m, const ResonanceRun& run) {
+  if (run.kind != TargetKind::ResonanceHz) {  // the small-signal frequency response (Fig. 15)
+    FrfRequest r;
+    r.temperatures_C = {run.T};
+    r.bias_A = run.bias;
+    r.stepped_sine = false;
+    r.threads = 1;
+    const FrfResult frf = run_frf(m, r);  // kept alive: cv refers into it
+    const FrfCurve& cv = frf.curves.at(0);
+    return run.kind == TargetKind::FrfPeakHz ? cv.first_resonance_Hz : cv.bandwidth_3dB_Hz;
+  }
+  const Conditions c = make_conditions(m, run.T);
+  const State st = make_state(m, c, run.bias);
+  double f = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < m.rod_count(); ++i) {
+    const double K = oscillator_stiffness(c, st, i);
+    const double mass = c.rods[static_cast<std::size_t>(i)].mass_osc_kg;
+    f = std::min(f, std::sqrt(K / mass) / (2.0 * physics::kPi));
+  }
+  return f;
+}
+
+}  // namespace identify_detail
+
+void simulate_measurement(const Model& m, const Measurement& meas, const ObjectiveSettings& s,
+                          std::vector<double>& y_um, std::vector<double>* B_T) {
+  identify_detail::StartCache starts(m);
+  const auto& [c, st] =
+      starts.get(meas.condition.temperature_C, identify_detail::record_initial_current(meas));
+  identify_detail::run_record(m, c, st, meas, s, y_um, B_T);
+}
+
+}  // namespace gmasim

@@ -1,0 +1,64 @@
+// The simulations of the identification objective besides its records (record_run.hpp): the
+// shared start states, the biased-sine runs of the scalar targets and the resonance targets.
+#pragma once
+
+#include <deque>
+#include <utility>
+#include <vector>
+
+#include "gmasim/identify.hpp"
+#include "gmasim/run_loop.hpp"
+
+namespace gmasim::identify_detail {
+
+// Conditions and the state at rest per (temperature, initial current): runs that share both
+// (every frequency and amplitude of a biased sine starting at its -3 A minimum) share one
+// make_state(), whose quasi-static ramp costs about as much as 300 steps.
+class StartCache {
+ public:
+  explicit StartCache(const Model& m) : m_(m) {}
+  const std::pair<Conditions, State>& get(double T, double I0);
+
+ private:
+  struct Entry {
+    double T, I0;
+    std::pair<Conditions, State> cs;
+  };
+  const Model& m_;
+  std::deque<Entry> entries_;
+};
+
+// The biased sine of a stroke, hysteresis or B_pp target at one temperature.
+struct SineRun {
+  double T, pp, f, min;
+  bool operator==(const SineRun&) const = default;
+};
+
+struct SineMetrics {
+  double stroke_um = 0, hysteresis_um = 0, B_pp_T = 0;
+};
+
+// A sine run's grid: steps_per_period steps per period (at least 8; dt_s of the settings
+// if given), target_periods periods. Throws InputError when it is too long.
+struct SineGrid {
+  StepGrid grid;
+  long per_period = 0;
+};
+SineGrid sine_target_grid(const SineRun& run, const ObjectiveSettings& s);
+
+// Runs the sine from the cached start state; the metrics are those of its last period, whose
+// current, y [um] and B [T] are left in I, y, B (buffers reused across calls).
+SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings& s,
+                     std::vector<double>& I, std::vector<double>& y, std::vector<double>& B,
+                     StartCache& starts);
+
+// A resonance_Hz (lowest eq. 15 oscillator frequency at the bias), frf_peak_Hz or
+// bandwidth_Hz (the small-signal frequency response of Fig. 15) target.
+struct ResonanceRun {
+  double T, bias;
+  TargetKind kind;  // ResonanceHz, FrfPeakHz or BandwidthHz
+  bool operator==(const ResonanceRun&) const = default;
+};
+double lowest_resonance_Hz(const Model& m, const ResonanceRun& run);
+
+}  // namespace gmasim::identify_detail
