@@ -111,6 +111,18 @@ def _paper_legend(ax):
     return h, lab
 
 
+def _finish_axes(ax, legend_title, claims, title=None):
+    """Grid and legend of a panel (with the paper's markers explained when claims are drawn),
+    and its title if given."""
+    if title is not None:
+        ax.set_title(title)
+    ax.grid(alpha=0.3)
+    if claims:
+        ax.legend(*_paper_legend(ax), title=legend_title, fontsize=7)
+    else:
+        ax.legend(title=legend_title, fontsize=8)
+
+
 def _value_at(cols, y, **cond):
     sel = np.ones(len(cols["temperature_C"]), dtype=bool)
     for k, v in cond.items():
@@ -174,11 +186,7 @@ def sweep_vs_temperature(sweep: Columns, frequency_Hz: float | None = None,
     for ax, lab in zip(axes, ("stroke (µm)", "hysteresis (µm)", "flux density B, peak-to-peak (T)")):
         ax.set_xlabel("temperature (°C)")
         ax.set_ylabel(lab)
-        ax.grid(alpha=0.3)
-        if claims:
-            ax.legend(*_paper_legend(ax), title="current p-p", fontsize=7)
-        else:
-            ax.legend(title="current p-p", fontsize=8)
+        _finish_axes(ax, "current p-p", claims)
     fig.suptitle(f"{title} ({frequency_Hz:g} Hz)")
     fig.tight_layout()
     return fig
@@ -250,12 +258,7 @@ def tracking_error(track: Columns, title="Closed-loop tracking error against tem
                         amplitude_um=c["amplitude_um"], frequency_Hz=c["frequency_Hz"])
         _mark_paper(ax, c["temperature_C"], ref * (1.0 + c["paper"] / 100.0), c)
     ax.set_ylabel("RMS tracking error (µm)")
-    ax.set_title(title)
-    ax.grid(alpha=0.3)
-    if claims:
-        ax.legend(*_paper_legend(ax), title="reference", fontsize=7)
-    else:
-        ax.legend(title="reference", fontsize=8)
+    _finish_axes(ax, "reference", claims, title)
     return fig
 
 
@@ -274,12 +277,7 @@ def retention(ret: Columns, title="Stroke retention against temperature (10 Hz)"
         _mark_paper(ax, c["temperature_C"], c["paper"], c)
     ax.set_xlabel("temperature (°C)")
     ax.set_ylabel("stroke / stroke at 20 °C (%)")
-    ax.set_title(title)
-    ax.grid(alpha=0.3)
-    if claims:
-        ax.legend(*_paper_legend(ax), title="current p-p", fontsize=7)
-    else:
-        ax.legend(title="current p-p", fontsize=8)
+    _finish_axes(ax, "current p-p", claims, title)
     return fig
 
 
