@@ -83,10 +83,10 @@ double changed(const gmasim::ParamDef& row, double v) {
 TEST(ParameterTable, EveryNumberOfTheShippedModelsHasItsRow) {
   for (const auto& spec : shipped_specs()) {
     for (const auto& [name, pv] : spec.params) {
-      ASSERT_NE(pv.def, nullptr) << spec.source << ": " << name;
-      EXPECT_EQ(pv.def, gmasim::find_param_def(spec, name)) << name;
-      EXPECT_EQ(pv.unit, pv.def->unit) << name;
-      EXPECT_FALSE(pv.def->doc.empty()) << name;
+      const gmasim::ParamDef* def = spec.def_of(name);
+      ASSERT_NE(def, nullptr) << spec.source << ": " << name;
+      EXPECT_EQ(spec.unit_of(name), def->unit) << name;
+      EXPECT_FALSE(def->doc.empty()) << name;
     }
   }
 }
@@ -125,7 +125,7 @@ TEST(ParameterTable, EachNumberLandsInTheFieldItsRowNames) {
   const auto spec = gmasim::builtin_model_spec();
   const gmasim::Model base = gmasim::compile(spec);
   for (const auto& [name, pv] : spec.params) {
-    const gmasim::ParamDef& row = *pv.def;
+    const gmasim::ParamDef& row = *spec.def_of(name);
     if (row.lands == nullptr) continue;  // reluctances: see ReluctancesSumIntoTheirBranches
     const std::size_t i = instance_of(spec, row, name);
     auto edited = spec;
@@ -143,8 +143,9 @@ TEST(ParameterTable, NoTwoNumbersLandInOnePlace) {
   gmasim::Model m = gmasim::compile(spec);
   std::map<const double*, std::string> owner;
   for (const auto& [name, pv] : spec.params) {
-    if (pv.def->lands == nullptr) continue;
-    const double* at = &pv.def->lands(m, instance_of(spec, *pv.def, name));
+    const gmasim::ParamDef& row = *spec.def_of(name);
+    if (row.lands == nullptr) continue;
+    const double* at = &row.lands(m, instance_of(spec, row, name));
     const auto [it, fresh] = owner.emplace(at, name);
     EXPECT_TRUE(fresh) << name << " and " << it->second << " land in the same field";
   }
@@ -264,6 +265,26 @@ TEST(OptionTable, SetOptionParsesOnceAndRefusesMixedReadings) {
     ADD_FAILURE() << "accepted an unknown option";
   } catch (const gmasim::InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr("unknown option 'options.colour'; known: options.stress_sign"));
+  }
+}
+
+// Several options set at once are judged as a whole: the rule between eq. 10's options holds
+// for the result, whatever the order of the assignments (--set, Model.with_params).
+TEST(OptionTable, AssignmentsAreCheckedTogetherInAnyOrder) {
+  const auto base = gmasim::builtin_model_spec();  // mean_field, room_referenced
+  for (const auto& order : {std::vector<std::string>{"options.eq10_temperature_scale=kelvin",
+                                                     "options.eq10_shape_law=printed"},
+                            std::vector<std::string>{"options.eq10_shape_law=printed",
+                                                     "options.eq10_temperature_scale=kelvin"}}) {
+    const auto spec = gmasim::apply_assignments(base, order);
+    EXPECT_EQ(spec.options.eq10_scale, gmasim::Eq10Scale::Kelvin);
+    EXPECT_EQ(spec.options.shape_law, gmasim::ShapeLaw::Printed);
+  }
+  try {
+    (void)gmasim::apply_assignments(base, {"options.eq10_temperature_scale=kelvin"});
+    ADD_FAILURE() << "accepted mean_field with kelvin";
+  } catch (const gmasim::InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("mixes reference temperatures"));
   }
 }
 

@@ -315,6 +315,15 @@ TEST(RunLoop, GridFactoriesApplyTheStepLimit) {
               HasSubstr("track y = 2.2e+08: too many (limit 2e+08)"));
   EXPECT_THAT(message([] { (void)StepGrid::sampled(0.0, 1e-4, 10.0, 0, "track y"); }),
               HasSubstr("must be >= 1"));
+  // Samples are rounded first, then counted with their steps: the checked count is the run's.
+  EXPECT_THAT(message([] { (void)StepGrid::sampled(0.0, 1e-4, 3e8, 1, "trk"); }),
+              HasSubstr("trk: samples = 3e+08: too many (limit 2e+08)"));
+  EXPECT_THAT(message([] { (void)StepGrid::sampled(0.0, 1e-4, 0.3, 5, "trk"); }),
+              HasSubstr("trk: 0.3 samples: need at least 1"));
+  EXPECT_EQ(StepGrid::sampled(0.0, 1e-4, 10.4, 3, "x").steps, 30);
+  EXPECT_EQ(StepGrid::sampled(0.0, 1e-4, 10.6, 3, "x").steps, 33);
+  EXPECT_THAT(message([] { (void)StepGrid::sampled(0.0, 1e-4, 2e8 / 4 + 0.6, 4, "trk"); }),
+              HasSubstr("trk = 2e+08: too many") /* 50000001 samples x 4 */);
   EXPECT_THAT(message([] { (void)StepGrid::quasi_static(1e300, "qs"); }),
               HasSubstr("qs = 1e+300: too many"));
   EXPECT_THAT(message([] { (void)StepGrid::covering(0.0, 1e300, 1e-5, "simulation"); }),

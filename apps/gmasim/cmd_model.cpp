@@ -30,17 +30,19 @@ int run_params(bool markdown) {
     fmt::print("{}", parameters_markdown());
     return 0;
   }
-  fmt::print("{:<54} {:<9} {:<16} {}\n", "key", "unit", "rule", "meaning");
+  fmt::print("{:<54} {:<9} {:<30} {:<9} {}\n", "key", "unit", "rule", "default", "meaning");
   for (const auto& g : parameter_groups())
     for (const auto& p : parameter_table())
       if (p.group == g.group)
-        fmt::print("{:<54} {:<9} {:<16} {}\n", fmt::format("{}.{}", g.path, p.key), p.unit,
-                   rule_text(p.rule), p.doc);
+        fmt::print("{:<54} {:<9} {:<30} {:<9} {} [{}]\n", fmt::format("{}.{}", g.path, p.key),
+                   p.unit, row_rule_text(p),
+                   p.default_value ? fmt::format("{:g}", *p.default_value) : "-", p.doc,
+                   p.lands_in);
   for (const auto& o : option_table()) {
     std::string words;
     for (const auto& c : o.choices) words += (words.empty() ? "" : "|") + std::string(c.word);
-    fmt::print("{:<54} {:<9} {:<16} {}\n", fmt::format("options.{}", o.key), "option", words,
-               o.doc);
+    fmt::print("{:<54} {:<9} {:<30} {:<9} {} [{}]\n", fmt::format("options.{}", o.key), "option",
+               words, "-", o.doc, o.lands_in);
   }
   return 0;
 }
@@ -61,9 +63,9 @@ int run_check(const std::string& path) {
         "  max |phi/A| of a rod                   {:.4f} T   ({})\n"
         "  max |phi/A - mu0 (H + M)| of a rod     {:.3g} T   ({:.3g} of mu0 (|H| + M_s^T); "
         "{})\n",
-        k.runs, m.options.magnetic_state == MagneticState::Consistent ? "consistent" : "printed",
-        k.max_B_sensor_T, k.max_B_rod_T, k.where_B_rod, k.max_inconsistency_T,
-        k.max_inconsistency_rel, k.where_inconsistency);
+        k.runs, option_word(*find_option_def("magnetic_state"), m.options), k.max_B_sensor_T,
+        k.max_B_rod_T, k.where_B_rod, k.max_inconsistency_T, k.max_inconsistency_rel,
+        k.where_inconsistency);
     if (!k.divergence.empty()) {
       fmt::print(stderr, "diverged: {}\n", k.divergence);
       return 3;

@@ -5,6 +5,7 @@
 #include <array>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "gmasim/circuit.hpp"
@@ -36,9 +37,10 @@ enum class MagneticState { Printed, Consistent };
 //                of the magnetisation alone (classical magnetoelastic scaling, docs/model.md).
 enum class Eq11Saturation { Temperature, Reference };
 
-// Parsed once, by the loader or ModelSpec::set_option, from the words of the option table
+// Parsed once, by the loader or ModelSpec::set_options, from the words of the option table
 // (gmasim/parameters.hpp). The defaults are the built-in model's readings (a test holds them
-// to models/mdma.toml); a model file must state every option.
+// to models/mdma.toml): a ModelSpec built in code has them unless it sets others; a model file
+// must state every option.
 struct Options {
   StressSign stress_sign = StressSign::CompressionNegative;
   Eq10Scale eq10_scale = Eq10Scale::RoomReferenced;
@@ -53,12 +55,12 @@ struct Options {
 // ---------------------------------------------------------------------------------------
 // ModelSpec: what the TOML file says, validated field by field, with provenance.
 // ---------------------------------------------------------------------------------------
+// A number of the model file. Its unit, rule and meaning are its row's in the parameter table
+// (ModelSpec::def_of, unit_of).
 struct ParamValue {
   double value = 0.0;
-  std::string unit;               // its row's unit (gmasim/parameters.hpp), e.g. "A/m"
-  std::string provenance;         // the trailing comment of the TOML line ("Table 4", ...)
-  long line = 0;                  // source line in the model file (0: a default of its row)
-  const ParamDef* def = nullptr;  // its row of the parameter table
+  std::string provenance;  // the trailing comment of the TOML line ("Table 4", ...)
+  long line = 0;           // source line in the model file (0: a default of its row)
 };
 
 struct SpecBranch {
@@ -92,9 +94,15 @@ struct ModelSpec {
   // Sets a number after checking it against its row's rule and the cross-field rules that
   // involve it; throws InputError (and leaves the spec unchanged) if unknown or refused.
   void set(const std::string& dotted, double value);
-  // Sets an option ("options.magnetic_state" or "magnetic_state") from its word; throws
-  // InputError naming the allowed words, or the rule between options it breaks.
-  void set_option(const std::string& name, const std::string& word);
+  // Sets options ("options.magnetic_state" or "magnetic_state") from their words, all at
+  // once: the rules between options (gmasim/parameters.hpp, check_options) apply to the
+  // result, whatever the order. Throws InputError naming the allowed words or the rule broken,
+  // and leaves the options unchanged.
+  void set_options(const std::vector<std::pair<std::string, std::string>>& name_word);
+  void set_option(const std::string& name, const std::string& word) { set_options({{name, word}}); }
+  // The row of a stored number (nullptr if none fits) and its unit ("-" if none).
+  const ParamDef* def_of(const std::string& key) const;
+  std::string unit_of(const std::string& key) const;
   long line_of(const std::string& dotted) const;
   // The full key a dotted name resolves to: the name itself, or the unique
   // "<name>_<unit suffix>" ("rod1.ja.k0" -> "rod1.ja.k0_A_per_m"); throws InputError if
@@ -286,9 +294,10 @@ Conditions make_conditions(const Model& m, double temperature_C, const Freeze& f
 // rk4_reference_step() writes the same fields by its own integration; quasi_static_step()
 // writes every field but t_s as one increment of make_state's ramp does (stages 1-2 without
 // eddy lag, then the force and the static equilibrium x = F / K). Nothing else writes a State,
-// except run_loop() (gmasim/run_loop.hpp), which sets t_s to its grid's time after each step
-// (t0 + k dt: no drift from repeated addition), and settle_at_bias's anhysteretic start
-// (M_irr = M = M_an, src/experiments/frf.cpp).
+// except run_loop() and run_loop_step() (gmasim/run_loop.hpp, the latter for the Stepper),
+// which set t_s to the grid's time after each step (t0 + k dt: no drift from repeated
+// addition), and settle_at_bias (src/experiments/frf.cpp): its anhysteretic start
+// (M_irr = M = M_an) and t_s = 0 once the bias point has settled.
 struct RodState {
   // integrated state
   double H_A_per_m = 0;     // eddy-filtered field (eq. 7); stage 2: the lag (consistent: Newton)

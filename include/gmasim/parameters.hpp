@@ -17,9 +17,17 @@ namespace gmasim {
 struct Model;
 struct ModelSpec;
 struct Options;
+struct ParamDef;
 
-// The value rule of a number (besides being finite and, unless 0, within 1e-30..1e30 in
-// magnitude, which every number obeys).
+// Every number of a model file is finite and, unless 0, within these magnitudes: no SI value
+// of the model lies outside (the smallest, eq. 1's alpha_pm2, is ~1e-7 /K^2; the largest, a
+// modulus, ~1e11 Pa), so such a number is a typo or a hostile input, and a subnormal one turns
+// into inf/NaN downstream (issue 8).
+inline constexpr double kMinMagnitude = 1e-30, kMaxMagnitude = 1e30;
+// Why `value` is no number of a model file (NaN, Inf, out of the magnitudes), or nullopt.
+std::optional<std::string> number_problem(double value);
+
+// The value rule of a number, besides number_problem().
 enum class Rule {
   Any,               // any finite number
   Positive,          // > 0
@@ -28,6 +36,10 @@ enum class Rule {
   AboveAbsoluteZero  // > -273.15 degC
 };
 std::string_view rule_text(Rule r);  // "> 0", ">= 0", "[0, 1)", "> -273.15 degC", "any"
+// The whole rule of a row: its Rule and its cross-field rule ("any, > reference.T_ref_C").
+std::string row_rule_text(const ParamDef& row);
+bool rule_holds(Rule r, double value);  // whether a finite value obeys r
+std::string rule_message(Rule r);       // "must be > 0", "must be in [0, 1)", ...
 
 // The tables of a model file that hold numbers.
 enum class Group {

@@ -1,7 +1,9 @@
-// The one fixed-step run loop (issue 10). Every time-stepping of the library runs through
+// The one fixed-step run loop (issue 10). Every time loop of the library runs through
 // run_loop(): simulate() (and with it sweep, ablate, compensate, params-vs-temperature and
 // `model check`), identify's measurement records and sine targets, track's plant between
-// controller samples, the stepped-sine FRF and the DC settling of the FRF bias point.
+// controller samples, the stepped-sine FRF and the DC settling of the FRF bias point; the
+// sample-by-sample Stepper takes the loop's single step, run_loop_step(). (A field-driven
+// record's root solve tries single steps from a copy of the state; that is no time loop.)
 //
 //   StepGrid   where the steps lie in time, built by one of its factories, which apply the
 //              step-count limit (kMaxSteps, gmasim/validate.hpp) in one place;
@@ -214,6 +216,22 @@ void run_loop(const Model& m, const Conditions& c, State& st, const StepGrid& g,
       }
       return;
   }
+}
+
+// Step k (1, 2, ...) of a Uniform grid from t = 0 with the current held over the step: the
+// loop's one step, with its checks and its time rule (State::t_s = k dt), for callers that
+// are handed one current at a time: the sample-by-sample Stepper (gmasim/stepper.hpp, the C
+// API, Python), which therefore judges divergence exactly as simulate() does.
+inline void run_loop_step(const Model& m, const Conditions& c, State& st, long k, double dt_s,
+                          double current_A) {
+  StepPoint p;
+  p.k = k;
+  p.sample = k - 1;
+  p.t_s = 0.0 + static_cast<double>(k) * dt_s;  // the Uniform clock's t0 + k dt with t0 = 0
+  p.dt_s = dt_s;
+  HeldCurrent drive{current_A};
+  NoRecorder record;
+  run_loop_detail::advance<false>(m, c, st, p, drive, record);
 }
 
 // run_loop without a recorder.

@@ -143,7 +143,7 @@ PYBIND11_MODULE(_gmasim, mod) {
           [](const Model& m) {
             py::dict d;
             for (const auto& [name, p] : m.spec.params)
-              d[py::str(name)] = py::make_tuple(p.value, p.unit, p.provenance);
+              d[py::str(name)] = py::make_tuple(p.value, m.spec.unit_of(name), p.provenance);
             return d;
           },
           "Every numeric parameter: name -> (value, unit, provenance)")
@@ -154,15 +154,16 @@ PYBIND11_MODULE(_gmasim, mod) {
           "with_params",
           [](const Model& m, const py::dict& values) {
             ModelSpec spec = m.spec;
+            std::vector<std::string> words;  // options: set together, checked as a whole
             for (const auto& [k, v] : values) {
               const std::string name = py::str(k);
               if (py::isinstance<py::str>(v)) {
-                spec = apply_assignments(std::move(spec), {name + "=" + v.cast<std::string>()},
-                                         "with_params");
+                words.push_back(name + "=" + v.cast<std::string>());
               } else {
                 spec.set(name, v.cast<double>());
               }
             }
+            if (!words.empty()) spec = apply_assignments(std::move(spec), words, "with_params");
             return std::make_shared<Model>(compile(spec));
           },
           py::arg("values"),

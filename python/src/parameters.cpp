@@ -20,7 +20,7 @@ void bind_parameters(py::module_& mod) {
           d["table"] = std::string(group_def(p.group).path);
           d["key"] = std::string(p.key);
           d["unit"] = std::string(p.unit);
-          d["rule"] = std::string(rule_text(p.rule));
+          d["rule"] = row_rule_text(p);
           d["doc"] = std::string(p.doc);
           d["default"] = p.default_value ? py::object(py::float_(*p.default_value)) : py::none();
           d["lands_in"] = std::string(p.lands_in);

@@ -62,7 +62,7 @@ Param make_param(const ModelSpec& start, const FitSpec& fit, const FitParameter&
   }
   Param p;
   p.key = key;
-  p.unit = start.params.at(key).unit;
+  p.unit = start.unit_of(key);
   p.scale = fp.scale;
   p.lo = fp.lower;
   p.hi = fp.upper;

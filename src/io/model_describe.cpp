@@ -53,12 +53,10 @@ namespace {
 
 using io_detail::join;
 
-std::string builtin_source_name() { return std::string(kBuiltinModelName) + " (built-in)"; }
-
 // The model text behind spec.source, for the comments of options and structure rows; empty
 // if it cannot be read (e.g. a spec parsed from a string).
 std::string source_text(const std::string& source) {
-  if (source == builtin_source_name()) return kBuiltinModelToml;
+  if (source == io_detail::builtin_source_name()) return kBuiltinModelToml;
   try {
     return io_detail::read_text_file(source, "model file");
   } catch (const InputError&) {
@@ -79,9 +77,11 @@ class Describer {
         lines_(io_detail::split_lines(text_, io_detail::StripCR::Yes)) {}
 
   std::vector<ParamRow> rows() {
-    for (const auto& [name, pv] : spec_.params)
-      rows_.push_back({name, fmt::format("{:g}", pv.value), pv.unit, pv.provenance, pv.line,
-                       pv.def ? std::string(pv.def->doc) : std::string()});
+    for (const auto& [name, pv] : spec_.params) {
+      const ParamDef* def = spec_.def_of(name);
+      rows_.push_back({name, fmt::format("{:g}", pv.value), spec_.unit_of(name), pv.provenance,
+                       pv.line, def ? std::string(def->doc) : std::string()});
+    }
     for (const auto& [name, value] : spec_.meta)
       add(name, value, "text", line_of(name), "the model's " + name.substr(5));
     for (const auto& o : option_table()) {

@@ -58,6 +58,8 @@ long node_line(const toml::node& n) {
   return l > 0 ? l : 1;
 }
 
+std::string builtin_source_name() { return std::string(kBuiltinModelName) + " (built-in)"; }
+
 bool valid_name(const std::string& name) {
   return !name.empty() && name.find('.') == std::string::npos;
 }
@@ -136,18 +138,15 @@ const toml::node* ModelLoader::required(const toml::table& t, std::string_view k
   return node;
 }
 
-void ModelLoader::store_number(const toml::node& node, const std::string& dotted,
-                               const ParamDef& row) {
+void ModelLoader::store_number(const toml::node& node, const std::string& dotted) {
   if (!node.is_integer() && !node.is_floating_point()) {
     problem(node_line(node), fmt::format("{}: expected a number, got {}", dotted, type_name(node)));
     return;
   }
   ParamValue pv;
   pv.value = node.value<double>().value_or(std::numeric_limits<double>::quiet_NaN());
-  pv.unit = std::string(row.unit);
   pv.provenance = comment_of(node);
   pv.line = node_line(node);
-  pv.def = &row;
   spec_.params[dotted] = std::move(pv);
 }
 
@@ -155,10 +154,8 @@ void ModelLoader::store_number(const toml::node& node, const std::string& dotted
 void ModelLoader::store_default(const std::string& dotted, const ParamDef& row) {
   ParamValue pv;
   pv.value = *row.default_value;
-  pv.unit = std::string(row.unit);
   pv.provenance = std::string(row.default_provenance);
   pv.line = 0;
-  pv.def = &row;
   spec_.params[dotted] = std::move(pv);
 }
 
@@ -241,7 +238,7 @@ void ModelLoader::read_group(const toml::table& t, Group g, const std::string& t
     if (row.group != g) continue;
     const std::string dotted = table_name + "." + std::string(row.key);
     if (const toml::node* node = t.get(row.key)) {
-      store_number(*node, dotted, row);
+      store_number(*node, dotted);
     } else if (row.default_value) {
       store_default(dotted, row);
     } else if (rule != TableRule::KeysOptional) {
@@ -250,9 +247,10 @@ void ModelLoader::read_group(const toml::table& t, Group g, const std::string& t
   }
 }
 
-void ModelLoader::read_group_table(const toml::table& parent, std::string_view key, Group g,
-                                   const std::string& dotted, long missing_line,
-                                   const std::vector<std::string>& extra) {
+void ModelLoader::read_group_table(const toml::table& parent, Group g, long missing_line,
+                                   std::string_view instance) {
+  const std::string dotted = schema::table_path(g, instance);
+  const std::string key = dotted.substr(dotted.rfind('.') + 1);
   const TableRule rule = group_def(g).table;
   const toml::node* node = parent.get(key);
   if (!node && rule == TableRule::Optional) return;
@@ -264,7 +262,7 @@ void ModelLoader::read_group_table(const toml::table& parent, std::string_view k
   const toml::table* t = table_at(parent, key, dotted, missing_line);
   if (!t) return;
   if (rule == TableRule::Defaulted) spec_.option_lines["[" + dotted + "]"] = node_line(*node);
-  read_group(*t, g, dotted, extra);
+  read_group(*t, g, dotted);
 }
 
 void ModelLoader::read_meta(const toml::table& root) {
@@ -325,10 +323,6 @@ void ModelLoader::read_options(const toml::table& root) {
 // =======================================================================================
 // Entry points
 // =======================================================================================
-namespace {
-std::string builtin_source_name() { return std::string(kBuiltinModelName) + " (built-in)"; }
-}  // namespace
-
 ModelSpec parse_model_spec(const std::string& toml_text, const std::string& source_name) {
   ModelSpec spec = io_detail::ModelLoader(toml_text, source_name).run();
   spec.text = toml_text;
@@ -341,7 +335,7 @@ ModelSpec load_model_spec(const std::string& path) {
 }
 
 ModelSpec builtin_model_spec() {
-  return parse_model_spec(kBuiltinModelToml, builtin_source_name());
+  return parse_model_spec(kBuiltinModelToml, io_detail::builtin_source_name());
 }
 
 Model load_model(const std::string& path) {

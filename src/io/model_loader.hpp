@@ -17,6 +17,8 @@
 
 namespace gmasim::io_detail {
 
+// "models/mdma.toml (built-in)": the source name of the built-in model.
+std::string builtin_source_name();
 std::string join(const std::vector<std::string>& items, std::string_view sep);
 std::string_view type_name(const toml::node& n);
 long node_line(const toml::node& n);
@@ -50,7 +52,7 @@ class ModelLoader {
                   const std::vector<std::string>& allowed);
   const toml::node* required(const toml::table& t, std::string_view key,
                              const std::string& table_name, long table_line);
-  void store_number(const toml::node& node, const std::string& dotted, const ParamDef& row);
+  void store_number(const toml::node& node, const std::string& dotted);
   void store_default(const std::string& dotted, const ParamDef& row);
   std::optional<std::string> string_of(const toml::node& node, const std::string& dotted);
   std::optional<std::string> read_string(const toml::table& t, std::string_view key,
@@ -65,12 +67,12 @@ class ModelLoader {
   // table may hold (sub-tables, structure), read elsewhere.
   void read_group(const toml::table& t, Group g, const std::string& table_name,
                   const std::vector<std::string>& extra = {});
-  // The table `key` of `parent` holding group `g`, under the group's table rule: a missing
-  // Required table is reported at `missing_line`; an absent Defaulted table takes every
-  // row's default; an absent Optional table is left out.
-  void read_group_table(const toml::table& parent, std::string_view key, Group g,
-                        const std::string& dotted, long missing_line,
-                        const std::vector<std::string>& extra = {});
+  // The table of group `g` (its path in parameter_groups(), for `instance`; `parent` holds
+  // its last component), under the group's table rule: a missing Required table is reported
+  // at `missing_line`; an absent Defaulted table takes every row's default; an absent
+  // Optional table is left out.
+  void read_group_table(const toml::table& parent, Group g, long missing_line,
+                        std::string_view instance = {});
   void read_options(const toml::table& root);
   void read_meta(const toml::table& root);
 

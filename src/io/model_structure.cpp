@@ -23,16 +23,16 @@ void ModelLoader::read_root(const toml::table& root) {
   check_top_level(root);
   read_meta(root);
   read_options(root);
-  read_group_table(root, "reference", Group::Reference, "reference", 1);
-  read_group_table(root, "material", Group::Material, "material", 1);
-  read_group_table(root, "preload", Group::Preload, "preload", 1);
-  read_group_table(root, "magnet", Group::Magnet, "magnet", 1);
+  read_group_table(root, Group::Reference, 1);
+  read_group_table(root, Group::Material, 1);
+  read_group_table(root, Group::Preload, 1);
+  read_group_table(root, Group::Magnet, 1);
   read_rods(root);
   read_circuit(root);
   read_sensor(root);
   read_mechanics(root);
-  read_group_table(root, "thermal_expansion", Group::ThermalExpansion, "thermal_expansion", 1);
-  read_group_table(root, "thermal_network", Group::ThermalNetwork, "thermal_network", 1);
+  read_group_table(root, Group::ThermalExpansion, 1);
+  read_group_table(root, Group::ThermalNetwork, 1);
 }
 
 void ModelLoader::check_top_level(const toml::table& root) {
@@ -103,7 +103,7 @@ void ModelLoader::read_rods(const toml::table& root) {
     }
     const auto& t = *node->as_table();
     read_group(t, Group::Rod, rod, {"ja"});
-    read_group_table(t, "ja", Group::RodJa, rod + ".ja", node_line(t));
+    read_group_table(t, Group::RodJa, node_line(t), rod);
   }
 }
 
@@ -129,9 +129,6 @@ std::optional<std::vector<std::string>> ModelLoader::read_reluctances(const toml
                                                                       long line) {
   const auto* rt = table_at(circuit, "reluctances_per_H", "circuit.reluctances_per_H", line);
   if (!rt) return std::nullopt;
-  const ParamDef* row = nullptr;
-  for (const auto& p : parameter_table())
-    if (p.group == Group::Reluctance) row = &p;
   std::vector<std::string> names;
   for (const auto& [key, node] : *rt) {
     const std::string name(key.str());
@@ -142,7 +139,7 @@ std::optional<std::vector<std::string>> ModelLoader::read_reluctances(const toml
       continue;
     }
     names.push_back(name);
-    store_number(node, "circuit.reluctances_per_H." + name, *row);
+    store_number(node, "circuit.reluctances_per_H." + name);
   }
   return names;
 }
@@ -311,10 +308,10 @@ void ModelLoader::read_mechanics(const toml::table& root) {
   check_keys(*t, "[mechanics]",
              {"elements", "sleeve_modulus", "sleeves", "chains", "output_stage"});
   // Optional: absent means the sensor reads the stack output.
-  read_group_table(*t, "output_stage", Group::OutputStage, "mechanics.output_stage", tl);
+  read_group_table(*t, Group::OutputStage, tl);
   bool members_ok = rods_ok_;
   members_ok = read_members(*t, tl, "elements", Group::Element, spec_.element_names) && members_ok;
-  read_group_table(*t, "sleeve_modulus", Group::SleeveModulus, "mechanics.sleeve_modulus", tl);
+  read_group_table(*t, Group::SleeveModulus, tl);
   // [mechanics.sleeves] is optional: a stack without sleeves (a single rod) has none.
   if (t->get("sleeves"))
     members_ok = read_members(*t, tl, "sleeves", Group::Sleeve, spec_.sleeve_names) && members_ok;

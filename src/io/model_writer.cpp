@@ -78,6 +78,7 @@ void replace_value(std::vector<std::string>& lines, long line_no, std::string_vi
 
 ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assignments,
                             std::string_view flag) {
+  std::vector<std::pair<std::string, std::string>> options;
   for (const std::string& a : assignments) {
     const std::string shown = clip_for_message(a);
     const auto eq = a.find('=');
@@ -94,7 +95,7 @@ ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assi
       if (value.empty() || value.find_first_of(" \t\"'#") != std::string::npos)
         throw InputError(
             fmt::format("{} '{}': an option value is one word (no spaces or quotes)", flag, shown));
-      spec.set_option(name, value);
+      options.emplace_back(name, value);  // set together below: checked as a whole
       continue;
     }
     double v = 0;
@@ -103,6 +104,7 @@ ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assi
           fmt::format("{} '{}': the value '{}' is not a finite number", flag, shown, value));
     spec.set(name, v);
   }
+  if (!options.empty()) spec.set_options(options);
   return spec;
 }
 

@@ -20,9 +20,9 @@ namespace gmasim {
 namespace schema {
 namespace {
 
-constexpr std::string_view kReserved[] = {
-    "meta",  "options", "reference", "material",  "preload",           "magnet",
-    "stack", "circuit", "sensor",    "mechanics", "thermal_expansion", "thermal_network"};
+// The tables of a model file that hold structure; the others are the parameter groups'.
+constexpr std::string_view kStructureTables[] = {"meta",    "options", "stack",
+                                                 "circuit", "sensor",  "mechanics"};
 
 // The table part of a dotted name ("rod1.ja" of "rod1.ja.k0_A_per_m").
 std::string table_of(const std::string& dotted) {
@@ -38,7 +38,17 @@ std::string other_of(const CrossRule& c, const std::string& dotted) {
 
 }  // namespace
 
-std::span<const std::string_view> reserved_tables() { return kReserved; }
+const std::vector<std::string>& reserved_tables() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> v(std::begin(kStructureTables), std::end(kStructureTables));
+    for (const auto& g : parameter_groups()) {
+      const std::string top(g.path.substr(0, g.path.find('.')));
+      if (!top.starts_with('<') && std::find(v.begin(), v.end(), top) == v.end()) v.push_back(top);
+    }
+    return v;
+  }();
+  return names;
+}
 
 std::vector<std::string> group_instances(const ModelSpec& spec, Group g) {
   switch (g) {
@@ -85,35 +95,12 @@ std::optional<std::string> check_value(const ModelSpec& spec, const std::string&
                                        double value) {
   const ParamDef* def = find_param_def(spec, dotted);
   const std::string unit = def ? std::string(def->unit) : std::string("-");
-  auto bad = [&](const std::string& rule) {
+  auto bad = [&](std::string_view rule) {
     return fmt::format("{}: {}", value_with_unit(dotted, value, unit), rule);
   };
-  if (std::isnan(value)) return bad("NaN is not allowed: every number must be finite");
-  if (std::isinf(value)) return bad("Inf is not allowed: every number must be finite");
-  // No SI value of the model is below 1e-30 or above 1e30 in magnitude (the smallest, eq. 1's
-  // alpha_pm2, is ~1e-7 /K^2; the largest, a modulus, ~1e11 Pa): such a number is a typo or
-  // a hostile input, and a subnormal one turns into inf/NaN downstream (issue 8).
-  if (value != 0.0 && !(std::fabs(value) >= 1e-30 && std::fabs(value) <= 1e30))
-    return bad(
-        "outside the range of any physical value of the model (1e-30 <= |v| <= 1e30, "
-        "or 0)");
+  if (auto problem = number_problem(value)) return bad(*problem);
   if (!def) return std::nullopt;
-  switch (def->rule) {
-    case Rule::Any:
-      break;
-    case Rule::Positive:
-      if (!(value > 0.0)) return bad("must be > 0");
-      break;
-    case Rule::NonNegative:
-      if (!(value >= 0.0)) return bad("must be >= 0");
-      break;
-    case Rule::UnitInterval:
-      if (!(value >= 0.0 && value < 1.0)) return bad("must be in [0, 1)");
-      break;
-    case Rule::AboveAbsoluteZero:
-      if (!(value > -273.15)) return bad("must be > -273.15 degC (absolute zero)");
-      break;
-  }
+  if (!rule_holds(def->rule, value)) return bad(rule_message(def->rule));
   if (def->cross.kind == CrossRule::None) return std::nullopt;
   const std::string other = other_of(def->cross, dotted);
   const auto it = spec.params.find(other);
@@ -121,7 +108,7 @@ std::optional<std::string> check_value(const ModelSpec& spec, const std::string&
   const bool below = def->cross.kind == CrossRule::Below;
   if (below ? value < it->second.value : value > it->second.value) return std::nullopt;
   return bad(fmt::format("must be {} {}", below ? "<" : ">",
-                         value_with_unit(other, it->second.value, it->second.unit)));
+                         value_with_unit(other, it->second.value, spec.unit_of(other))));
 }
 
 std::vector<std::string> dependents(const ModelSpec& spec, const std::string& dotted) {
@@ -234,24 +221,32 @@ void ModelSpec::set(const std::string& dotted, double value) {
   }
 }
 
-void ModelSpec::set_option(const std::string& name, const std::string& word) {
-  const OptionDef* def = find_option_def(name);
-  if (!def) {
-    std::string known;
-    for (const auto& o : option_table())
-      known += (known.empty() ? "" : ", ") + std::string("options.") + std::string(o.key);
-    throw InputError(
-        located(source, 0, fmt::format("unknown option '{}'; known: {}", name, known)));
-  }
-  const std::string dotted = "options." + std::string(def->key);
-  auto refuse = [&](const std::string& problem) {
-    throw InputError(located(source, line_of(dotted),
-                             fmt::format("cannot set {} = {}: {}", dotted, word, problem)));
-  };
+void ModelSpec::set_options(const std::vector<std::pair<std::string, std::string>>& name_word) {
   Options changed = options;
-  if (auto problem = set_option_word(*def, changed, word)) refuse(*problem);
-  if (auto problem = check_options(changed)) refuse(problem->message);
+  for (const auto& [name, word] : name_word) {
+    const OptionDef* def = find_option_def(name);
+    if (!def) {
+      std::string known;
+      for (const auto& o : option_table())
+        known += (known.empty() ? "" : ", ") + std::string("options.") + std::string(o.key);
+      throw InputError(
+          located(source, 0, fmt::format("unknown option '{}'; known: {}", name, known)));
+    }
+    if (auto problem = set_option_word(*def, changed, word))
+      throw InputError(located(source, line_of("options." + std::string(def->key)), *problem));
+  }
+  if (auto problem = check_options(changed))
+    throw InputError(located(source, line_of(problem->key), problem->message));
   options = changed;
+}
+
+const ParamDef* ModelSpec::def_of(const std::string& key) const {
+  return find_param_def(*this, key);
+}
+
+std::string ModelSpec::unit_of(const std::string& key) const {
+  const ParamDef* def = def_of(key);
+  return def ? std::string(def->unit) : std::string("-");
 }
 
 long ModelSpec::line_of(const std::string& dotted) const {

@@ -13,7 +13,7 @@
 namespace gmasim::schema {
 
 // Top-level tables with fixed names (a rod may not use one of these names).
-std::span<const std::string_view> reserved_tables();
+const std::vector<std::string>& reserved_tables();
 
 // The instances of a group in a spec: the rod, element, sleeve or branch names; {""} for a
 // single table; {} for an optional table the spec does not have (output stage) and for

@@ -122,10 +122,10 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
     double chi = 0.0;
     ja_step(r.H_A_per_m, H[i], rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m, M[i], &chi);
     const double B1 = flux_density(H[i], r.M_A_per_m);
-    r.Hc_A_per_m = quasi_static ? H[i]
-                                : eddy_static_field_trapezoid(r.H_A_per_m, H[i], r.Hc_A_per_m,
-                                                              B0[i], B1, rc.eddy_geometry_s_m_per_H,
-                                                              h_s);
+    r.Hc_A_per_m = quasi_static
+                       ? H[i]
+                       : eddy_static_field_trapezoid(r.H_A_per_m, H[i], r.Hc_A_per_m, B0[i], B1,
+                                                     rc.eddy_geometry_s_m_per_H, h_s);
     r.H_prev_A_per_m = r.H_A_per_m;
     r.H_A_per_m = H[i];
     r.M_prev_A_per_m = r.M_A_per_m;
@@ -139,16 +139,15 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
 // The magnetic state at rest (no eddy lag: eq. 7 with dB/dt = 0) moved along its
 // hysteresis loop to the MMF of current_A and the magnets at pm_scale: one increment of
 // make_state's ramp and of quasi_static_step.
-void quasi_static_magnetic_update(const Model& m, const Conditions& c, State& s,
-                                  double current_A, double pm_scale, double t) {
+void quasi_static_magnetic_update(const Model& m, const Conditions& c, State& s, double current_A,
+                                  double pm_scale, double t) {
   const std::size_t n = s.rods.size();
   if (m.options.magnetic_state == MagneticState::Consistent) {
     consistent_magnetic_update(m, c, s, current_A, pm_scale, 1.0, true, t);
     return;
   }
   for (std::size_t i = 0; i < n; ++i)
-    s.rod_reluctance[i] =
-        set_rod_permeability(m, i, c.rods[i], s.rods[i], s.rods[i].M_A_per_m, t);
+    s.rod_reluctance[i] = set_rod_permeability(m, i, c.rods[i], s.rods[i], s.rods[i].M_A_per_m, t);
   if (!solve_circuit(m.circuit, s.rod_reluctance, current_A, pm_scale, s.circuit))
     throw DivergenceError(t, "", "nodal matrix of the circuit", 0.0, "not positive definite");
   for (std::size_t i = 0; i < n; ++i) {

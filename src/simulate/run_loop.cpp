@@ -69,8 +69,10 @@ StepGrid StepGrid::sampled(double t0_s, double sample_s, double samples, long su
   if (substeps < 1)
     throw InputError(fmt::format("{}: {} steps per sample: must be >= 1", what, substeps));
   StepGrid g;
-  (void)checked_count(samples * static_cast<double>(substeps), kMaxSteps, what);
-  const long n = std::lround(samples);
+  // The samples (rounded to the nearest whole sample, at least 1), then the steps in all.
+  const long n = checked_count(samples, kMaxSteps, fmt::format("{}: samples", what));
+  if (n < 1) throw InputError(fmt::format("{}: {:g} samples: need at least 1", what, samples));
+  (void)checked_count(static_cast<double>(n) * static_cast<double>(substeps), kMaxSteps, what);
   check_step(sample_s, what);
   g.clock = StepClock::Sampled;
   g.t0_s = t0_s;

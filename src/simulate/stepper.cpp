@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/run_loop.hpp"
 #include "gmasim/simulate.hpp"
 #include "gmasim/validate.hpp"
 
@@ -51,15 +52,14 @@ double Stepper::step(double current_A) {
                     divergence_message_));
   checked_current(current_A);
   try {
-    gmasim::step(*model_, conditions_, state_, {current_A, dt_s_});
+    run_loop_step(*model_, conditions_, state_, steps_ + 1, dt_s_, current_A);
   } catch (const DivergenceError& e) {
     diverged_ = true;
     divergence_message_ = e.what();
     divergence_t_s_ = e.time_s;
     throw;
   }
-  ++steps_;
-  state_.t_s = static_cast<double>(steps_) * dt_s_;  // as simulate(): no drift from addition
+  ++steps_;  // run_loop_step set t_s = steps_ dt, as simulate(): no drift from addition
   return state_.y_m;
 }
 
