@@ -41,12 +41,8 @@ StepGrid StepGrid::uniform(double t0_s, double dt_s, double steps, std::string_v
 }
 
 StepGrid StepGrid::covering(double t0_s, double duration_s, double dt_s, std::string_view what) {
-  StepGrid g;
-  g.steps = checked_step_count(duration_s, dt_s, what);
-  g.clock = StepClock::Uniform;
-  g.t0_s = t0_s;
-  g.dt_s = dt_s;
-  return g;
+  const long steps = checked_step_count(duration_s, dt_s, what);
+  return uniform(t0_s, dt_s, static_cast<double>(steps), what);
 }
 
 StepGrid StepGrid::spanning(double t0_s, double t1_s, double steps, std::string_view what) {
