@@ -14,6 +14,34 @@
 namespace gmasim::cli {
 namespace {
 
+// The energy ledgers (docs/model.md, "Energy ledgers") as mean powers over the metrics window,
+// and the coil's terminal quantities.
+void print_energy(const Result& r, bool periodic) {
+  const auto& e = r.energy;
+  const double T = e.duration_s;
+  const auto& c = r.coil;
+  fmt::print("  energy, mean power {} [W]:\n", periodic ? "over the last period" : "over the run");
+  fmt::print(
+      "    magnetic:   coil {:.4g} + magnet {:.3g} = stored {:.3g} + hysteresis {:.4g} + eddy "
+      "{:.4g}  (residual {:.2g} of the input)\n",
+      e.coil_J / T, e.magnet_J / T, (e.d_circuit_J + e.d_series_J + e.d_material_J) / T,
+      e.hysteresis_J / T, e.eddy_J / T, e.magnetic_residual_rel);
+  fmt::print(
+      "    mechanical: force {:.4g} + stiffness {:.4g} = stored {:.3g} + damping {:.4g}  "
+      "(residual {:.2g})\n",
+      e.force_work_J / T, e.stiffness_work_J / T, (e.d_kinetic_J + e.d_elastic_J) / T,
+      e.damping_J / T, e.mechanical_residual_rel);
+  fmt::print(
+      "    coupling:   the mechanical input, not drawn from the coil (one-way coupling), is "
+      "{:.2f} % of the magnetic input\n",
+      100.0 * e.coupling_fraction);
+  fmt::print(
+      "    coil:       {:.4g} A rms, {:.4g} V rms ({:.4g} V peak) with R = {:.3g} ohm; power "
+      "{:.4g} W mean (copper {:.4g} W), {:.4g} W peak, {:.4g} VA apparent\n",
+      c.current_rms_A, c.voltage_rms_V, c.voltage_peak_V, c.resistance_ohm, c.power_mean_W,
+      c.copper_W, c.power_peak_W, c.apparent_VA);
+}
+
 struct SimulateArgs {
   ModelArgs model;
   std::string waveform_csv, kind = "sine", out = "out/simulate";
@@ -102,6 +130,7 @@ int run_simulate(const SimulateArgs& a) {
   for (const auto& q : r.quantities)
     fmt::print("  {:<22} rms {:.6g}  peak {:.6g}  p-p {:.6g}  mean {:.6g}\n", q.name, q.rms, q.peak,
                q.pp, q.mean);
+  if (r.has_energy) print_energy(r, s.waveform.periodic());
   fmt::print("  thermal expansion {:.3f} um ({} the output y)\n", r.thermal_expansion_um,
              model.options.thermal_expansion_in_output ? "included in" : "not in");
   if (r.heating.rows() > 1) {
@@ -114,13 +143,14 @@ int run_simulate(const SimulateArgs& a) {
     fmt::print(
         "  self-heating over {:.1f} s (thermal step {:.3g} s, ambient {:.1f} degC):\n"
         "    coil {:.2f} degC, rods {:.2f} degC, housing {:.2f} degC at the end\n"
-        "    losses at the end: copper {:.3f} W, eddy {:.4f} W, hysteresis {:.4f} W\n"
+        "    losses at the end: copper {:.3f} W, eddy {:.4f} W, hysteresis {:.4f} W, damping "
+        "{:.4f} W\n"
         "    stroke {:.3f} um over thermal step {}, {:.3f} um over the last ({:+.2f} %)\n"
         "    energy: in {:.2f} J = stored {:.2f} J + to ambient {:.2f} J (residual {:.2e} J)\n",
         h.columns[0][n], h.columns[0][1], std::isnan(a.ambient_C) ? a.temperature_C : a.ambient_C,
         h.column("coil_C")[n], h.column("rods_C")[n], h.column("housing_C")[n],
         h.column("P_copper_W")[n], h.column("P_eddy_W")[n], h.column("P_hysteresis_W")[n],
-        h.column("stroke_um")[b], b, h.column("stroke_um")[n],
+        h.column("P_damping_W")[n], h.column("stroke_um")[b], b, h.column("stroke_um")[n],
         (h.column("stroke_um")[n] / h.column("stroke_um")[b] - 1.0) * 100.0, r.energy_in_J,
         r.energy_stored_J, r.energy_out_J, balance);
   }

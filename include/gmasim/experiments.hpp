@@ -106,10 +106,11 @@ struct SmallSignalModel {
   std::vector<double> x0_m, M0_A_per_m, H0_A_per_m;                   // the bias point
   double y0_m = 0;
   // Consistent magnetic state (model.hpp, MagneticState): the rods' port equations
-  //   k_f l_i (dH_i + kappa_i s dB_i) + sum_j S_ij A_j dB_j = b_i dI,  dB = mu0 (1 + chi) dH,
-  // with S (n x n row-major) and b the circuit seen from the rod branches [1/H, A-turns/A].
+  //   l_i (dH_i + kappa_i s dB_i) + sum_j S_ij A_j dB_j = b_i dI,  dB = mu0 (1 + chi) dH,
+  // with S (n x n row-major) and b the circuit seen from the rod branches, each rod's own series
+  // reluctance R_s (k_f, physics::series_reluctance) on S's diagonal [1/H, A-turns/A].
   bool consistent = false;
-  std::vector<double> port_S_per_H, port_b_At_per_A, kfl_m, kappa_s_m_per_H, area_m2;
+  std::vector<double> port_S_per_H, port_b_At_per_A, length_m, kappa_s_m_per_H, area_m2;
   // Output stage (model.hpp, OutputStageModel), if any: Y_sensor = Y_stack (c s + k)/(m s^2 +
   // c s + k).
   bool output_stage = false;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "gmasim/circuit.hpp"
+#include "gmasim/energy.hpp"
 #include "gmasim/parameters.hpp"
 #include "gmasim/physics/jiles_atherton.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
@@ -260,6 +261,12 @@ struct RodConditions {
   double sigma_Pa;                 // signed prestress used in eq. (3), (6), (13)
   double sigma_p_Pa;               // compressive prestress magnitude of eq. (11)
   double k_f, k_j;
+  // Consistent magnetic state: the lossless series reluctance that carries the MMF Table 4's
+  // k_f assigns to the rod branch outside the Terfenol-D (joints of the short rods, magnetizer
+  // interfaces, leakage paths: air, epoxy, iron), (k_f - 1) l^T / (mu0 (1 + chi_m) A^T): at the
+  // initial permeability mu0 (1 + chi_m) of eq. (3)/(5) the rod then sees the field H_c =
+  // U / (k_f l) of eq. (7) (docs/model.md, "The magnetic state"). 0 in the printed reading.
+  double series_reluctance_per_H;
   double mass_osc_kg;               // eq. (24) + (27)
   double damping_osc_N_s_per_m;     // eq. (25) + (28)
   double fixed_compliance_m_per_N;  // sum of 1/k of the chain's non-rod members (eq. 18)
@@ -320,6 +327,9 @@ struct RodState {
   double k_rod_N_per_m = 0;   // axial stiffness (eq. 17); stage 3
   double k_load_N_per_m = 0;  // load-chain stiffness (eq. 18); stage 3
   double B_T = 0;  // the flux density the circuit assigns to the rod, phi / A; end of step()
+  double K_osc_N_per_m = 0;  // the oscillator's stiffness over the last step (eq. 16 at mid-step);
+                             // stage 3 (make_state: at rest)
+  RodEnergy energy;          // the ledgers' running sums (gmasim/energy.hpp); end of step()
 };
 
 struct State {
@@ -334,6 +344,7 @@ struct State {
   CircuitWorkspace circuit;  // stage 1: the rod branches' fluxes phi (eq. 23), the consistent
                              // state's linearised rod MMFs (rod_extra_mmf)
   std::vector<double> rod_reluctance;  // per rod, eq. (2) (consistent: linearised); stage 1
+  EnergyAccumulators energy;  // the ledgers (gmasim/energy.hpp): booked by step() when enabled
 };
 
 // Sizes every buffer, and places the actuator at rest in its quasi-static equilibrium

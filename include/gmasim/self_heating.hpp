@@ -21,17 +21,6 @@ inline double copper_loss_J(double i0_A, double i1_A, double R_ohm, double dt_s)
   return 0.5 * (i0_A * i0_A + i1_A * i1_A) * R_ohm * dt_s;
 }
 
-// Magnetic losses of one rod over one step, from its field and material state at the two
-// ends (midpoint rule), with B_mat = mu0 (H + M) the flux density of the material state:
-//   source work   w = V Hc dB_mat    (the circuit's static field drives the rod; eq. 7)
-//   eddy loss     e = V (Hc - H) dB_mat  (the eq. 7 eddy field times dB: kappa (dB/dt)^2 V dt)
-//   hysteresis    w - e = V H dB_mat, whose cycle integral is the JA loop area.
-struct RodLoss {
-  double eddy_J = 0, hysteresis_J = 0;
-};
-RodLoss rod_loss_J(double volume_m3, double Hc0, double H0, double M0, double Hc1, double H1,
-                   double M1);
-
 // One backward-Euler step of the network  C dT/dt = P - G (T - ...):
 //   C_c T_c' = P_coil - G_cr (T_c - T_r) - G_ch (T_c - T_h)
 //   C_r T_r' = P_rods - G_cr (T_r - T_c) - G_rh (T_r - T_h)

@@ -58,6 +58,11 @@ struct SelfHeatingSettings {
 
 struct SimulationSettings {
   double temperature_C = 20.0;  // start temperature of every node (self-heating) or the fixed one
+  // Book the energy ledgers (gmasim/energy.hpp) and the coil's terminal quantities over the
+  // metrics window (Result::energy, Result::coil). Self-heating books them whatever this says
+  // (its losses come from the ledger). Experiments that run many simulations turn it off: it
+  // solves every branch of the circuit and integrates each oscillator's power at every step.
+  bool energy_ledger = true;
   Waveform waveform;
   double periods = 3.0;     // run length for periodic waveforms
   double duration_s = 0.0;  // run length for the others (Table: its last time if 0)
@@ -109,6 +114,17 @@ struct QuantityStats {
   double rms = 0, peak = 0, pp = 0, mean = 0;
 };
 
+// The coil as an amplifier sees it over the metrics window: v = i R + sum N dphi/dt (the
+// terminal voltage with the coil's resistance at its temperature; thermal_network).
+struct CoilElectrical {
+  double resistance_ohm = 0;
+  double current_rms_A = 0, voltage_rms_V = 0, voltage_peak_V = 0;
+  double power_mean_W = 0;  // mean i v = copper + magnetic input
+  double power_peak_W = 0;  // max |i v|
+  double copper_W = 0;      // mean i^2 R
+  double apparent_VA = 0;   // V_rms I_rms
+};
+
 struct Result {
   TimeSeries series;
   std::vector<QuantityStats> quantities;  // filled by add_quantity_stats()
@@ -122,9 +138,14 @@ struct Result {
   bool diverged = false;
   std::string error;  // DivergenceError message when diverged
   double thermal_expansion_um = 0;
+  // The energy ledgers over the metrics window (SimulationSettings::energy_ledger).
+  bool has_energy = false;
+  EnergyBalance energy;
+  CoilElectrical coil;
   // Self-heating: one row per thermal step (t_s, coil_C, rods_C, housing_C, P_copper_W,
-  // P_eddy_W, P_hysteresis_W, P_ambient_W, stroke_um over the step, E_in_J, E_stored_J,
-  // E_out_J cumulative) and the run's energy balance.
+  // P_eddy_W, P_hysteresis_W, P_damping_W (the rods' losses from the ledger), P_ambient_W,
+  // stroke_um over the step, E_in_J, E_stored_J, E_out_J cumulative) and the run's heat
+  // balance.
   TimeSeries heating;
   double energy_in_J = 0, energy_stored_J = 0, energy_out_J = 0;
 };

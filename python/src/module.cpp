@@ -40,6 +40,43 @@ py::dict metrics_dict(const Metrics& m) {
   return d;
 }
 
+// The energy ledgers over the metrics window as mean powers [W] (gmasim/energy.hpp).
+py::dict energy_dict(const Model& m, const Result& r) {
+  const auto& e = r.energy;
+  const double T = e.duration_s;
+  py::dict d;
+  d["window_s"] = T;
+  d["coil_input_W"] = e.coil_J / T;
+  d["magnet_work_W"] = e.magnet_J / T;
+  d["magnetic_stored_change_W"] = (e.d_circuit_J + e.d_series_J + e.d_material_J) / T;
+  d["hysteresis_W"] = e.hysteresis_J / T;
+  d["eddy_W"] = e.eddy_J / T;
+  d["magnetic_residual_rel"] = e.magnetic_residual_rel;
+  py::dict rods;
+  for (std::size_t i = 0; i < e.rod_hysteresis_J.size() && i < m.rods.size(); ++i) {
+    py::dict rd;
+    rd["hysteresis_W"] = e.rod_hysteresis_J[i] / T;
+    rd["eddy_W"] = e.rod_eddy_J[i] / T;
+    rods[py::str(m.rods[i].name)] = rd;
+  }
+  d["rods"] = rods;
+  d["force_work_W"] = e.force_work_J / T;
+  d["stiffness_work_W"] = e.stiffness_work_J / T;
+  d["mechanical_stored_change_W"] = (e.d_kinetic_J + e.d_elastic_J) / T;
+  d["damping_W"] = e.damping_J / T;
+  d["mechanical_residual_rel"] = e.mechanical_residual_rel;
+  d["coupling_fraction"] = e.coupling_fraction;
+  d["coil_resistance_ohm"] = r.coil.resistance_ohm;
+  d["coil_current_rms_A"] = r.coil.current_rms_A;
+  d["coil_voltage_rms_V"] = r.coil.voltage_rms_V;
+  d["coil_voltage_peak_V"] = r.coil.voltage_peak_V;
+  d["coil_power_mean_W"] = r.coil.power_mean_W;
+  d["coil_power_peak_W"] = r.coil.power_peak_W;
+  d["coil_copper_W"] = r.coil.copper_W;
+  d["coil_apparent_VA"] = r.coil.apparent_VA;
+  return d;
+}
+
 }  // namespace gmasim::py_bind
 
 namespace {
@@ -100,6 +137,7 @@ py::dict simulate_py(const Model& m, double temperature_C, double current_pp_A, 
   d["diverged"] = r.diverged;
   d["error"] = r.error;
   d["thermal_expansion_um"] = r.thermal_expansion_um;
+  if (r.has_energy) d["energy"] = energy_dict(m, r);
   if (self_heating) {
     d["heating"] = series_dict(r.heating);
     d["energy_in_J"] = r.energy_in_J;

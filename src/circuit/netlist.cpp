@@ -272,17 +272,18 @@ bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_
       ok = rod_solve<Eigen::Dynamic>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, nb);
   }
   if (!ok) return false;
-  if (!all_branches) {  // the step needs only the rod fluxes: phi_r = (drop_r + F_r) / R_r
-    for (int r = 0; r < k; ++r)
-      set_flux(c, static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)]),
-               rod_reluctance_per_H, current_A, pm_scale, nb.v(r), ws);
-    return true;
-  }
+  // The rod fluxes from the k x k solve, phi_r = (drop_r + F_r) / R_r (the same numbers
+  // whether or not the other branches are wanted); the others from the node potentials.
+  for (int r = 0; r < k; ++r)
+    set_flux(c, static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)]),
+             rod_reluctance_per_H, current_A, pm_scale, nb.v(r), ws);
+  if (!all_branches) return true;
   nb.rhs.noalias() = current_A * L.psi_coil + pm_scale * L.psi_pm;
   nb.rhs.noalias() -= L.W * nb.z;
   for (std::size_t b = 0; b < c.branches.size(); ++b)
-    set_flux(c, b, rod_reluctance_per_H, current_A, pm_scale, potential_drop(c.branches[b], nb.rhs),
-             ws);
+    if (c.branches[b].rod < 0)
+      set_flux(c, b, rod_reluctance_per_H, current_A, pm_scale,
+               potential_drop(c.branches[b], nb.rhs), ws);
   return true;
 }
 

@@ -90,33 +90,53 @@ std::vector<double> log_grid(double f0, double f1, int n) {
 // ---------------------------------------------------------------------------------------
 // Bias point
 // ---------------------------------------------------------------------------------------
-State settle_at_bias(const Model& m, const Conditions& c, double bias_A, BiasState bias_state) {
-  State s = make_state(m, c, bias_A);  // virgin curve, static equilibrium
-  const std::size_t n = s.rods.size();
+// The printed reading: put each rod on its anhysteretic curve, M_irr = M = M_an(H + alpha M),
+// at the field it sees; the circuit then moves the field (mu depends on M), so repeat until the
+// fixed point holds, with DC steps in between that let H, the circuit and the mechanics follow.
+void anhysteretic_fixed_point(const Model& m, const Conditions& c, State& s, double bias_A) {
   double tau_max = 0.0;
   for (const auto& r : s.rods) tau_max = std::max(tau_max, r.tau_s);
-  if (bias_state == BiasState::Anhysteretic) {
-    // Put each rod on its anhysteretic curve, M_irr = M = M_an(H + alpha M), at the field it
-    // sees; the circuit then moves the field (mu depends on M), so repeat until the fixed
-    // point holds. DC steps in between let H, the circuit and the mechanics follow.
-    for (int it = 0; it < 60; ++it) {
-      double change = 0.0;
-      for (std::size_t i = 0; i < n; ++i) {
-        const auto& rc = c.rods[i];
-        auto& r = s.rods[i];
-        JaCoefficients anh = rc.ja;
-        anh.c = 1.0;  // M = M_an(H + alpha M)
-        const double M =
-            ja_total_magnetisation(r.H_A_per_m, r.M_A_per_m, r.M_A_per_m, rc.MsT_ja, anh);
-        change = std::max(change, std::fabs(M - r.Mirr_A_per_m) / rc.MsT_ja);
-        r.Mirr_A_per_m = M;
-        r.M_A_per_m = M;
-        r.M_prev_A_per_m = M;
-      }
-      run_dc(m, c, s, bias_A, std::max(5.0 * tau_max, 1e-3));
-      if (change < 1e-10) break;
+  for (int it = 0; it < 60; ++it) {
+    double change = 0.0;
+    for (std::size_t i = 0; i < s.rods.size(); ++i) {
+      const auto& rc = c.rods[i];
+      auto& r = s.rods[i];
+      JaCoefficients anh = rc.ja;
+      anh.c = 1.0;  // M = M_an(H + alpha M)
+      const double M =
+          ja_total_magnetisation(r.H_A_per_m, r.M_A_per_m, r.M_A_per_m, rc.MsT_ja, anh);
+      change = std::max(change, std::fabs(M - r.Mirr_A_per_m) / rc.MsT_ja);
+      r.Mirr_A_per_m = M;
+      r.M_A_per_m = M;
+      r.M_prev_A_per_m = M;
     }
+    run_dc(m, c, s, bias_A, std::max(5.0 * tau_max, 1e-3));
+    if (change < 1e-10) break;
   }
+}
+
+State settle_at_bias(const Model& m, const Conditions& c, double bias_A, BiasState bias_state) {
+  State s;
+  if (bias_state == BiasState::Anhysteretic &&
+      m.options.magnetic_state == MagneticState::Consistent) {
+    // The consistent reading: the quasi-static ramp of make_state with every rod's JA law
+    // reduced to its anhysteretic curve, M = M_an(H + alpha M) (c = 1, eq. 9), so that the
+    // circuit, the fields and the magnetisations are solved together (the fixed point above
+    // does not converge when a rod's series reluctance makes its branch nearly flux-driven).
+    // Then M_irr = M_an = M, where the full law of eq. (9) holds the same state.
+    Conditions anh = c;
+    for (auto& rc : anh.rods) rc.ja.c = 1.0;
+    s = make_state(m, anh, bias_A);
+    for (auto& r : s.rods) {
+      r.Mirr_A_per_m = r.M_A_per_m;
+      r.M_prev_A_per_m = r.M_A_per_m;
+    }
+  } else {
+    s = make_state(m, c, bias_A);  // virgin curve, static equilibrium
+    if (bias_state == BiasState::Anhysteretic) anhysteretic_fixed_point(m, c, s, bias_A);
+  }
+  double tau_max = 0.0;
+  for (const auto& r : s.rods) tau_max = std::max(tau_max, r.tau_s);
   // Let H (eddy lag), M and the oscillators come to rest at the bias.
   run_dc(m, c, s, bias_A, std::max(20.0 * tau_max, 10e-3));
   s.t_s = 0.0;
@@ -161,9 +181,9 @@ void linearise_ports(const Model& m, const Conditions& c, const State& s, Circui
     const auto& r = s.rods[i];
     for (std::size_t j = 0; j < n; ++j)
       L.port_S_per_H.push_back(RS(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) -
-                               (i == j ? Rp[i] : 0.0));
+                               (i == j ? Rp[i] - rc.series_reluctance_per_H : 0.0));
     L.port_b_At_per_A.push_back(b(static_cast<Eigen::Index>(i)));
-    L.kfl_m.push_back(rc.k_f * rc.length_m);
+    L.length_m.push_back(rc.length_m);
     L.kappa_s_m_per_H.push_back(rc.eddy_geometry_s_m_per_H);
     L.area_m2.push_back(rc.area_m2);
     const double He = r.H_A_per_m + rc.ja.alpha * r.M_A_per_m;
@@ -281,7 +301,7 @@ std::complex<double> SmallSignalModel::response(double f_Hz) const {
         A(i, j) = port_S_per_H[ui * static_cast<std::size_t>(n) + uj] * area_m2[uj] * kMu0 *
                   (1.0 + chi[uj]);
       }
-      A(i, i) += kfl_m[ui] * (1.0 + kappa_s_m_per_H[ui] * sj * kMu0 * (1.0 + chi[ui]));
+      A(i, i) += length_m[ui] * (1.0 + kappa_s_m_per_H[ui] * sj * kMu0 * (1.0 + chi[ui]));
     }
     const Eigen::VectorXcd dH = A.partialPivLu().solve(b);
     for (Eigen::Index i = 0; i < N; ++i) dM(i) = chi[static_cast<std::size_t>(i)] * dH(i);

@@ -215,6 +215,52 @@ void write_self_heating(JsonWriter& w, const Result& r) {
   w.end_object();
 }
 
+// The energy ledgers over the metrics window (gmasim/energy.hpp), as mean powers [W], and
+// the coil's terminal quantities.
+void write_energy(JsonWriter& w, const Model& m, const Result& r) {
+  const auto& e = r.energy;
+  const double T = e.duration_s;
+  w.key("energy").begin_object();
+  w.numbers({{"window_s", T}});
+  w.key("magnetic").begin_object();
+  w.numbers({{"coil_input_W", e.coil_J / T},
+             {"magnet_work_W", e.magnet_J / T},
+             {"stored_change_W", (e.d_circuit_J + e.d_series_J + e.d_material_J) / T},
+             {"hysteresis_W", e.hysteresis_J / T},
+             {"eddy_W", e.eddy_J / T},
+             {"residual_W", e.magnetic_residual_J / T},
+             {"residual_rel", e.magnetic_residual_rel}});
+  w.key("rods").begin_object();
+  for (std::size_t i = 0; i < e.rod_hysteresis_J.size() && i < m.rods.size(); ++i) {
+    w.key(m.rods[i].name).begin_object();
+    w.numbers({{"hysteresis_W", e.rod_hysteresis_J[i] / T}, {"eddy_W", e.rod_eddy_J[i] / T}});
+    w.end_object();
+  }
+  w.end_object();
+  w.end_object();
+  w.key("mechanical").begin_object();
+  w.numbers({{"force_work_W", e.force_work_J / T},
+             {"stiffness_work_W", e.stiffness_work_J / T},
+             {"stored_change_W", (e.d_kinetic_J + e.d_elastic_J) / T},
+             {"damping_W", e.damping_J / T},
+             {"residual_W", e.mechanical_residual_J / T},
+             {"residual_rel", e.mechanical_residual_rel}});
+  w.end_object();
+  w.numbers({{"coupling_fraction", e.coupling_fraction}});
+  const auto& c = r.coil;
+  w.key("coil").begin_object();
+  w.numbers({{"resistance_ohm", c.resistance_ohm},
+             {"current_rms_A", c.current_rms_A},
+             {"voltage_rms_V", c.voltage_rms_V},
+             {"voltage_peak_V", c.voltage_peak_V},
+             {"power_mean_W", c.power_mean_W},
+             {"power_peak_W", c.power_peak_W},
+             {"copper_W", c.copper_W},
+             {"apparent_VA", c.apparent_VA}});
+  w.end_object();
+  w.end_object();
+}
+
 }  // namespace
 
 std::string fnv1a64_hex(std::string_view data) {
@@ -282,6 +328,7 @@ std::string metrics_json(const Result& r, const SimulationSettings& s, const Mod
     w.end_object();
   }
   w.key("thermal_expansion_um").number(r.thermal_expansion_um);
+  if (r.has_energy) write_energy(w, m, r);
   if (r.heating.rows() > 0) write_self_heating(w, r);
   if (!timeseries_csv_text.empty()) {
     // Pairs this file with the timeseries.csv written with it (write_files_atomic).

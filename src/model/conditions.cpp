@@ -172,6 +172,9 @@ void rod_material(const Model& m, const RodModel& rod, const Conditions& c, cons
                                  src, rc.rho_ohm_m, T));
   rc.eddy_geometry_s_m_per_H =
       eddy_time_constant(1.0, rc.r_outer_m, rc.r_inner_m, rod.k_j, rc.rho_ohm_m);
+  rc.series_reluctance_per_H = m.options.magnetic_state == MagneticState::Consistent
+                                   ? series_reluctance(rod.k_f, rc.length_m, mat.chi_m, rc.area_m2)
+                                   : 0.0;
 }
 
 // Eq. (24)-(28): rod i's oscillator mass, damping and the fixed part of its load compliance,

@@ -2,6 +2,7 @@
 // strain and force (eq. 11-14) -> mechanics (eq. 15-18). See docs/model.md, "The step".
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -58,7 +59,8 @@ void advance_output_stage(const OutputStageModel& o, double y0_m, double y1_m, d
 
 // Consistent magnetic state (docs/model.md, "Magnetic state"). At the end of the step every
 // rod i satisfies, with its own JA state (eq. 9) and the circuit (eq. 23):
-//   phi_i = A_i B_i,  B_i = mu0 (H_i + M_i(H_i)),  U_i = k_f l_i H_c,i  (eq. 7, first line)
+//   phi_i = A_i B_i,  B_i = mu0 (H_i + M_i(H_i)),  U_i = l_i H_c,i + R_s,i phi_i  (eq. 7, first
+//   line, with k_f's series reluctance R_s: physics::series_reluctance)
 //   H_c,i = H_i + kappa_i dB_i/dt  (eq. 7's eddy field, trapezoidal over the step)
 // Newton's method on the rods' fields: each rod is linearised at the iterate H* (slope
 // dM/dH of ja_step) into a branch  U = R_eff phi + U_off, the circuit is solved with
@@ -89,11 +91,12 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
       M[i] = Mi;
       Bs[i] = flux_density(H[i], Mi);
       mud[i] = kMu0 * (1.0 + chi);
-      const double kfl = rc.k_f * rc.length_m;
-      s.rod_reluctance[i] = kfl / rc.area_m2 * (1.0 / mud[i] + g[i]);
-      s.circuit.rod_extra_mmf[i] = -kfl * (H[i] - Bs[i] / mud[i] - g[i] * B0[i] - e0[i]);
+      const double l = rc.length_m;
+      s.rod_reluctance[i] = l / rc.area_m2 * (1.0 / mud[i] + g[i]) + rc.series_reluctance_per_H;
+      s.circuit.rod_extra_mmf[i] = -l * (H[i] - Bs[i] / mud[i] - g[i] * B0[i] - e0[i]);
     }
-    if (!solve_circuit(m.circuit, s.rod_reluctance, current_A, pm_scale, s.circuit, false))
+    if (!solve_circuit(m.circuit, s.rod_reluctance, current_A, pm_scale, s.circuit,
+                       s.energy.enabled))
       throw DivergenceError(t1, "", "nodal matrix of the circuit", 0.0, "not positive definite");
     worst = 0.0;
     bool converged = true;
@@ -176,7 +179,8 @@ void settle_at_rest(const Model& m, const Conditions& c, State& s) {
   for (std::size_t i = 0; i < n; ++i) {  // static equilibrium x = F / K (eq. 15 at rest)
     auto& r = s.rods[i];
     r.k_load_N_per_m = load_stiffness(c.rods[i], s);
-    r.x_m = r.F_N / (r.k_rod_N_per_m + r.k_load_N_per_m);
+    r.K_osc_N_per_m = r.k_rod_N_per_m + r.k_load_N_per_m;
+    r.x_m = r.F_N / r.K_osc_N_per_m;
     r.v_m_per_s = 0.0;
   }
   double y_stack = 0.0;
@@ -199,14 +203,18 @@ State make_state(const Model& m, const Conditions& c, double current_A) {
   s.rods.assign(n, RodState{});
   s.rod_reluctance.assign(n, 0.0);
   s.circuit.resize(m.circuit);
+  s.energy.phi_prev_Wb.assign(m.circuit.branches.size(), 0.0);
   s.current_A = current_A;
   // Quasi-static ramp of the total MMF from zero (demagnetised rods, no field) to its
   // value at t = 0, along the initial magnetisation curve; no eddy lag (at rest).
   const int ramp_steps = 400;
   for (int k = 1; k <= ramp_steps; ++k) {
     const double f = static_cast<double>(k) / ramp_steps;
+    s.energy.enabled = k == ramp_steps;  // the last increment solves every branch (the ledger's
+                                         // start values, gmasim/energy.hpp)
     quasi_static_magnetic_update(m, c, s, f * current_A, f * c.pm_scale, 0.0);
   }
+  s.energy.enabled = false;
   settle_at_rest(m, c, s);
   return s;
 }
@@ -226,6 +234,23 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
   const double h = in.dt_s;
   const double t1 = s.t_s + h;
   const std::size_t n = s.rods.size();
+  std::array<StepStart, 8> start{};
+  const double current0_A = s.current_A;
+  if (s.energy.enabled) {  // the ledgers' start values (gmasim/energy.hpp)
+    std::copy(s.circuit.phi.begin(), s.circuit.phi.end(), s.energy.phi_prev_Wb.begin());
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& r = s.rods[i];
+      start[i] = {r.H_A_per_m,
+                  r.Hc_A_per_m,
+                  r.M_A_per_m,
+                  r.Mirr_A_per_m,
+                  flux_density(r.H_A_per_m, r.M_A_per_m),
+                  r.x_m,
+                  r.v_m_per_s,
+                  r.F_N,
+                  r.K_osc_N_per_m};
+    }
+  }
 
   if (m.options.magnetic_state == MagneticState::Consistent) {
     // 1-2. Circuit, eddy field and JA solved together (consistent_magnetic_update).
@@ -245,7 +270,8 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
       Mx = Mx > lim ? lim : (Mx < -lim ? -lim : Mx);
       s.rod_reluctance[i] = set_rod_permeability(m, i, rc, r, Mx, t1);
     }
-    if (!solve_circuit(m.circuit, s.rod_reluctance, in.current_A, c.pm_scale, s.circuit, false))
+    if (!solve_circuit(m.circuit, s.rod_reluctance, in.current_A, c.pm_scale, s.circuit,
+                       s.energy.enabled))
       throw DivergenceError(t1, "", "nodal matrix of the circuit", 0.0, "not positive definite");
 
     // 2. Per rod: static field (eq. 7), eddy lag (eq. 7), JA (eq. 9), force (eq. 11-14).
@@ -267,16 +293,20 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
   // 3. Mechanics (eq. 15-18): each rod's oscillator, exact over the step with the force
   //    linear from F_n to F_{n+1} and the stiffness at the end of the step (which needs
   //    every rod's new modulus first: eq. 18 couples them).
-  std::array<double, 8> F0{};
+  std::array<double, 8> F0{}, K0{};
   for (std::size_t i = 0; i < n; ++i) {
     F0[i] = s.rods[i].F_N;
+    K0[i] = s.rods[i].k_rod_N_per_m + s.rods[i].k_load_N_per_m;
     update_rod_mechanics(m.material, c.rods[i], s.rods[i]);
   }
   for (std::size_t i = 0; i < n; ++i) {
     const auto& rc = c.rods[i];
     auto& r = s.rods[i];
     r.k_load_N_per_m = load_stiffness(rc, s);
-    const double K = r.k_rod_N_per_m + r.k_load_N_per_m;  // eq. (16)
+    // Eq. (16) at mid-step: the stiffness varies with M over the step (the Delta-E effect);
+    // its mean keeps the update second order in h (docs/model.md, "Time step").
+    const double K = 0.5 * (K0[i] + r.k_rod_N_per_m + r.k_load_N_per_m);
+    r.K_osc_N_per_m = K;
     oscillator_step(rc.mass_osc_kg, rc.damping_osc_N_s_per_m, K, F0[i], r.F_N, h, r.x_m,
                     r.v_m_per_s);
     check(r.x_m, t1, m.rods[i].name, "x [m]", 1.0);
@@ -290,6 +320,7 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
   s.t_s = t1;
   s.current_A = in.current_A;
   finish_outputs(m, c, s);
+  if (s.energy.enabled) book_step_energy(m, c, s, start.data(), current0_A, in.current_A, h);
 }
 
 }  // namespace gmasim

@@ -126,20 +126,54 @@ double peak_to_peak(std::span<const double> v) {
   return *hi - *lo;
 }
 
+namespace {
+
+// Rows [b, e) of v (and the row e that closes a periodic window, when recorded) refined by
+// `factor` points per sample interval with the cubic Hermite interpolant whose slopes are the
+// centred differences (Catmull-Rom; third order in the sample spacing). The metrics of a
+// window are then taken from the refined samples, so that the sampling of the extremes and
+// the linear interpolation of the loop's branches add an error of third order in the step,
+// below the integrator's second order (docs/model.md, "Time step").
+std::vector<double> refine_window(const std::vector<double>& t, const std::vector<double>& v,
+                                  std::size_t b, std::size_t e, int factor) {
+  const std::size_t last = std::min(e, t.size() - 1);  // the closing row, if any
+  auto slope = [&](std::size_t k) {
+    const std::size_t lo = k > 0 ? k - 1 : k, hi = k + 1 < t.size() ? k + 1 : k;
+    return (v[hi] - v[lo]) / (t[hi] - t[lo]);
+  };
+  std::vector<double> out;
+  out.reserve((last - b) * static_cast<std::size_t>(factor) + 1);
+  for (std::size_t k = b; k < last; ++k) {
+    const double h = t[k + 1] - t[k];
+    const double m0 = slope(k) * h, m1 = slope(k + 1) * h;
+    for (int j = 0; j < factor; ++j) {
+      const double s = static_cast<double>(j) / factor, s2 = s * s, s3 = s2 * s;
+      out.push_back((2 * s3 - 3 * s2 + 1) * v[k] + (s3 - 2 * s2 + s) * m0 +
+                    (-2 * s3 + 3 * s2) * v[k + 1] + (s3 - s2) * m1);
+    }
+  }
+  if (last < e) out.push_back(v[last]);  // no closing row: keep the last sample
+  return out;
+}
+
+}  // namespace
+
 Metrics compute_metrics(const TimeSeries& ts, double t0, double t1) {
   const auto& t = ts.column("t_s");
-  const auto& I = ts.column("current_A");
-  const auto& y = ts.column("y_um");
-  const auto& B = ts.column("B_T");
   const auto [b, e] = window_rows(t, t0, t1);
   Metrics m;
   m.window_start_s = t0;
   m.window_end_s = t1;
   if (e <= b + 2)
     throw InputError(fmt::format("metrics window [{}, {}] s holds fewer than 3 samples", t0, t1));
-  std::tie(m.stroke_um, m.y_mean_um) = pp_and_mean(y, b, e);
-  m.B_pp_T = pp_and_mean(B, b, e).first;
-  m.hysteresis_um = hysteresis_width(I, y, b, e);
+  constexpr int kRefine = 8;
+  const auto I = refine_window(t, ts.column("current_A"), b, e, kRefine);
+  const auto y = refine_window(t, ts.column("y_um"), b, e, kRefine);
+  const auto B = refine_window(t, ts.column("B_T"), b, e, kRefine);
+  m.stroke_um = peak_to_peak(y);
+  m.y_mean_um = pp_and_mean(ts.column("y_um"), b, e).second;
+  m.B_pp_T = peak_to_peak(B);
+  m.hysteresis_um = hysteresis_width(I, y, 0, y.size());
   return m;
 }
 

@@ -93,8 +93,9 @@ struct SelfHeatingRun {
   double interval_s = 0, ambient_C = 0, T_ref_C = 20;
   const ThermalNetworkModel* net = nullptr;
   NodeTemperatures T, T0;
-  double E_copper = 0, E_eddy = 0, E_hyst = 0, y_min = 0, y_max = 0, i_prev = 0;
-  std::vector<double> volume_m3, Hc_prev, H_prev, M_prev;  // per rod, sized once
+  double E_copper = 0, y_min = 0, y_max = 0, i_prev = 0;
+  // The ledger's running sums of the rods' losses at the start of the interval [J].
+  double E_eddy0 = 0, E_hyst0 = 0, E_damp0 = 0;
 
   SelfHeatingRun(const Model& m, const SimulationSettings& s, const RunLength& L, Result& r) {
     enabled = s.self_heating.enabled;
@@ -118,42 +119,39 @@ struct SelfHeatingRun {
           "{:.4g} s (min C/G over coil, rods, housing); shorten the thermal step",
           interval_s, tau));
     T = T0 = {s.temperature_C, s.temperature_C, s.temperature_C};
-    const std::size_t n = m.rods.size();
-    volume_m3.assign(n, 0.0);
-    Hc_prev.assign(n, 0.0);
-    H_prev.assign(n, 0.0);
-    M_prev.assign(n, 0.0);
-    r.heating.names = {"t_s",        "coil_C",   "rods_C",         "housing_C",
-                       "P_copper_W", "P_eddy_W", "P_hysteresis_W", "P_ambient_W",
-                       "stroke_um",  "E_in_J",   "E_stored_J",     "E_out_J"};
+    r.heating.names = {"t_s",      "coil_C",         "rods_C",      "housing_C",   "P_copper_W",
+                       "P_eddy_W", "P_hysteresis_W", "P_damping_W", "P_ambient_W", "stroke_um",
+                       "E_in_J",   "E_stored_J",     "E_out_J"};
     r.heating.columns.assign(r.heating.names.size(), {});
     const double rows =
         static_cast<double>(L.grid.steps) / static_cast<double>(steps_per_interval) + 2;
     for (auto& col : r.heating.columns) col.reserve(static_cast<std::size_t>(rows));
   }
 
-  void remember(std::size_t i, const RodState& rs) {
-    Hc_prev[i] = rs.Hc_A_per_m;
-    H_prev[i] = rs.H_A_per_m;
-    M_prev[i] = rs.M_A_per_m;
-  }
-
-  void push_row(Result& r, double t, double Pc, double Pe, double Ph, double Pa, double stroke) {
-    const double row[] = {t,      T.coil_C,      T.rods_C,          T.housing_C,   Pc, Pe, Ph, Pa,
-                          stroke, r.energy_in_J, r.energy_stored_J, r.energy_out_J};
+  void push_row(Result& r, double t, double Pc, double Pe, double Ph, double Pd, double Pa,
+                double stroke) {
+    const double row[] = {
+        t,      T.coil_C,      T.rods_C,          T.housing_C,   Pc, Pe, Ph, Pd, Pa,
+        stroke, r.energy_in_J, r.energy_stored_J, r.energy_out_J};
     for (std::size_t j = 0; j < r.heating.columns.size(); ++j)
       r.heating.columns[j].push_back(row[j]);
   }
 
-  void begin(const Conditions& c, const State& st, Result& r) {
-    if (!enabled) return;
-    for (std::size_t i = 0; i < volume_m3.size(); ++i) {
-      volume_m3[i] = c.rods[i].area_m2 * c.rods[i].length_m;
-      remember(i, st.rods[i]);
+  static void rod_losses(const State& st, double& eddy, double& hyst, double& damp) {
+    eddy = hyst = damp = 0.0;
+    for (const auto& rs : st.rods) {
+      eddy += rs.energy.eddy_J;
+      hyst += rs.energy.hysteresis_J;
+      damp += rs.energy.damping_J;
     }
+  }
+
+  void begin(const State& st, Result& r) {
+    if (!enabled) return;
     i_prev = st.current_A;
     y_min = y_max = st.y_m;
-    push_row(r, st.t_s, 0, 0, 0, 0, 0);
+    rod_losses(st, E_eddy0, E_hyst0, E_damp0);
+    push_row(r, st.t_s, 0, 0, 0, 0, 0, 0);
   }
 
   void after_step(const Model& m, const SimulationSettings& s, Conditions& c, const State& st,
@@ -161,30 +159,27 @@ struct SelfHeatingRun {
     E_copper +=
         copper_loss_J(i_prev, st.current_A, coil_resistance_ohm(*net, T_ref_C, T.coil_C), dt);
     i_prev = st.current_A;
-    for (std::size_t i = 0; i < volume_m3.size(); ++i) {
-      const RodState& rs = st.rods[i];
-      const RodLoss l = rod_loss_J(volume_m3[i], Hc_prev[i], H_prev[i], M_prev[i], rs.Hc_A_per_m,
-                                   rs.H_A_per_m, rs.M_A_per_m);
-      E_eddy += l.eddy_J;
-      E_hyst += l.hysteresis_J;
-      remember(i, rs);
-    }
     y_min = std::min(y_min, st.y_m);
     y_max = std::max(y_max, st.y_m);
     if (++in_interval < steps_per_interval && !last) return;
-    // One thermal step: the interval's mean powers heat the network. The magnetic work of an
-    // interval that is not whole periods holds a change of stored field energy, which may be
-    // negative: the rods then receive no heat from it (never a cooling by the field).
+    // One thermal step: the interval's mean powers heat the network. The rods' losses are the
+    // energy ledger's hysteresis, eddy-current and damping terms (gmasim/energy.hpp), each
+    // >= 0 by its own law.
     const double span = static_cast<double>(in_interval) * dt;
-    const double Pc = E_copper / span, Pe = std::max(0.0, E_eddy) / span,
-                 Ph = std::max(0.0, E_hyst) / span;
-    const double E_out = thermal_network_step(*net, T, Pc, Pe + Ph, ambient_C, span);
-    r.energy_in_J += (Pc + Pe + Ph) * span;
+    double eddy = 0, hyst = 0, damp = 0;
+    rod_losses(st, eddy, hyst, damp);
+    const double Pc = E_copper / span, Pe = (eddy - E_eddy0) / span, Ph = (hyst - E_hyst0) / span,
+                 Pd = (damp - E_damp0) / span;
+    const double E_out = thermal_network_step(*net, T, Pc, Pe + Ph + Pd, ambient_C, span);
+    r.energy_in_J += (Pc + Pe + Ph + Pd) * span;
     r.energy_out_J += E_out;
     r.energy_stored_J = stored_heat_J(*net, T, T0);
-    push_row(r, st.t_s, Pc, Pe, Ph, E_out / span, (y_max - y_min) * 1e6);
+    push_row(r, st.t_s, Pc, Pe, Ph, Pd, E_out / span, (y_max - y_min) * 1e6);
     in_interval = 0;
-    E_copper = E_eddy = E_hyst = 0;
+    E_copper = 0;
+    E_eddy0 = eddy;
+    E_hyst0 = hyst;
+    E_damp0 = damp;
     y_min = y_max = st.y_m;
     try {
       c = make_conditions(m, T.rods_C, s.freeze);
@@ -197,6 +192,53 @@ struct SelfHeatingRun {
   }
 };
 
+// The energy ledgers over the metrics window: a snapshot at its start, the coil's terminal
+// quantities summed over its steps, the balance at its end.
+struct EnergyWindow {
+  bool enabled = false;
+  long start_step = 0;  // the snapshot is taken after this step (0: before the first)
+  EnergySnapshot from;
+  long n = 0;
+  double R_ohm = 0, i_prev = 0;
+  double sum_i2 = 0, sum_v2 = 0, v_peak = 0, p_peak = 0, copper_J = 0, dt_s = 0;
+
+  void at(const Model& m, const Conditions& c, const State& st, long k, double dt) {
+    if (!enabled) return;
+    if (k == start_step) {
+      from = energy_snapshot(m, c, st);
+      i_prev = st.current_A;
+      return;
+    }
+    if (k < start_step) return;
+    const double i_mid = 0.5 * (i_prev + st.current_A);
+    const double v = i_mid * R_ohm + st.energy.coil_emf_V;
+    sum_i2 += i_mid * i_mid;
+    sum_v2 += v * v;
+    v_peak = std::max(v_peak, std::fabs(v));
+    p_peak = std::max(p_peak, std::fabs(i_mid * v));
+    copper_J += copper_loss_J(i_prev, st.current_A, R_ohm, dt);
+    i_prev = st.current_A;
+    dt_s = dt;
+    ++n;
+  }
+
+  void finish(const Model& m, const Conditions& c, const State& st, Result& r) const {
+    if (!enabled || n == 0) return;
+    r.energy = energy_balance(from, energy_snapshot(m, c, st));
+    const double span = r.energy.duration_s, N = static_cast<double>(n);
+    auto& e = r.coil;
+    e.resistance_ohm = R_ohm;
+    e.current_rms_A = std::sqrt(sum_i2 / N);
+    e.voltage_rms_V = std::sqrt(sum_v2 / N);
+    e.voltage_peak_V = v_peak;
+    e.power_peak_W = p_peak;
+    e.copper_W = copper_J / span;
+    e.power_mean_W = e.copper_W + r.energy.coil_J / span;
+    e.apparent_VA = e.voltage_rms_V * e.current_rms_A;
+    r.has_energy = true;
+  }
+};
+
 // What simulate() does after each step: self-heating (which may replace the Conditions the
 // loop reads), the decimated record, the step count and the progress callback.
 struct SimulationRecorder {
@@ -204,11 +246,13 @@ struct SimulationRecorder {
   const SimulationSettings& s;
   Conditions& c;  // the object run_loop() reads at every step
   SelfHeatingRun& heat;
+  EnergyWindow& energy;
   Result& r;
   long nsteps, report_every;
 
   void operator()(const State& st, const StepPoint& p) {
     const long k = p.k;
+    energy.at(m, c, st, k, p.dt_s);
     if (heat.enabled) heat.after_step(m, s, c, st, p.dt_s, k == nsteps, r);
     if (k % s.record_every == 0 || k == nsteps) record(c, st, r.series);
     r.steps = k;
@@ -310,14 +354,21 @@ Result simulate(const Model& m, const SimulationSettings& s) {
   r.thermal_expansion_um = c.thermal_expansion_m * 1e6;
   make_columns(m, r.series, static_cast<std::size_t>(nsteps / s.record_every + 2));
   SelfHeatingRun heat(m, s, L, r);
+  EnergyWindow energy;
+  energy.enabled = s.energy_ledger || s.self_heating.enabled;
+  if (w.periodic()) energy.start_step = nsteps - std::lround(w.period_s() / L.grid.dt_s);
+  energy.R_ohm = coil_resistance_ohm(m.thermal_network, m.T_ref_C, s.temperature_C);
   const auto wall0 = std::chrono::steady_clock::now();
   try {
     State st = make_state(m, c, w.current_at(0.0));
+    st.energy.enabled = energy.enabled;
     record(c, st, r.series);
-    heat.begin(c, st, r);
+    energy.at(m, c, st, 0, L.grid.dt_s);
+    heat.begin(st, r);
     run_loop(
         m, c, st, L.grid, [&w](double t) { return w.current_at(t); },
-        SimulationRecorder{m, s, c, heat, r, nsteps, std::max(1L, nsteps / 100)});
+        SimulationRecorder{m, s, c, heat, energy, r, nsteps, std::max(1L, nsteps / 100)});
+    energy.finish(m, c, st, r);
   } catch (const DivergenceError& e) {
     r.diverged = true;
     r.error = e.what();

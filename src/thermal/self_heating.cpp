@@ -26,14 +26,6 @@ double coil_resistance_ohm(const ThermalNetworkModel& n, double T_ref_C, double 
   return n.coil_resistance_ohm * (1.0 + n.coil_alpha_per_K * (coil_C - T_ref_C));
 }
 
-RodLoss rod_loss_J(double V, double Hc0, double H0, double M0, double Hc1, double H1, double M1) {
-  const double dB = physics::kMu0 * ((H1 - H0) + (M1 - M0));
-  const double Hc = 0.5 * (Hc0 + Hc1), H = 0.5 * (H0 + H1);
-  RodLoss l;
-  l.eddy_J = V * (Hc - H) * dB;
-  l.hysteresis_J = V * H * dB;
-  return l;
-}
 
 double thermal_network_step(const ThermalNetworkModel& n, NodeTemperatures& T, double P_coil_W,
                             double P_rods_W, double ambient_C, double dt_s) {

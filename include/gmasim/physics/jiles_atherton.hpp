@@ -122,7 +122,7 @@ inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, dou
   if (d0 <= 0.0 && d1 <= 0.0) return Mirr0;  // pinned for the whole step
   double s = std::fabs(dHe), u0 = Man0;
   double ds_dHe1 = delta;  // d|He1 - He0| / dHe1
-  if (d0 <= 0.0) {  // M_an crosses M_irr inside the step: relax over the remainder only
+  if (d0 <= 0.0) {         // M_an crosses M_irr inside the step: relax over the remainder only
     const double frac = d1 / (d1 - d0);
     // d frac / dHe1 = -d0 (dd1/dHe1) / (d1 - d0)^2 with dd1/dHe1 = delta dMan1.
     ds_dHe1 = delta * frac - s * d0 * delta * dMan1 / ((d1 - d0) * (d1 - d0));
@@ -133,8 +133,8 @@ inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, dou
   const LagWeights w = lag_weights(r);
   // d/dHe1 through M_an1 (weight 1 - q) and through r = s/k (dq/dr = (E - q)/r).
   const double dq_dr = r > 1e-12 ? (w.E - w.q) / r : -0.5;
-  dMirr_dHe1 = (1.0 - w.q) * dMan1 +
-               ds_dHe1 / k_A_per_m * (-(Mirr0 - u0) * w.E - (Man1 - u0) * dq_dr);
+  dMirr_dHe1 =
+      (1.0 - w.q) * dMan1 + ds_dHe1 / k_A_per_m * (-(Mirr0 - u0) * w.E - (Man1 - u0) * dq_dr);
   return Man1 + (Mirr0 - u0) * w.E - (Man1 - u0) * w.q;
 }
 
@@ -189,6 +189,80 @@ inline void ja_step(double H0, double H1, double MsT_A_per_m, const JaCoefficien
 inline void ja_step(double H0, double H1, double MsT_A_per_m, const JaCoefficients& p, double& Mirr,
                     double& M) {
   ja_step(H0, H1, MsT_A_per_m, p, Mirr, M, M);
+}
+
+// ---------------------------------------------------------------------------------------
+// Energy of eq. (9) (docs/model.md, "Energy ledgers"). With H_e = H + alpha M and
+// M = (1 - c) M_irr + c M_an(H_e), the magnetic work on the material splits exactly into the
+// change of a stored energy and a dissipation that is never negative:
+//   mu0 H dM = d Phi + (1 - c) mu0 (H_e - H_an(M_irr)) dM_irr,
+//   Phi = mu0 [ -alpha M^2/2 + c (H_e M_an(H_e) - G(H_e)) + (1 - c) Psi(M_irr) ],
+// G(H_e) = int_0^He M_an = M_s a ln(sinh(He/a)/(He/a)) (the Langevin free energy), H_an the
+// inverse of the anhysteretic curve and Psi(M) = H_an(M) M - G(H_an(M)) its Legendre dual.
+// Where M_irr moves, (M_an(H_e) - M_irr) delta > 0 (eq. 9's guard), so H_e - H_an(M_irr) has
+// the sign of dM_irr: the dissipation is >= 0 (the JA loop area, Jiles and Atherton 1986).
+// ---------------------------------------------------------------------------------------
+
+// ln(sinh x / x), even in x, without overflow or cancellation [-].
+inline double log_sinh_over_x(double x) {
+  const double ax = std::fabs(x);
+  if (ax < 0.1) {
+    const double x2 = x * x;
+    return x2 * (1.0 / 6.0 - x2 * (1.0 / 180.0 - x2 * (1.0 / 2835.0 - x2 / 37800.0)));
+  }
+  // sinh x / x = e^x (1 - e^{-2x}) / (2x)
+  return ax + std::log1p(-std::exp(-2.0 * ax)) - std::log(2.0 * ax);
+}
+
+// G(H_e) = int_0^He M_an(h) dh = M_s a ln(sinh(He/a)/(He/a))  [A^2/m^2].
+inline double anhysteretic_coenergy(double He_A_per_m, double MsT_A_per_m, double a_A_per_m) {
+  return MsT_A_per_m * a_A_per_m * log_sinh_over_x(He_A_per_m / a_A_per_m);
+}
+
+// The inverse of the Langevin function: x with L(x) = m, |m| < 1. Newton's method from
+// `guess` (or, if it is not finite, from x = m (3 - m^2)/(1 - m^2), Cohen's approximant),
+// converged to 1e-14 in L.
+inline double inverse_langevin(double m, double guess = std::nan("")) {
+  double x = std::isfinite(guess) ? guess : m * (3.0 - m * m) / (1.0 - m * m);
+  for (int it = 0; it < 50; ++it) {
+    const LangevinValue v = langevin_pair(x);
+    const double r = v.L - m;
+    if (std::fabs(r) <= 1e-14) break;
+    double dx = r / v.dL;
+    // keep the iterate on the side where L is defined and monotone (|L| < 1)
+    if (std::fabs(dx) > 0.5 * (1.0 + std::fabs(x)))
+      dx = (dx > 0 ? 0.5 : -0.5) * (1.0 + std::fabs(x));
+    x -= dx;
+  }
+  return x;
+}
+
+// H_an(M): the field on the anhysteretic curve of eq. (9) where M_an = M  [A/m].
+inline double anhysteretic_field(double M_A_per_m, double MsT_A_per_m, double a_A_per_m,
+                                 double guess_A_per_m = std::nan("")) {
+  return a_A_per_m * inverse_langevin(M_A_per_m / MsT_A_per_m, guess_A_per_m / a_A_per_m);
+}
+
+// Phi of the split above: the energy eq. (9) stores in the material per unit volume,
+// beyond the field's mu0 H^2/2  [J/m^3]. Han_irr = anhysteretic_field(M_irr).
+inline double ja_stored_energy_density(double H_A_per_m, double M_A_per_m, double Mirr_A_per_m,
+                                       double Han_irr_A_per_m, double MsT_A_per_m,
+                                       const JaCoefficients& p) {
+  const double He = H_A_per_m + p.alpha * M_A_per_m;
+  const double Man = anhysteretic(He, MsT_A_per_m, p.a_A_per_m);
+  const double psi = Han_irr_A_per_m * Mirr_A_per_m -
+                     anhysteretic_coenergy(Han_irr_A_per_m, MsT_A_per_m, p.a_A_per_m);
+  return kMu0 * (-0.5 * p.alpha * M_A_per_m * M_A_per_m +
+                 p.c * (He * Man - anhysteretic_coenergy(He, MsT_A_per_m, p.a_A_per_m)) +
+                 (1.0 - p.c) * psi);
+}
+
+// The dissipation density of the split over one step, by the trapezoidal rule on
+// g = H_e - H_an(M_irr) along M_irr: (1 - c) mu0 (g0 + g1)/2 (M_irr1 - M_irr0)  [J/m^3].
+// g0 is 0 where M_irr starts to move inside the step (there M_an = M_irr, eq. 9's guard).
+inline double ja_dissipation_density(double g0_A_per_m, double g1_A_per_m, double Mirr0_A_per_m,
+                                     double Mirr1_A_per_m, const JaCoefficients& p) {
+  return (1.0 - p.c) * kMu0 * 0.5 * (g0_A_per_m + g1_A_per_m) * (Mirr1_A_per_m - Mirr0_A_per_m);
 }
 
 }  // namespace gmasim::physics
