@@ -199,8 +199,8 @@ TEST(Frf, ResonanceAndBandwidthOfBothReadings) {
   EXPECT_LT(shift_of(built_in), 0.03);
 
   ModelSpec light = builtin_model_spec();
-  light.set("mechanics.output_stage.damping_N_s_per_m", 10.0);
-  light.set("mechanics.output_stage.stiffness_N_per_m", 4.6e5);
+  light.set("mechanics.sensor_mount.damping_N_s_per_m", 10.0);
+  light.set("mechanics.sensor_mount.stiffness_N_per_m", 4.6e5);
   const FrfResult lightly_damped = run_frf(compile(light), r);
   for (const auto& cv : lightly_damped.curves) {
     EXPECT_NEAR(cv.first_resonance_Hz, 1270.0, 0.02 * 1270.0) << cv.temperature_C << " degC";

@@ -83,14 +83,16 @@ int run_frf_cmd(FrfArgs& a) {
       fmt::print(" {:.3f} ms", c.eddy_tau_ms[k]);
     fmt::print("\n");
   }
-  if (model.output_stage.enabled) {
-    const auto& os = model.output_stage;
+  if (model.sensor_mount.enabled) {
+    const auto& sm = model.sensor_mount;
     fmt::print(
-        "\n  The first resonance is the output stage's ({:.3g} kg, {:.4g} N/m, {:.3g} N s/m: "
-        "{:.0f} Hz alone), driven by the rod stack; eq. (15)'s rod oscillators ring at the "
-        "modes above (docs/model.md, \"The output stage\").\n",
-        os.mass_kg, os.stiffness_N_per_m, os.damping_N_s_per_m,
-        std::sqrt(os.stiffness_N_per_m / os.mass_kg) / (2.0 * 3.141592653589793));
+        "\n  The first resonance is the sensor mount's ({:.3g} kg probe and bracket, {:.4g} N/m, "
+        "{:.3g} N s/m: {:.0f} Hz), shaken by the {:.3g} kg housing's recoil against the moving "
+        "stack; eq. (15)'s rod oscillators ring at the modes above (docs/model.md, \"The sensor "
+        "mount\").\n",
+        sm.mass_kg, sm.stiffness_N_per_m, sm.damping_N_s_per_m,
+        std::sqrt(sm.stiffness_N_per_m / sm.mass_kg) / (2.0 * 3.141592653589793),
+        sm.actuator_mass_kg);
   } else {
     fmt::print(
         "\n  This model has no output stage: the paper's {:g} Hz first resonance is not a mode "

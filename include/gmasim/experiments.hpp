@@ -111,10 +111,11 @@ struct SmallSignalModel {
   // reluctance R_s (k_f, physics::series_reluctance) on S's diagonal [1/H, A-turns/A].
   bool consistent = false;
   std::vector<double> port_S_per_H, port_b_At_per_A, length_m, kappa_s_m_per_H, area_m2;
-  // Output stage (model.hpp, OutputStageModel), if any: Y_sensor = Y_stack (c s + k)/(m s^2 +
-  // c s + k).
-  bool output_stage = false;
-  double os_mass_kg = 0, os_stiffness_N_per_m = 0, os_damping_N_s_per_m = 0;
+  // Sensor mount (model.hpp, SensorMountModel), if any: Y_sensor = Y_stack - u with the probe's
+  // deflection u = Q m s^2 / (m s^2 + c s + k), Q = sum recoil_per_x_i X_i the housing's recoil.
+  bool sensor_mount = false;
+  double sm_mass_kg = 0, sm_stiffness_N_per_m = 0, sm_damping_N_s_per_m = 0;
+  std::vector<double> recoil_per_x;  // (m_i/2 + m_lr,i) / M_actuator per rod [-]
   // Y(j 2 pi f)/I [m/A].
   std::complex<double> response(double f_Hz) const;
 };

@@ -168,6 +168,7 @@ struct RodModel {
 struct Material {  // Terfenol-D, shared by the rods
   double Ms_A_per_m, lambda_s, sigma_lambda_Pa, Es_Pa, Tc_C, rho0_ohm_m, drho_dT_ohm_m_per_K;
   double beta_per_K, chi_m, x_exponent, alpha_thermal_per_K;
+  double kf_reference_mu_r;  // mu_r of the series reluctance (physics::series_reluctance)
 };
 
 struct ChainElementModel {  // a magnetizer, output rod or disk spring: constant m, k, c
@@ -182,13 +183,17 @@ struct SleeveModel {  // eq. (19)
   double alpha_thermal_per_K;
 };
 
-// Optional output stage (`[mechanics.output_stage]`): the output head and displacement
-// sensor on a compliant, temperature-independent mount, driven at its base by the stack
-// output y_stack:  m z'' + c (z' - y_stack') + k (z - y_stack) = 0. The sensor reads z. Its
-// reaction on the stack is neglected (k is far below the rods' stiffness). docs/model.md.
-struct OutputStageModel {
+// Optional sensor mount (`[mechanics.sensor_mount]`; docs/model.md, "The sensor mount"): the
+// capacitive probe on its bracket on the housing (section 4.5: the sensor, on the outer shell,
+// "has certain vibrations"). The housing of mass M (the whole actuator, section 1) recoils
+// against the stack's momentum p = sum_i (m_i/2 + m_lr,i) x_i (eq. 27's masses), x_h = -p/M;
+// the probe's deflection u on the bracket obeys m u'' + c u' + k u = -m x_h'', and the sensor
+// reads y_stack - u. Temperature-independent; the recoil's back-action on the stack is not
+// modelled (the stack's motion is relative to the housing, as in eq. 15).
+struct SensorMountModel {
   bool enabled = false;
   double mass_kg = 0, stiffness_N_per_m = 0, damping_N_s_per_m = 0;
+  double actuator_mass_kg = 0;
 };
 
 // Lumped thermal network of self-heating (optional table [thermal_network], every key
@@ -232,7 +237,7 @@ struct Model {
   std::vector<ChainElementModel> elements;
   std::vector<SleeveModel> sleeves;
   std::vector<std::vector<ChainLink>> chains;  // per rod
-  OutputStageModel output_stage;
+  SensorMountModel sensor_mount;
   ThermalNetworkModel thermal_network;
   ThermalExpansionModel thermal_expansion;
   // eq. (21) alpha*l products of the stack [m/K], from thermal_expansion and the rods
@@ -268,6 +273,7 @@ struct RodConditions {
   // U / (k_f l) of eq. (7) (docs/model.md, "The magnetic state"). 0 in the printed reading.
   double series_reluctance_per_H;
   double mass_osc_kg;               // eq. (24) + (27)
+  double momentum_mass_kg;          // m/2 + m_lr (eq. 27): the stack's momentum per unit x
   double damping_osc_N_s_per_m;     // eq. (25) + (28)
   double fixed_compliance_m_per_N;  // sum of 1/k of the chain's non-rod members (eq. 18)
   std::array<int, 8> chain_rods;    // rods inside this rod's load chain (eq. 18)
@@ -335,10 +341,12 @@ struct RodState {
 struct State {
   double t_s = 0;        // end of the last step; end of step(): t_s + dt
   double current_A = 0;  // coil current at t_s; end of step(): StepInput::current_A
-  double y_m = 0;        // the output the sensor reads: z with an output stage, else y_stack (+ x_T
+  double y_m = 0;        // the output the sensor reads: y_stack - u with a sensor mount (+ x_T
                          // if the option says so); end of step()
   double y_stack_m = 0;  // x1 + x2 + x3 (eq. 20); end of step()
-  double z_m = 0, z_v_m_per_s = 0;  // output stage (if any): displacement and velocity; stage 3
+  // Sensor mount (if any): q = p / M, the housing's recoil -x_h; z follows q through the bracket
+  // (m z'' + c (z' - q') + k (z - q) = 0), so the probe's deflection is u = q - z; stage 3.
+  double q_m = 0, z_m = 0, z_v_m_per_s = 0;
   double B_T = 0;  // flux density seen by the induction coil (sensor branches); end of step()
   std::vector<RodState> rods;
   CircuitWorkspace circuit;  // stage 1: the rod branches' fluxes phi (eq. 23), the consistent

@@ -50,7 +50,7 @@ enum class Group {
   Rod,               // [<rod>] for each rod of stack.rods
   RodJa,             // [<rod>.ja]
   Element,           // [mechanics.elements.<name>]
-  OutputStage,       // [mechanics.output_stage] (optional)
+  SensorMount,       // [mechanics.sensor_mount] (optional)
   SleeveModulus,     // [mechanics.sleeve_modulus] (optional, every key defaulted)
   Sleeve,            // [mechanics.sleeves.<name>]
   Branch,            // [[circuit.branches]] (numbers optional, absent = 0)

@@ -265,11 +265,13 @@ SmallSignalModel linearise(const Model& m, const Conditions& c, const State& s) 
   }
   CircuitWorkspace ws;
   ws.resize(m.circuit);
-  if (m.output_stage.enabled) {
-    L.output_stage = true;
-    L.os_mass_kg = m.output_stage.mass_kg;
-    L.os_stiffness_N_per_m = m.output_stage.stiffness_N_per_m;
-    L.os_damping_N_s_per_m = m.output_stage.damping_N_s_per_m;
+  if (m.sensor_mount.enabled) {
+    L.sensor_mount = true;
+    L.sm_mass_kg = m.sensor_mount.mass_kg;
+    L.sm_stiffness_N_per_m = m.sensor_mount.stiffness_N_per_m;
+    L.sm_damping_N_s_per_m = m.sensor_mount.damping_N_s_per_m;
+    for (std::size_t i = 0; i < n; ++i)
+      L.recoil_per_x.push_back(c.rods[i].momentum_mass_kg / m.sensor_mount.actuator_mass_kg);
   }
   L.G.assign(n * n, 0.0);
   if (m.options.magnetic_state == MagneticState::Consistent) {
@@ -315,17 +317,20 @@ std::complex<double> SmallSignalModel::response(double f_Hz) const {
     }
     dM = A.partialPivLu().solve(b);
   }
-  cd Y = 0.0;
+  cd Y = 0.0, Q = 0.0;
   for (Eigen::Index i = 0; i < N; ++i) {
     const auto ui = static_cast<std::size_t>(i);
     cd dF = 0.0;
     for (Eigen::Index j = 0; j < N; ++j)
       dF += D_N_per_A_per_m[ui * static_cast<std::size_t>(n) + static_cast<std::size_t>(j)] * dM(j);
-    Y += dF / (mass_kg[ui] * sj * sj + damping_N_s_per_m[ui] * sj + stiffness_N_per_m[ui]);
+    const cd X = dF / (mass_kg[ui] * sj * sj + damping_N_s_per_m[ui] * sj + stiffness_N_per_m[ui]);
+    Y += X;
+    if (sensor_mount) Q += recoil_per_x[ui] * X;
   }
-  if (output_stage)
-    Y *= (os_damping_N_s_per_m * sj + os_stiffness_N_per_m) /
-         (os_mass_kg * sj * sj + os_damping_N_s_per_m * sj + os_stiffness_N_per_m);
+  // The probe's deflection u = Q s^2 / (s^2 + (c/m) s + k/m) (model.hpp, SensorMountModel).
+  if (sensor_mount)
+    Y -= Q * sj * sj * sm_mass_kg /
+         (sm_mass_kg * sj * sj + sm_damping_N_s_per_m * sj + sm_stiffness_N_per_m);
   return Y;
 }
 
@@ -460,8 +465,8 @@ double settling_time_s(const SmallSignalModel& lin) {
     const double zw = lin.damping_N_s_per_m[i] / (2.0 * lin.mass_kg[i]);
     t_settle = std::max({t_settle, 10.0 * lin.tau_s[i], 10.0 / zw});
   }
-  if (lin.output_stage && lin.os_damping_N_s_per_m > 0)
-    t_settle = std::max(t_settle, 10.0 * 2.0 * lin.os_mass_kg / lin.os_damping_N_s_per_m);
+  if (lin.sensor_mount && lin.sm_damping_N_s_per_m > 0)
+    t_settle = std::max(t_settle, 10.0 * 2.0 * lin.sm_mass_kg / lin.sm_damping_N_s_per_m);
   return t_settle;
 }
 

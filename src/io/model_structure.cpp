@@ -305,10 +305,15 @@ void ModelLoader::read_mechanics(const toml::table& root) {
   const auto* t = table_at(root, "mechanics", "mechanics", 1);
   if (!t) return;
   const long tl = node_line(*t);
+  if (const auto* old = t->get("output_stage"))
+    problem(node_line(*old),
+            "[mechanics.output_stage] is gone: the 1270 Hz body is the displacement sensor's "
+            "mount, [mechanics.sensor_mount] (mass_kg, stiffness_N_per_m, damping_N_s_per_m, "
+            "actuator_mass_kg; docs/model.md, \"The sensor mount\")");
   check_keys(*t, "[mechanics]",
-             {"elements", "sleeve_modulus", "sleeves", "chains", "output_stage"});
+             {"elements", "sleeve_modulus", "sleeves", "chains", "sensor_mount", "output_stage"});
   // Optional: absent means the sensor reads the stack output.
-  read_group_table(*t, Group::OutputStage, tl);
+  read_group_table(*t, Group::SensorMount, tl);
   bool members_ok = rods_ok_;
   members_ok = read_members(*t, tl, "elements", Group::Element, spec_.element_names) && members_ok;
   read_group_table(*t, Group::SleeveModulus, tl);

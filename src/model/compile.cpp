@@ -161,7 +161,7 @@ void build_chains(const ModelSpec& spec, Model& m) {
 
 // Quantities formed from several parameters.
 void derive(const ModelSpec& spec, Model& m) {
-  m.output_stage.enabled = !schema::group_instances(spec, Group::OutputStage).empty();
+  m.sensor_mount.enabled = !schema::group_instances(spec, Group::SensorMount).empty();
   double rod_mass_kg = 0.0;
   for (const auto& rod : m.rods) rod_mass_kg += rod.mass_kg;
   auto& n = m.thermal_network;

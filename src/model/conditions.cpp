@@ -173,7 +173,7 @@ void rod_material(const Model& m, const RodModel& rod, const Conditions& c, cons
   rc.eddy_geometry_s_m_per_H =
       eddy_time_constant(1.0, rc.r_outer_m, rc.r_inner_m, rod.k_j, rc.rho_ohm_m);
   rc.series_reluctance_per_H = m.options.magnetic_state == MagneticState::Consistent
-                                   ? series_reluctance(rod.k_f, rc.length_m, mat.chi_m, rc.area_m2)
+                                   ? series_reluctance(rod.k_f, rc.length_m, mat.kf_reference_mu_r, rc.area_m2)
                                    : 0.0;
 }
 
@@ -204,6 +204,7 @@ void rod_chain(const Model& m, std::size_t i, const Conditions& c, RodConditions
     }
   }
   rc.mass_osc_kg = oscillator_mass(m.rods[i].mass_kg, m_load);
+  rc.momentum_mass_kg = 0.5 * m.rods[i].mass_kg + m_load;
   rc.damping_osc_N_s_per_m = m.rods[i].damping_N_s_per_m + 1.0 / inv_c;
   rc.fixed_compliance_m_per_N = inv_k_fixed;
 }

@@ -37,8 +37,8 @@ double& in_element(Model& m, std::size_t i) {
   return m.elements[i].*P;
 }
 template <auto P>
-double& in_output_stage(Model& m, std::size_t) {
-  return m.output_stage.*P;
+double& in_sensor_mount(Model& m, std::size_t) {
+  return m.sensor_mount.*P;
 }
 template <auto P>
 double& in_sleeve(Model& m, std::size_t i) {
@@ -88,8 +88,9 @@ constexpr GroupDef kGroups[] = {
     {G::Element, "mechanics.elements.<name>", TableRule::Required,
      "A member of a load chain with constant mass, stiffness and damping (magnetizer, output "
      "rod, disk spring)"},
-    {G::OutputStage, "mechanics.output_stage", TableRule::Optional,
-     "The output head and sensor on a compliant mount (absent: the sensor reads the stack)"},
+    {G::SensorMount, "mechanics.sensor_mount", TableRule::Optional,
+     "The displacement sensor's probe on its bracket on the housing, shaken by the housing's "
+     "recoil against the moving stack (absent: the sensor reads the stack output)"},
     {G::SleeveModulus, "mechanics.sleeve_modulus", TableRule::Defaulted,
      "The sleeves' modulus law E_t^T = E_t - dE_t/dT T, eq. (19)"},
     {G::Sleeve, "mechanics.sleeves.<name>", TableRule::Required,
@@ -141,6 +142,11 @@ const ParamDef kParams[] = {
      LAND(in_material, Material, chi_m)},
     {G::Material, "x", "-", R::Positive, "critical exponent x of M_s^T, eq. (4)",
      LAND(in_material, Material, x_exponent)},
+    {G::Material, "kf_reference_mu_r", "-", R::Positive,
+     "relative permeability at which Table 4's k_f split a rod branch's MMF: the consistent "
+     "reading's series reluctance (k_f - 1) l / (mu0 mu_r A), eq. (7)",
+     LAND(in_material, Material, kf_reference_mu_r), 20.84,
+     "default: 1 + chi_m of Table 5, eq. (3)'s permeability at M = 0"},
     {G::Material, "alpha_thermal_per_K", "1/K", R::NonNegative,
      "thermal expansion coefficient of the rods, eq. (21) and l^T, A^T",
      LAND(in_material, Material, alpha_thermal_per_K)},
@@ -207,13 +213,16 @@ const ParamDef kParams[] = {
      LAND(in_element, ChainElementModel, stiffness_N_per_m)},
     {G::Element, "damping_N_s_per_m", "N s/m", R::Positive, "damping, in series in eq. (28)",
      LAND(in_element, ChainElementModel, damping_N_s_per_m)},
-    // [mechanics.output_stage]
-    {G::OutputStage, "mass_kg", "kg", R::Positive, "mass of the output head",
-     LAND(in_output_stage, OutputStageModel, mass_kg)},
-    {G::OutputStage, "stiffness_N_per_m", "N/m", R::Positive, "stiffness of its mount",
-     LAND(in_output_stage, OutputStageModel, stiffness_N_per_m)},
-    {G::OutputStage, "damping_N_s_per_m", "N s/m", R::NonNegative, "damping of its mount",
-     LAND(in_output_stage, OutputStageModel, damping_N_s_per_m)},
+    // [mechanics.sensor_mount]
+    {G::SensorMount, "mass_kg", "kg", R::Positive, "mass of the sensor probe and its bracket",
+     LAND(in_sensor_mount, SensorMountModel, mass_kg)},
+    {G::SensorMount, "stiffness_N_per_m", "N/m", R::Positive, "stiffness of the bracket",
+     LAND(in_sensor_mount, SensorMountModel, stiffness_N_per_m)},
+    {G::SensorMount, "damping_N_s_per_m", "N s/m", R::NonNegative, "damping of the bracket",
+     LAND(in_sensor_mount, SensorMountModel, damping_N_s_per_m)},
+    {G::SensorMount, "actuator_mass_kg", "kg", R::Positive,
+     "mass of the whole actuator, which recoils against its moving stack (section 1: 787 g)",
+     LAND(in_sensor_mount, SensorMountModel, actuator_mass_kg)},
     // [mechanics.sleeve_modulus]
     {G::SleeveModulus, "Et_Pa", "Pa", R::Positive, "E_t, the modulus law's 0 degC value, eq. (19)",
      LAND(in_model, Model, Et_Pa), 200e9, "default: steel; used only by [mechanics.sleeves]"},

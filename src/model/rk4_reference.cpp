@@ -56,10 +56,10 @@ void rhs(const Model& m, const Conditions& c, State& s, Y& y, double I, Y& dy) {
 
 void rk4_reference_step(const Model& m, const Conditions& c, State& s, double I0, double Imid,
                         double I1, double h) {
-  if (m.options.magnetic_state != MagneticState::Printed || m.output_stage.enabled)
+  if (m.options.magnetic_state != MagneticState::Printed || m.sensor_mount.enabled)
     throw InputError(
-        "rk4_reference_step: the RK4 reference integrates the printed magnetic state without an "
-        "output stage only (options.magnetic_state = \"printed\", no [mechanics.output_stage])");
+        "rk4_reference_step: the RK4 reference integrates the printed magnetic state without a "
+        "sensor mount only (options.magnetic_state = \"printed\", no [mechanics.sensor_mount])");
   const std::size_t n = s.rods.size();
   Y y0, k1, k2, k3, k4, yt;
   for (std::size_t i = 0; i < n; ++i) {

@@ -66,8 +66,8 @@ std::vector<std::string> group_instances(const ModelSpec& spec, Group g) {
     }
     case Group::Reluctance:
       return {};
-    case Group::OutputStage: {  // present when the spec holds any of its numbers
-      const std::string prefix = table_path(Group::OutputStage, "") + ".";
+    case Group::SensorMount: {  // present when the spec holds any of its numbers
+      const std::string prefix = table_path(Group::SensorMount, "") + ".";
       const auto it = spec.params.lower_bound(prefix);
       if (it == spec.params.end() || !it->first.starts_with(prefix)) return {};
       return {""};

@@ -32,7 +32,7 @@ void finish_outputs(const Model& m, const Conditions& c, State& s) {
   double y = 0.0;
   for (const auto& r : s.rods) y += r.x_m;
   s.y_stack_m = y;  // eq. (20)
-  if (m.output_stage.enabled) y = s.z_m;
+  if (m.sensor_mount.enabled) y += s.z_m - s.q_m;  // the probe's deflection u = q - z
   if (m.options.thermal_expansion_in_output) y += c.thermal_expansion_m;
   s.y_m = y;
   double phi = 0.0, area = 0.0;
@@ -46,15 +46,23 @@ void finish_outputs(const Model& m, const Conditions& c, State& s) {
     s.rods[i].B_T = s.rods[i].phi_Wb / c.rods[i].area_m2;
 }
 
-// The output stage (model.hpp, OutputStageModel): m z'' + c z' + k z = c y' + k y with the
-// stack output y linear over the step, so the forcing is linear too and oscillator_step is
-// exact.
-void advance_output_stage(const OutputStageModel& o, double y0_m, double y1_m, double h_s,
+// The housing's recoil q = p / M (model.hpp, SensorMountModel): p = sum (m/2 + m_lr) x.
+double recoil_m(const Model& m, const Conditions& c, const State& s) {
+  double p = 0.0;
+  for (std::size_t i = 0; i < s.rods.size(); ++i) p += c.rods[i].momentum_mass_kg * s.rods[i].x_m;
+  return p / m.sensor_mount.actuator_mass_kg;
+}
+
+// The sensor mount (model.hpp, SensorMountModel): with w = u - q, m w'' + c w' + k w =
+// -(c q' + k q), so z = -w = q - u solves m z'' + c (z' - q') + k (z - q) = 0 with q linear over
+// the step: linear forcing, and oscillator_step is exact.
+void advance_sensor_mount(const SensorMountModel& o, double q0_m, double q1_m, double h_s,
                           State& s) {
-  const double ydot = (y1_m - y0_m) / h_s;
+  const double qdot = (q1_m - q0_m) / h_s;
   const double c = o.damping_N_s_per_m, k = o.stiffness_N_per_m;
-  oscillator_step(o.mass_kg, c, k, c * ydot + k * y0_m, c * ydot + k * y1_m, h_s, s.z_m,
+  oscillator_step(o.mass_kg, c, k, c * qdot + k * q0_m, c * qdot + k * q1_m, h_s, s.z_m,
                   s.z_v_m_per_s);
+  s.q_m = q1_m;
 }
 
 // Consistent magnetic state (docs/model.md, "Magnetic state"). At the end of the step every
@@ -183,10 +191,10 @@ void settle_at_rest(const Model& m, const Conditions& c, State& s) {
     r.x_m = r.F_N / r.K_osc_N_per_m;
     r.v_m_per_s = 0.0;
   }
-  double y_stack = 0.0;
-  for (const auto& r : s.rods) y_stack += r.x_m;
-  s.z_m = y_stack;  // the output stage at rest on the stack
-  s.z_v_m_per_s = 0.0;
+  if (m.sensor_mount.enabled) {  // the probe at rest on its bracket: u = 0
+    s.q_m = s.z_m = recoil_m(m, c, s);
+    s.z_v_m_per_s = 0.0;
+  }
   finish_outputs(m, c, s);
 }
 
@@ -311,11 +319,9 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
                     r.v_m_per_s);
     check(r.x_m, t1, m.rods[i].name, "x [m]", 1.0);
   }
-  if (m.output_stage.enabled) {
-    double y1 = 0.0;
-    for (const auto& r : s.rods) y1 += r.x_m;
-    advance_output_stage(m.output_stage, s.y_stack_m, y1, h, s);
-    check(s.z_m, t1, "output stage", "z [m]", 1.0);
+  if (m.sensor_mount.enabled) {
+    advance_sensor_mount(m.sensor_mount, s.q_m, recoil_m(m, c, s), h, s);
+    check(s.z_m, t1, "sensor mount", "z [m]", 1.0);
   }
   s.t_s = t1;
   s.current_A = in.current_A;

@@ -96,11 +96,12 @@ inline double static_field(double phi_Wb, double k_f, double mu_H_per_m, double 
 // H_c = phi/(k_f mu A) gives the Terfenol-D 1/k_f of the MMF U = phi l/(mu A) across the rod
 // branch. The rest, (k_f - 1)/k_f of it, drops outside the Terfenol-D (joints between the short
 // rods, magnetizer interfaces, leakage paths): a lossless, linear series reluctance that takes
-// the same share at the initial permeability mu0 (1 + chi_m) of eq. (3) with eq. (5):
-//   R_s = (k_f - 1) l / (mu0 (1 + chi_m) A)      [1/H]
+// the same share of it when the rod's relative permeability is mu_r (a model constant: eq. (3)
+// spans mu_r = 1 + chi_m = 20.8 at M = 0 down to a few near saturation):
+//   R_s = (k_f - 1) l / (mu0 mu_r A)      [1/H]
 // so that U = l H_c + R_s phi and, for a linear rod of that permeability, H_c = U/(k_f l).
-inline double series_reluctance(double k_f, double length_m, double chi_m, double area_m2) {
-  return (k_f - 1.0) * length_m / (kMu0 * (1.0 + chi_m) * area_m2);
+inline double series_reluctance(double k_f, double length_m, double mu_r, double area_m2) {
+  return (k_f - 1.0) * length_m / (kMu0 * mu_r * area_m2);
 }
 
 // Eq. (7), second line: time constant of the first-order eddy-current lag [s].
