@@ -86,6 +86,7 @@ int run_simulate(const SimulateArgs& a) {
   const Model model = load_model_args(a.model);
   SimulationSettings s;
   s.temperature_C = a.temperature_C;
+  s.energy_ledger = true;
   s.waveform = make_waveform(a);
   s.periods = a.periods;
   s.duration_s = a.duration_s;

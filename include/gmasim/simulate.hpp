@@ -59,10 +59,11 @@ struct SelfHeatingSettings {
 struct SimulationSettings {
   double temperature_C = 20.0;  // start temperature of every node (self-heating) or the fixed one
   // Book the energy ledgers (gmasim/energy.hpp) and the coil's terminal quantities over the
-  // metrics window (Result::energy, Result::coil). Self-heating books them whatever this says
-  // (its losses come from the ledger). Experiments that run many simulations turn it off: it
-  // solves every branch of the circuit and integrates each oscillator's power at every step.
-  bool energy_ledger = true;
+  // metrics window (Result::energy, Result::coil). `gmasim simulate`, Python's simulate() and
+  // `model check` turn it on; self-heating books them whatever this says (its losses come from
+  // the ledger). Off by default for the experiments that run many simulations: it solves every
+  // branch of the circuit and integrates each oscillator's power at every step.
+  bool energy_ledger = false;
   Waveform waveform;
   double periods = 3.0;     // run length for periodic waveforms
   double duration_s = 0.0;  // run length for the others (Table: its last time if 0)
@@ -167,6 +168,17 @@ Result simulate(const Model& m, const SimulationSettings& s);
 // Metrics over [t0, t1] of a recorded run (uses columns t_s, current_A, y_um, B_T).
 Metrics compute_metrics(const TimeSeries& ts, double t0_s, double t1_s);
 
+// Stroke, hysteresis and B p-p of the samples [b, e) of one window (the row e, when given,
+// closes a periodic window), from their cubic Hermite refinement (third order in the sample
+// spacing, below the integrator's second order): the one loop measure of simulate(), the
+// sweeps and identify's sine targets.
+struct LoopMetrics {
+  double stroke_um = 0, hysteresis_um = 0, B_pp_T = 0;
+};
+LoopMetrics loop_metrics(const std::vector<double>& t_s, const std::vector<double>& current_A,
+                         const std::vector<double>& y_um, const std::vector<double>& B_T,
+                         std::size_t b, std::size_t e);
+
 // max - min of v; 0 for an empty span. The one peak-to-peak of metrics, fits and records.
 double peak_to_peak(std::span<const double> v);
 
@@ -201,6 +213,12 @@ struct MagneticStateCheck {
   double max_inconsistency_T = 0;                // max |phi_i / A_i - mu0 (H_i + M_i)|
   double max_inconsistency_rel = 0;              // the same over mu0 (|H| + M_s^T) of that rod
   std::string where_B_rod, where_inconsistency;  // "rod2, 150 degC, 12 A, 10 Hz, t = ... s"
+  // The energy ledgers (gmasim/energy.hpp) over the last period of each run: the worse
+  // relative residual of the two, where, and the largest coupling fraction (the mechanical
+  // input the one-way coupling does not draw from the coil, over the magnetic input).
+  double energy_residual_rel = 0;
+  std::string where_energy;
+  double max_coupling_fraction = 0;
   int runs = 0;
   std::string divergence;  // the first run that diverged, if any (its samples still count)
 };

@@ -90,6 +90,7 @@ py::dict simulate_py(const Model& m, double temperature_C, double current_pp_A, 
                      const std::vector<std::string>& quantities, bool self_heating,
                      double thermal_step_s, py::object ambient_C) {
   SimulationSettings s;
+  s.energy_ledger = true;
   s.self_heating.enabled = self_heating;
   s.self_heating.thermal_step_s = thermal_step_s;
   if (!ambient_C.is_none()) s.self_heating.ambient_C = ambient_C.cast<double>();

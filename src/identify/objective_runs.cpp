@@ -44,12 +44,13 @@ SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings
   const long n_per = g.per_period, total = g.grid.steps;
   const auto& [c, st0] = starts.get(run.T, w.current_at(0.0));
   State st = st0;
-  I.assign(static_cast<std::size_t>(n_per), 0.0);
-  y.assign(static_cast<std::size_t>(n_per), 0.0);
-  B.assign(static_cast<std::size_t>(n_per), 0.0);
-  const long first = total - n_per;  // record samples k in [first, total)
+  const auto rows = static_cast<std::size_t>(n_per) + 1;  // the last period and its closing row
+  I.assign(rows, 0.0);
+  y.assign(rows, 0.0);
+  B.assign(rows, 0.0);
+  const long first = total - n_per;  // record samples k in [first, total]
   auto rec = [&](const State& x, long k) {
-    if (k < first || k >= total) return;
+    if (k < first || k > total) return;
     const auto i = static_cast<std::size_t>(k - first);
     I[i] = x.current_A;
     y[i] = x.y_m * 1e6;
@@ -59,10 +60,13 @@ SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings
   run_loop(
       m, c, st, g.grid, [&w](double t) { return w.current_at(t); },
       [&](const State& x, const StepPoint& p) { rec(x, p.k); });
+  std::vector<double> t(rows);  // uniform: only the spacing matters to the refinement
+  for (std::size_t k = 0; k < rows; ++k) t[k] = static_cast<double>(k);
+  const LoopMetrics L = loop_metrics(t, I, y, B, 0, rows - 1);
   SineMetrics r;
-  r.stroke_um = peak_to_peak(y);
-  r.B_pp_T = peak_to_peak(B);
-  r.hysteresis_um = hysteresis_width(I, y, 0, y.size());
+  r.stroke_um = L.stroke_um;
+  r.B_pp_T = L.B_pp_T;
+  r.hysteresis_um = L.hysteresis_um;
   return r;
 }
 

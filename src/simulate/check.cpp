@@ -17,12 +17,27 @@ MagneticStateCheck check_magnetic_state(const Model& m) {
         s.temperature_C = T;
         s.waveform = biased_sine(I, f);
         s.periods = 2;
+        s.energy_ledger = true;
         const Conditions c = make_conditions(m, T);
         const Result r = simulate(m, s);
         ++out.runs;
         const auto where = [&](const std::string& rod, double t) {
           return fmt::format("{}, {:g} degC, {:g} A, {:g} Hz, t = {:.6f} s", rod, T, I, f, t);
         };
+        if (r.has_energy) {  // the worse ledger over the last period (gmasim/energy.hpp)
+          const double res =
+              std::max(r.energy.magnetic_residual_rel, r.energy.mechanical_residual_rel);
+          if (res > out.energy_residual_rel || !std::isfinite(res)) {
+            out.energy_residual_rel = res;
+            out.where_energy = fmt::format("{:g} degC, {:g} A, {:g} Hz ({} ledger)", T, I, f,
+                                           r.energy.magnetic_residual_rel >=
+                                                   r.energy.mechanical_residual_rel
+                                               ? "magnetic"
+                                               : "mechanical");
+          }
+          out.max_coupling_fraction = std::max(out.max_coupling_fraction,
+                                               std::fabs(r.energy.coupling_fraction));
+        }
         const auto& t = r.series.column("t_s");
         const auto& B = r.series.column("B_T");
         for (double b : B) out.max_B_sensor_T = std::max(out.max_B_sensor_T, std::fabs(b));

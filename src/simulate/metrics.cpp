@@ -158,6 +158,16 @@ std::vector<double> refine_window(const std::vector<double>& t, const std::vecto
 
 }  // namespace
 
+LoopMetrics loop_metrics(const std::vector<double>& t, const std::vector<double>& current_A,
+                         const std::vector<double>& y_um, const std::vector<double>& B_T,
+                         std::size_t b, std::size_t e) {
+  constexpr int kRefine = 8;
+  const auto I = refine_window(t, current_A, b, e, kRefine);
+  const auto y = refine_window(t, y_um, b, e, kRefine);
+  const auto B = refine_window(t, B_T, b, e, kRefine);
+  return {peak_to_peak(y), hysteresis_width(I, y, 0, y.size()), peak_to_peak(B)};
+}
+
 Metrics compute_metrics(const TimeSeries& ts, double t0, double t1) {
   const auto& t = ts.column("t_s");
   const auto [b, e] = window_rows(t, t0, t1);
@@ -166,14 +176,12 @@ Metrics compute_metrics(const TimeSeries& ts, double t0, double t1) {
   m.window_end_s = t1;
   if (e <= b + 2)
     throw InputError(fmt::format("metrics window [{}, {}] s holds fewer than 3 samples", t0, t1));
-  constexpr int kRefine = 8;
-  const auto I = refine_window(t, ts.column("current_A"), b, e, kRefine);
-  const auto y = refine_window(t, ts.column("y_um"), b, e, kRefine);
-  const auto B = refine_window(t, ts.column("B_T"), b, e, kRefine);
-  m.stroke_um = peak_to_peak(y);
-  m.y_mean_um = pp_and_mean(ts.column("y_um"), b, e).second;
-  m.B_pp_T = peak_to_peak(B);
-  m.hysteresis_um = hysteresis_width(I, y, 0, y.size());
+  const auto& y = ts.column("y_um");
+  const LoopMetrics L = loop_metrics(t, ts.column("current_A"), y, ts.column("B_T"), b, e);
+  m.stroke_um = L.stroke_um;
+  m.hysteresis_um = L.hysteresis_um;
+  m.B_pp_T = L.B_pp_T;
+  m.y_mean_um = pp_and_mean(y, b, e).second;
   return m;
 }
 
