@@ -83,6 +83,7 @@ void write_outputs(const IdentifyArgs& a, const IdentifyResult& r, const ModelSp
   p.fit = a.fit;
   p.start_model = model_label(a.model);
   p.report_dir = a.report;
+  p.fitted_claims = fitted_claims(load_fit_spec(a.fit));
   // The start's own text: the file as read, with any --set values written into it.
   const std::string start_text = a.model.sets.empty() ? start.text : model_toml(start, "--set");
   const fs::path out(a.out);

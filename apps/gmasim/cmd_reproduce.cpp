@@ -55,8 +55,12 @@ int run_reproduce_cmd(const ReproduceArgs& a) {
   const ClaimCount n = count_claims(r.claims);
   fmt::print("gmasim reproduce  model: {}\n  {}\n  claims: {}\n", model_label(a.model),
              r.model_readings, claims.source);
+  fmt::print("  {}\n", fitted_predicted_line(n));
   fmt::print("  {} of {} applicable claims pass ({} claims); study took {:.1f} s\n", n.pass,
              n.applicable, r.claims.size(), r.wall_time_s);
+  for (const auto& t : r.trends)
+    fmt::print("  trend: {} {} ({:+.3g} /A, paper {:+.3g} /A)\n", t.what, t.pass ? "PASS" : "FAIL",
+               t.ours_slope, t.paper_slope);
   if (!a.doc.empty())
     for (const auto& id : unexplained_failures(r.claims, notes))
       fmt::print(stderr, "gmasim reproduce: warning: failing claim {} has no explanation{}\n", id,

@@ -128,7 +128,9 @@ enum class TargetKind {
   RetentionPct,         // 100 stroke(T) / stroke(T_ref) [%]
   ResonanceHz,          // lowest natural frequency of eq. (15) at (T, bias current) [Hz]
   FrfPeakHz,   // peak of the small-signal |Y/I| at (T, bias) (FrfCurve::first_resonance_Hz) [Hz]
-  BandwidthHz  // -3 dB point of the small-signal |Y/I| at (T, bias) [Hz]
+  BandwidthHz,  // -3 dB point of the small-signal |Y/I| at (T, bias) [Hz]
+  ModulusGPa    // mean over the rods of the Delta-E modulus E_G (eq. 13) at rest at (T, bias)
+                // [GPa]: Table 6's k_i = E A / l say about 30 GPa (READING-NOTES)
 };
 std::string target_kind_name(TargetKind k);
 
@@ -141,13 +143,22 @@ struct FitTarget {
   double weight = 1.0;  // relative to a measurement file of weight 1
   double scale = 0.0;   // normaliser: error % = 100 (sim - value) / scale; 0: |value|
   long line = 0;
+  std::string claim;  // the claim this target stands for ([[target]] claim = "<id>"), or ""
 };
 
 struct FitSpec {
   std::string source;
   std::vector<FitParameter> parameters;
   std::vector<FitTarget> targets;
+  // [[by_construction]] claim = "<id>", reason = "...": claims no target fits but a chosen
+  // constant sets (eq. 21's sleeve length sets the 0.662 um/degC); they count as fitted.
+  std::vector<std::pair<std::string, std::string>> by_construction;
 };
+
+// The claims a fit with this spec is fitted to: its targets' claims, then the
+// by-construction ones (no duplicates). gmasim identify writes them into the fitted model's
+// [calibration] fitted_claims; gmasim reproduce counts every other claim as a prediction.
+std::vector<std::string> fitted_claims(const FitSpec& spec);
 
 // A TOML file ([[parameter]] and [[target]] tables), or inline
 // "name:lower:upper[:log][,name:lower:upper...]". Throws InputError.
@@ -413,6 +424,7 @@ struct FitProvenance {
   std::string fit;          // fit spec source
   std::string report_dir;   // where the fit report is
   std::string start_model;  // start model label
+  std::vector<std::string> fitted_claims;  // fitted_claims(the fit spec): the [calibration] table
 };
 
 // The start model's text with each fitted value replaced and its provenance comment set;

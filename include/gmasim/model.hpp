@@ -90,6 +90,9 @@ struct ModelSpec {
   std::vector<std::string> element_names;                  // mechanics.elements.*
   std::vector<std::string> sleeve_names;                   // mechanics.sleeves.*
   std::map<std::string, std::vector<std::string>> chains;  // rod -> load chain (eq. 18/27/28)
+  // [calibration] fitted_claims: the claims this model was fitted to (gmasim identify writes
+  // them); gmasim reproduce counts the other claims as predictions.
+  std::vector<std::string> fitted_claims;
 
   double get(const std::string& dotted) const;  // throws InputError if unknown
   // Sets a number after checking it against its row's rule and the cross-field rules that

@@ -27,6 +27,9 @@ struct Claim {
   std::string note;          // why it passes/fails, or why it is not applicable
   std::string kind;          // the extractor (ClaimSpec::kind)
   ClaimCondition condition;  // where it holds (NaN fields: not part of the claim)
+  // The model was fitted to it (its [calibration] fitted_claims: a target of the calibration,
+  // or set by a chosen constant); otherwise it is a prediction.
+  bool fitted = false;
   double rel_diff() const;   // (ours - paper)/|paper|, NaN if not applicable
 };
 
@@ -36,6 +39,19 @@ struct ReproduceOptions {
   // The claims to score; nullptr: the built-in data/claims.toml. Not owned.
   const ClaimsData* claims = nullptr;
 };
+
+// The sign of a trend across current, beside the claims (not counted among them): the
+// least-squares slope against current of the paper's values of one claim kind at 6/8/10/12 A
+// and of ours (issue 18: the paper's flux drop falls with current, 5.6 -> 4.2 %).
+struct TrendCheck {
+  std::string kind;   // "stroke_drop_pct", "hysteresis_drop_pct", "flux_drop_pct"
+  std::string what;   // "stroke drop 20 -> 70 degC at 10 Hz"
+  std::vector<double> currents_pp_A, paper, ours;
+  double paper_slope = 0, ours_slope = 0;  // per ampere, in the claims' unit
+  bool pass = false;                       // the same sign (both 0 counts as the same)
+};
+std::vector<TrendCheck> trend_checks(const std::vector<Claim>& claims);
+std::string trends_markdown(const std::vector<TrendCheck>& trends);
 
 struct ReproduceResult {
   // The requests, kept for the reports.
@@ -59,6 +75,7 @@ struct ReproduceResult {
   double wall_time_s = 0.0;
   std::string model_source;
   std::string model_readings;  // the options in force, e.g. "eq10: mean_field, kelvin"
+  std::vector<TrendCheck> trends;  // the sign of each trend across current (trend_checks)
 };
 
 ReproduceResult run_reproduce(const Model& m, const ReproduceOptions& o,
@@ -69,10 +86,17 @@ ReproduceResult run_reproduce(const Model& m, const ReproduceOptions& o,
 // ours = NaN (fail) with a note saying so.
 std::vector<Claim> score_claims(const ReproduceResult& r, const ClaimsData& data);
 
-// How many claims pass, of how many applicable.
+// How many claims pass, of how many applicable; and apart, the fitted ones and the predictions.
 struct ClaimCount {
   int pass = 0, applicable = 0;
+  int fitted_pass = 0, fitted = 0, predicted_pass = 0, predicted = 0;
 };
+// "claims: F of Nf fitted pass; P of Np predicted pass"
+std::string fitted_predicted_line(const ClaimCount& n);
+
+// Marks the claims the model was fitted to (its spec's [calibration] fitted_claims). Throws
+// InputError naming the model file and line for an id that is not a claim of `claims`.
+void mark_fitted(std::vector<Claim>& claims, const ModelSpec& spec);
 ClaimCount count_claims(const std::vector<Claim>& claims);
 
 // The claims table as markdown (one row per claim) and the summary line "N of M pass".
@@ -87,7 +111,7 @@ struct ComparedModel {
 std::string comparison_markdown(const std::vector<ComparedModel>& models);
 
 // The claims as a report table (columns id, claim, source, kind, paper, ours, unit,
-// rel_diff, tolerance, result, pass, the condition: temperature_C, reference_temperature_C,
+// rel_diff, tolerance, result, pass, fitted, the condition: temperature_C, reference_temperature_C,
 // current_pp_A, frequency_Hz, amplitude_um (empty/null where not part of the claim), note).
 Report claims_report(const std::vector<Claim>& claims);
 

@@ -86,6 +86,8 @@ ReproduceResult run_reproduce(const Model& m, const ReproduceOptions& o,
     }
   }
   r.claims = score_claims(r, o.claims ? *o.claims : builtin_claims());
+  mark_fitted(r.claims, m.spec);
+  r.trends = trend_checks(r.claims);
   next();
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
@@ -107,6 +109,7 @@ Report claims_report(const std::vector<Claim>& claims) {
                "tolerance",
                "result",
                "pass",
+               "fitted",
                "temperature_C",
                "reference_temperature_C",
                "current_pp_A",
@@ -117,7 +120,7 @@ Report claims_report(const std::vector<Claim>& claims) {
     const ClaimCondition& k = c.condition;
     t.rows.push_back({c.id, c.claim, c.source, c.kind, c.paper, c.ours, c.unit, c.rel_diff(),
                       c.tolerance, std::string(!c.applicable ? "n/a" : (c.pass ? "pass" : "fail")),
-                      c.pass, k.temperature_C, k.reference_temperature_C, k.current_pp_A,
+                      c.pass, c.fitted, k.temperature_C, k.reference_temperature_C, k.current_pp_A,
                       k.frequency_Hz, k.amplitude_um, c.note});
   }
   rep.tables.push_back(std::move(t));
@@ -129,8 +132,86 @@ ClaimCount count_claims(const std::vector<Claim>& claims) {
   for (const auto& c : claims) {
     n.applicable += c.applicable;
     n.pass += c.pass;
+    if (!c.applicable) continue;
+    (c.fitted ? n.fitted : n.predicted) += 1;
+    (c.fitted ? n.fitted_pass : n.predicted_pass) += c.pass;
   }
   return n;
+}
+
+std::string fitted_predicted_line(const ClaimCount& n) {
+  return fmt::format("claims: {} of {} fitted pass; {} of {} predicted pass", n.fitted_pass,
+                     n.fitted, n.predicted_pass, n.predicted);
+}
+
+void mark_fitted(std::vector<Claim>& claims, const ModelSpec& spec) {
+  for (const auto& id : spec.fitted_claims) {
+    const auto it =
+        std::find_if(claims.begin(), claims.end(), [&](const Claim& c) { return c.id == id; });
+    if (it == claims.end())
+      throw InputError(fmt::format(
+          "{}:{}: calibration.fitted_claims: '{}' is not a claim of the claims scored", spec.source,
+          spec.line_of("calibration.fitted_claims"), id));
+    it->fitted = true;
+  }
+}
+
+namespace {
+
+double slope(const std::vector<double>& x, const std::vector<double>& y) {
+  const double n = static_cast<double>(x.size());
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    sx += x[i];
+    sy += y[i];
+    sxx += x[i] * x[i];
+    sxy += x[i] * y[i];
+  }
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+int sign_of(double v) { return v > 0 ? 1 : (v < 0 ? -1 : 0); }
+
+}  // namespace
+
+std::vector<TrendCheck> trend_checks(const std::vector<Claim>& claims) {
+  std::vector<TrendCheck> out;
+  for (const char* kind : {"stroke_drop_pct", "hysteresis_drop_pct", "flux_drop_pct"}) {
+    TrendCheck t;
+    t.kind = kind;
+    for (const auto& c : claims) {
+      if (c.kind != kind || !c.applicable || !std::isfinite(c.condition.current_pp_A)) continue;
+      if (t.what.empty()) t.what = c.claim.substr(0, c.claim.find(','));
+      t.currents_pp_A.push_back(c.condition.current_pp_A);
+      t.paper.push_back(c.paper);
+      t.ours.push_back(c.ours);
+    }
+    if (t.currents_pp_A.size() < 2) continue;
+    t.paper_slope = slope(t.currents_pp_A, t.paper);
+    t.ours_slope = slope(t.currents_pp_A, t.ours);
+    t.pass = std::isfinite(t.ours_slope) && sign_of(t.paper_slope) == sign_of(t.ours_slope);
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
+std::string trends_markdown(const std::vector<TrendCheck>& trends) {
+  if (trends.empty()) return "";
+  std::string md =
+      "\n### Trends across current (beside the claims, not counted)\n\n"
+      "The sign of the least-squares slope against current of the paper's four values and of "
+      "ours.\n\n| trend | currents (A) | paper | ours | paper slope | our slope | result |\n"
+      "|---|---|---|---|---|---|---|\n";
+  auto list = [](const std::vector<double>& v) {
+    std::string s;
+    for (double x : v) s += (s.empty() ? "" : " / ") + fmt::format("{:.3g}", x);
+    return s;
+  };
+  for (const auto& t : trends)
+    md += fmt::format("| {} | {} | {} | {} | {:+.3g} /A | {:+.3g} /A | {} |\n", t.what,
+                      list(t.currents_pp_A), list(t.paper), list(t.ours), t.paper_slope,
+                      t.ours_slope, t.pass ? "PASS" : "FAIL");
+  return md;
 }
 
 namespace {
@@ -150,20 +231,25 @@ std::string md_cell(std::string s) {
 
 std::string claims_markdown(const std::vector<Claim>& claims) {
   std::string md =
-      "| # | claim | source | paper | ours | unit | rel. diff | tolerance | result | note |\n"
-      "|---|---|---|---|---|---|---|---|---|---|\n";
+      "| # | claim | source | paper | ours | unit | rel. diff | tolerance | fitted / predicted | "
+      "result | note |\n"
+      "|---|---|---|---|---|---|---|---|---|---|---|\n";
   int n = 0;
   for (const auto& c : claims) {
     const double rd = c.rel_diff();
-    md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", ++n,
+    md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", ++n,
                       md_cell(c.claim), md_cell(c.source), md_number(c.paper), md_number(c.ours),
                       c.unit, std::isfinite(rd) ? fmt::format("{:+.1f} %", 100 * rd) : "-",
-                      md_cell(c.tolerance), !c.applicable ? "n/a" : (c.pass ? "PASS" : "FAIL"),
-                      md_cell(c.note));
+                      md_cell(c.tolerance),
+                      !c.applicable ? "-" : (c.fitted ? "fitted" : "predicted"),
+                      !c.applicable ? "n/a" : (c.pass ? "PASS" : "FAIL"), md_cell(c.note));
   }
   const ClaimCount k = count_claims(claims);
-  md += fmt::format("\n**{} of {} applicable claims pass** ({} claims, {} not applicable).\n",
-                    k.pass, k.applicable, n, n - k.applicable);
+  md += fmt::format(
+      "\n**{} of {} applicable claims pass** ({} claims, {} not applicable): **{}**. A fitted "
+      "claim is a target of the model's calibration (or set by a chosen constant); only the "
+      "predicted ones test the model.\n",
+      k.pass, k.applicable, n, n - k.applicable, fitted_predicted_line(k));
   return md;
 }
 

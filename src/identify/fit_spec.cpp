@@ -39,6 +39,7 @@ constexpr KindName kKinds[] = {
     {TargetKind::ResonanceHz, "resonance_Hz", false, false},
     {TargetKind::FrfPeakHz, "frf_peak_Hz", false, false},
     {TargetKind::BandwidthHz, "bandwidth_Hz", false, false},
+    {TargetKind::ModulusGPa, "modulus_GPa", false, false},
 };
 
 std::string kind_list() {
@@ -316,7 +317,30 @@ FitTarget read_target(const toml::table& t, const std::string& src, const Claims
                                            g.current_pp_A, g.frequency_Hz)
                              : fmt::format("{} {:g}C {:g}A", kn.name, g.temperature_C, g.bias_A));
   if (from && !label) g.label = fmt::format("{} ({})", claim_id, g.label);
+  g.claim = claim_id;
   return g;
+}
+
+// [[by_construction]]: a claim a chosen constant sets, with the reason.
+std::pair<std::string, std::string> read_by_construction(const toml::table& t,
+                                                         const std::string& src,
+                                                         const ClaimsData& claims) {
+  check_keys(t, {"claim", "reason"}, "[[by_construction]]", src);
+  const long line = line_of(t);
+  const auto id = t["claim"].value<std::string>();
+  const auto reason = t["reason"].value<std::string>();
+  if (!id || id->empty())
+    throw InputError(located(src, line, "[[by_construction]]: claim = \"<id>\" is required"));
+  if (!reason || reason->empty())
+    throw InputError(located(
+        src, line, fmt::format("[[by_construction]] claim '{}': reason = \"...\" is required "
+                               "(which constant sets it, and how)",
+                               *id)));
+  if (!claims.find(*id))
+    throw InputError(located(src, line,
+                             fmt::format("[[by_construction]]: unknown claim '{}' (not in {})",
+                                         *id, claims.source)));
+  return {*id, *reason};
 }
 
 bool parse_double(std::string_view s, double& v) {
@@ -377,7 +401,8 @@ FitSpec parse_fit_spec(const std::string& toml_text, const std::string& source_n
   const toml::table root = io_detail::parse_toml(toml_text, source_name);
   FitSpec spec;
   spec.source = source_name;
-  check_keys(root, {"claims", "parameter", "target"}, "the fit spec", source_name);
+  check_keys(root, {"claims", "parameter", "target", "by_construction"}, "the fit spec",
+             source_name);
   // `claims = "file"` (relative to the spec): the claims `[[target]] claim = "<id>"` refers
   // to, instead of the built-in data/claims.toml.
   std::optional<ClaimsData> own_claims;
@@ -411,9 +436,22 @@ FitSpec parse_fit_spec(const std::string& toml_text, const std::string& source_n
     spec.parameters.push_back(read_parameter(*t, source_name));
   for (const auto* t : tables("target"))
     spec.targets.push_back(read_target(*t, source_name, claims));
+  for (const auto* t : tables("by_construction"))
+    spec.by_construction.push_back(
+        read_by_construction(*t, source_name, claims ? *claims : builtin_claims()));
   if (spec.parameters.empty())
     throw InputError(located(source_name, 1, "no [[parameter]] to fit: name at least one"));
   return spec;
+}
+
+std::vector<std::string> fitted_claims(const FitSpec& spec) {
+  std::vector<std::string> ids;
+  auto add = [&](const std::string& id) {
+    if (!id.empty() && std::find(ids.begin(), ids.end(), id) == ids.end()) ids.push_back(id);
+  };
+  for (const auto& t : spec.targets) add(t.claim);
+  for (const auto& [id, reason] : spec.by_construction) add(id);
+  return ids;
 }
 
 FitSpec load_fit_spec(const std::string& file_or_inline) {

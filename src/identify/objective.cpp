@@ -177,7 +177,7 @@ void add_targets(Objective::Impl& I, const Model& start_model, double& W) {
       }
     }
     if (t.kind == TargetKind::ResonanceHz || t.kind == TargetKind::FrfPeakHz ||
-        t.kind == TargetKind::BandwidthHz) {
+        t.kind == TargetKind::BandwidthHz || t.kind == TargetKind::ModulusGPa) {
       const ResonanceRun rr{t.temperature_C, t.bias_A, t.kind};
       const auto it = std::find(I.res_runs.begin(), I.res_runs.end(), rr);
       td.res_run = static_cast<int>(it - I.res_runs.begin());

@@ -173,6 +173,7 @@ struct Objective::Impl {
       case TargetKind::ResonanceHz:
       case TargetKind::FrfPeakHz:
       case TargetKind::BandwidthHz:
+      case TargetKind::ModulusGPa:
         return res[static_cast<std::size_t>(td.res_run)];
     }
     return 0.0;

@@ -71,6 +71,13 @@ SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings
 }
 
 double lowest_resonance_Hz(const Model& m, const ResonanceRun& run) {
+  if (run.kind == TargetKind::ModulusGPa) {  // eq. (13) at rest, mean over the rods
+    const Conditions c = make_conditions(m, run.T);
+    const State st = make_state(m, c, run.bias);
+    double E = 0.0;
+    for (const auto& r : st.rods) E += r.E_Pa;
+    return E / static_cast<double>(st.rods.size()) * 1e-9;
+  }
   if (run.kind != TargetKind::ResonanceHz) {  // the small-signal frequency response (Fig. 15)
     FrfRequest r;
     r.temperatures_C = {run.T};

@@ -56,9 +56,10 @@ SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings
 // bandwidth_Hz (the small-signal frequency response of Fig. 15) target.
 struct ResonanceRun {
   double T, bias;
-  TargetKind kind;  // ResonanceHz, FrfPeakHz or BandwidthHz
+  TargetKind kind;  // ResonanceHz, FrfPeakHz, BandwidthHz or ModulusGPa (at rest, no sine)
   bool operator==(const ResonanceRun&) const = default;
 };
+// The value of a target computed at rest or from the small-signal response (no sine run).
 double lowest_resonance_Hz(const Model& m, const ResonanceRun& run);
 
 }  // namespace gmasim::identify_detail

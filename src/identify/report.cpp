@@ -313,8 +313,21 @@ std::string fitted_model_toml(const std::string& start_text, const ModelSpec& st
                       p.report_dir.empty() ? "" : fmt::format("; report: {}", p.report_dir));
   head += "# Fitted values carry an 'identified:' provenance comment.\n#\n";
   std::string text = head;
-  for (std::size_t i = earlier_run_header_lines(lines); i < lines.size(); ++i)
-    text += lines[i] + "\n";
+  bool in_calibration = false;  // the start's [calibration] table is replaced by this fit's
+  for (std::size_t i = earlier_run_header_lines(lines); i < lines.size(); ++i) {
+    const std::string& l = lines[i];
+    if (l.starts_with("[")) in_calibration = l.starts_with("[calibration]");
+    if (!in_calibration) text += l + "\n";
+  }
+  if (!p.fitted_claims.empty()) {
+    text +=
+        "\n[calibration]  # the claims this model was fitted to (gmasim identify: the fit spec's "
+        "claim targets and [[by_construction]] claims); gmasim reproduce counts every other "
+        "claim as a prediction\nfitted_claims = [";
+    for (std::size_t k = 0; k < p.fitted_claims.size(); ++k)
+      text += fmt::format("{}\"{}\"", k == 0 ? "" : ", ", p.fitted_claims[k]);
+    text += "]\n";
+  }
 
   // The file must load and carry exactly the fitted values.
   const ModelSpec check = parse_model_spec(text, "fitted model");

@@ -91,6 +91,7 @@ class ModelLoader {
                           const std::optional<std::vector<std::string>>& reluctances);
   void read_nodes(const toml::table& circuit, long circuit_line);
   void read_sensor(const toml::table& root);
+  void read_calibration(const toml::table& root);
   void read_mechanics(const toml::table& root);
   bool read_members(const toml::table& mech, long mech_line, std::string_view key, Group g,
                     std::vector<std::string>& names);

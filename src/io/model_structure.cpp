@@ -30,6 +30,7 @@ void ModelLoader::read_root(const toml::table& root) {
   read_rods(root);
   read_circuit(root);
   read_sensor(root);
+  read_calibration(root);
   read_mechanics(root);
   read_group_table(root, Group::ThermalExpansion, 1);
   read_group_table(root, Group::ThermalNetwork, 1);
@@ -296,6 +297,29 @@ void ModelLoader::read_sensor(const toml::table& root) {
                                   "[[circuit.branches]])",
                                   b.name));
     spec_.flux_sensor_branches.push_back(b.name);
+  }
+}
+
+// ---- calibration ----------------------------------------------------------------------
+
+// Optional: the claims (data/claims.toml ids) the model was fitted to; `gmasim reproduce`
+// counts every other claim as a prediction. Written by `gmasim identify` (its fit spec's claim
+// targets and [[by_construction]] claims); the ids are checked against the claims when scored.
+void ModelLoader::read_calibration(const toml::table& root) {
+  if (!root.get("calibration")) return;  // optional: an uncalibrated model predicts every claim
+  const auto* t = table_at(root, "calibration", "calibration", 1);
+  if (!t) return;
+  check_keys(*t, "[calibration]", {"fitted_claims"});
+  const auto* node = required(*t, "fitted_claims", "calibration", node_line(*t));
+  if (!node) return;
+  auto list = string_array(*node, "calibration.fitted_claims");
+  if (!list) return;
+  spec_.option_lines["calibration.fitted_claims"] = node_line(*node);
+  std::set<std::string> seen;
+  for (const auto& c : *list) {
+    if (!seen.insert(c.name).second)
+      problem(c.line, fmt::format("calibration.fitted_claims: claim '{}' is listed twice", c.name));
+    spec_.fitted_claims.push_back(c.name);
   }
 }
 

@@ -21,8 +21,8 @@ namespace schema {
 namespace {
 
 // The tables of a model file that hold structure; the others are the parameter groups'.
-constexpr std::string_view kStructureTables[] = {"meta",    "options", "stack",
-                                                 "circuit", "sensor",  "mechanics"};
+constexpr std::string_view kStructureTables[] = {"meta",   "options",   "stack",      "circuit",
+                                                 "sensor", "mechanics", "calibration"};
 
 // The table part of a dotted name ("rod1.ja" of "rod1.ja.k0_A_per_m").
 std::string table_of(const std::string& dotted) {
