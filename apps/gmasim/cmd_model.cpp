@@ -47,7 +47,7 @@ int run_params(bool markdown) {
   return 0;
 }
 
-int run_check(ModelArgs args, const std::string& file) {
+int run_check(ModelArgs args, const std::string& file, bool dt_table) {
   if (!file.empty()) {
     if (!args.path.empty() && args.path != file)
       throw InputError(fmt::format("model check: the file '{}' and --model '{}' name two models; "
@@ -56,6 +56,10 @@ int run_check(ModelArgs args, const std::string& file) {
     args.path = file;
   }
   const std::string path = model_label(args);
+  if (dt_table) {  // docs/model.md, "Time step" (its test compares the page with this output)
+    fmt::print("{}", time_step_table_markdown(load_model_args(args)));
+    return 0;
+  }
   try {
     const Model m = load_model_args(args);
     (void)make_conditions(m, m.T_ref_C);
@@ -127,6 +131,10 @@ Runner add_model(CLI::App& app) {
       "20/70/150 degC x 6/12 A x 10/400 Hz: flux densities, consistency and the energy ledgers");
   check->add_option("file", *check_path, "Model file (TOML); same as --model");
   add_model_options(check, *check_model);
+  auto dt_table = std::make_shared<bool>(false);
+  check->add_flag("--dt-table", *dt_table,
+                  "Print only the time-step table of docs/model.md (convergence as dt halves, "
+                  "observed order, the eddy field's ringing threshold), as Markdown");
   return [=]() -> int {
     if (show->parsed()) return run_show(*show_model, *show_doc);
     if (params->parsed()) return run_params(*params_markdown);
@@ -137,7 +145,7 @@ Runner add_model(CLI::App& app) {
                  save_model_args->sets.size(), save_model_args->sets.size() == 1 ? "" : "s");
       return 0;
     }
-    if (check->parsed()) return run_check(*check_model, *check_path);
+    if (check->parsed()) return run_check(*check_model, *check_path, *dt_table);
     return -1;
   };
 }

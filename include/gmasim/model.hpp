@@ -164,6 +164,7 @@ struct RodModel {
   std::string name;
   double length_m, outer_diameter_m, inner_diameter_m, mass_kg;  // at T_ref
   double k_f, k_j;           // eq. (7) flux-leakage and eddy-current factors
+  double joint_gap_m;        // consistent reading: equivalent air gap of the rod's joints
   double damping_N_s_per_m;  // c_i of eq. (25)
   JaReference ja;
 };
@@ -171,7 +172,6 @@ struct RodModel {
 struct Material {  // Terfenol-D, shared by the rods
   double Ms_A_per_m, lambda_s, sigma_lambda_Pa, Es_Pa, Tc_C, rho0_ohm_m, drho_dT_ohm_m_per_K;
   double beta_per_K, chi_m, x_exponent, alpha_thermal_per_K;
-  double kf_reference_mu_r;  // mu_r of the series reluctance (physics::series_reluctance)
 };
 
 struct ChainElementModel {  // a magnetizer, output rod or disk spring: constant m, k, c
@@ -269,11 +269,9 @@ struct RodConditions {
   double sigma_Pa;                 // signed prestress used in eq. (3), (6), (13)
   double sigma_p_Pa;               // compressive prestress magnitude of eq. (11)
   double k_f, k_j;
-  // Consistent magnetic state: the lossless series reluctance that carries the MMF Table 4's
-  // k_f assigns to the rod branch outside the Terfenol-D (joints of the short rods, magnetizer
-  // interfaces, leakage paths: air, epoxy, iron), (k_f - 1) l^T / (mu0 (1 + chi_m) A^T): at the
-  // initial permeability mu0 (1 + chi_m) of eq. (3)/(5) the rod then sees the field H_c =
-  // U / (k_f l) of eq. (7) (docs/model.md, "The magnetic state"). 0 in the printed reading.
+  // Consistent magnetic state: the lossless reluctance of the rod's joints in series with the
+  // Terfenol-D, g / (mu0 A^T) (physics::joint_reluctance; docs/model.md, "The magnetic
+  // state"). 0 in the printed reading.
   double series_reluctance_per_H;
   double mass_osc_kg;               // eq. (24) + (27)
   double momentum_mass_kg;          // m/2 + m_lr (eq. 27): the stack's momentum per unit x

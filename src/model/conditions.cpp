@@ -173,7 +173,7 @@ void rod_material(const Model& m, const RodModel& rod, const Conditions& c, cons
   rc.eddy_geometry_s_m_per_H =
       eddy_time_constant(1.0, rc.r_outer_m, rc.r_inner_m, rod.k_j, rc.rho_ohm_m);
   rc.series_reluctance_per_H = m.options.magnetic_state == MagneticState::Consistent
-                                   ? series_reluctance(rod.k_f, rc.length_m, mat.kf_reference_mu_r, rc.area_m2)
+                                   ? joint_reluctance(rod.joint_gap_m, rc.area_m2)
                                    : 0.0;
 }
 

@@ -142,11 +142,6 @@ const ParamDef kParams[] = {
      LAND(in_material, Material, chi_m)},
     {G::Material, "x", "-", R::Positive, "critical exponent x of M_s^T, eq. (4)",
      LAND(in_material, Material, x_exponent)},
-    {G::Material, "kf_reference_mu_r", "-", R::Positive,
-     "relative permeability at which Table 4's k_f split a rod branch's MMF: the consistent "
-     "reading's series reluctance (k_f - 1) l / (mu0 mu_r A), eq. (7)",
-     LAND(in_material, Material, kf_reference_mu_r), 20.84,
-     "default: 1 + chi_m of Table 5, eq. (3)'s permeability at M = 0"},
     {G::Material, "alpha_thermal_per_K", "1/K", R::NonNegative,
      "thermal expansion coefficient of the rods, eq. (21) and l^T, A^T",
      LAND(in_material, Material, alpha_thermal_per_K)},
@@ -178,6 +173,10 @@ const ParamDef kParams[] = {
      LAND(in_rod, RodModel, k_f)},
     {G::Rod, "k_j", "-", R::Positive, "eddy-current factor k_j of eq. (7)",
      LAND(in_rod, RodModel, k_j)},
+    {G::Rod, "joint_gap_m", "m", R::NonNegative,
+     "consistent reading: the equivalent air gap of the rod's joints (between its short rods and "
+     "against the magnetizers), a lossless series reluctance g / (mu0 A) in its branch",
+     LAND(in_rod, RodModel, joint_gap_m), 0.0, "default: no joints (one solid rod)"},
     {G::Rod, "damping_N_s_per_m", "N s/m", R::Positive, "damping c_i, eq. (25)",
      LAND(in_rod, RodModel, damping_N_s_per_m)},
     // [<rod>.ja]

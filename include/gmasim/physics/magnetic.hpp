@@ -92,17 +92,15 @@ inline double static_field(double phi_Wb, double k_f, double mu_H_per_m, double 
   return phi_Wb / (k_f * mu_H_per_m * area_m2);
 }
 
-// Eq. (7), first line, consistent reading (docs/model.md, "The magnetic state"): the printed
-// H_c = phi/(k_f mu A) gives the Terfenol-D 1/k_f of the MMF U = phi l/(mu A) across the rod
-// branch. The rest, (k_f - 1)/k_f of it, drops outside the Terfenol-D (joints between the short
-// rods, magnetizer interfaces, leakage paths): a lossless, linear series reluctance that takes
-// the same share of it when the rod's relative permeability is mu_r (a model constant: eq. (3)
-// spans mu_r = 1 + chi_m = 20.8 at M = 0 down to a few near saturation):
-//   R_s = (k_f - 1) l / (mu0 mu_r A)      [1/H]
-// so that U = l H_c + R_s phi and, for a linear rod of that permeability, H_c = U/(k_f l).
-inline double series_reluctance(double k_f, double length_m, double mu_r, double area_m2) {
-  return (k_f - 1.0) * length_m / (kMu0 * mu_r * area_m2);
-}
+// Eq. (7), first line, consistent reading (docs/model.md, "The magnetic state"): the MMF across
+// a rod branch that does not drop across the Terfenol-D drops across its joints (between its
+// short rods, and against the magnetizers): air or epoxy gaps of total equivalent length g, a
+// lossless, linear series reluctance
+//   R_s = g / (mu0 A)      [1/H]
+// so that U = l H_c + R_s phi. (The printed reading's k_f, which divides the field by 3.8-12.3,
+// would need gaps of millimetres to centimetres: it compensated eq. (3)'s permeability in the
+// printed circuit and has no place here.)
+inline double joint_reluctance(double gap_m, double area_m2) { return gap_m / (kMu0 * area_m2); }
 
 // Eq. (7), second line: time constant of the first-order eddy-current lag [s].
 //   H(s) = H_c(s) / (1 + tau s),  tau = mu (r1^2 - r2^2) / (4 k_j rho)
