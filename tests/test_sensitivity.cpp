@@ -208,7 +208,9 @@ TEST(Identifiability, FindsTheProductPair) {
   EXPECT_EQ(id.rank, 2);
   const Direction& d = id.directions[2];
   EXPECT_TRUE(d.near_null);
+  EXPECT_TRUE(d.weak);  // below one tolerance per unit
   EXPECT_FALSE(id.directions[1].near_null);
+  EXPECT_FALSE(id.directions[1].weak);  // ~2 tolerances per unit
   EXPECT_NEAR(std::fabs(d.components[0]), std::sqrt(0.5), 1e-12);
   EXPECT_NEAR(d.components[0], -d.components[1], 1e-12);
   EXPECT_NEAR(d.components[2], 0.0, 1e-12);

@@ -134,13 +134,19 @@ void print_identifiability(const SensitivityResult& r, std::FILE* f) {
              "\n  identifiability: {} quantities with a scale, {} parameters; rank {} (singular "
              "values above the near-null ratio), condition {:.3g}\n",
              id.quantities.size(), r.parameters.size(), id.rank, id.condition);
+  int weak = 0;
+  for (const auto& d : id.directions) weak += d.weak ? 1 : 0;
+  fmt::print(f,
+             "    {} weak directions (singular value < 1: a factor e along them moves the "
+             "quantities by less than one tolerance)\n",
+             weak);
   for (std::size_t k = 0; k < id.directions.size(); ++k) {
     const Direction& d = id.directions[k];
     const bool smallest = k + 3 >= id.directions.size();
-    if (!d.near_null && !smallest) continue;
-    fmt::print(f, "    {} sigma {:.3g} ({:.2g} of the largest): {}\n",
-               d.near_null ? "near-null" : "small    ", d.singular_value, d.ratio,
-               direction_text(d, r.parameters));
+    if (!d.near_null && !d.weak && !smallest) continue;
+    fmt::print(f, "    {:<9} sigma {:.3g} ({:.2g} of the largest): {}\n",
+               d.near_null ? "near-null" : (d.weak ? "weak" : "smallest"), d.singular_value,
+               d.ratio, direction_text(d, r.parameters));
   }
   for (std::size_t j = 0; j < id.correlation.size(); ++j)
     for (std::size_t k = j + 1; k < id.correlation.size(); ++k)

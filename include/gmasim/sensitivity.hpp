@@ -154,10 +154,13 @@ struct SensitivityEntry {
   std::string message;  // why it is flagged (the refused step's message, ...)
 };
 
-struct Direction {                 // a right singular vector of the scaled Jacobian
-  double singular_value = 0;       // change of the quantities [tolerances] per unit step along it
-  double ratio = 0;                // singular_value / the largest
-  bool near_null = false;          // ratio < near_null_ratio
+struct Direction {            // a right singular vector of the scaled Jacobian
+  double singular_value = 0;  // change of the quantities [tolerances] per unit step along it
+  double ratio = 0;           // singular_value / the largest
+  bool near_null = false;     // ratio < near_null_ratio
+  // singular_value < 1: a change of the parameters by a factor e along it moves the
+  // quantities (root-sum-square) by less than one tolerance; the claims do not pin it down
+  bool weak = false;
   std::vector<double> components;  // per parameter, unit norm, the largest positive
 };
 

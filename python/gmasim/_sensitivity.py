@@ -82,7 +82,8 @@ def sensitivity(model, params: Sequence | str | None = None, claims: Iterable[st
         ``disagreement`` : (Q, P) |scaled - scaled_small| / max(|.|)
         ``flags`` : (Q, P) str: "ok", "disagree", "nonfinite", "step_refused"
         ``identifiability`` : dict: ``jacobian`` (per tolerance), ``singular_values``,
-            ``directions`` (rows: unit vectors over the parameters), ``near_null``,
+            ``directions`` (rows: unit vectors over the parameters), ``near_null`` (below
+            near_null_ratio of the largest), ``weak`` (singular value < 1 tolerance per unit),
             ``combinations`` (text), ``correlation`` (P, P), ``std_dev``, ``rank``,
             ``condition``, ``quantities`` (rows used), ``excluded``
         ``evaluations``, ``threads``, ``wall_time_s``
@@ -102,4 +103,5 @@ def sensitivity(model, params: Sequence | str | None = None, claims: Iterable[st
     ident["directions"] = np.array(ident["directions"], dtype=float).reshape(-1, n)
     ident["correlation"] = np.array(ident["correlation"], dtype=float).reshape(n, n)
     ident["near_null"] = np.array(ident["near_null"], dtype=bool)
+    ident["weak"] = np.array(ident["weak"], dtype=bool)
     return r

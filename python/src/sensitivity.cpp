@@ -28,17 +28,19 @@ py::dict identifiability_dict(const SensitivityResult& r) {
   d["column_norm"] = to_numpy(id.column_norm);
   std::vector<double> s;
   std::vector<std::vector<double>> v;
-  std::vector<bool> near;
+  std::vector<bool> near, weak;
   std::vector<std::string> text;
   for (const auto& dir : id.directions) {
     s.push_back(dir.singular_value);
     v.push_back(dir.components);
     near.push_back(dir.near_null);
+    weak.push_back(dir.weak);
     text.push_back(direction_text(dir, r.parameters));
   }
   d["singular_values"] = to_numpy(s);
   d["directions"] = matrix(v);
   d["near_null"] = near;
+  d["weak"] = weak;
   d["combinations"] = text;
   d["correlation"] = matrix(id.correlation);
   d["std_dev"] = to_numpy(id.std_dev);

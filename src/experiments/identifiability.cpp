@@ -53,6 +53,7 @@ std::vector<Direction> directions_of(const Eigen::MatrixXd& J, double ratio) {
     dir.singular_value = d.s(k);
     dir.ratio = smax > 0 ? d.s(k) / smax : 0.0;
     dir.near_null = dir.ratio < ratio;
+    dir.weak = d.s(k) < 1.0;
     Eigen::VectorXd v = d.V.col(k);
     Eigen::Index big = 0;
     v.cwiseAbs().maxCoeff(&big);

@@ -192,7 +192,7 @@ std::string identifiability_json(const SensitivityResult& r, const std::string& 
   for (const auto& d : id.directions) {
     w.begin_object(JsonLayout::Inline);
     w.key("singular_value").number(d.singular_value).key("ratio").number(d.ratio);
-    w.key("near_null").boolean(d.near_null);
+    w.key("near_null").boolean(d.near_null).key("weak").boolean(d.weak);
     w.key("combination").string(direction_text(d, r.parameters));
     w.key("components").begin_array();
     for (double c : d.components) w.number(c);
