@@ -24,7 +24,8 @@ VALUE        the number as the paragraph shows it; it (or the same digits withou
              check cannot drift apart.
 TOLERANCE    `+- 0.05` (absolute) or `+- 2%` (relative to VALUE); default: half a unit in the
              last digit of VALUE (the quote is the result rounded as written).
-`~=` may also be written `≈` or `==`, `+-` also `±`. The comment may span lines.
+`~=` may also be written `≈` or `==`, `+-` also `±`. The comment may span lines. A marker
+inside a code block or an inline code span is an example, not a check.
 
 Each distinct command runs once per invocation. Exit status: 0 every check holds, 1 a check
 failed (each failure printed as file:line: what, the number found and the one quoted), 2 a
@@ -116,10 +117,21 @@ def parse_marker(body: str, file: pathlib.Path, line: int, paragraph: str) -> Ch
     return Check(file, line, command, file_part, pointer, value_text, tol, paragraph)
 
 
+FENCE = re.compile(r"^(```|~~~).*?^\1[^\n]*$", re.S | re.M)
+CODE_SPAN = re.compile(r"(`+)(?!`).*?(?<!`)\1(?!`)", re.S)
+
+
+def without_code(text: str) -> str:
+    """The text with fenced code blocks and inline code spans blanked (newlines kept): a
+    marker shown as an example in code is not a check."""
+    blank = lambda m: re.sub(r"[^\n]", " ", m.group(0))  # noqa: E731
+    return CODE_SPAN.sub(blank, FENCE.sub(blank, text))
+
+
 def parse_file(path: pathlib.Path) -> list[Check]:
     text = path.read_text(encoding="utf-8")
     checks = []
-    for m in MARKER.finditer(text):
+    for m in MARKER.finditer(without_code(text)):
         line = text.count("\n", 0, m.start()) + 1
         checks.append(parse_marker(m.group(1), path, line, paragraph_at(text, m.start())))
     return checks

@@ -40,6 +40,16 @@ def test_quote_must_be_a_whole_number_of_the_text():
     assert not cq.quoted_in("the value 0.415", "0.41")
 
 
+def test_markers_in_code_are_examples(tmp_path):
+    page = tmp_path / "p.md"
+    page.write_text("Use `<!-- check: gmasim x | /a ~= 1 -->` like this.\n\n```\n"
+                    "<!-- check: gmasim y | /b ~= 2 -->\n```\n\nIt is 3.\n"
+                    "<!-- check: gmasim z | /c ~= 3 -->\n")
+    checks = cq.parse_file(page)
+    assert [c.command for c in checks] == [["gmasim", "z"]]
+    assert checks[0].line == 8
+
+
 def test_marker_syntax_errors(tmp_path):
     with pytest.raises(cq.MarkerError, match="must start with 'gmasim'"):
         cq.parse_marker("rm -rf / | /x ~= 1", tmp_path, 1, "1")

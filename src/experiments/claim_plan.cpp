@@ -216,18 +216,19 @@ ClaimPlan plan_claims(const ClaimsData& claims, bool quick, std::vector<MetricQu
     plan_parts(n, p);
   }
   plan_metrics(p);
-  // The most expensive first (measured, one thread: a tracking part ~0.8 s, the ablation
-  // ~0.5 s, the 20-150 degC runs ~0.4 s, an FRF curve ~0.1 s, a sweep point ~0.05 s).
+  // The most expensive first (measured per model on one core, all claims: the tracking runs
+  // 0.6 s, the ablation 0.5 s, the 20-150 degC runs 0.4 s, the sweeps 0.4 s in all (0.05-0.1
+  // s each), a metric run 0.05 s, the small-signal FRF 0.03 s).
   if (p.full) p.units.push_back({UnitKind::Full});
   if (p.track) p.units.push_back({UnitKind::Track});
   if (p.ablate) p.units.push_back({UnitKind::Ablate});
   if (p.params) p.units.push_back({UnitKind::Params});
-  if (p.frf) p.units.push_back({UnitKind::Frf});
   for (std::size_t k = 0; k < p.sweeps_10Hz.size(); ++k)
     p.units.push_back({UnitKind::Sweep10Hz, k});
   for (std::size_t k = 0; k < p.sweeps_dynamic.size(); ++k)
     p.units.push_back({UnitKind::SweepDynamic, k});
   for (std::size_t k = 0; k < p.metric_points.size(); ++k) p.units.push_back({UnitKind::Metric, k});
+  if (p.frf) p.units.push_back({UnitKind::Frf});
   if (!p.functions.empty()) p.units.push_back({UnitKind::Functions});
   return p;
 }
