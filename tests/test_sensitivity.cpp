@@ -163,6 +163,11 @@ TEST(Sensitivity, FlagsNonSmoothAndInvalidPoints) {
   EXPECT_EQ(s.entries[0][0].flag, EntryFlag::StepRefused);
   EXPECT_NE(s.entries[0][0].message.find("must be >= 0"), std::string::npos)
       << s.entries[0][0].message;
+  // Identifiability keeps the quantity; the parameter is a column no quantity sees.
+  EXPECT_EQ(s.identifiability.quantities.size(), 1u);
+  EXPECT_EQ(s.identifiability.column_norm[0], 0.0);
+  ASSERT_EQ(s.identifiability.excluded.size(), 1u);
+  EXPECT_NE(s.identifiability.excluded[0].find("rod3.inner_diameter_m"), std::string::npos);
 }
 
 // Simulated quantities (a claim from two sweep runs, a metric quantity): the two steps agree

@@ -286,14 +286,26 @@ SensitivityEntry entry(const SensitivityRequest& r, const ParameterInfo& p, cons
 }
 
 Identifiability identify_from(const SensitivityRequest& r, const SensitivityResult& res) {
-  std::vector<std::string> names;
+  std::vector<std::string> names, excluded;
   std::vector<double> scales;
   std::vector<std::vector<double>> rows;
-  std::vector<std::string> excluded;
+  // A parameter with no finite derivative at all (every stencil refused, ...) enters as a
+  // column of zeros (no quantity sees it) rather than removing every quantity.
+  const std::size_t np = res.parameters.size();
+  std::vector<bool> dead(np, true);
+  for (const auto& row : res.entries)
+    for (std::size_t j = 0; j < np; ++j) dead[j] = dead[j] && !std::isfinite(row[j].scaled_large);
+  for (std::size_t j = 0; j < np; ++j)
+    if (dead[j])
+      excluded.push_back(res.parameters[j].name + ": no finite derivative (a column of zeros)");
   for (std::size_t i = 0; i < res.quantities.size(); ++i) {
     const QuantityInfo& qi = res.quantities[i];
+    std::vector<double> row;
     bool finite = true;
-    for (const auto& en : res.entries[i]) finite = finite && std::isfinite(en.scaled_large);
+    for (std::size_t j = 0; j < np; ++j) {
+      row.push_back(dead[j] ? 0.0 : res.entries[i][j].scaled_large);
+      finite = finite && std::isfinite(row.back());
+    }
     if (!(std::isfinite(qi.scale) && qi.scale > 0.0)) {
       excluded.push_back(qi.name + ": no scale (" + qi.scale_source + ")");
     } else if (!finite) {
@@ -301,13 +313,10 @@ Identifiability identify_from(const SensitivityRequest& r, const SensitivityResu
     } else {
       names.push_back(qi.name);
       scales.push_back(qi.scale);
-      std::vector<double> row;
-      for (const auto& en : res.entries[i]) row.push_back(en.scaled_large);
       rows.push_back(std::move(row));
     }
   }
-  Identifiability id =
-      analyse_identifiability(names, scales, rows, res.parameters.size(), r.near_null_ratio);
+  Identifiability id = analyse_identifiability(names, scales, rows, np, r.near_null_ratio);
   id.excluded = std::move(excluded);
   return id;
 }
