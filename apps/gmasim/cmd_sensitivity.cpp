@@ -80,6 +80,8 @@ void check_flags(const SensitivityArgs& a) {
     throw InputError(fmt::format("--floor {}: must be in [0, 1)", r.floor_fraction));
   if (r.threads < 0 || r.threads > 4096)
     throw InputError(fmt::format("--threads {}: must be in [0, 4096] (0: all cores)", r.threads));
+  if (a.json == "-" && a.csv == "-")
+    throw InputError("--json - and --csv -: only one of them can go to standard output");
   if (a.plot && a.out.empty())
     throw InputError(
         "--plot draws into --out DIR: give --out (with --json/--csv alone no "

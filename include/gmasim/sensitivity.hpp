@@ -32,7 +32,8 @@ namespace gmasim {
 // taken at: the sweep points at their conditions (with their reference runs), the FRF's
 // small-signal curves at their temperatures (no stepped sine: no claim reads it), the
 // tracking, ablation and 20-150 degC runs they need, the thermal expansion. Every point is
-// the same run as in the full study, so the numbers are the same (tested). A claim whose
+// the same run as in the full study, so the numbers are the same (tested; a tracking claim's
+// note names the smallest error among the temperatures run). A claim whose
 // kind this planner does not know (a new extractor) makes it run the whole study.
 // Throws InputError for an unknown id.
 std::vector<Claim> run_claims(const Model& m, const ReproduceOptions& o,

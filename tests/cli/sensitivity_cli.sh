@@ -38,6 +38,7 @@ check "refused step" 0 "step_refused" $S --param rod3.inner_diameter_m:0.001 --c
 check "unknown param" 2 "unknown parameter 'nope'" $S --param nope --out "$T/c"
 check "unknown claim" 2 "unknown quantity 'nope'" $S --param material.Ms_A_per_m --claim nope --out "$T/c"
 check "no param" 2 "no parameter: give --param" $S --out "$T/c"
+check "one stdout" 2 "only one of them can go to standard output" $S --param material.Ms_A_per_m --json - --csv -
 check "plot needs out" 2 "--plot draws into --out DIR" $S --param material.Ms_A_per_m --json - --plot
 # No output over an input.
 cp "$ROOT/models/mdma.toml" "$T/m.toml"
