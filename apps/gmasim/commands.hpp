@@ -24,6 +24,7 @@ Runner add_ablate(CLI::App& app);   // cmd_ablate.cpp
 Runner add_params(CLI::App& app);   // cmd_params.cpp: params-vs-temperature
 Runner add_thermal(CLI::App& app);  // cmd_params.cpp: thermal
 Runner add_compensate(CLI::App& app);  // cmd_compensate.cpp
+Runner add_sensitivity(CLI::App& app);  // cmd_sensitivity.cpp
 
 // --model FILE and --set name=value (repeatable), on every command that runs a model.
 struct ModelArgs {

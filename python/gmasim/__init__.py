@@ -12,6 +12,8 @@ adds plotting helpers (``gmasim.plots``). Units are SI and named in every key
     gmasim.plots.sweep_vs_temperature(s["points"])
     st = gmasim.Stepper(m, temperature_C=20, dt_s=1e-5)  # sample by sample (docs/c_api.md)
     y_um = st.step(1.5)
+    s = gmasim.sensitivity(m, params=["material.Ms_A_per_m"], claims=["stroke_drop_8A"])
+    s["derivative"]   # (quantities x parameters): d claim / d ln parameter
 """
 from ._gmasim import *  # noqa: F401,F403
 from ._gmasim import (FREEZE_LAWS, DivergenceError, InputError, Model, Stepper, ablate, claims,  # noqa: F401
@@ -19,7 +21,9 @@ from ._gmasim import (FREEZE_LAWS, DivergenceError, InputError, Model, Stepper, 
                       thermal_expansion, track)
 from ._gmasim import __git_describe__, __version__  # noqa: F401
 from . import plots  # noqa: F401
+from ._sensitivity import fit_parameters, sensitivity  # noqa: F401
 
 __all__ = ["Model", "Stepper", "simulate", "sweep", "frf", "track", "compensate", "ablate",
            "params_vs_temperature", "parameter_table",
-           "thermal_expansion", "claims", "plots", "InputError", "DivergenceError", "FREEZE_LAWS"]
+           "thermal_expansion", "claims", "sensitivity", "fit_parameters", "plots", "InputError",
+           "DivergenceError", "FREEZE_LAWS"]

@@ -248,10 +248,41 @@ def params(out):
     return plots.params_vs_temperature(read_csv(pathlib.Path(out) / "params.csv"))
 
 
+def sensitivity(out):
+    """The heatmap of sensitivity.json (per tolerance; rows without one per 10 % of their
+    value) beside the correlations of identifiability.json."""
+    out = pathlib.Path(out)
+    doc = json.loads((out / "sensitivity.json").read_text())
+    params = [p["name"] for p in doc["parameters"]]
+    quants = [q["name"] for q in doc["quantities"]]
+    S = np.full((len(quants), len(params)), np.nan)
+    flags = np.full(S.shape, "ok", dtype=object)
+    relative = []
+    for i, q in enumerate(doc["quantities"]):
+        scale = q["scale"]
+        relative.append(scale is None)
+        if scale is None and q["value"] not in (None, 0):
+            scale = 0.1 * abs(q["value"])
+        for j, p in enumerate(params):
+            e = doc["entries"][q["name"]][p]
+            if e["scaled"] is not None and scale:
+                S[i, j] = e["scaled"] / scale
+            flags[i, j] = e["flag"]
+    ident = out / "identifiability.json"
+    corr = None
+    if ident.exists():
+        corr = np.array([[np.nan if v is None else v for v in row]
+                         for row in json.loads(ident.read_text())["correlation"]], dtype=float)
+    return plots.sensitivity_heatmap(quants, params, S, flags=flags, correlation=corr,
+                                     relative_rows=relative,
+                                     title=f"gmasim sensitivity: {doc.get('model', '')}")
+
+
 # A renderer returns the command's figure (saved as OUT/<command>.png|svg) or yields
 # (stem, figure) pairs (OUT/<stem>.png|svg), each saved and closed before the next is drawn.
 RENDERERS = {"simulate": simulate, "frf": bode_db, "sweep": sweep, "track": track,
-             "compensate": compensate, "ablate": ablate, "params": params, "identify": identify}
+             "compensate": compensate, "ablate": ablate, "params": params, "identify": identify,
+             "sensitivity": sensitivity}
 
 
 def render(command: str, out) -> list[pathlib.Path]:

@@ -364,3 +364,58 @@ def claims_overview(claims: Sequence[dict], title="The paper's claims: ours agai
     ax.grid(alpha=0.3, axis="x", which="both")
     fig.tight_layout()
     return fig
+
+
+def sensitivity_heatmap(quantities: Sequence[str], parameters: Sequence[str], per_tolerance,
+                        flags=None, correlation=None, relative_rows: Sequence[bool] | None = None,
+                        title="Sensitivity: d q / d ln p per tolerance"):
+    """Heatmap of ``per_tolerance[i, j]`` (quantity i, parameter j: the change of q, in units
+    of its tolerance, per unit relative change of the parameter) on a symmetric-log colour
+    scale; flagged entries (``flags[i, j] != "ok"``) crossed out. ``relative_rows`` marks rows
+    without a tolerance (ranking claims) normalised by 10 % of their value instead (label
+    ending in "*"). With ``correlation`` (P x P) a second panel shows the parameters'
+    correlations from identifiability."""
+    from matplotlib.colors import SymLogNorm
+
+    S = np.asarray(per_tolerance, dtype=float)
+    nq, npar = S.shape
+    panels = 2 if correlation is not None else 1
+    fig = plt.figure(figsize=(3.6 + 0.42 * npar * panels + 1.5 * (panels - 1), max(3.4, 2.0 + 0.2 * nq)))
+    ax = fig.add_subplot(1, panels, 1)
+    finite = S[np.isfinite(S)]
+    vmax = max(float(np.max(np.abs(finite))) if finite.size else 1.0, 1.0)
+    norm = SymLogNorm(linthresh=0.1, vmin=-vmax, vmax=vmax, base=10)
+    im = ax.imshow(np.ma.masked_invalid(S), cmap="RdBu_r", norm=norm, aspect="auto",
+                   interpolation="nearest")
+    labels = [q + ("*" if relative_rows is not None and relative_rows[i] else "")
+              for i, q in enumerate(quantities)]
+    ax.set_yticks(range(nq), labels, fontsize=6)
+    ax.set_xticks(range(npar), parameters, fontsize=6, rotation=60, ha="right")
+    if nq * npar <= 800:
+        for i in range(nq):
+            for j in range(npar):
+                if np.isfinite(S[i, j]) and abs(S[i, j]) >= 0.05:
+                    ax.text(j, i, f"{S[i, j]:.2g}", ha="center", va="center", fontsize=4.5,
+                            color="white" if abs(S[i, j]) > 0.3 * vmax else "black")
+    if flags is not None:
+        fl = np.asarray(flags)
+        for i, j in zip(*np.nonzero(fl != "ok")):
+            ax.plot([j - 0.45, j + 0.45], [i - 0.45, i + 0.45], color="black", lw=0.8)
+            ax.plot([j - 0.45, j + 0.45], [i + 0.45, i - 0.45], color="black", lw=0.8)
+    fig.colorbar(im, ax=ax, shrink=0.6, label="Δq per tolerance per unit ln p (or p/s)")
+    ax.set_title(title, fontsize=9)
+    if correlation is not None:
+        C = np.asarray(correlation, dtype=float)
+        ax2 = fig.add_subplot(1, panels, 2)
+        im2 = ax2.imshow(np.ma.masked_invalid(C), cmap="RdBu_r", vmin=-1, vmax=1,
+                         interpolation="nearest")
+        ax2.set_xticks(range(npar), parameters, fontsize=6, rotation=60, ha="right")
+        ax2.set_yticks(range(npar), parameters, fontsize=6)
+        for i in range(npar):
+            for j in range(npar):
+                if np.isfinite(C[i, j]) and i != j and abs(C[i, j]) >= 0.5:
+                    ax2.text(j, i, f"{C[i, j]:.2f}", ha="center", va="center", fontsize=5)
+        fig.colorbar(im2, ax=ax2, shrink=0.6, label="correlation")
+        ax2.set_title("Parameter correlations (from the claims' tolerances)", fontsize=9)
+    fig.tight_layout()
+    return fig

@@ -15,4 +15,5 @@ pybind11::dict metrics_dict(const Metrics& m);
 void bind_experiments(pybind11::module_& mod);  // experiments.cpp
 void bind_stepper(pybind11::module_& mod);      // stepper.cpp: Stepper, __version__
 void bind_parameters(pybind11::module_& mod);   // parameters.cpp: parameter_table()
+void bind_sensitivity(pybind11::module_& mod);  // sensitivity.cpp: _sensitivity
 }  // namespace gmasim::py_bind

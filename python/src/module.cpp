@@ -238,4 +238,5 @@ PYBIND11_MODULE(_gmasim, mod) {
   gmasim::py_bind::bind_experiments(mod);
   gmasim::py_bind::bind_stepper(mod);
   gmasim::py_bind::bind_parameters(mod);
+  gmasim::py_bind::bind_sensitivity(mod);
 }
