@@ -166,9 +166,9 @@ TEST(Identify, FrequencyResponseTargetsAreTheFrfCommandsNumbers) {
   // frf_peak_Hz and bandwidth_Hz are gmasim frf's first resonance and -3 dB point.
   const FitSpec fit = parse_fit_spec(R"(
 [[parameter]]
-name = "mechanics.output_stage.stiffness_N_per_m"
-lower = 3e5
-upper = 9e5
+name = "mechanics.sensor_mount.stiffness_N_per_m"
+lower = 1.03e6
+upper = 1.54e6
 [[target]]
 kind = "frf_peak_Hz"
 temperature_C = 20.0
@@ -189,6 +189,42 @@ value = 2000.0
   EXPECT_DOUBLE_EQ(tf[0].simulated, frf.curves[0].first_resonance_Hz);
   EXPECT_DOUBLE_EQ(tf[1].simulated, frf.curves[1].bandwidth_3dB_Hz);
   EXPECT_NEAR(tf[0].simulated, 1270.0, 0.01 * 1270.0);
+}
+
+// modulus_GPa (issue 18): the mean over the rods of eq. (13)'s E_G at rest at the bias, the
+// number Table 6's stiffnesses pin (k_i = E A_i / l: 30 GPa); the training set, with the claim
+// targets and [[by_construction]] claims, is what identify writes into [calibration].
+TEST(Identify, ModulusTargetIsTheRodsMeanModulusAtRest) {
+  const FitSpec fit = parse_fit_spec(R"(
+[[parameter]]
+name = "material.Es_Pa"
+lower = 4e10
+upper = 1.1e11
+[[target]]
+kind = "modulus_GPa"
+temperature_C = 20.0
+value = 30.0
+[[target]]
+claim = "stroke_drop_8A"
+[[by_construction]]
+claim = "thermal_model"
+reason = "the sleeve length"
+)",
+                                     "modulus.toml");
+  const Objective obj(builtin_model_spec(), MeasurementSet{}, fit, ci_objective());
+  const auto tf = obj.target_fits(obj.start_unit());
+  ASSERT_EQ(tf.size(), 2u);
+  const Model m = load_model("");
+  const Conditions c = make_conditions(m, 20.0);
+  const State st = make_state(m, c, 1.0);
+  double E = 0.0;
+  for (const auto& r : st.rods) E += r.E_Pa;
+  EXPECT_DOUBLE_EQ(tf[0].simulated, E / 3.0 * 1e-9);
+  EXPECT_EQ(fitted_claims(fit), (std::vector<std::string>{"stroke_drop_8A", "thermal_model"}));
+  EXPECT_THROW(parse_fit_spec("[[parameter]]\nname = \"material.Es_Pa\"\nlower = 4e10\nupper = "
+                              "1.1e11\n[[by_construction]]\nclaim = \"thermal_model\"\n",
+                              "noreason.toml"),
+               InputError);
 }
 
 TEST(Identify, ScalarTargetsAloneCalibrateAParameter) {

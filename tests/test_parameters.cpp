@@ -206,9 +206,17 @@ TEST(ParameterTable, UnitsAgreeWithKeySuffixes) {
 
 TEST(ParameterTable, DefaultsOnlyInDefaultedTablesAndObeyTheirRules) {
   for (const auto& row : gmasim::parameter_table()) {
-    const bool defaulted = gmasim::group_def(row.group).table == gmasim::TableRule::Defaulted;
-    EXPECT_EQ(row.default_value.has_value(), defaulted) << row.key;
-    EXPECT_EQ(!row.default_provenance.empty(), defaulted) << row.key;
+    // A defaulted table defaults every key; a required table may default a key that a model
+    // need not state (rodN.joint_gap_m: a rod without joints); an optional table has none (its
+    // presence switches a feature on, and then every key is stated).
+    const auto table = gmasim::group_def(row.group).table;
+    if (table == gmasim::TableRule::Defaulted) {
+      EXPECT_TRUE(row.default_value.has_value()) << row.key;
+    }
+    if (table == gmasim::TableRule::Optional || table == gmasim::TableRule::KeysOptional) {
+      EXPECT_FALSE(row.default_value.has_value()) << row.key;
+    }
+    EXPECT_EQ(!row.default_provenance.empty(), row.default_value.has_value()) << row.key;
     if (!row.default_value) continue;
     if (row.rule == gmasim::Rule::Positive) {
       EXPECT_GT(*row.default_value, 0.0) << row.key;

@@ -37,11 +37,11 @@ int run_track_cmd(TrackArgs& a) {
   const auto& g = a.req.gains;
   fmt::print("gmasim track  model: {}\n", model_label(a.model));
   fmt::print(
-      "  PID kp {} A/um, ki {} A/um per sample, kd {} A/um per sample (per-sample gains at {} "
-      "Hz);\n  controller and sensor at {} Hz, plant step {:.3g} us; current = {} A + u, clipped "
-      "to +-{} A; sensor noise {} um RMS\n",
+      "  PID kp {} /um, ki {} /um per sample, kd {} /um per sample (per-sample gains at {} "
+      "Hz);\n  controller and sensor at {} Hz, plant step {:.3g} us; current = {} A + {} A x u "
+      "(the amplifier), clipped to +-{} A; sensor noise {} um RMS\n",
       g.kp, g.ki, g.kd, g.reference_rate_Hz, a.req.sample_rate_Hz, res.plant_dt_s * 1e6,
-      a.req.bias_A, a.req.current_limit_A, a.req.sensor_noise_um);
+      a.req.bias_A, a.req.amplifier_A_per_unit, a.req.current_limit_A, a.req.sensor_noise_um);
   fmt::print("  reference y_bias + A sin(2 pi f t); errors over the last of {} periods\n",
              a.req.periods);
   fmt::print("  {:>6} {:>7} {:>7} {:>11} {:>11} {:>8} {:>9} {:>14}\n", "T degC", "A um", "f Hz",
@@ -90,7 +90,11 @@ Runner add_track(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--frequencies", a->frequencies, "Reference frequencies [Hz]")
       ->capture_default_str();
-  sub->add_option("--kp", a->req.gains.kp, "Proportional gain [A/um]")->capture_default_str();
+  sub->add_option("--kp", a->req.gains.kp, "Proportional gain [unit/um]")->capture_default_str();
+  sub->add_option("--amplifier-gain", a->req.amplifier_A_per_unit,
+                  "Coil current per unit of PID output [A/unit] (the amplifier; the paper does not "
+                  "print it: docs/experiments.md)")
+      ->capture_default_str();
   sub->add_option("--ki", a->req.gains.ki,
                   "Integral gain [A/um per sample at --gain-rate]: u += ki * sum(e)")
       ->capture_default_str();

@@ -29,12 +29,11 @@ struct State;
 // Per-rod running sums [J], advanced by step() while EnergyAccumulators::enabled.
 struct RodEnergy {
   double material_work_J = 0;   // l A int H dB (trapezoid over each step)
-  double hysteresis_J = 0;      // l A int of physics::ja_dissipation_density
+  double hysteresis_J = 0;      // l A physics::ja_step_dissipation over each step
   double eddy_J = 0;            // l A int kappa (dB/dt)^2 dt (consistent); printed: (Hc - H) dB
   double force_work_J = 0;      // int F dx over the exact oscillator update (Gauss-Legendre)
   double stiffness_work_J = 0;  // 1/2 (K_new - K_old) x^2 at each step boundary
   double damping_J = 0;         // int c v^2 dt (eq. 25's c + c_lr), Gauss-Legendre
-  double Han_irr_A_per_m = std::numeric_limits<double>::quiet_NaN();  // H_an(M_irr), warm start
 };
 
 // Model-wide running sums [J] and the step's coil EMF; phi_prev_Wb holds every branch's flux

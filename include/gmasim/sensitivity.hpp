@@ -47,16 +47,15 @@ std::vector<Claim> run_claims(const Model& m, const ReproduceOptions& o,
 // SweepRequest's defaults).
 struct MetricQuantity {
   std::string name;        // e.g. "stroke_um@20C_8A_10Hz"
-  std::string unit;        // of the field
-  double Metrics::*field;  // what is read from Result::metrics
+  std::string unit;                   // of the value
+  double (*read)(const Result& run);  // the value, from a simulate run with the energy ledger
   double temperature_C, current_pp_A, frequency_Hz;
   double relative_scale;    // its scale (identifiability, flag floor): this x |value at p0|
   std::string description;  // what it is
 };
 
-// The built-in metric quantities: the table in src/experiments/sensitivity_quantities.cpp.
-// The extension point for the energy ledger's losses: once Metrics has a field (e.g.
-// P_hysteresis_W), one row there adds it to every sensitivity run.
+// The built-in metric quantities: the table in src/experiments/sensitivity_quantities.cpp
+// (one row each: the loop metrics and the energy ledger's losses).
 std::vector<MetricQuantity> builtin_metric_quantities();
 
 // A quantity computed from the compiled model by the caller (C++ only: tests, scripts).

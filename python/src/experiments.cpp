@@ -113,8 +113,10 @@ void bind_track(py::module_& mod) {
       "track",
       [](const Model& m, std::vector<double> temperatures_C, std::vector<double> amplitudes_um,
          std::vector<double> frequencies_Hz, double kp, double ki, double kd, double sample_rate_Hz,
-         double bias_A, double sensor_noise_um, double periods, int threads) {
+         double bias_A, double sensor_noise_um, double periods, int threads,
+         double amplifier_A_per_unit) {
         TrackRequest r;
+        r.amplifier_A_per_unit = amplifier_A_per_unit;
         r.temperatures_C = std::move(temperatures_C);
         r.amplitudes_um = std::move(amplitudes_um);
         r.frequencies_Hz = std::move(frequencies_Hz);
@@ -132,7 +134,7 @@ void bind_track(py::module_& mod) {
       py::arg("frequencies_Hz") = TrackRequest{}.frequencies_Hz, py::arg("kp") = 0.2,
       py::arg("ki") = 0.03, py::arg("kd") = 0.007, py::arg("sample_rate_Hz") = 10000.0,
       py::arg("bias_A") = 1.0, py::arg("sensor_noise_um") = 0.0, py::arg("periods") = 4.0,
-      py::arg("threads") = 0,
+      py::arg("threads") = 0, py::arg("amplifier_A_per_unit") = TrackRequest{}.amplifier_A_per_unit,
       "Closed-loop tracking with the discrete PID (Fig. 16); gains' units in docs/experiments.md");
 }
 

@@ -268,14 +268,22 @@ std::string unit_name(const Unit& u) {
 
 namespace {
 
+// One metric point: the sweep's run (its settings) with the energy ledgers booked.
 void run_metric_point(const ClaimPlan& p, std::size_t k, const Model& m, PartResults& out) {
-  const SweepResult s = run_sweep(m, p.metric_points[k]);
-  const SweepPoint& pt = s.points.front();
+  const SweepRequest& r = p.metric_points[k];
+  SimulationSettings s;
+  s.temperature_C = r.temperatures_C.front();
+  s.waveform = biased_sine(r.currents_pp_A.front(), r.frequencies_Hz.front(), r.current_min_A);
+  s.periods = r.periods;
+  s.dt_s = r.dt_s;
+  s.freeze = r.freeze;
+  s.energy_ledger = true;
+  const Result run = simulate(m, s);
   for (std::size_t q = 0; q < p.metrics.size(); ++q) {
     if (p.metric_point_of[q] != k) continue;
-    out.metric_values[q] = pt.diverged ? kNaN : pt.metrics.*(p.metrics[q].field);
+    out.metric_values[q] = run.diverged || !run.has_energy ? kNaN : p.metrics[q].read(run);
   }
-  if (pt.diverged) throw DivergenceError(pt.error);
+  if (run.diverged) throw DivergenceError(run.error);
 }
 
 void run_unit_body(const ClaimPlan& p, const Unit& u, const Model& m, PartResults& out) {

@@ -123,6 +123,7 @@ Report track_report(const Model& m, const TrackRequest& req, const TrackResult& 
   r.meta.emplace_back("plant_dt_s", res.plant_dt_s);
   r.meta.emplace_back("bias_A", req.bias_A);
   r.meta.emplace_back("current_limit_A", req.current_limit_A);
+  r.meta.emplace_back("amplifier_A_per_unit", req.amplifier_A_per_unit);
   r.meta.emplace_back("sensor_noise_um_rms", req.sensor_noise_um);
   r.meta.emplace_back("noise_seed", static_cast<double>(req.noise_seed));
   r.meta.emplace_back("periods", req.periods);

@@ -113,6 +113,7 @@ void check_request(const TrackRequest& r) {
   require_in(r.sample_rate_Hz, 0.0, 1e3 * kMaxFrequency_Hz, "PID sample rate", "Hz");
   require_in(r.bias_A, -kMaxCurrent_A, kMaxCurrent_A, "bias current", "A");
   require_in(r.current_limit_A, 0.0, kMaxCurrent_A, "current limit", "A");
+  require_in(r.amplifier_A_per_unit, 1e-6, 1e6, "amplifier gain", "A per unit");
   for (double g : {r.gains.kp, r.gains.ki, r.gains.kd}) require_finite(g, "PID gain");
   // The gains are per sample at this rate (Pid): a rate of 4.9e-324 Hz would scale kd by
   // 1e300+ (found by the mutation campaign).
@@ -193,9 +194,10 @@ struct SampledController {
     const double u = pid.update(ref.at(tk) - y_meas);
     const double K_ref = r.feedforward.static_gain_um_per_A;
     const double ff = K_ref > 0.0 ? (ref.at(tk) - ref.y_bias_um) / K_ref : 0.0;
+    const double a = r.amplifier_A_per_unit;
     I = r.feedforward.enabled()
-            ? std::clamp(r.bias_A + g * (u + ff), -r.current_limit_A, r.current_limit_A)
-            : r.bias_A + u;
+            ? std::clamp(r.bias_A + g * (a * u + ff), -r.current_limit_A, r.current_limit_A)
+            : r.bias_A + a * u;
     if (example) {
       auto& col = example->columns;
       col[0].push_back(tk);
@@ -238,9 +240,10 @@ void track_point(const Model& m, const Conditions& c, const TrackRequest& r, con
   const StepGrid grid = StepGrid::sampled(
       0.0, Ts, static_cast<double>(std::lround(r.periods * period / Ts)), sub, "plant steps");
   const double t_end = static_cast<double>(grid.samples()) * Ts;
-  // The PID's own limits are those of u = (i - bias) / g, so its anti-windup acts where the
+  // The PID's own limits are those of u = (i - bias) / (g a), so its anti-windup acts where the
   // current clips.
   const double g = r.feedforward.gain_at(j.T);
+  const double ga = g * r.amplifier_A_per_unit;
   p.feedforward_gain = g;
   try {
     State s = make_state(m, c, r.bias_A);
@@ -249,8 +252,8 @@ void track_point(const Model& m, const Conditions& c, const TrackRequest& r, con
     SampledController drive{r,
                             grid,
                             ref,
-                            Pid(r.gains, r.sample_rate_Hz, (-r.current_limit_A - r.bias_A) / g,
-                                (r.current_limit_A - r.bias_A) / g),
+                            Pid(r.gains, r.sample_rate_Hz, (-r.current_limit_A - r.bias_A) / ga,
+                                (r.current_limit_A - r.bias_A) / ga),
                             g,
                             std::mt19937_64(seed),
                             example};

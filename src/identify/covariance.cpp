@@ -273,7 +273,16 @@ void fill_covariance(const Objective& obj, BatchEvaluator& ev, const std::vector
   double ss = 0.0;
   for (double v : r) ss += v * v;
   const double dof = static_cast<double>(m) - static_cast<double>(n);
-  const double s2 = dof > 0 ? ss / dof : 0.0;
+  if (!(dof > 0)) {  // no residual degrees of freedom: the scatter, and so s^2, is unknown
+    out.covariance_ok = false;
+    out.covariance_note = fmt::format(
+        "{} residuals for {} parameters: no residual degrees of freedom, so the residual "
+        "variance, and with it every interval, cannot be estimated (the fit solves its targets; "
+        "`gmasim sensitivity` shows how well they pin each parameter)",
+        m, n);
+    return;
+  }
+  const double s2 = ss / dof;
   out.residual_sigma = std::sqrt(s2);
   const Covariance c = scaled_covariance(J, s2);
   out.covariance_ok = true;

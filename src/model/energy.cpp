@@ -36,19 +36,9 @@ void book_rod_magnetic(const Model& m, const RodConditions& rc, const StepStart&
     e.eddy_J += V * rc.eddy_geometry_s_m_per_H * dB * dB / h;
   else  // printed: the lag's eddy field H_c - H against the material's dB
     e.eddy_J += V * 0.5 * ((a.Hc - a.H) + (r.Hc_A_per_m - r.H_A_per_m)) * dB;
-  // Eq. (9)'s dissipation along M_irr (physics::ja_dissipation_density).
-  const auto& p = rc.ja;
-  const double He0 = a.H + p.alpha * a.M, He1 = r.H_A_per_m + p.alpha * r.M_A_per_m;
-  const double Han0 = std::isfinite(e.Han_irr_A_per_m)
-                          ? e.Han_irr_A_per_m
-                          : anhysteretic_field(a.Mirr, rc.MsT_ja, p.a_A_per_m);
-  const double Han1 = r.Mirr_A_per_m == a.Mirr
-                          ? Han0
-                          : anhysteretic_field(r.Mirr_A_per_m, rc.MsT_ja, p.a_A_per_m, Han0);
-  double g0 = He0 - Han0;
-  if (g0 * (He1 - He0) <= 0.0) g0 = 0.0;  // M_irr starts to move inside the step (eq. 9 guard)
-  e.hysteresis_J += V * ja_dissipation_density(g0, He1 - Han1, a.Mirr, r.Mirr_A_per_m, p);
-  e.Han_irr_A_per_m = Han1;
+  // Eq. (9)'s dissipation over the step along the path H, M linear (physics::ja_step_dissipation).
+  e.hysteresis_J +=
+      V * ja_step_dissipation(a.H, a.M, r.H_A_per_m, r.M_A_per_m, rc.MsT_ja, rc.ja);
 }
 
 // The mechanical terms of rod i over one step: the oscillator's exact update (F linear, K

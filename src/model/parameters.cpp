@@ -147,7 +147,8 @@ const ParamDef kParams[] = {
      LAND(in_material, Material, alpha_thermal_per_K)},
     // [preload]
     {G::Preload, "force_N", "N", R::NonNegative,
-     "preload F_pre; each rod's prestress is F_pre / A_i, eq. (3), (6), (11), (13)",
+     "preload F_pre through the rods in series; each rod's prestress is F_pre / A_i^T (its "
+     "area at temperature), eq. (3), (6), (11), (13)",
      LAND(in_model, Model, preload_N)},
     // [magnet]
     {G::Magnet, "alpha_pm1_per_K", "1/K", R::Any, "first-order coefficient of F_pm^T, eq. (1)",
@@ -169,7 +170,9 @@ const ParamDef kParams[] = {
     {G::Rod, "length_m", "m", R::Positive, "length l_i, eq. (2), (17)",
      LAND(in_rod, RodModel, length_m)},
     {G::Rod, "mass_kg", "kg", R::Positive, "mass m_i, eq. (24)", LAND(in_rod, RodModel, mass_kg)},
-    {G::Rod, "k_f", "-", R::Positive, "flux-leakage factor k_f of eq. (7)",
+    {G::Rod, "k_f", "-", R::Positive,
+     "flux-leakage factor k_f of eq. (7) (the printed reading; the consistent reading uses "
+     "joint_gap_m)",
      LAND(in_rod, RodModel, k_f)},
     {G::Rod, "k_j", "-", R::Positive, "eddy-current factor k_j of eq. (7)",
      LAND(in_rod, RodModel, k_j)},
