@@ -170,14 +170,14 @@ TEST(Frf, PrintedReadingSteppedSineMatchesTheLinearisation) {
   expect_stepped_sine_matches_linearisation(mdma_printed());
 }
 
-// The printed reading cannot carry Fig. 15: its eddy lag sets a bandwidth of a few hundred
-// Hz and nothing rings below 5 kHz (READING-NOTES). The built-in model's output stage
-// carries the measured 1270 Hz with the bandwidth above 2000 Hz. Its peak shifts 1.4 %
-// from 20 to 70 degC (paper < 0.17 %): with damping ratio 0.37 the peak is shaped by the
-// eddy lag, whose time constant falls as rho rises (eq. 8). A lightly damped stage (ratio
-// 0.09) keeps the shift < 0.2 %, so the mechanics alone are temperature-independent, but it
-// loses the bandwidth (the -3 dB point of a lightly damped mode lies at ~1.5 f_n) and
-// destabilises the PID of Fig. 16 (docs/calibration.md).
+// The printed reading cannot carry Fig. 15: its eddy lag sets a bandwidth of a few hundred Hz
+// and nothing rings below 5 kHz (READING-NOTES). The built-in model's sensor mount carries the
+// measured 1270 Hz (fitted: the bracket's stiffness is a calibration parameter); being
+// temperature-independent, the peak moves < 0.17 % from 20 to 70 degC (observed 0.005 %), as
+// the paper measures. Its antiresonance just above the peak (the probe then moves in phase with
+// the target) sets the -3 dB point (observed 1299 Hz against the paper's > 2000 Hz; docs/
+// failing_claims.md), and the peak's amplitude follows the stack's small-signal gain, which
+// falls with temperature (observed -41 %; the paper: hardly changes).
 TEST(Frf, ResonanceAndBandwidthOfBothReadings) {
   FrfRequest r;
   r.temperatures_C = {20, 70};
@@ -189,24 +189,20 @@ TEST(Frf, ResonanceAndBandwidthOfBothReadings) {
     EXPECT_LT(cv.bandwidth_3dB_Hz, 2000.0);
     EXPECT_EQ(cv.first_resonance_Hz, 0.0);
   }
-  auto shift_of = [](const FrfResult& res) {
-    return std::fabs(res.curves[1].first_resonance_Hz / res.curves[0].first_resonance_Hz - 1.0);
-  };
   const FrfResult built_in = run_frf(mdma(), r);
-  EXPECT_NEAR(built_in.curves[0].first_resonance_Hz, 1270.0, 0.01 * 1270.0);      // 1272 Hz
-  for (const auto& cv : built_in.curves) EXPECT_GT(cv.bandwidth_3dB_Hz, 2000.0);  // 2054, 2135
-  EXPECT_GT(shift_of(built_in), 0.01);                                            // observed 1.4 %
-  EXPECT_LT(shift_of(built_in), 0.03);
-
-  ModelSpec light = builtin_model_spec();
-  light.set("mechanics.sensor_mount.damping_N_s_per_m", 10.0);
-  light.set("mechanics.sensor_mount.stiffness_N_per_m", 4.6e5);
-  const FrfResult lightly_damped = run_frf(compile(light), r);
-  for (const auto& cv : lightly_damped.curves) {
-    EXPECT_NEAR(cv.first_resonance_Hz, 1270.0, 0.02 * 1270.0) << cv.temperature_C << " degC";
-    EXPECT_LT(cv.bandwidth_3dB_Hz, 1.6 * cv.first_resonance_Hz);  // observed 1.48
+  const auto& sm = mdma().sensor_mount;
+  const double fn = std::sqrt(sm.stiffness_N_per_m / sm.mass_kg) / (2.0 * physics::kPi);
+  for (const auto& cv : built_in.curves) {
+    EXPECT_NEAR(cv.first_resonance_Hz, 1270.0, 0.01 * 1270.0) << cv.temperature_C;
+    EXPECT_NEAR(cv.first_resonance_Hz, fn, 0.03 * fn) << cv.temperature_C;  // the mount's
+    EXPECT_GT(cv.bandwidth_3dB_Hz, cv.first_resonance_Hz);                     // antiresonance
+    EXPECT_LT(cv.bandwidth_3dB_Hz, 1.1 * cv.first_resonance_Hz);
+    EXPECT_GT(cv.first_resonance_mag_um_per_A, cv.static_gain_um_per_A);
   }
-  EXPECT_LT(shift_of(lightly_damped), 0.002);  // observed 0.08 %; the paper: < 0.17 %
+  const auto& c0 = built_in.curves[0];
+  const auto& c1 = built_in.curves[1];
+  EXPECT_LT(std::fabs(c1.first_resonance_Hz / c0.first_resonance_Hz - 1.0), 0.0017);
+  EXPECT_LT(c1.first_resonance_mag_um_per_A, c0.first_resonance_mag_um_per_A);
 }
 
 // Starting from the virgin curve instead, the JA minor loop creeps (M_irr keeps moving on

@@ -64,9 +64,11 @@ int run_frf_cmd(FrfArgs& a) {
                  l ? fmt::format("{:.2f}", c.linear_phase_deg[k]) : "-", mis);
     }
     auto hz = [](double f) { return f > 0 ? fmt::format("{:.1f} Hz", f) : std::string("none"); };
-    fmt::print("  first resonance (largest |Y/I| peak in {}-{} Hz): {}   (paper, Fig. 15: {} Hz)\n",
-               a.req.f_min_Hz, a.req.f_max_Hz, hz(c.first_resonance_Hz),
-               res.paper_first_resonance_Hz);
+    fmt::print(
+        "  first resonance (largest |Y/I| peak in {}-{} Hz): {}, |Y/I| {:.4g} um/A   (paper, "
+        "Fig. 15: {} Hz)\n",
+        a.req.f_min_Hz, a.req.f_max_Hz, hz(c.first_resonance_Hz), c.first_resonance_mag_um_per_A,
+        res.paper_first_resonance_Hz);
     if (a.req.small_signal)
       fmt::print("  |Y/I| peak of the linear model searched up to {:.0f} Hz: {}\n",
                  c.linear_peak_search_max_Hz, hz(c.linear_peak_extended_Hz));
@@ -83,6 +85,18 @@ int run_frf_cmd(FrfArgs& a) {
       fmt::print(" {:.3f} ms", c.eddy_tau_ms[k]);
     fmt::print("\n");
   }
+  // The resonance's shift and the change of its amplitude across the temperatures (Fig. 15:
+  // the paper's peak moves < 0.17 % and its amplitude hardly changes).
+  const auto& c0 = res.curves.front();
+  const auto& c1 = res.curves.back();
+  if (res.curves.size() > 1 && c0.first_resonance_Hz > 0 && c1.first_resonance_Hz > 0)
+    fmt::print(
+        "\n  {:g} -> {:g} degC: first resonance {:+.3f} % in frequency, {:+.1f} % in amplitude "
+        "(|Y/I| {:.4g} -> {:.4g} um/A)\n",
+        c0.temperature_C, c1.temperature_C,
+        100.0 * (c1.first_resonance_Hz / c0.first_resonance_Hz - 1.0),
+        100.0 * (c1.first_resonance_mag_um_per_A / c0.first_resonance_mag_um_per_A - 1.0),
+        c0.first_resonance_mag_um_per_A, c1.first_resonance_mag_um_per_A);
   if (model.sensor_mount.enabled) {
     const auto& sm = model.sensor_mount;
     fmt::print(
@@ -95,7 +109,7 @@ int run_frf_cmd(FrfArgs& a) {
         sm.actuator_mass_kg);
   } else {
     fmt::print(
-        "\n  This model has no output stage: the paper's {:g} Hz first resonance is not a mode "
+        "\n  This model has no sensor mount: the paper's {:g} Hz first resonance is not a mode "
         "of eq. (15) with Table 6's masses and stiffnesses; its diagonal oscillators ring at the "
         "frequencies above and the eddy-current lag sets the roll-off (docs/experiments.md).\n",
         res.paper_first_resonance_Hz);

@@ -145,6 +145,7 @@ struct FrfCurve {
   // Small-signal linearisation about the bias point [um/A, deg]
   std::vector<double> linear_mag_um_per_A, linear_phase_deg;
   double first_resonance_Hz = 0;  // largest peak of |Y/I| (linear model) in the band, 0 if none
+  double first_resonance_mag_um_per_A = 0;  // |Y/I| there (0 if no peak)
   // The same search on the linear model continued above f_max, up to twice the highest
   // mode (0 if |Y/I| has no local maximum there either).
   double linear_peak_extended_Hz = 0, linear_peak_search_max_Hz = 0;

@@ -143,14 +143,24 @@ CompensatePoint solve_point(const Model& m, const CompensateRequest& r, double T
       } else if (fa >= 0.0) {
         x = a;  // even the smallest drive reaches the target
       } else {
-        // Stop when the bracket is narrower than the drive change that moves the stroke
-        // by the tolerance (secant slope of the bracket).
+        // Stop when the bracket is narrower than the drive change that moves the stroke by
+        // the tolerance: at the steeper of the first bracket's secant and the secant of the
+        // last two evaluations (a saturating stroke curve is steeper at the root than over
+        // the first bracket).
+        double slope = (fb - fa) / (b - a), x_last = std::nan(""), f_last = std::nan("");
+        auto f = [&](double v) {
+          const double fv = stroke(v).stroke_um - target;
+          if (std::isfinite(x_last) && v != x_last)
+            slope = std::max(slope, std::fabs((fv - f_last) / (v - x_last)));
+          x_last = v;
+          f_last = fv;
+          return fv;
+        };
         auto tol = [&](double lo, double hi) {
-          return hi - lo <= 1e-12 * hi || (hi - lo) * (fb - fa) / (b - a) < 0.5 * r.tolerance_um;
+          return hi - lo <= 1e-12 * hi || (hi - lo) * slope < 0.5 * r.tolerance_um;
         };
         std::uintmax_t iters = 60;
-        const auto [lo, hi] = boost::math::tools::toms748_solve(
-            [&](double v) { return stroke(v).stroke_um - target; }, a, b, fa, fb, tol, iters);
+        const auto [lo, hi] = boost::math::tools::toms748_solve(f, a, b, fa, fb, tol, iters);
         x = 0.5 * (lo + hi);
       }
     }

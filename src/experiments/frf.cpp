@@ -551,6 +551,8 @@ void fill_curve(FrfCurve& cv, const SmallSignalModel& lin, const cd* stepped,
   if (!r.small_signal) {
     cv.first_resonance_Hz = cv.stepped_first_resonance_Hz;
     cv.bandwidth_3dB_Hz = cv.stepped_bandwidth_3dB_Hz;
+    for (std::size_t k = 0; k < f.size(); ++k)
+      if (f[k] == cv.first_resonance_Hz) cv.first_resonance_mag_um_per_A = cv.stepped_mag_um_per_A[k];
     return;
   }
   // Resonance and bandwidth of the linear model on a dense grid (cheap to evaluate).
@@ -558,6 +560,8 @@ void fill_curve(FrfCurve& cv, const SmallSignalModel& lin, const cd* stepped,
   std::vector<double> md(fd.size());
   for (std::size_t k = 0; k < fd.size(); ++k) md[k] = std::abs(lin.response(fd[k]));
   cv.first_resonance_Hz = find_resonance_Hz(fd, md);
+  if (cv.first_resonance_Hz > 0)
+    cv.first_resonance_mag_um_per_A = std::abs(lin.response(cv.first_resonance_Hz)) * 1e6;
   cv.bandwidth_3dB_Hz = find_bandwidth_3dB_Hz(fd, md);
   // The same search beyond the band, up to twice the highest mode.
   double f_top = r.f_max_Hz;
