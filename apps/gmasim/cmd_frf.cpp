@@ -27,6 +27,22 @@ struct FrfArgs {
   bool progress = false;
 };
 
+// The resonance's shift and the change of its amplitude across the temperatures (Fig. 15:
+// the paper's peak moves < 0.17 % and its amplitude hardly changes).
+void print_resonance_change(const FrfResult& res) {
+  const auto& c0 = res.curves.front();
+  const auto& c1 = res.curves.back();
+  if (res.curves.size() < 2 || !(c0.first_resonance_Hz > 0) || !(c1.first_resonance_Hz > 0))
+    return;
+  fmt::print(
+      "\n  {:g} -> {:g} degC: first resonance {:+.3f} % in frequency, {:+.1f} % in amplitude "
+      "(|Y/I| {:.4g} -> {:.4g} um/A)\n",
+      c0.temperature_C, c1.temperature_C,
+      100.0 * (c1.first_resonance_Hz / c0.first_resonance_Hz - 1.0),
+      100.0 * (c1.first_resonance_mag_um_per_A / c0.first_resonance_mag_um_per_A - 1.0),
+      c0.first_resonance_mag_um_per_A, c1.first_resonance_mag_um_per_A);
+}
+
 int run_frf_cmd(FrfArgs& a) {
   const Model model = load_model_args(a.model);
   a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
@@ -85,18 +101,7 @@ int run_frf_cmd(FrfArgs& a) {
       fmt::print(" {:.3f} ms", c.eddy_tau_ms[k]);
     fmt::print("\n");
   }
-  // The resonance's shift and the change of its amplitude across the temperatures (Fig. 15:
-  // the paper's peak moves < 0.17 % and its amplitude hardly changes).
-  const auto& c0 = res.curves.front();
-  const auto& c1 = res.curves.back();
-  if (res.curves.size() > 1 && c0.first_resonance_Hz > 0 && c1.first_resonance_Hz > 0)
-    fmt::print(
-        "\n  {:g} -> {:g} degC: first resonance {:+.3f} % in frequency, {:+.1f} % in amplitude "
-        "(|Y/I| {:.4g} -> {:.4g} um/A)\n",
-        c0.temperature_C, c1.temperature_C,
-        100.0 * (c1.first_resonance_Hz / c0.first_resonance_Hz - 1.0),
-        100.0 * (c1.first_resonance_mag_um_per_A / c0.first_resonance_mag_um_per_A - 1.0),
-        c0.first_resonance_mag_um_per_A, c1.first_resonance_mag_um_per_A);
+  print_resonance_change(res);
   if (model.sensor_mount.enabled) {
     const auto& sm = model.sensor_mount;
     fmt::print(

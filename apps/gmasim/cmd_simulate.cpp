@@ -82,8 +82,7 @@ Waveform make_waveform(const SimulateArgs& a) {
   return w;
 }
 
-int run_simulate(const SimulateArgs& a) {
-  const Model model = load_model_args(a.model);
+SimulationSettings settings_of(const SimulateArgs& a) {
   SimulationSettings s;
   s.temperature_C = a.temperature_C;
   s.energy_ledger = true;
@@ -97,6 +96,12 @@ int run_simulate(const SimulateArgs& a) {
   s.self_heating.thermal_step_s = a.thermal_step_s;
   s.self_heating.ambient_C = a.ambient_C;
   s.freeze = parse_freeze(a.freeze);
+  return s;
+}
+
+int run_simulate(const SimulateArgs& a) {
+  const Model model = load_model_args(a.model);
+  const SimulationSettings s = settings_of(a);
   ensure_output_dir(a.out);  // fail before the run, not after it
   Result r = simulate(model, s);
   if (!r.diverged && !a.quantities.empty()) add_quantity_stats(r, a.quantities);

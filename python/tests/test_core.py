@@ -13,10 +13,12 @@ def test_simulate_returns_numpy_series_and_metrics(mdma):
     s = r["series"]
     assert isinstance(s["y_um"], np.ndarray)
     assert s["t_s"].shape == s["y_um"].shape
-    # stroke = peak-to-peak of y over the last period
+    # stroke = peak-to-peak of y over the last period (of its cubic refinement: between the
+    # samples' peak-to-peak and a hair above it, docs/model.md "Time step")
     t = s["t_s"]
     last = (t >= r["metrics"]["window_start_s"] - 1e-12) & (t < r["metrics"]["window_end_s"] - 1e-12)
-    assert np.ptp(s["y_um"][last]) == pytest.approx(r["metrics"]["stroke_um"], rel=1e-12)
+    sampled = np.ptp(s["y_um"][last])
+    assert sampled <= r["metrics"]["stroke_um"] <= sampled * (1 + 1e-6)
     # the stack output is the sum of the rods' displacements (eq. 20); the sensor reads the
     # output stage, which follows it within a micrometre at 10 Hz
     np.testing.assert_allclose(s["y_stack_um"], s["rod1_x_um"] + s["rod2_x_um"] + s["rod3_x_um"], rtol=1e-12, atol=1e-12)

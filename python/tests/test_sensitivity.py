@@ -42,11 +42,14 @@ def test_metric_quantity_and_identifiability(mdma):
     assert ident["directions"].shape == (2, 2)
 
 
-def test_fit_parameters_and_errors(mdma):
+def test_fit_parameters_and_errors(mdma, tmp_path):
     ps = gmasim.fit_parameters(mdma, SOURCE_DIR / "calibration" / "consistent.toml")
-    assert len(ps) == 12
-    assert ("magnet.alpha_pm1_per_K", pytest.approx(3e-4)) in ps  # 0 in the model: the bounds' width
+    assert len(ps) == 11
     assert ("material.Ms_A_per_m", 0.0) in ps
+    fit0 = tmp_path / "fit0.toml"
+    fit0.write_text('[[parameter]]\nname = "magnet.alpha_pm1_per_K"\nlower = -3e-4\nupper = 0.0\n')
+    ps0 = gmasim.fit_parameters(mdma, fit0)
+    assert ("magnet.alpha_pm1_per_K", pytest.approx(3e-4)) in ps0  # 0 in the model: the bounds' width
     with pytest.raises(gmasim.InputError, match="unknown quantity 'nope'"):
         gmasim.sensitivity(mdma, params=["material.Ms_A_per_m"], claims=["nope"])
     with pytest.raises(gmasim.InputError, match="no parameter"):

@@ -238,65 +238,70 @@ void quasi_static_step(const Model& m, const Conditions& c, State& s, double cur
   }
 }
 
+namespace {
+
+// The ledgers' start values (gmasim/energy.hpp): every branch's flux and each rod's state
+// before the step.
+void energy_start(State& s, std::array<StepStart, 8>& start) {
+  std::copy(s.circuit.phi.begin(), s.circuit.phi.end(), s.energy.phi_prev_Wb.begin());
+  for (std::size_t i = 0; i < s.rods.size(); ++i) {
+    const auto& r = s.rods[i];
+    start[i] = {r.H_A_per_m, r.Hc_A_per_m, r.M_A_per_m, r.Mirr_A_per_m,
+                flux_density(r.H_A_per_m, r.M_A_per_m), r.x_m, r.v_m_per_s, r.F_N,
+                r.K_osc_N_per_m};
+  }
+}
+
+// The printed magnetic state's stages 1-2 (model.hpp, MagneticState::Printed).
+void printed_magnetic_update(const Model& m, const Conditions& c, State& s, const StepInput& in,
+                             double t1) {
+  const double h = in.dt_s;
+  const std::size_t n = s.rods.size();
+  // 1. Rod reluctances (eq. 2-3) at the magnetisation extrapolated to the end of the step
+  //    (M* = 2 M_n - M_{n-1}, second order), then the nodal solve (eq. 23).
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& rc = c.rods[i];
+    auto& r = s.rods[i];
+    double Mx = 2.0 * r.M_A_per_m - r.M_prev_A_per_m;
+    const double lim = 0.999 * rc.MsT_mu;
+    Mx = Mx > lim ? lim : (Mx < -lim ? -lim : Mx);
+    s.rod_reluctance[i] = set_rod_permeability(m, i, rc, r, Mx, t1);
+  }
+  if (!solve_circuit(m.circuit, s.rod_reluctance, in.current_A, c.pm_scale, s.circuit,
+                     s.energy.enabled))
+    throw DivergenceError(t1, "", "nodal matrix of the circuit", 0.0, "not positive definite");
+  // 2. Per rod: static field (eq. 7), eddy lag (eq. 7), JA (eq. 9).
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto& rc = c.rods[i];
+    auto& r = s.rods[i];
+    const double Hc1 = rod_static_field(m, i, rc, r, s.circuit);
+    r.tau_s = r.mu_r * kMu0 * rc.eddy_geometry_s_m_per_H;
+    const double H1 = first_order_lag_step(r.H_A_per_m, r.Hc_A_per_m, Hc1, h, r.tau_s);
+    const double M_guess = 2.0 * r.M_A_per_m - r.M_prev_A_per_m;  // linear extrapolation
+    r.M_prev_A_per_m = r.M_A_per_m;
+    ja_step(r.H_A_per_m, H1, rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m, M_guess);
+    r.H_A_per_m = H1;
+    r.Hc_A_per_m = Hc1;
+  }
+}
+
+}  // namespace
+
 void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
   const double h = in.dt_s;
   const double t1 = s.t_s + h;
   const std::size_t n = s.rods.size();
   std::array<StepStart, 8> start{};
   const double current0_A = s.current_A;
-  if (s.energy.enabled) {  // the ledgers' start values (gmasim/energy.hpp)
-    std::copy(s.circuit.phi.begin(), s.circuit.phi.end(), s.energy.phi_prev_Wb.begin());
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto& r = s.rods[i];
-      start[i] = {r.H_A_per_m,
-                  r.Hc_A_per_m,
-                  r.M_A_per_m,
-                  r.Mirr_A_per_m,
-                  flux_density(r.H_A_per_m, r.M_A_per_m),
-                  r.x_m,
-                  r.v_m_per_s,
-                  r.F_N,
-                  r.K_osc_N_per_m};
-    }
-  }
-
-  if (m.options.magnetic_state == MagneticState::Consistent) {
-    // 1-2. Circuit, eddy field and JA solved together (consistent_magnetic_update).
+  if (s.energy.enabled) energy_start(s, start);
+  // 1-2. Circuit, eddy field and JA: in the consistent state solved together by Newton.
+  if (m.options.magnetic_state == MagneticState::Consistent)
     consistent_magnetic_update(m, c, s, in.current_A, c.pm_scale, h, false, t1);
-    for (std::size_t i = 0; i < n; ++i) {
-      check(s.rods[i].H_A_per_m, t1, m.rods[i].name, "H [A/m]", 1e9);
-      check(s.rods[i].M_A_per_m, t1, m.rods[i].name, "M [A/m]", 1.5 * c.rods[i].MsT_ja);
-    }
-  } else {
-    // 1. Rod reluctances (eq. 2-3) at the magnetisation extrapolated to the end of the
-    //    step (M* = 2 M_n - M_{n-1}, second order), then the nodal solve (eq. 23).
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto& rc = c.rods[i];
-      auto& r = s.rods[i];
-      double Mx = 2.0 * r.M_A_per_m - r.M_prev_A_per_m;
-      const double lim = 0.999 * rc.MsT_mu;
-      Mx = Mx > lim ? lim : (Mx < -lim ? -lim : Mx);
-      s.rod_reluctance[i] = set_rod_permeability(m, i, rc, r, Mx, t1);
-    }
-    if (!solve_circuit(m.circuit, s.rod_reluctance, in.current_A, c.pm_scale, s.circuit,
-                       s.energy.enabled))
-      throw DivergenceError(t1, "", "nodal matrix of the circuit", 0.0, "not positive definite");
-
-    // 2. Per rod: static field (eq. 7), eddy lag (eq. 7), JA (eq. 9), force (eq. 11-14).
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto& rc = c.rods[i];
-      auto& r = s.rods[i];
-      const double Hc1 = rod_static_field(m, i, rc, r, s.circuit);
-      r.tau_s = r.mu_r * kMu0 * rc.eddy_geometry_s_m_per_H;
-      const double H1 = first_order_lag_step(r.H_A_per_m, r.Hc_A_per_m, Hc1, h, r.tau_s);
-      const double M_guess = 2.0 * r.M_A_per_m - r.M_prev_A_per_m;  // linear extrapolation
-      r.M_prev_A_per_m = r.M_A_per_m;
-      ja_step(r.H_A_per_m, H1, rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m, M_guess);
-      r.H_A_per_m = H1;
-      r.Hc_A_per_m = Hc1;
-      check(H1, t1, m.rods[i].name, "H [A/m]", 1e9);
-      check(r.M_A_per_m, t1, m.rods[i].name, "M [A/m]", 1.5 * rc.MsT_ja);
-    }
+  else
+    printed_magnetic_update(m, c, s, in, t1);
+  for (std::size_t i = 0; i < n; ++i) {
+    check(s.rods[i].H_A_per_m, t1, m.rods[i].name, "H [A/m]", 1e9);
+    check(s.rods[i].M_A_per_m, t1, m.rods[i].name, "M [A/m]", 1.5 * c.rods[i].MsT_ja);
   }
   // 3. Mechanics (eq. 15-18): each rod's oscillator, exact over the step with the force
   //    linear from F_n to F_{n+1} and the stiffness at the end of the step (which needs

@@ -53,7 +53,7 @@ check "saved option" 0 "options.magnetic_state +printed" "$B" model show --model
 check "self-heating" 0 "energy: in .* J = stored .* J \+ to ambient" "$B" simulate --self-heating --set thermal_network.coil_heat_capacity_J_per_K=2 --periods 10 --dt 5e-5 --record-every 50 --out "$T/heat"
 [[ -s "$T/heat/self_heating.csv" ]] && grep -q '"self_heating"' "$T/heat/metrics.json" && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: self-heating outputs"; }
 check "thermal step too long" 2 "fastest time constant" "$B" simulate --self-heating --set thermal_network.coil_heat_capacity_J_per_K=0.01 --periods 2 --out "$T/heat2"
-check "compensate" 0 "70.0 +9\.[0-9]+ +-3.0000" "$B" compensate --temperatures 20,70 --no-track --periods 2 --out "$T/comp"
+check "compensate" 0 "70.0 +4\.[0-9]+ +-3.0000" "$B" compensate --temperatures 20,70 --reference-current-pp 4 --no-track --periods 2 --out "$T/comp"
 check "compensate bad list" 2 "temperatures must increase" "$B" compensate --temperatures 70,20 --no-track --out "$T/comp2"
 check "step metrics" 0 "step +y .* rise \(10-90 %\)" "$B" simulate --waveform-kind step --level 0 --step-to 4 --step-time 0.002 --duration 0.01 --out "$T/step"
 # --plot needs the Python package of this build (absent in the sanitize-native build).
@@ -76,7 +76,7 @@ check "simulate --freeze" 0 "stroke" "$B" simulate --periods 2 --temperature 70 
 grep -q '"frozen": \["mu_G", "E_t"\]' "$T/fz/metrics.json" && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: frozen in metrics.json"; }
 check "unknown law to freeze" 2 "unknown law 'mu' to freeze; known: mu_G, rho_G, M, E_G, E_t, F_pm, geometry" "$B" simulate --freeze mu --out "$T/fz2"
 check "progress eta" 0 "simulate: 100000/100000 \(100 %\), .* s elapsed, ETA" "$B" simulate --periods 10 --progress --out "$T/prog"
-check "single-rod template" 0 "OK \(57 parameters, 1 rods" "$B" model check "$(dirname "$0")/../../models/single_rod.toml"
+check "single-rod template" 0 "OK \(58 parameters, 1 rods" "$B" model check "$(dirname "$0")/../../models/single_rod.toml"
 check "help has units" 0 "Operating temperature \[degC\]" "$B" simulate --help
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]
