@@ -76,3 +76,22 @@ def test_committed_scores_agree_with_the_committed_outputs():
         assert (s["claims_pass"], s["claims_applicable"]) == (npass, napp)
         assert s["fit_rms_pct"] == pytest.approx(rms, rel=1e-3)
     assert set(rows) <= {r["name"] for r in cfg["reading"]}
+
+
+def test_training_set_is_declared_in_the_fit_spec_and_installed():
+    """Issue 18: the calibration's training set is declared before the fit (the fit spec's claim
+    targets and [[by_construction]] claims), the installed model carries exactly it, and
+    fitted + predicted are the applicable claims."""
+    fit = _load(SOURCE_DIR / "calibration" / "consistent.toml")
+    declared = [t["claim"] for t in fit["target"] if "claim" in t]
+    declared += [b["claim"] for b in fit.get("by_construction", [])]
+    assert all(b.get("reason") for b in fit.get("by_construction", []))
+    model = _load(SOURCE_DIR / "models" / "mdma.toml")
+    assert model["calibration"]["fitted_claims"] == declared
+    claims = _load(SOURCE_DIR / "data" / "claims.toml")["claim"]
+    applicable = [c["id"] for c in claims if c["tolerance"]["kind"] != "not_applicable"]
+    assert len(applicable) == 34
+    assert set(declared) <= set(applicable)
+    predicted = [c for c in applicable if c not in declared]
+    assert len(declared) + len(predicted) == len(applicable)
+    assert len(predicted) >= len(declared)  # most claims test the model
