@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <map>
 #include <string>
 
@@ -271,3 +273,17 @@ TEST(Numerics, StrokeAndHysteresisConvergeAtSecondOrder) {
     }
 }
 
+
+// docs/model.md's time-step table is the output of `gmasim model check --dt-table` on the
+// built-in model (between its markers): regenerate it when the model or the step change.
+TEST(DocsTimeStepTable, IsCurrent) {
+  std::ifstream in(std::string(GMASIM_SOURCE_DIR) + "/docs/model.md");
+  const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string a = "<!-- dt-table: gmasim model check --dt-table -->\n",
+                    b = "<!-- end dt-table -->";
+  const auto i = doc.find(a), j = doc.find(b);
+  ASSERT_NE(i, std::string::npos);
+  ASSERT_NE(j, std::string::npos);
+  EXPECT_EQ(doc.substr(i + a.size(), j - i - a.size()), time_step_table_markdown(mdma()))
+      << "regenerate: gmasim model check --dt-table, between the markers of docs/model.md";
+}

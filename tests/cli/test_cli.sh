@@ -28,6 +28,10 @@ touch "$T/file"
 check "unwritable out" 2 "output directory is not writable" "$B" simulate --out "$T/file/sub"
 check "model show" 0 "rod1.ja.k0_A_per_m +3032 +A/m +Table 4" "$B" model show
 check "model check ok" 0 "OK" "$B" model check "$(dirname "$0")/../../models/mdma.toml"
+# Issue 18: no file is the built-in model; the worse energy ledger closes to <= 1e-6 per cycle.
+res="$("$B" model check 2>&1 | sed -nE 's/^energy balance residual: ([0-9.eE+-]+).*/\1/p')"
+awk -v r="$res" 'BEGIN { exit !(r != "" && r + 0 <= 1e-6) }' && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: energy balance residual '$res' > 1e-6"; }
+check "model check --set" 0 "with --set" "$B" model check --set material.x=0.45
 sed 's/^length_m = 0.030  # derived: k_1/length_m = -0.030  # derived: k_1/' "$(dirname "$0")/../../models/mdma.toml" >"$T/bad.toml"
 check "negative length" 2 "bad.toml:[0-9]+: rod1.length_m = -0.03 m: must be > 0" "$B" model check "$T/bad.toml"
 printf '[meta\nname = 1\n' >"$T/syntax.toml"
