@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/validate.hpp"
 #include "internal.hpp"
 
 namespace gmasim {
@@ -30,6 +31,28 @@ void check_options(const IdentifyOptions& o) {
   positive(o.migrants, "--migrants");
   if (o.population < 8)
     throw InputError(fmt::format("--population {}: must be >= 8", o.population));
+  // Counts that become threads, memory and time (issue 19, item 4): each island is a thread,
+  // each individual an evaluation per generation.
+  if (o.islands > kMaxIslands)
+    throw InputError(fmt::format(
+        "--islands {}: at most {} per rank (each island is a thread); use MPI ranks for more",
+        o.islands, kMaxIslands));
+  if (o.population > kMaxPopulation)
+    throw InputError(fmt::format("--population {}: at most {} individuals per island", o.population,
+                                 kMaxPopulation));
+  if (static_cast<double>(o.islands) * o.population * std::max(1, o.generations) >
+      kMaxGaEvaluations)
+    throw InputError(fmt::format(
+        "--islands {} x --population {} x --generations {} = {:.3g} evaluations per rank: more "
+        "than {:g} (days of work); lower one of them",
+        o.islands, o.population, o.generations,
+        static_cast<double>(o.islands) * o.population * std::max(1, o.generations),
+        kMaxGaEvaluations));
+  if (o.generations > kMaxGenerations)
+    throw InputError(fmt::format("--generations {}: at most {}", o.generations, kMaxGenerations));
+  if (o.threads < 0 || o.threads > kMaxThreads)
+    throw InputError(
+        fmt::format("--threads {}: must be 0 (all cores) or in [1, {}]", o.threads, kMaxThreads));
   if (o.migrants >= o.population)
     throw InputError(
         fmt::format("--migrants {}: must be < the population {}", o.migrants, o.population));

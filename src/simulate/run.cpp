@@ -9,6 +9,7 @@
 #include "gmasim/self_heating.hpp"
 #include "gmasim/simulate.hpp"
 #include "gmasim/validate.hpp"
+#include "gmasim/validity.hpp"
 
 namespace gmasim {
 namespace {
@@ -57,14 +58,41 @@ struct RunLength {
   double duration_s = 0;
 };
 
+// A step the user gave (dt_s, --dt): within [kMinStepDt_s, kMaxStepDt_s], and for a periodic
+// run (or a chirp's highest frequency) at least kMinStepsPerPeriod steps per period.
+void check_user_dt(const SimulationSettings& s) {
+  if (s.dt_s == 0.0) return;
+  const double dt = s.dt_s;
+  if (dt < kMinStepDt_s || dt > kMaxStepDt_s)
+    throw InputError(fmt::format(
+        "dt = {:g} s (--dt, dt_s): must be in [{:g}, {:g}] s (a longer step resolves neither the "
+        "eddy currents nor the mechanical modes, a shorter one no longer holds the state; "
+        "docs/model.md, \"Time step\"); 0 = the automatic rule",
+        dt, kMinStepDt_s, kMaxStepDt_s));
+  const auto& w = s.waveform;
+  double f = 0.0;
+  if (w.periodic()) f = w.frequency_Hz;
+  if (w.kind == WaveformKind::Chirp) f = std::max(w.f0_Hz, w.f1_Hz);
+  if (f > 0.0 && 1.0 / (f * dt) < kMinStepsPerPeriod * (1.0 - 1e-9))
+    throw InputError(fmt::format(
+        "dt = {:g} s (--dt, dt_s) gives {:.4g} steps per period at {:g} Hz: at least {:g} are "
+        "needed (the loop moves by more than 1 % when dt is halved below that; docs/model.md, "
+        "\"Time step\"); lower --dt to <= {:.4g} s, or 0 for the automatic rule",
+        dt, 1.0 / (f * dt), f, kMinStepsPerPeriod, 1.0 / (f * kMinStepsPerPeriod)));
+}
+
 RunLength run_length(const SimulationSettings& s) {
   const auto& w = s.waveform;
+  check_user_dt(s);
   RunLength L;
   double dt = s.dt_s > 0.0 ? s.dt_s : auto_dt(w);
+  double per_steps = 0.0;  // periodic: steps per period
   if (w.periodic()) {
     // Whole steps per period, so the last period's window is sampled exactly.
     const double per = w.period_s();
-    dt = per / static_cast<double>(steps_to_resolve(per / dt, 0, "steps per period"));
+    const long n = steps_to_resolve(per / dt, 0, "steps per period");
+    dt = per / static_cast<double>(n);
+    per_steps = static_cast<double>(n);
     L.duration_s = s.periods * per;
   } else {
     L.duration_s = s.duration_s;
@@ -72,6 +100,11 @@ RunLength run_length(const SimulationSettings& s) {
     if (L.duration_s == 0.0 && w.kind == WaveformKind::Chirp) L.duration_s = w.duration_s;
     if (!(L.duration_s > 0.0))
       throw InputError(fmt::format("duration {} s: must be > 0", L.duration_s));
+    if (L.duration_s < dt * (1.0 - 1e-9))
+      throw InputError(fmt::format(
+          "duration = {:g} s (--duration): shorter than one time step ({:g} s); lengthen the run "
+          "or give a shorter --dt",
+          L.duration_s, dt));
   }
   L.grid = StepGrid::covering(0.0, L.duration_s, dt, "simulation");
   const double rows = static_cast<double>(L.grid.steps) / s.record_every + 2.0;
@@ -80,7 +113,38 @@ RunLength run_length(const SimulationSettings& s) {
         "simulation: {} steps recorded every {} give {:.4g} rows (limit {:g}); record less often "
         "(record_every, --record-every) or shorten the run",
         L.grid.steps, s.record_every, rows, kMaxRecordedRows));
+  // The metrics' window (the last period, or the whole run) must hold enough recorded samples.
+  const double window_steps = w.periodic() ? per_steps : static_cast<double>(L.grid.steps);
+  const double samples = std::floor(window_steps / s.record_every) + (w.periodic() ? 0.0 : 1.0);
+  if (samples < kMinMetricSamples)
+    throw InputError(fmt::format(
+        "record_every = {} (--record-every) with {:g} steps {} records {:g} sample(s) there: the "
+        "metrics need at least {:g}; record more often{}",
+        s.record_every, window_steps, w.periodic() ? "per period" : "in the run", samples,
+        kMinMetricSamples, w.periodic() ? "" : " or lengthen the run (--duration)"));
   return L;
+}
+
+// Memory (issue 19, item 7): the recorded series (8 bytes a value) and, for the CLI, its CSV
+// text twice over (the formatting buffer and the string, ~17 characters a value): 42 bytes a
+// value. Refused before the run when that exceeds the memory available, naming the remedy.
+constexpr double kRecordBytesPerValue = 8.0 + 2.0 * 17.0;
+
+void check_record_memory(const Model& m, const SimulationSettings& s, const RunLength& L) {
+  const double rows = static_cast<double>(L.grid.steps) / s.record_every + 2.0;
+  const double columns = 6.0 + 9.0 * static_cast<double>(m.rods.size());
+  const double bytes = rows * columns * kRecordBytesPerValue;
+  if (bytes < 1e8) return;  // below 100 MB: not worth reading /proc
+  const auto avail = memory_available();
+  if (!avail || bytes <= avail->bytes) return;
+  const double factor = std::max(2.0, std::ceil(bytes / (0.5 * avail->bytes)));
+  require_memory(bytes,
+                 fmt::format("simulation: recording {:.4g} rows x {:g} columns ({} steps, every "
+                             "{}-th recorded)",
+                             rows, columns, L.grid.steps, s.record_every),
+                 fmt::format("record less often (--record-every {:g}, record_every) or shorten "
+                             "the run",
+                             static_cast<double>(s.record_every) * factor));
 }
 
 // The slower thermal clock of self-heating (gmasim/self_heating.hpp): accumulates the
@@ -255,7 +319,10 @@ void validate(const Waveform& w) {
         throw InputError(fmt::format("{}: needs equally long, non-empty t_s and current_A", src));
       for (std::size_t k = 0; k < w.table_t_s.size(); ++k) {
         require_finite(w.table_t_s[k], src + ": t_s", "s");
-        current(w.table_current_A[k], "waveform current");
+        if (!(std::fabs(w.table_current_A[k]) <= kMaxCurrent_A))  // named only when it fails
+          current(w.table_current_A[k], fmt::format("{}: sample {} (t = {:g} s): waveform current",
+                                                    src, k + 1, w.table_t_s[k])
+                                            .c_str());
         if (k > 0 && !(w.table_t_s[k] > w.table_t_s[k - 1]))
           throw InputError(fmt::format("{}: time {:g} s does not increase (previous {:g} s)", src,
                                        w.table_t_s[k], w.table_t_s[k - 1]));
@@ -301,6 +368,7 @@ Result simulate(const Model& m, const SimulationSettings& s) {
   const auto& w = s.waveform;
   validate(s);
   const RunLength L = run_length(s);
+  check_record_memory(m, s, L);
   const double duration = L.duration_s;
   const long nsteps = L.grid.steps;
 
@@ -313,6 +381,7 @@ Result simulate(const Model& m, const SimulationSettings& s) {
   const auto wall0 = std::chrono::steady_clock::now();
   try {
     State st = make_state(m, c, w.current_at(0.0));
+    check_physical_validity(m, c, st, 0.0);  // the rest state too (gmasim/validity.hpp)
     record(c, st, r.series);
     heat.begin(c, st, r);
     run_loop(
