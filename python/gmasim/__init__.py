@@ -12,6 +12,12 @@ adds plotting helpers (``gmasim.plots``). Units are SI and named in every key
     gmasim.plots.sweep_vs_temperature(s["points"])
     st = gmasim.Stepper(m, temperature_C=20, dt_s=1e-5)  # sample by sample (docs/c_api.md)
     y_um = st.step(1.5)
+
+Errors: gmasim.InputError (a ValueError: a value out of range, with the rule), TypeError (an
+argument of the wrong type, named), gmasim.DivergenceError (an ArithmeticError: the run
+diverged; simulate() and Stepper.step() both raise it, and simulate's exception carries the
+partial run as its ``result`` attribute). Values far outside Terfenol-D's known range and
+temperatures outside a model's validated range give a UserWarning.
 """
 from ._gmasim import *  # noqa: F401,F403
 from ._gmasim import (FREEZE_LAWS, DivergenceError, InputError, Model, Stepper, ablate, claims,  # noqa: F401
@@ -19,6 +25,13 @@ from ._gmasim import (FREEZE_LAWS, DivergenceError, InputError, Model, Stepper, 
                       thermal_expansion, track)
 from ._gmasim import __git_describe__, __version__  # noqa: F401
 from . import plots  # noqa: F401
+from ._arguments import checked as _checked
+
+# Every function of the extension module checks its arguments' types first, so that a wrong
+# one is a TypeError naming the argument and the expected type (issue 19, item 11).
+simulate, sweep, frf, track, compensate, ablate, params_vs_temperature, thermal_expansion, claims = (
+    _checked(f) for f in (simulate, sweep, frf, track, compensate, ablate, params_vs_temperature,
+                          thermal_expansion, claims))
 
 __all__ = ["Model", "Stepper", "simulate", "sweep", "frf", "track", "compensate", "ablate",
            "params_vs_temperature", "parameter_table",
