@@ -265,3 +265,30 @@ TEST(Hardening, Item11WaveformValuesAreShownExactly) {
   EXPECT_THAT(input_error([&] { validate(w); }),
               HasSubstr("w.csv: sample 2 (t = 0.001 s): waveform current = 1000.0001 A"));
 }
+
+// A quasi-static record has no time: a divergence names the file, the data row and the drive
+// value it was moving to, not "t = 0".
+TEST(Hardening, Item11QuasiStaticDivergenceNamesTheRow) {
+  ModelSpec spec = load_model_spec(std::string(GMASIM_SOURCE_DIR) + "/models/single_rod.toml");
+  spec.set("circuit.branches.coil.coil_turns", 5.0);  // 1000 A x 5 turns: at most ~1e5 A/m
+  const Model m = compile(spec);
+  Measurement rec;
+  rec.path = "loop.csv";
+  rec.condition.temperature_C = 20.0;
+  rec.condition.quasi_static = true;
+  rec.condition.label = "loop";
+  rec.drive_kind = DriveInput::Field;
+  rec.drive = {0.0, 1e3, 2e3, 5e6, 1e3};  // the 4th field is out of reach
+  for (std::size_t k = 0; k < rec.drive.size(); ++k) {
+    rec.t_s.push_back(static_cast<double>(k));
+    rec.response.push_back(0.0);
+  }
+  std::vector<double> y;
+  try {
+    simulate_measurement(m, rec, ObjectiveSettings{}, y);
+    ADD_FAILURE() << "no DivergenceError";
+  } catch (const DivergenceError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("loop.csv: quasi-static record, moving to data row 4 "
+                                    "(field_A_per_m = 5e+06, pass 1 of 1)"));
+  }
+}

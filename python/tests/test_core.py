@@ -93,7 +93,7 @@ def test_every_number_is_checked_before_it_becomes_a_count(mdma, kwargs, message
 
 
 def test_experiment_requests_are_validated(mdma):
-    with pytest.raises(gmasim.InputError, match=r"reference amplitude = 1e\+300 um"):
+    with pytest.raises(gmasim.InputError, match=r"reference amplitude \(--amplitudes\) = 1e\+300 um"):
         gmasim.track(mdma, temperatures_C=[20], amplitudes_um=[1e300])
     with pytest.raises(gmasim.InputError, match="frequency points"):
         gmasim.frf(mdma, temperatures_C=[20], points=2_000_000_000)

@@ -411,14 +411,14 @@ void check_request(const FrfRequest& r) {
                                  r.settle_periods, r.measure_periods));
   if (!r.stepped_sine && !r.small_signal)
     throw InputError("frf: neither the stepped sine nor the small-signal method is selected");
-  for (double T : r.temperatures_C) require_finite(T, "temperature", "degC");
+  for (double T : r.temperatures_C) require_finite(T, "temperature (--temperatures)", "degC");
   if (static_cast<double>(r.temperatures_C.size()) > kMaxListValues)
     throw InputError(fmt::format("frf: {} temperatures: too many (limit {:g})",
                                  r.temperatures_C.size(), kMaxListValues));
-  require_in(r.f_max_Hz, 0.0, kMaxFrequency_Hz, "maximum frequency", "Hz");
-  (void)checked_count(r.points, kMaxFrfPoints, "frequency points");
-  require_in(r.amplitude_A, 0.0, kMaxCurrent_A, "amplitude", "A");
-  require_in(r.bias_A, -kMaxCurrent_A, kMaxCurrent_A, "bias current", "A");
+  require_in(r.f_max_Hz, 0.0, kMaxFrequency_Hz, "maximum frequency (--f-max)", "Hz");
+  (void)checked_count(r.points, kMaxFrfPoints, "frequency points (--points)");
+  require_in(r.amplitude_A, 0.0, kMaxCurrent_A, "amplitude (--amplitude)", "A");
+  require_in(r.bias_A, -kMaxCurrent_A, kMaxCurrent_A, "bias current (--bias)", "A");
   require_int_in(r.settle_periods, 1, 1000000, "settle periods");
   require_int_in(r.measure_periods, 1, 1000000, "measure periods");
   if (r.stepped_sine) {

@@ -99,7 +99,8 @@ RunLength run_length(const SimulationSettings& s) {
     if (L.duration_s == 0.0 && w.kind == WaveformKind::Table) L.duration_s = w.table_t_s.back();
     if (L.duration_s == 0.0 && w.kind == WaveformKind::Chirp) L.duration_s = w.duration_s;
     if (!(L.duration_s > 0.0))
-      throw InputError(fmt::format("duration {} s: must be > 0", L.duration_s));
+      throw InputError(
+          fmt::format("duration = {} s (--duration, duration_s): must be > 0", L.duration_s));
     if (L.duration_s < dt * (1.0 - 1e-9))
       throw InputError(fmt::format(
           "duration = {:g} s (--duration): shorter than one time step ({:g} s); lengthen the run "
@@ -343,12 +344,15 @@ void validate(const SimulationSettings& s) {
   require_finite(s.temperature_C, "temperature", "degC");
   validate(s.waveform);
   if (!(s.dt_s >= 0.0) || !std::isfinite(s.dt_s))
-    throw InputError(fmt::format("dt {} s: must be > 0 (or 0 for the automatic rule)", s.dt_s));
+    throw InputError(
+        fmt::format("dt = {} s (--dt, dt_s): must be > 0 (or 0 for the automatic rule)", s.dt_s));
   if (s.record_every < 1)
-    throw InputError(fmt::format("record_every {}: must be >= 1", s.record_every));
+    throw InputError(
+        fmt::format("record_every = {} (--record-every): must be >= 1", s.record_every));
   if (s.waveform.periodic()) {
     require_finite(s.periods, "periods");
-    if (!(s.periods >= 1.0)) throw InputError(fmt::format("periods {}: must be >= 1", s.periods));
+    if (!(s.periods >= 1.0))
+      throw InputError(fmt::format("periods = {} (--periods): must be >= 1", s.periods));
     require_in(s.periods, 1.0, kMaxPeriods, "periods");
   }
   require_nonnegative(s.duration_s, "duration", "s");
@@ -359,8 +363,9 @@ void validate(const SimulationSettings& s) {
     if (!std::isnan(h.ambient_C))
       require_in(h.ambient_C, -273.15, 1e4, "ambient temperature", "degC");
     if (h.thermal_step_s > 0.0 && h.thermal_step_s < L.grid.dt_s)
-      throw InputError(fmt::format("thermal step {} s: shorter than the time step {} s",
-                                   h.thermal_step_s, L.grid.dt_s));
+      throw InputError(
+          fmt::format("thermal step = {} s (--thermal-step): shorter than the time step {} s",
+                      h.thermal_step_s, L.grid.dt_s));
   }
 }
 

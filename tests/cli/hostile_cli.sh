@@ -103,7 +103,7 @@ ok "5 no output after a refused run" test ! -e s/timeseries.csv
 # ---- 6, 7. lists -------------------------------------------------------------------------
 check "6 range step 1e-300" 2 "range 30:1e-300:70 has .* values \(limit 100000\)" \
   "$B" sweep --temperatures 20,30:1e-300:70 --periods 1 --out sw
-check "7 track --amplitudes 1e300" 2 "reference amplitude = 1e\+300 um: must be in \[0 um, 10000 um\]" \
+check "7 track --amplitudes 1e300" 2 "reference amplitude \(--amplitudes\) = 1e\+300 um: must be in \[0 um, 10000 um\]" \
   "$B" track --amplitudes 1e300 --temperatures 20 --out tr
 ok "7 no track.csv after a refused run" test ! -e tr/track.csv
 
@@ -116,7 +116,7 @@ check "8 k_j = 1e-320" 2 "kj.toml:[0-9]+: rod1.k_j = .*: outside the range of an
 # ---- 9. size limits ---------------------------------------------------------------------
 check "9 model check /dev/zero" 2 "larger than 256 MiB" "$B" model check /dev/zero
 check "9 --resume /dev/zero" 2 "checkpoint is larger than 256 MiB" "${R[@]}" /dev/zero
-check "9 frf --points 2e9" 2 "frequency points = 2e\+09: too many \(limit 100000\)" "$B" frf --points 2000000000 --out f
+check "9 frf --points 2e9" 2 "frequency points \(--points\) = 2e\+09: too many \(limit 100000\)" "$B" frf --points 2000000000 --out f
 printf 't_s,current_A\n100,1\n100.01,2\n' >w_late.csv
 check "9 waveform starting at t = 100 s" 2 "starts at t = 100 s; a waveform table must start at t = 0" \
   "$B" simulate --waveform w_late.csv --out s
