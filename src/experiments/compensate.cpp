@@ -206,7 +206,9 @@ CompensateResult run_compensate(const Model& m, const CompensateRequest& r,
   res.reference = ref.metrics;
   res.target_stroke_um = r.target_stroke_um > 0.0 ? r.target_stroke_um : ref.metrics.stroke_um;
   if (!(res.target_stroke_um > 0.0))
-    throw InputError("compensate: the reference drive gives no stroke (0 um): no target");
+    throw InputError(
+        "compensate: the reference drive (--reference-current-pp, --current-min) gives no stroke "
+        "(0 um): no target; give a drive that moves the actuator");
 
   res.points.resize(r.temperatures_C.size());
   res.threads = resolve_thread_count(r.threads, r.temperatures_C.size());

@@ -107,7 +107,11 @@ RunLength run_length(const SimulationSettings& s) {
           "or give a shorter --dt",
           L.duration_s, dt));
   }
-  L.grid = StepGrid::covering(0.0, L.duration_s, dt, "simulation");
+  L.grid = StepGrid::covering(
+      0.0, L.duration_s, dt,
+      w.kind == WaveformKind::Table && !w.table_source.empty()
+          ? "simulation of " + clip_for_message(w.table_source) + " (its last time)"
+          : std::string("simulation"));
   const double rows = static_cast<double>(L.grid.steps) / s.record_every + 2.0;
   if (rows > kMaxRecordedRows)
     throw InputError(fmt::format(
