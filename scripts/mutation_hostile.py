@@ -332,8 +332,9 @@ def case_absurd_physics(rng, s, bin_, d, timeout):
 
 # ---- concurrent: two runs on one --out --------------------------------------------------------
 def case_concurrent(rng, s, bin_, d, timeout):
-    runs = [["simulate", "--current-pp", repr(rng.choice([4.0, 6.0, 8.0, 10.0])), "--periods",
-             repr(rng.choice([1, 2, 3])), "--frequency", "100", "--out", "o"] for _ in range(2)]
+    periods = repr(rng.choice([1, 2, 3]))  # equally long runs: their renames coincide
+    runs = [["simulate", "--current-pp", repr(pp), "--periods", periods, "--frequency", "100",
+             "--out", "o"] for pp in rng.sample([4.0, 6.0, 8.0, 10.0], 2)]
     if rng.random() < 0.3:
         runs[1] = ["sweep", "--temperatures", "20", "--currents", "8", "--frequencies", "100",
                    "--periods", "1", "--out", "o"]
@@ -381,9 +382,13 @@ def case_signal(rng, s, bin_, d, timeout):
                "--checkpoint", "ck.txt"]
         delay = rng.uniform(0.3, 2.0)
     else:
-        cmd = ["simulate", "--periods", repr(rng.choice([20, 40, 80])), "--frequency", "10",
+        cmd = ["simulate", "--periods", repr(rng.choice([5, 10, 20])), "--frequency", "10",
                "--out", "o"]
-        delay = rng.uniform(0.05, 4.0)
+        # Time one undisturbed run, then signal the next within its second half: the writing
+        # of a 20-80 MB timeseries.csv.
+        t0 = time.monotonic()
+        _run([bin_, *cmd[:-1], "o_timing"], d, timeout)
+        delay = rng.uniform(0.4, 1.0) * (time.monotonic() - t0)
     p = subprocess.Popen([bin_, *cmd], cwd=d, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     rc, sent = _wait_after(p, sig, delay)
     err = p.stderr.read().decode("utf-8", "replace") if p.stderr else ""

@@ -84,7 +84,8 @@ void validate_request(const Model& m, const CompensateRequest& r) {
         r.max_current_A));
   require_in(r.target_stroke_um, 0.0, kMaxTrackAmplitude_um, "target stroke (--target-stroke)",
              "um");
-  if (r.temperatures_C.empty()) throw InputError("compensate: no temperature given");
+  if (r.temperatures_C.empty())
+    throw InputError("compensate: no temperature given (--temperatures): give at least one");
   if (static_cast<double>(r.temperatures_C.size()) > kMaxListValues)
     throw InputError(fmt::format("compensate: {} temperatures (limit {:g})",
                                  r.temperatures_C.size(), kMaxListValues));

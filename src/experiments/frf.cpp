@@ -394,7 +394,8 @@ double find_bandwidth_3dB_Hz(const std::vector<double>& f, const std::vector<dou
 namespace {
 
 void check_request(const FrfRequest& r) {
-  if (r.temperatures_C.empty()) throw InputError("frf: no temperature given");
+  if (r.temperatures_C.empty())
+    throw InputError("frf: no temperature given (--temperatures): give at least one");
   if (!(r.f_min_Hz > 0.0) || !std::isfinite(r.f_min_Hz))
     throw InputError(fmt::format("lowest frequency (--f-min) = {} Hz: must be > 0", r.f_min_Hz));
   if (!(r.f_max_Hz > r.f_min_Hz) || !std::isfinite(r.f_max_Hz))

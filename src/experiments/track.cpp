@@ -90,7 +90,7 @@ struct Job {
 };
 
 void check_positive_list(const std::vector<double>& v, const char* what, const char* unit) {
-  if (v.empty()) throw InputError(fmt::format("track: no {} given", what));
+  if (v.empty()) throw InputError(fmt::format("track: no {} given: give at least one", what));
   for (double x : v)
     if (!(x > 0.0) || !std::isfinite(x))
       throw InputError(fmt::format("{} = {} {}: must be > 0", what, x, unit));
@@ -100,7 +100,8 @@ void check_positive_list(const std::vector<double>& v, const char* what, const c
 }
 
 void check_request(const TrackRequest& r) {
-  if (r.temperatures_C.empty()) throw InputError("track: no temperature given");
+  if (r.temperatures_C.empty())
+    throw InputError("track: no temperature given (--temperatures): give at least one");
   for (double T : r.temperatures_C) require_finite(T, "temperature (--temperatures)", "degC");
   check_positive_list(r.amplitudes_um, "reference amplitude (--amplitudes)", "um");
   check_positive_list(r.frequencies_Hz, "reference frequency (--frequencies)", "Hz");
@@ -136,7 +137,8 @@ void check_request(const TrackRequest& r) {
           "controller cannot see the reference; raise --sample-rate to at least {} Hz",
           r.sample_rate_Hz, f, 2.0 * f));
   if (!(r.current_limit_A > 0.0) || !std::isfinite(r.current_limit_A))
-    throw InputError(fmt::format("current limit {} A: must be > 0", r.current_limit_A));
+    throw InputError(
+        fmt::format("current limit (--current-limit) = {} A: must be > 0", r.current_limit_A));
   if (!(std::fabs(r.bias_A) < r.current_limit_A))
     throw InputError(fmt::format("bias current {} A: must lie inside the current limit +-{} A",
                                  r.bias_A, r.current_limit_A));
