@@ -129,21 +129,25 @@ void check_request(const TrackRequest& r) {
     throw InputError(
         fmt::format("track grid of {:.4g} runs: too many (limit {:g})", runs, kMaxGridRuns));
   if (!(r.sample_rate_Hz > 0.0) || !std::isfinite(r.sample_rate_Hz))
-    throw InputError(fmt::format("PID sample rate {} Hz: must be > 0", r.sample_rate_Hz));
+    throw InputError(
+        fmt::format("PID sample rate (--sample-rate) = {} Hz: must be > 0", r.sample_rate_Hz));
   for (double f : r.frequencies_Hz)
     if (r.sample_rate_Hz < 2.0 * f)
       throw InputError(fmt::format(
-          "PID sample rate {} Hz is below twice the reference frequency {} Hz (Nyquist): the "
+          "PID sample rate (--sample-rate) = {} Hz is below twice the reference frequency {} Hz "
+          "(Nyquist): the "
           "controller cannot see the reference; raise --sample-rate to at least {} Hz",
           r.sample_rate_Hz, f, 2.0 * f));
   if (!(r.current_limit_A > 0.0) || !std::isfinite(r.current_limit_A))
     throw InputError(
         fmt::format("current limit (--current-limit) = {} A: must be > 0", r.current_limit_A));
   if (!(std::fabs(r.bias_A) < r.current_limit_A))
-    throw InputError(fmt::format("bias current {} A: must lie inside the current limit +-{} A",
-                                 r.bias_A, r.current_limit_A));
+    throw InputError(fmt::format(
+        "bias current (--bias) = {} A: must lie inside the current limit (--current-limit) +-{} A",
+        r.bias_A, r.current_limit_A));
   if (!(r.sensor_noise_um >= 0.0) || !std::isfinite(r.sensor_noise_um))
-    throw InputError(fmt::format("sensor noise {} um: must be >= 0", r.sensor_noise_um));
+    throw InputError(
+        fmt::format("sensor noise (--sensor-noise) = {} um: must be >= 0", r.sensor_noise_um));
   if (!(r.periods >= 1.0) || !std::isfinite(r.periods))
     throw InputError(fmt::format("periods {}: must be >= 1", r.periods));
   if (!(r.dt_s >= 0.0) || !std::isfinite(r.dt_s))

@@ -66,13 +66,15 @@ void check_options(const IdentifyOptions& o) {
 // The start model must evaluate: a search from a model that cannot be simulated under
 // these settings would penalise every candidate alike and end "successfully" with nothing
 // determined (issue 8). A candidate that fails later is penalised; the start is not.
-void check_start_evaluates(const Objective& obj, const std::vector<double>& u_start,
-                           double f_start) {
+void check_start_evaluates(const Objective& obj, const std::vector<double>& u_start, double f_start,
+                           const std::string& source) {
   if (f_start < Objective::kPenalty) return;
   const std::string why = obj.failure_reason(u_start);
-  throw InputError(fmt::format("the start model cannot be evaluated: {}{}",
-                               why.empty() ? "its error is not finite" : why,
-                               "; fix the start model or the settings before searching"));
+  throw InputError(fmt::format(
+      "the start model {} (--model) cannot be evaluated on the data and targets (--data, "
+      "--fit): {}{}",
+      source, why.empty() ? "its error is not finite" : why,
+      "; fix the start model or the settings before searching"));
 }
 
 // Levenberg-Marquardt from the GA's best (u, f), which it replaces when it is better; its
@@ -161,7 +163,7 @@ IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, cons
   const std::vector<double> u_start = obj.start_unit();
   const double f_start = obj.rms_pct(u_start);
   res.start_rms_pct = f_start;
-  check_start_evaluates(obj, u_start, f_start);
+  check_start_evaluates(obj, u_start, f_start, start.source);
 
   // ---- global search, local refinement ------------------------------------------------
   const GaOutcome ga = run_ga(obj, o, comm, u_start, f_start);

@@ -111,7 +111,7 @@ RunLength run_length(const SimulationSettings& s) {
       0.0, L.duration_s, dt,
       w.kind == WaveformKind::Table && !w.table_source.empty()
           ? "simulation of " + clip_for_message(w.table_source) + " (its last time)"
-          : std::string("simulation"));
+          : std::string("simulation (--dt, --duration or --periods)"));
   const double rows = static_cast<double>(L.grid.steps) / s.record_every + 2.0;
   if (rows > kMaxRecordedRows)
     throw InputError(fmt::format(

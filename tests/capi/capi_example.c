@@ -104,6 +104,15 @@ static void error_paths(const gmasim_model* model) {
   CHECK_STATUS(gmasim_sim_create(model, 400.0, 1e-5, 0.0, &sim), GMASIM_E_INPUT);
   CHECK(strstr(gmasim_last_error(), "Curie") != NULL, "message: %s", gmasim_last_error());
   CHECK_STATUS(gmasim_sim_create(model, 20.0, 0.5, 0.0, &sim), GMASIM_E_INPUT);
+  /* Issue 19, item 2: below GMASIM_MIN_DT_S (1e-29 s took y to 0; a denormal step gave
+   * "nodal matrix = 0"). */
+  CHECK_STATUS(gmasim_sim_create(model, 20.0, 1e-29, 0.0, &sim), GMASIM_E_INPUT);
+  CHECK(strstr(gmasim_last_error(), "must be >= 1e-12 s") != NULL, "message: %s",
+        gmasim_last_error());
+  CHECK_STATUS(gmasim_sim_create(model, 20.0, 4.9e-324, 0.0, &sim), GMASIM_E_INPUT);
+  CHECK_STATUS(gmasim_sim_create(model, 20.0, GMASIM_MIN_DT_S, 0.0, &sim), GMASIM_OK);
+  gmasim_sim_free(sim);
+  sim = NULL;
   CHECK_STATUS(gmasim_sim_create(model, 20.0, 1e-5, 0.0, &sim), GMASIM_OK);
   if (!sim) return;
   CHECK_STATUS(gmasim_sim_step(sim, not_a_number), GMASIM_E_ARGUMENT);

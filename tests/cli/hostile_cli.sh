@@ -143,7 +143,7 @@ check "11 undated record without --dt" 2 "steps of 1e-05 s over the record's 400
   "$B" identify --data d/m_undated.toml --fit 'material.lambda_s:0.8e-3:1.2e-3' --out m6.toml \
   --population 8 --generations 1 --no-plots --quiet
 sed 's/^coil_turns = 720.0 /coil_turns = 7.2e9 /' "$SRC/models/mdma.toml" >start_div.toml
-check "11 a start model that diverges stops the run" 2 "the start model cannot be evaluated: diverged" \
+check "11 a start model that diverges stops the run" 2 "the start model start_div.toml \(--model\) cannot be evaluated on the data and targets \(--data, --fit\): diverged" \
   "$B" "${ID[@]}" --model start_div.toml --out m7.toml --generations 1
 
 # ---- 12. simulate writes one set ---------------------------------------------------------
