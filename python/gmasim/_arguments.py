@@ -58,7 +58,12 @@ def _is_numbers_1d(v) -> bool:
 
 
 def _is_strings(v) -> bool:
-    return isinstance(v, (list, tuple)) and all(isinstance(x, str) for x in v)
+    if isinstance(v, (str, bytes, dict)):
+        return False
+    try:
+        return all(isinstance(x, (str, np.str_)) for x in v)
+    except TypeError:
+        return False
 
 
 # pybind11 type text -> (check, what it must be)
