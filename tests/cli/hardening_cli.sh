@@ -13,7 +13,7 @@ cd "$T"
 source "$SRC/tests/cli/check_lib.sh"
 # ulimit -v does not mix with AddressSanitizer's shadow memory: those checks need a plain build.
 SANITIZED=0
-if grep -q "AddressSanitizer" "$B" 2>/dev/null; then SANITIZED=1; fi
+if ldd "$B" 2>/dev/null | grep -q libasan || grep -aq __asan_init "$B" 2>/dev/null; then SANITIZED=1; fi
 sha() { sha256sum "$1" | cut -d' ' -f1; }
 unchanged() {  # name, file, the hash it had
   ok "$1" test "$(sha "$2")" = "$3"
