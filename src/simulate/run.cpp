@@ -182,10 +182,11 @@ struct SelfHeatingRun {
     interval_s = static_cast<double>(steps_per_interval) * L.grid.dt_s;
     const double tau = fastest_time_constant_s(*net);
     if (interval_s > tau)
-      throw InputError(fmt::format(
-          "thermal step {:.4g} s: longer than the thermal network's fastest time constant "
-          "{:.4g} s (min C/G over coil, rods, housing); shorten the thermal step",
-          interval_s, tau));
+      throw InputError(
+          fmt::format("thermal step (--thermal-step) = {:.4g} s: longer than the thermal network's "
+                      "fastest time constant "
+                      "{:.4g} s (min C/G over coil, rods, housing); shorten the thermal step",
+                      interval_s, tau));
     T = T0 = {s.temperature_C, s.temperature_C, s.temperature_C};
     const std::size_t n = m.rods.size();
     volume_m3.assign(n, 0.0);
