@@ -11,8 +11,12 @@ with a time limit, and classifies the outcome:
     crash     killed by a signal, exit >= 128, exit 4 (internal error), or a sanitizer report
     hang      the time limit was reached
     nonsense  exit 0, but an output file or the summary holds NaN or Inf
-    unclear   exit 1 or 2 whose message names neither the mutated file nor a flag nor a value
+    unclear   exit 1 or 2 whose message names no file:line, flag or key, or states no rule
     ok        exit 0 with finite outputs, or a clear refusal (1, 2), or a diagnosed divergence (3)
+
+Issue 19 added six hostile classes (scripts/mutation_hostile.py, judged by the issue's rules:
+outputs equal to inputs, tiny and denormal steps, absurd but finite physics, concurrent runs on
+one output, signals during writes, resource limits); `--classes issue19` runs only those.
 
 It writes OUT/campaign.csv (one row per run), OUT/summary.json, and keeps the inputs of every
 finding under OUT/findings/. Exit 0 if there are no crashes, hangs or nonsense. Standard
@@ -34,6 +38,8 @@ import sys
 import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "scripts"))
+import mutation_hostile as hostile  # noqa: E402
 
 HOSTILE_NUMBERS = ["nan", "NaN", "inf", "-inf", "1e300", "-1e300", "1e-300", "1e-320", "0", "-0",
                    "-1", "2e9", "9223372036854775808", "1e18", "+-1", "0x10", "1e", "", "  ",
@@ -171,10 +177,11 @@ def case(kind: str, rng: random.Random, s: dict, d: pathlib.Path) -> tuple[list[
         args[args.index(flag) + 1] = value
     else:
         args += [flag, value]
-    if sub == "simulate" and flag in ("--level", "--step-to", "--step-time"):
-        args += ["--waveform-kind", "step", "--duration", "0.01"]
-    if sub == "simulate" and flag in ("--f0", "--f1", "--amplitude", "--offset"):
-        args += ["--waveform-kind", "chirp", "--duration", "0.01"]
+    if sub == "simulate" and flag in ("--level", "--step-to", "--step-time", "--f0", "--f1",
+                                      "--amplitude", "--offset"):
+        # A sine's flags would contradict the step or chirp (a usage error since issue 19).
+        kind = "step" if flag in ("--level", "--step-to", "--step-time") else "chirp"
+        args = [flag, value, "--waveform-kind", kind, "--duration", "0.01"]
     return [sub, *args, "--out", "o"], ""
 
 
@@ -201,24 +208,29 @@ def classify(rc: int | None, out: str, err: str, d: pathlib.Path, mutated: str,
         return "ok", "accepted"
     if rc == 3:  # a divergence must name its time (and rod, quantity) on stderr
         return ("ok", "diverged") if "diverged at t =" in err else ("unclear", err.strip()[:200])
-    if rc in (1, 2):
+    if rc in (1, 2):  # the issue-19 test: names a file:line, flag or key, and states a rule
         msg = err.strip()
-        clear = (mutated and mutated in msg) or "--" in msg or "=" in msg or ":" in msg
-        return ("ok", "refused") if clear and len(msg) < 5000 else ("unclear", msg[:200])
+        clear = hostile.clear_message(err)
+        return ("ok", "refused") if clear else ("unclear", msg[:200])
     return "unclear", f"exit {rc}: {err.strip()[:200]}"
 
 
-def one(i: int, kind: str, seed: int, s: dict, bin_: str, timeout: float, keep: pathlib.Path):
+def one(i: int, kind: str, seed: int, s: dict, bin_: str, timeout: float, keep: pathlib.Path,
+        py_env: dict):
     rng = random.Random(seed * 1_000_003 + i)
     with tempfile.TemporaryDirectory(prefix="gmasim_mut_") as tmp:
         d = pathlib.Path(tmp)
-        cmd, mutated = case(kind, rng, s, d)
-        try:
-            p = subprocess.run([bin_, *cmd], cwd=d, capture_output=True, timeout=timeout)
-            rc, out, err = p.returncode, p.stdout.decode("utf-8", "replace"), p.stderr.decode("utf-8", "replace")
-        except subprocess.TimeoutExpired:
-            rc, out, err = None, "", ""
-        verdict, why = classify(rc, out, err, d, mutated, cmd)
+        rc, err = "", ""
+        if kind in hostile.KINDS:
+            verdict, why, cmd = hostile.run_case(kind, rng, s, bin_, d, timeout, py_env)
+        else:
+            cmd, mutated = case(kind, rng, s, d)
+            try:
+                p = subprocess.run([bin_, *cmd], cwd=d, capture_output=True, timeout=timeout)
+                rc, out, err = p.returncode, p.stdout.decode("utf-8", "replace"), p.stderr.decode("utf-8", "replace")
+            except subprocess.TimeoutExpired:
+                rc, out, err = None, "", ""
+            verdict, why = classify(rc, out, err, d, mutated, cmd)
         if verdict != "ok":
             dest = keep / f"{i:05d}_{kind}_{verdict}"
             shutil.copytree(d, dest, dirs_exist_ok=True)
@@ -235,6 +247,8 @@ def main(argv=None) -> int:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--timeout", type=float, default=60.0, help="seconds per run")
     ap.add_argument("--out", default=str(ROOT / "out/mutation"))
+    ap.add_argument("--classes", choices=["all", "mutation", "issue19"], default="all",
+                    help="the mutation classes of issue 8, the hostile classes of issue 19, or both")
     a = ap.parse_args(argv)
     if not 1 <= a.runs <= 10_000_000 or not 1 <= a.jobs <= 256 or not 0 < a.timeout <= 3600:
         print("mutation_campaign.py: --runs 1..1e7, --jobs 1..256, --timeout (0, 3600] s", file=sys.stderr)
@@ -249,12 +263,18 @@ def main(argv=None) -> int:
     shutil.copy2(pathlib.Path(a.bin).resolve(), bin_)
     with tempfile.TemporaryDirectory(prefix="gmasim_seed_") as tmp:
         s = seeds(pathlib.Path(tmp), bin_)
-    kinds = ["model"] * 30 + ["waveform"] * 15 + ["measurement"] * 10 + ["manifest"] * 8 + \
+    kinds = []
+    if a.classes != "issue19":
+        kinds += ["model"] * 30 + ["waveform"] * 15 + ["measurement"] * 10 + ["manifest"] * 8 + \
             ["fit"] * 10 + ["checkpoint"] * 10 + ["flags"] * 17
+    if a.classes != "mutation":
+        kinds += ["same_file"] * 10 + ["tiny_step"] * 10 + ["absurd_physics"] * 10 + \
+            ["concurrent"] * 5 + ["signal"] * 5 + ["rlimit"] * 5
+    py_env = dict(os.environ, PYTHONPATH=str(pathlib.Path(a.bin).resolve().parent.parent / "python"))
     plan = [(i, random.Random(a.seed * 7919 + i).choice(kinds)) for i in range(a.runs)]
     rows = []
     with cf.ThreadPoolExecutor(max_workers=a.jobs) as ex:
-        futs = [ex.submit(one, i, k, a.seed, s, bin_, a.timeout, keep) for i, k in plan]
+        futs = [ex.submit(one, i, k, a.seed, s, bin_, a.timeout, keep, py_env) for i, k in plan]
         for n, f in enumerate(cf.as_completed(futs), 1):
             rows.append(f.result())
             if n % 250 == 0:

@@ -4,11 +4,13 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "alloc_counter.hpp"
@@ -249,6 +251,54 @@ TEST(CApi, NullHandlesAndPointersAreArgumentErrors) {
   const char* name = nullptr;
   EXPECT_EQ(gmasim_model_rod_name(m.get(), 3, &name), GMASIM_E_ARGUMENT);
   EXPECT_THAT(gmasim_model_last_error(m.get()), HasSubstr("rod index 3"));
+}
+
+// Issue 19, item 12: a freed handle, a handle of the other type or a forged one is refused with
+// GMASIM_E_ARGUMENT; a double free is an error code, not an abort in glibc. Many handles made
+// and freed from several threads stay distinct and live exactly until freed.
+TEST(CApi, FreedAndUnknownHandlesAreErrorCodes) {
+  gmasim_model* m = nullptr;
+  ASSERT_EQ(gmasim_model_load(nullptr, &m), GMASIM_OK);
+  gmasim_sim* s = nullptr;
+  ASSERT_EQ(gmasim_sim_create(m, 20.0, 1e-5, 0.0, &s), GMASIM_OK);
+  EXPECT_EQ(gmasim_model_free(m), GMASIM_OK);
+  EXPECT_EQ(gmasim_model_free(m), GMASIM_E_ARGUMENT);
+  EXPECT_THAT(gmasim_last_error(), HasSubstr("gmasim_model_free: model = "));
+  EXPECT_THAT(gmasim_last_error(), HasSubstr("not a live gmasim_model handle (freed already"));
+  int n = 0;
+  EXPECT_EQ(gmasim_model_rod_count(m, &n), GMASIM_E_ARGUMENT);
+  EXPECT_EQ(gmasim_sim_step(s, 1.0), GMASIM_OK);  // the sim keeps its model alive
+  EXPECT_EQ(gmasim_sim_free(s), GMASIM_OK);
+  double v = 0.0;
+  EXPECT_EQ(gmasim_sim_y_m(s, &v), GMASIM_E_ARGUMENT);
+  EXPECT_EQ(gmasim_sim_free(s), GMASIM_E_ARGUMENT);
+  EXPECT_STRNE(gmasim_sim_last_error(s), "");
+  EXPECT_EQ(gmasim_sim_free(reinterpret_cast<gmasim_sim*>(0x1)), GMASIM_E_ARGUMENT);
+  EXPECT_EQ(gmasim_model_free(reinterpret_cast<gmasim_model*>(&v)), GMASIM_E_ARGUMENT);
+
+  std::vector<std::thread> pool;
+  std::atomic<int> bad{0};
+  for (int t = 0; t < 4; ++t)
+    pool.emplace_back([&bad] {
+      std::vector<gmasim_model*> mine;
+      for (int k = 0; k < 50; ++k) {
+        gmasim_model* h = nullptr;
+        if (gmasim_model_load(nullptr, &h) != GMASIM_OK) ++bad;
+        mine.push_back(h);
+        if (k % 3 == 0) {  // free some early: their slots are reused by later loads
+          if (gmasim_model_free(h) != GMASIM_OK) ++bad;
+          if (gmasim_model_free(h) != GMASIM_E_ARGUMENT) ++bad;
+          mine.back() = nullptr;
+        }
+      }
+      for (gmasim_model* h : mine) {
+        int rods = 0;
+        if (h && (gmasim_model_rod_count(h, &rods) != GMASIM_OK || rods != 3)) ++bad;
+        if (gmasim_model_free(h) != GMASIM_OK) ++bad;
+      }
+    });
+  for (auto& th : pool) th.join();
+  EXPECT_EQ(bad.load(), 0);
 }
 
 TEST(CApi, BadNumbersAreRefusedAndLeaveTheSimUntouched) {

@@ -142,7 +142,7 @@ TEST(Sweep, BadRequestsAreClearInputErrors) {
             std::string::npos);
   EXPECT_NE(run([](SweepRequest& r) {
               r.frequencies_Hz = {10, 0};
-            }).find("frequency 0 Hz: must be > 0"),
+            }).find("frequency (--frequencies) = 0 Hz: must be > 0"),
             std::string::npos);
   EXPECT_NE(run([](SweepRequest& r) { r.frequencies_Hz = {-5}; }).find("must be > 0"),
             std::string::npos);

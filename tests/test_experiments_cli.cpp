@@ -63,7 +63,7 @@ TEST(ExperimentsCli, BadRequestsExitWithCode2AndSayWhy) {
   const std::string out = " --out " + dir.string();
   std::string text;
   EXPECT_EQ(run_cli("sweep --frequencies 0" + out, text), 2);
-  EXPECT_NE(text.find("frequency 0 Hz: must be > 0"), std::string::npos) << text;
+  EXPECT_NE(text.find("frequency (--frequencies) = 0 Hz: must be > 0"), std::string::npos) << text;
   EXPECT_EQ(run_cli("sweep --temperatures ''" + out, text), 2);
   EXPECT_NE(text.find("empty grid"), std::string::npos) << text;
   EXPECT_EQ(run_cli("sweep --temperatures 20,abc" + out, text), 2);

@@ -40,13 +40,13 @@ namespace {
 FitSpec eight_parameters() {
   return parse_fit_spec(R"(
 [[parameter]]
-name = "rod1.ja.k0"
+name = "rod1.ja.k0_A_per_m"
 lower = 1500.0
 upper = 6000.0
 scale = "log"
 start = 3500.0
 [[parameter]]
-name = "rod1.ja.a0"
+name = "rod1.ja.a0_A_per_m"
 lower = 3000.0
 upper = 12000.0
 scale = "log"
@@ -69,7 +69,7 @@ upper = 3.0
 scale = "log"
 start = 0.9
 [[parameter]]
-name = "material.beta"
+name = "material.beta_per_K"
 lower = -4e-5
 upper = -2e-6
 scale = "log"
@@ -81,7 +81,7 @@ upper = 50.0
 scale = "log"
 start = 17.0
 [[parameter]]
-name = "rod1.damping"
+name = "rod1.damping_N_s_per_m"
 lower = 50.0
 upper = 1500.0
 scale = "log"
@@ -331,7 +331,7 @@ TEST(Identify, SyntheticTwelveConditionsRecoverEightParameters) {
     EXPECT_THAT(back.params.at(p.name).provenance, HasSubstr("identified: gmasim identify"));
   }
   EXPECT_THAT(text, HasSubstr("# command: gmasim identify --data manifest.toml"));
-  EXPECT_EQ(back.get("rod2.ja.k0"), 4808.0);  // untouched values stay
+  EXPECT_EQ(back.get("rod2.ja.k0_A_per_m"), 4808.0);  // untouched values stay
   const std::string json = fit_report_json(r, prov);
   EXPECT_THAT(json, HasSubstr("\"ci95\": ["));
   EXPECT_THAT(json, HasSubstr("\"correlation\": ["));
@@ -344,7 +344,7 @@ TEST(Identify, CheckpointRoundTripAndResumeNeverWorse) {
   rq.temperatures_C = {20, 70};
   rq.currents_pp_A = {8};
   const MeasurementSet set = synthesize_measurements(mdma(), rq);
-  const FitSpec fit = load_fit_spec("rod1.ja.k0:1500:6000:log,material.chi_m:8:50:log");
+  const FitSpec fit = load_fit_spec("rod1.ja.k0_A_per_m:1500:6000:log,material.chi_m:8:50:log");
   IdentifyOptions o = ci_options();
   o.refine = false;
   o.generations = 6;
@@ -368,7 +368,7 @@ TEST(Identify, CheckpointRoundTripAndResumeNeverWorse) {
   EXPECT_GE(b.history.size(), a.history.size());
   // Another fit spec cannot resume it.
   IdentifyOptions o3 = o2;
-  const FitSpec other = load_fit_spec("rod1.ja.k0:1500:6000:log,material.chi_m:8:60:log");
+  const FitSpec other = load_fit_spec("rod1.ja.k0_A_per_m:1500:6000:log,material.chi_m:8:60:log");
   EXPECT_THAT(input_error([&] { (void)identify(printed_spec(), set, other, o3); }),
               HasSubstr("other fitted parameters or bounds"));
   std::ofstream(o.checkpoint_path) << "gmasim-identify-checkpoint 1\nfp_parameters x\n";
@@ -382,13 +382,16 @@ TEST(Identify, StopFlagEndsCleanlyWithTheBestSoFar) {
   rq.frequencies_Hz = {100};
   const MeasurementSet set = synthesize_measurements(mdma(), rq);
   const FitSpec fit = load_fit_spec("material.chi_m:8:50:log");
-  std::atomic<bool> stop{true};  // as if SIGINT came during the first epoch
+  std::atomic<bool> stop{true};  // as if SIGINT came during the first population
   IdentifyOptions o = ci_options();
   o.generations = 100;
   o.stop = &stop;
   const IdentifyResult r = identify(printed_spec(), set, fit, o);
   EXPECT_TRUE(r.interrupted);
-  EXPECT_EQ(r.generations_done, o.migrate_every);
+  // Issue 19, item 4: the stop takes effect within one evaluation, so not even the first
+  // population is finished (it used to run the whole first epoch: generations_done ==
+  // migrate_every); the best so far is the start model.
+  EXPECT_EQ(r.generations_done, 0);
   EXPECT_LE(r.rms_pct, r.start_rms_pct);
   EXPECT_EQ(r.parameters.size(), 1u);
 }

@@ -184,13 +184,14 @@ TEST(Measurements, WrittenSetReadsBackBitForBit) {
 
 // ---- fit spec -------------------------------------------------------------------------
 TEST(FitSpec, InlineAndTomlForms) {
-  const FitSpec a = load_fit_spec("rod1.ja.k0:1000:8000:log,material.chi_m:5:40");
+  const FitSpec a = load_fit_spec("rod1.ja.k0_A_per_m:1000:8000:log,material.chi_m:5:40");
   ASSERT_EQ(a.parameters.size(), 2u);
   EXPECT_EQ(a.parameters[0].scale, ParamScale::Log);
   EXPECT_EQ(a.parameters[1].scale, ParamScale::Linear);
   EXPECT_DOUBLE_EQ(a.parameters[1].upper, 40.0);
   const FitSpec b = parse_fit_spec(
-      "[[parameter]]\nname = \"material.beta\"\nlower = -3e-5\nupper = -1e-6\nscale = \"log\"\n"
+      "[[parameter]]\nname = \"material.beta_per_K\"\nlower = -3e-5\nupper = -1e-6\nscale = "
+      "\"log\"\n"
       "[[target]]\nkind = \"stroke_change_pct\"\ntemperature_C = 70.0\ncurrent_pp_A = 6.0\n"
       "frequency_Hz = 10.0\nvalue = -11.3\n",
       "spec.toml");
@@ -219,7 +220,7 @@ TEST(FitSpec, RejectsBadSpecsWithLine) {
               HasSubstr("s.toml:5: unknown key 'uper' in [[parameter]]"));
   EXPECT_THAT(input_error([] { (void)parse_fit_spec("[[target]]\nkind = \"speed\"\n", "s.toml"); }),
               HasSubstr("s.toml:1: [[target]]: kind must be one of"));
-  EXPECT_THAT(input_error([] { (void)load_fit_spec("rod1.ja.k0:1000"); }),
+  EXPECT_THAT(input_error([] { (void)load_fit_spec("rod1.ja.k0_A_per_m:1000"); }),
               HasSubstr("has 2 fields"));
   // Names and bounds are checked against the model.
   const MeasurementSet none;

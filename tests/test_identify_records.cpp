@@ -243,7 +243,7 @@ TEST(Records, RelativeStrainFitsOnlyWithItsOffsetRule) {
   const ModelSpec spec =
       load_model_spec(std::string(GMASIM_SOURCE_DIR) + "/models/single_rod.toml");
   FitSpec fit;
-  fit.parameters.push_back({"rod.ja.k0", 1000.0, 9000.0, ParamScale::Log, false, 0.0, 1});
+  fit.parameters.push_back({"rod.ja.k0_A_per_m", 1000.0, 9000.0, ParamScale::Log, false, 0.0, 1});
   auto rms_at_truth = [&](OffsetMode written, OffsetMode declared, double shift) {
     SyntheticRequest q = r;
     q.offset = written;
@@ -368,7 +368,7 @@ TEST(Records, BadRecordsAreRefusedWithFileLineAndRule) {
   MeasurementSet set;
   set.items.push_back(load_measurement_csv(path));
   FitSpec fit;
-  fit.parameters.push_back({"rod1.ja.k0", 1000.0, 9000.0, ParamScale::Log, false, 0.0, 1});
+  fit.parameters.push_back({"rod1.ja.k0_A_per_m", 1000.0, 9000.0, ParamScale::Log, false, 0.0, 1});
   const std::string msg =
       input_error([&] { (void)Objective(builtin_model_spec(), set, fit, ObjectiveSettings{}); });
   EXPECT_THAT(msg,

@@ -178,21 +178,35 @@ TEST(ModelFile, LoadFromFileUsesPathAsSource) {
 // =======================================================================================
 // ModelSpec::get / set / line_of
 // =======================================================================================
-TEST(ModelSpecAccess, GetExactAndByPrefix) {
+// Issue 19, item 9: a dimensional key must carry its unit suffix; without it the name is
+// refused with the suffixed name suggested (it used to resolve, and `--set rod1.length=50` read
+// 50 m unseen). A dimensionless key's own name needs no suffix; an unambiguous abbreviation of a
+// dimensionless key ("material.lambda" for lambda_s) still resolves.
+TEST(ModelSpecAccess, GetExactNamesAndRefuseUnitlessDimensionalKeys) {
   const auto spec = fixture_spec();
   EXPECT_EQ(spec.get("rod1.ja.k0_A_per_m"), 3032.0);
-  EXPECT_EQ(spec.get("rod1.ja.k0"), 3032.0);
-  EXPECT_EQ(spec.get("material.Ms"), 7.65e5);
-  EXPECT_EQ(spec.get("mechanics.sleeves.t1.A2"), 27.178e-6);
+  EXPECT_EQ(spec.get("material.Ms_A_per_m"), 7.65e5);
+  EXPECT_EQ(spec.get("mechanics.sleeves.t1.A2_m2"), 27.178e-6);
   EXPECT_EQ(spec.get("circuit.reluctances_per_H.R_pm"), 1.88e6);
-  EXPECT_EQ(spec.line_of("rod1.ja.k0"), line_of(builtin_text(), "k0_A_per_m = 3032.0"));
+  EXPECT_EQ(spec.get("material.lambda"), spec.get("material.lambda_s"));
+  EXPECT_EQ(spec.get("material.chi_m"), 19.84);
+  EXPECT_THAT(input_error([&] { (void)spec.get("rod1.ja.k0"); }),
+              HasSubstr("parameter 'rod1.ja.k0' has a unit: write 'rod1.ja.k0_A_per_m' (the "
+                        "value in A/m)"));
+  EXPECT_THAT(input_error([&] { (void)spec.get("material.Ms"); }),
+              HasSubstr("write 'material.Ms_A_per_m'"));
+  auto changed = spec;
+  EXPECT_THAT(input_error([&] { changed.set("rod1.length", 50.0); }),
+              HasSubstr("write 'rod1.length_m' (the value in m)"));
+  EXPECT_EQ(changed.get("rod1.length_m"), 0.030);  // unchanged
+  EXPECT_EQ(spec.line_of("rod1.ja.k0_A_per_m"), line_of(builtin_text(), "k0_A_per_m = 3032.0"));
   EXPECT_EQ(spec.line_of("options.stress_sign"), line_of(builtin_text(), "stress_sign = "));
   EXPECT_EQ(spec.line_of("no.such.thing"), 0);
 }
 
 TEST(ModelSpecAccess, SetChangesOnlyTheValue) {
   auto spec = fixture_spec();
-  spec.set("rod2.ja.k0", 5000.0);
+  spec.set("rod2.ja.k0_A_per_m", 5000.0);
   const auto& pv = spec.params.at("rod2.ja.k0_A_per_m");
   EXPECT_EQ(pv.value, 5000.0);
   EXPECT_EQ(spec.unit_of("rod2.ja.k0_A_per_m"), "A/m");
@@ -223,13 +237,13 @@ TEST(ModelSpecAccess, AmbiguousPrefix) {
 
 TEST(ModelSpecAccess, SetRejectsValuesBreakingTheRules) {
   auto spec = fixture_spec();
-  EXPECT_THAT(input_error([&] { spec.set("rod1.length", -1.0); }),
+  EXPECT_THAT(input_error([&] { spec.set("rod1.length_m", -1.0); }),
               HasSubstr("rod1.length_m = -1 m: must be > 0"));
   EXPECT_EQ(spec.get("rod1.length_m"), 0.030);  // unchanged
-  EXPECT_THAT(input_error([&] { spec.set("rod1.outer_diameter", 0.01); }),
+  EXPECT_THAT(input_error([&] { spec.set("rod1.outer_diameter_m", 0.01); }),
               HasSubstr("rod1.inner_diameter_m = 0.015 m: must be < rod1.outer_diameter_m"));
   EXPECT_EQ(spec.get("rod1.outer_diameter_m"), 0.020);
-  EXPECT_THAT(input_error([&] { spec.set("material.Ms", std::nan("")); }),
+  EXPECT_THAT(input_error([&] { spec.set("material.Ms_A_per_m", std::nan("")); }),
               HasSubstr("NaN is not allowed"));
 }
 

@@ -230,7 +230,8 @@ TEST(Compensate, UnreachableTargetsAndBadRequestsAreReported) {
   refused([](auto& q) { q.temperatures_C = {400.0}; }, "Curie");
   refused([](auto& q) { q.temperatures_C = {70.0, 20.0}; }, "must increase");
   refused([](auto& q) { q.max_current_A = 4.0; }, "beyond the maximum current");
-  refused([](auto& q) { q.max_current_A = 2.0; }, "current minimum = -3 A: must be in");
+  refused([](auto& q) { q.max_current_A = 2.0; },
+          "current minimum (--current-min) = -3 A: must be in");
   refused([](auto& q) { q.reference_current_pp_A = 0.0; }, "must be > 0");
   refused([](auto& q) { q.target_stroke_um = 1e300; }, "target stroke");
   refused([](auto& q) { q.tolerance_um = 0.0; }, "stroke tolerance");

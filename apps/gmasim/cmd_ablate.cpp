@@ -21,8 +21,9 @@ struct AblateArgs {
 
 int run_ablate_cmd(AblateArgs& a) {
   const Model model = load_model_args(a.model);
+  warn_temperatures(model, {a.req.temperature_C}, "--temperature");
   a.req.frequencies_Hz = parse_list(a.frequencies, "--frequencies", "Hz");
-  ensure_output_dir(a.out);
+  prepare_output_dir(a.out, {"ablate"}, model_inputs(a.model));
   const AblateResult res = run_ablate(model, a.req);
   auto files = write_report(a.out, "ablate", ablate_report(model, a.req, res));
 

@@ -72,6 +72,8 @@ void print_track(const CompensatedTrack& t) {
 int run_compensate_cmd(CompensateArgs& a) {
   const Model model = load_model_args(a.model);
   a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
+  warn_temperatures(model, a.req.temperatures_C, "--temperatures");
+  warn_temperatures(model, {a.req.reference_temperature_C}, "--reference-temperature");
   a.req.adjust = parse_compensation_adjust(a.adjust);
   if (!a.no_track) {
     a.track.temperatures_C = a.track_temperatures.empty()
@@ -81,7 +83,7 @@ int run_compensate_cmd(CompensateArgs& a) {
     a.track.frequencies_Hz = parse_list(a.track_frequencies, "--track-frequencies", "Hz");
     a.track.threads = a.req.threads;
   }
-  ensure_output_dir(a.out);
+  prepare_output_dir(a.out, {"compensate"}, model_inputs(a.model));
   const CompensateResult res =
       run_compensate(model, a.req, stderr_progress("compensate", a.progress));
   std::unique_ptr<CompensatedTrack> tr;

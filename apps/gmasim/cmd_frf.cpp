@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <cmath>
-
 #include <complex>
 #include <memory>
 
@@ -21,8 +20,7 @@ constexpr double kDeg = 3.14159265358979323846 / 180.0;
 struct FrfArgs {
   bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
   ModelArgs model;
-  std::string out = "out/frf", temperatures = "20,70", method = "both",
-                     bias_state = "anhysteretic";
+  std::string out = "out/frf", temperatures = "20,70", method = "both", bias_state = "anhysteretic";
   FrfRequest req;
   bool progress = false;
 };
@@ -46,11 +44,12 @@ void print_resonance_change(const FrfResult& res) {
 int run_frf_cmd(FrfArgs& a) {
   const Model model = load_model_args(a.model);
   a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
+  warn_temperatures(model, a.req.temperatures_C, "--temperatures");
   a.req.stepped_sine = a.method != "linear";
   a.req.small_signal = a.method != "stepped";
   a.req.bias_state =
       a.bias_state == "initial-curve" ? BiasState::InitialCurve : BiasState::Anhysteretic;
-  ensure_output_dir(a.out);
+  prepare_output_dir(a.out, {"frf"}, model_inputs(a.model));
   const FrfResult res = run_frf(model, a.req, stderr_progress("frf", a.progress));
   auto files = write_report(a.out, "frf", frf_report(model, a.req, res));
 

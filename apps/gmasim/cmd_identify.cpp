@@ -32,7 +32,8 @@ std::atomic<bool> g_stop{false};
 
 extern "C" void on_stop_signal(int sig) {
   g_stop.store(true);
-  std::signal(sig, SIG_DFL);  // a second signal ends the process at once
+  // A second signal ends the process at once (after removing the temporaries of a write).
+  install_fatal_signal_handler(sig);
 }
 
 struct IdentifyArgs {
@@ -74,6 +75,30 @@ std::string command_line() {
 int env_int(const char* name, int fallback) {
   const char* v = std::getenv(name);
   return v ? std::atoi(v) : fallback;
+}
+
+// What identify reads: the start model, the manifest and its measurement files, the fit spec
+// (when it is a file) and the checkpoint it resumes.
+std::vector<FileArg> identify_inputs(const IdentifyArgs& a, const MeasurementSet& data) {
+  std::vector<FileArg> in = model_inputs(a.model);
+  in.push_back({a.data, "--data"});
+  for (const auto& m : data.items) in.push_back({m.path, "--data (a measurement file)"});
+  std::error_code ec;
+  if (fs::is_regular_file(a.fit, ec)) in.push_back({a.fit, "--fit"});
+  in.push_back({a.opt.resume_path, "--resume"});
+  return in;
+}
+
+// What it writes: the model, the checkpoint, the report directory's files.
+std::vector<FileArg> identify_outputs(const IdentifyArgs& a) {
+  std::vector<FileArg> out = {{a.out, "--out"}};
+  if (!a.opt.checkpoint_path.empty()) out.push_back({a.opt.checkpoint_path, "--checkpoint"});
+  for (auto& f : files_in(
+           a.report,
+           {"fit_report.json", "fit_report.md", "convergence.csv", "convergence.png", "overlay_*"},
+           "--report"))
+    out.push_back(std::move(f));
+  return out;
 }
 
 void write_outputs(const IdentifyArgs& a, const IdentifyResult& r, const ModelSpec& start) {
@@ -160,12 +185,16 @@ int run_identify_body(IdentifyArgs& a, Communicator& comm) {
   const ModelSpec start = load_model_spec_args(a.model);
   const MeasurementSet data = a.data.empty() ? MeasurementSet{} : load_manifest(a.data);
   const FitSpec fit = load_fit_spec(a.fit);
+  require_outputs_distinct(identify_inputs(a, data), identify_outputs(a),
+                           {{"--resume", "--checkpoint"}});
   IdentifyOptions o = a.opt;
   o.refine = !a.no_refine;
   o.profile = !a.no_profile;
   o.comm = &comm;
   o.stop = &g_stop;
-  if (o.threads <= 0) {
+  if (o.threads < 0)  // before the default below hides it (issue 19, item 4)
+    throw InputError(fmt::format("--threads {}: must be 0 (all cores) or >= 1", o.threads));
+  if (o.threads == 0) {
     const int local =
         std::max(1, env_int("OMPI_COMM_WORLD_LOCAL_SIZE", comm.size() > 1 ? comm.size() : 1));
     o.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / local);
@@ -253,6 +282,8 @@ int run_synthesize(SynthArgs& a) {
                  : a.offset == "fitted"     ? OffsetMode::Fitted
                                             : OffsetMode::Absolute;
   const Model m = compile(spec);
+  require_outputs_distinct(model_inputs(a.model),
+                           files_in(a.out, {"manifest.toml", "truth.toml", "*.csv"}, "--out"));
   const MeasurementSet set = synthesize_measurements(m, a.req);
   write_measurement_set(set, a.out);
   write_file_atomic((fs::path(a.out) / "truth.toml").string(), truth);

@@ -8,14 +8,28 @@
 #include "gmasim/io.hpp"
 #include "gmasim/parameters.hpp"
 #include "gmasim/simulate.hpp"
+#include "gmasim/validity.hpp"
 
 namespace gmasim::cli {
 namespace {
 
+// The two temperature ranges of a model (issue 19, item 8): where its laws can be computed
+// (outside: refused) and where it was validated (outside: a warning).
+std::string ranges_text(const Model& m) {
+  const auto c = computable_range(m);
+  return fmt::format(
+      "computable {} (outside: refused); validated {} (validity.validated_min_C/max_C; outside: "
+      "a warning)",
+      c ? range_text(*c) : std::string("nowhere (not even at reference.T_ref_C)"),
+      range_text(validated_range(m)));
+}
+
 int run_show(const ModelArgs& a, bool doc) {
   const ModelSpec spec = load_model_spec_args(a);
-  (void)compile(spec);  // show only valid models
+  const Model m = compile(spec);  // show only valid models
+  print_model_warnings(m);
   fmt::print("# {}\n", model_label(a));
+  fmt::print("# temperatures: {}\n", ranges_text(m));
   fmt::print("{:<48} {:>14}  {:<10} {}\n", "parameter", "value", "unit",
              doc ? "meaning" : "provenance");
   for (const auto& row : describe_model(spec))
@@ -66,6 +80,12 @@ int run_check(ModelArgs args, const std::string& file, bool dt_table) {
     fmt::print("{}: OK ({} parameters, {} rods, {} circuit nodes, {} branches)\n", path,
                m.spec.params.size(), m.rods.size(), m.circuit.node_count(),
                m.circuit.branch_count());
+    fmt::print("temperatures: {}\n", ranges_text(m));
+    for (const auto& w : model_warnings(m)) fmt::print("warning: {}\n", w);
+    const TemperatureRange v = validated_range(m);
+    if (const auto c = computable_range(m); c && (v.min_C < c->min_C || v.max_C > c->max_C))
+      fmt::print("warning: the validated range {} reaches beyond the computable range {}\n",
+                 range_text(v), range_text(*c));
     const MagneticStateCheck k = check_magnetic_state(m);
     fmt::print(
         "magnetic state over {} runs (20/70/150 degC x 6/12 A x 10/400 Hz), "
@@ -140,6 +160,7 @@ Runner add_model(CLI::App& app) {
     if (params->parsed()) return run_params(*params_markdown);
     if (save->parsed()) {
       const ModelSpec spec = load_model_spec_args(*save_model_args);
+      require_outputs_distinct(model_inputs(*save_model_args), {{*save_out, "--out"}});
       save_model(spec, *save_out, "gmasim model save --set");
       fmt::print("wrote {} ({} with {} change{})\n", *save_out, model_label(save_model_args->path),
                  save_model_args->sets.size(), save_model_args->sets.size() == 1 ? "" : "s");

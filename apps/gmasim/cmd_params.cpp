@@ -16,8 +16,7 @@ namespace {
 struct ParamsArgs {
   bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
   ModelArgs model;
-  std::string out = "out/params", temperatures = "20,40,60,80,100,120,150",
-                     retention = "6,8,10,12";
+  std::string out = "out/params", temperatures = "20,40,60,80,100,120,150", retention = "6,8,10,12";
   ParamsVsTemperatureRequest req;
 };
 
@@ -33,8 +32,9 @@ void print_thermal(const ThermalExpansionResult& t) {
 int run_params_cmd(ParamsArgs& a) {
   const Model model = load_model_args(a.model);
   a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
+  warn_temperatures(model, a.req.temperatures_C, "--temperatures");
   a.req.retention_currents_pp_A = parse_list(a.retention, "--retention-currents", "A");
-  ensure_output_dir(a.out);
+  prepare_output_dir(a.out, {"params", "thermal"}, model_inputs(a.model));
   const auto res = run_params_vs_temperature(model, a.req);
   auto files = write_report(a.out, "params", params_report(model, a.req, res));
   const auto th = thermal_expansion_coefficient(model);
@@ -118,7 +118,7 @@ Runner add_thermal(CLI::App& app) {
   return [=]() -> int {
     if (!sub->parsed()) return -1;
     const Model m = load_model_args(*model);
-    ensure_output_dir(*out);
+    prepare_output_dir(*out, {"thermal"}, model_inputs(*model));
     const auto th = thermal_expansion_coefficient(m);
     const auto files = write_report(*out, "thermal", thermal_report(m, th));
     fmt::print("gmasim thermal  model: {}\n", model_label(*model));

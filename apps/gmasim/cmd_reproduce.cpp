@@ -37,6 +37,18 @@ int run_reproduce_cmd(const ReproduceArgs& a) {
   o.threads = a.threads;
   o.quick = a.quick;
   o.claims = &claims;
+  // Every input (model, claims, notes, the compared models) against the report directory
+  // (report.md, claims.*, data/, figures/: any file in it) and --doc.
+  std::vector<FileArg> inputs = model_inputs(a.model);
+  inputs.push_back({a.claims, "--claims"});
+  inputs.push_back({a.doc_notes, "--doc-notes"});
+  for (const auto& c : a.compare) inputs.push_back({c, "--compare"});
+  if (a.out.empty()) ensure_output_dir(a.out);
+  std::vector<FileArg> outputs = files_in(a.out, {"*"}, "--out");
+  for (const char* sub : {"data", "figures"})
+    outputs.push_back({(std::filesystem::path(a.out) / sub / "*").string(), "--out"});
+  if (!a.doc.empty()) outputs.push_back({a.doc, "--doc"});
+  require_outputs_distinct(inputs, outputs);
   ensure_output_dir(a.out);
   const bool tty = isatty(fileno(stderr)) != 0;
   const ReproduceResult r = run_reproduce(model, o, [tty](std::size_t done, std::size_t total) {

@@ -1,15 +1,20 @@
 // gmasim simulate: one time-domain run of the model.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "commands.hpp"
 #include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
 #include "gmasim/simulate.hpp"
+#include "gmasim/validate.hpp"
 
 namespace gmasim::cli {
 namespace {
@@ -82,6 +87,47 @@ Waveform make_waveform(const SimulateArgs& a) {
   return w;
 }
 
+// The flags that shape the current waveform, and the waveforms that use each (issue 19, item
+// 10): a flag the chosen waveform ignores is a usage error, never silently dropped. "csv" is
+// --waveform FILE.
+struct WaveformFlag {
+  const char* flag;
+  std::vector<std::string> kinds;
+};
+const std::vector<WaveformFlag>& waveform_flags() {
+  static const std::vector<WaveformFlag> flags = {
+      {"--current-pp", {"sine"}},  {"--current-min", {"sine"}},
+      {"--frequency", {"sine"}},   {"--periods", {"sine"}},
+      {"--level", {"dc", "step"}}, {"--step-to", {"step"}},
+      {"--step-time", {"step"}},   {"--f0", {"chirp"}},
+      {"--f1", {"chirp"}},         {"--amplitude", {"chirp"}},
+      {"--offset", {"chirp"}},     {"--duration", {"dc", "step", "chirp", "csv"}},
+  };
+  return flags;
+}
+
+void check_waveform_flags(const CLI::App& sub, const SimulateArgs& a) {
+  const bool csv = !a.waveform_csv.empty();
+  if (csv && sub.count("--waveform-kind") > 0)
+    throw UsageError(fmt::format(
+        "--waveform-kind {} with --waveform {}: the CSV is the whole current waveform; give one "
+        "of them",
+        a.kind, clip_for_message(a.waveform_csv)));
+  const std::string kind = csv ? "csv" : a.kind;
+  const std::string used_by =
+      csv ? "--waveform " + clip_for_message(a.waveform_csv) : "--waveform-kind " + a.kind;
+  for (const auto& f : waveform_flags()) {
+    if (sub.count(f.flag) == 0) continue;
+    if (std::find(f.kinds.begin(), f.kinds.end(), kind) != f.kinds.end()) continue;
+    std::vector<std::string> users;
+    for (const auto& k : f.kinds)
+      users.push_back(k == "csv" ? "--waveform FILE" : "--waveform-kind " + k);
+    throw UsageError(
+        fmt::format("{}: this run's waveform is {}, which does not use it (only {} do); remove {}",
+                    f.flag, used_by, fmt::join(users, ", "), f.flag));
+  }
+}
+
 SimulationSettings settings_of(const SimulateArgs& a) {
   SimulationSettings s;
   s.temperature_C = a.temperature_C;
@@ -99,10 +145,26 @@ SimulationSettings settings_of(const SimulateArgs& a) {
   return s;
 }
 
+// Fails before the run, not after it: no output may replace an input (the model file, the
+// waveform CSV; issue 19, item 1), and the directory must be writable.
+void prepare_simulate_out(const SimulateArgs& a) {
+  std::vector<FileArg> inputs = model_inputs(a.model);
+  if (!a.waveform_csv.empty()) inputs.push_back({a.waveform_csv, "--waveform"});
+  if (a.out.empty()) ensure_output_dir(a.out);  // refuses the empty name
+  require_outputs_distinct(inputs, files_in(a.out,
+                                            {"timeseries.csv", "metrics.json", "self_heating.csv",
+                                             "simulate.png", "simulate.svg"},
+                                            "--out"));
+  ensure_output_dir(a.out);
+}
+
 int run_simulate(const SimulateArgs& a) {
   const Model model = load_model_args(a.model);
+  warn_temperatures(model, {a.temperature_C}, "--temperature");
+  if (a.self_heating && !std::isnan(a.ambient_C))
+    warn_temperatures(model, {a.ambient_C}, "--ambient");
   const SimulationSettings s = settings_of(a);
-  ensure_output_dir(a.out);  // fail before the run, not after it
+  prepare_simulate_out(a);
   Result r = simulate(model, s);
   if (!r.diverged && !a.quantities.empty()) add_quantity_stats(r, a.quantities);
   const std::filesystem::path dir(a.out);
@@ -235,7 +297,11 @@ Runner add_simulate(CLI::App& app) {
                   "Self-heating: ambient temperature [degC]; default: --temperature");
   sub->add_flag("--plot", a->plot, "Also draw <out>/simulate.png and .svg (matplotlib)");
   sub->add_option("--out", a->out, "Output directory")->capture_default_str();
-  return [a, sub]() -> int { return sub->parsed() ? run_simulate(*a) : -1; };
+  return [a, sub]() -> int {
+    if (!sub->parsed()) return -1;
+    check_waveform_flags(*sub, *a);
+    return run_simulate(*a);
+  };
 }
 
 }  // namespace gmasim::cli

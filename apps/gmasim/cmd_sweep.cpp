@@ -25,9 +25,11 @@ struct SweepArgs {
 int run_sweep_cmd(SweepArgs& a) {
   const Model model = load_model_args(a.model);
   a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
+  warn_temperatures(model, a.req.temperatures_C, "--temperatures");
+  warn_temperatures(model, {a.req.reference_temperature_C}, "--reference-temperature");
   a.req.currents_pp_A = parse_list(a.currents, "--currents", "A");
   a.req.frequencies_Hz = parse_list(a.frequencies, "--frequencies", "Hz");
-  ensure_output_dir(a.out);
+  prepare_output_dir(a.out, {"sweep"}, model_inputs(a.model));
   const SweepResult res = run_sweep(model, a.req, stderr_progress("sweep", a.progress));
   auto files = write_report(a.out, "sweep", sweep_report(model, a.req, res));
 
@@ -60,8 +62,7 @@ int run_sweep_cmd(SweepArgs& a) {
         print_error(fmt::format(
             "{} of {} points diverged (recorded in the output); first at {:g} degC, {:g} A, "
             "{:g} Hz: {}",
-            diverged, res.points.size(), p.temperature_C, p.current_pp_A, p.frequency_Hz,
-            p.error));
+            diverged, res.points.size(), p.temperature_C, p.current_pp_A, p.frequency_Hz, p.error));
         break;
       }
     return 3;

@@ -17,7 +17,7 @@ struct TrackArgs {
   bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
   ModelArgs model;
   std::string out = "out/track", temperatures = "20:10:70", amplitudes = "10,20",
-                     frequencies = "10,100";
+              frequencies = "10,100";
   TrackRequest req;
   bool progress = false;
 };
@@ -25,9 +25,10 @@ struct TrackArgs {
 int run_track_cmd(TrackArgs& a) {
   const Model model = load_model_args(a.model);
   a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
+  warn_temperatures(model, a.req.temperatures_C, "--temperatures");
   a.req.amplitudes_um = parse_list(a.amplitudes, "--amplitudes", "um");
   a.req.frequencies_Hz = parse_list(a.frequencies, "--frequencies", "Hz");
-  ensure_output_dir(a.out);
+  prepare_output_dir(a.out, {"track"}, model_inputs(a.model));
   const TrackResult res = run_track(model, a.req, stderr_progress("track", a.progress));
   auto files = write_report(a.out, "track", track_report(model, a.req, res));
   const std::string ex = (std::filesystem::path(a.out) / "track_example.csv").string();
@@ -65,9 +66,9 @@ int run_track_cmd(TrackArgs& a) {
   if (diverged > 0) {
     for (const auto& p : res.points)
       if (p.diverged) {  // the first one's diagnosis (time, rod, quantity) on stderr too
-        print_error(fmt::format("{} of {} points diverged; first at {:g} degC, {:g} um, {:g} Hz: {}",
-                                diverged, res.points.size(), p.temperature_C, p.amplitude_um,
-                                p.frequency_Hz, p.error));
+        print_error(fmt::format(
+            "{} of {} points diverged; first at {:g} degC, {:g} um, {:g} Hz: {}", diverged,
+            res.points.size(), p.temperature_C, p.amplitude_um, p.frequency_Hz, p.error));
         break;
       }
     return 3;

@@ -7,22 +7,35 @@
 #include <string>
 #include <vector>
 
+#include "gmasim/errors.hpp"
+#include "gmasim/io.hpp"
 #include "gmasim/model.hpp"
 
 namespace gmasim::cli {
 
 using Runner = std::function<int()>;
 
+// A usage error found after parsing (flags that contradict each other): exit 1, like CLI11's.
+struct UsageError : InputError {
+  using InputError::InputError;
+};
+
+// The message of a CLI11 parse error, made to name the word and the rule (cli_messages.cpp):
+// "unknown command 'simulat'; did you mean 'simulate'?", "--temperature '80C': not a number
+// (in degC, without the unit)", else CLI11's own text.
+std::string parse_error_message(const CLI::App& app, const CLI::ParseError& e, int argc,
+                                char** argv);
+
 Runner add_simulate(CLI::App& app);
 Runner add_model(CLI::App& app);
 Runner add_reproduce(CLI::App& app);
-Runner add_identify(CLI::App& app);  // cmd_identify.cpp: identify, identify synthesize
-Runner add_sweep(CLI::App& app);    // cmd_sweep.cpp
-Runner add_frf(CLI::App& app);      // cmd_frf.cpp
-Runner add_track(CLI::App& app);    // cmd_track.cpp
-Runner add_ablate(CLI::App& app);   // cmd_ablate.cpp
-Runner add_params(CLI::App& app);   // cmd_params.cpp: params-vs-temperature
-Runner add_thermal(CLI::App& app);  // cmd_params.cpp: thermal
+Runner add_identify(CLI::App& app);    // cmd_identify.cpp: identify, identify synthesize
+Runner add_sweep(CLI::App& app);       // cmd_sweep.cpp
+Runner add_frf(CLI::App& app);         // cmd_frf.cpp
+Runner add_track(CLI::App& app);       // cmd_track.cpp
+Runner add_ablate(CLI::App& app);      // cmd_ablate.cpp
+Runner add_params(CLI::App& app);      // cmd_params.cpp: params-vs-temperature
+Runner add_thermal(CLI::App& app);     // cmd_params.cpp: thermal
 Runner add_compensate(CLI::App& app);  // cmd_compensate.cpp
 Runner add_sensitivity(CLI::App& app);  // cmd_sensitivity.cpp
 
@@ -32,16 +45,32 @@ struct ModelArgs {
   std::vector<std::string> sets;  // "name=value" (gmasim::apply_assignments)
 };
 void add_model_options(CLI::App* sub, ModelArgs& a,
-                       const std::string& what = "Model file (TOML); default: the built-in MDMA "
-                                                 "model");
+                       const std::string& what =
+                           "Model file (TOML); default: the built-in MDMA "
+                           "model");
 ModelSpec load_model_spec_args(const ModelArgs& a);  // the file (or built-in) with --set applied
 Model load_model_args(const ModelArgs& a);           // ... compiled
 // "models/mdma.toml (built-in)" or the path, plus " with --set a=1, b=2" when there are any.
 std::string model_label(const ModelArgs& a);
+// The model file as an input of the command ({} for the built-in model).
+std::vector<FileArg> model_inputs(const ModelArgs& a);
+// An experiment's output directory: refuses it if a file the command writes there (stems:
+// "sweep" covers sweep*.csv|json|png|svg) would overwrite an input, then ensure_output_dir.
+void prepare_output_dir(const std::string& dir, const std::vector<std::string>& stems,
+                        const std::vector<FileArg>& inputs);
 
 // Shared helpers.
 std::string model_label(const std::string& path);  // "models/mdma.toml (built-in)" or path
 void print_error(const std::string& what);
+void print_warning(const std::string& what);  // "gmasim: warning: ..." on stderr
+// The handler that removes the temporaries of a write in progress and lets `sig` end the
+// process (main installs it for SIGINT, SIGTERM, SIGHUP; identify's second signal gets it).
+void install_fatal_signal_handler(int sig);
+// The model's values far outside Terfenol-D's known range (gmasim/validity.hpp), as warnings.
+void print_model_warnings(const Model& m);
+// One warning naming `flag` and the temperatures outside the model's validated range.
+void warn_temperatures(const Model& m, const std::vector<double>& temperatures_C,
+                       const std::string& flag);
 // Throws InputError if a floating-point flag of the parsed command is NaN or infinite.
 void require_finite_numbers(const CLI::App& app);
 

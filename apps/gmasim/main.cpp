@@ -3,17 +3,22 @@
 // unknown flag, a value that is not a number, a non-finite number) is a usage error, 1.
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <new>
 #include <vector>
 
 #include "commands.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
+#include "gmasim/validity.hpp"
 #include "gmasim/version.h"
 
 namespace gmasim::cli {
@@ -60,17 +65,81 @@ ModelSpec load_model_spec_args(const ModelArgs& a) {
   return apply_assignments(std::move(spec), a.sets, "--set");
 }
 
-Model load_model_args(const ModelArgs& a) { return compile(load_model_spec_args(a)); }
+Model load_model_args(const ModelArgs& a) {
+  Model m = compile(load_model_spec_args(a));
+  print_model_warnings(m);
+  return m;
+}
+
+void print_warning(const std::string& what) {
+  std::fprintf(stderr, "gmasim: warning: %s\n", what.c_str());
+}
+
+void print_model_warnings(const Model& m) {
+  for (const auto& w : model_warnings(m)) print_warning(w);
+}
+
+void warn_temperatures(const Model& m, const std::vector<double>& temperatures_C,
+                       const std::string& flag) {
+  std::vector<double> outside;
+  for (const double T : temperatures_C)
+    if (temperature_warning(m, T) && std::find(outside.begin(), outside.end(), T) == outside.end())
+      outside.push_back(T);
+  if (outside.empty()) return;
+  if (outside.size() > 8) outside.resize(8);
+  print_warning(fmt::format(
+      "{} {} degC: outside the range where {} was validated, {} (validity.validated_min_C/max_C); "
+      "the results there are an extrapolation",
+      flag, fmt::join(outside, ", "), m.spec.source, range_text(validated_range(m))));
+}
+
+std::vector<FileArg> model_inputs(const ModelArgs& a) {
+  if (a.path.empty()) return {};
+  return {{a.path, "--model"}};
+}
+
+void prepare_output_dir(const std::string& dir, const std::vector<std::string>& stems,
+                        const std::vector<FileArg>& inputs) {
+  if (dir.empty()) ensure_output_dir(dir);  // refuses the empty name first
+  std::vector<std::string> names;
+  for (const auto& s : stems) names.push_back(s + "*");
+  require_outputs_distinct(inputs, files_in(dir, names, "--out"));
+  ensure_output_dir(dir);
+}
 
 std::string model_label(const ModelArgs& a) {
   std::string s = model_label(a.path);
-  if (!a.sets.empty()) s += " with --set " + clip_error_message(fmt::format("{}", fmt::join(a.sets, ", ")));
+  if (!a.sets.empty())
+    s += " with --set " + clip_error_message(fmt::format("{}", fmt::join(a.sets, ", ")));
   return s;
 }
 
 }  // namespace gmasim::cli
 
+namespace {
+
+// SIGINT, SIGTERM, SIGHUP: the temporaries of a write in progress are removed, then the signal
+// ends the process as it would have (issue 19, item 5). SIGXFSZ (a file over `ulimit -f`) is
+// ignored, so that write() fails with EFBIG and the run reports the file and the limit instead
+// of dying without a word.
+extern "C" void on_fatal_signal(int sig) {
+  gmasim::remove_pending_temporaries();
+  // write(2) only: async-signal-safe. The files of a finished write are whole; none is partial.
+  static const char msg[] = "gmasim: stopped by a signal; no partial output file is left\n";
+  (void)!::write(STDERR_FILENO, msg, sizeof msg - 1);
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
+}
+
+}  // namespace
+
+namespace gmasim::cli {
+void install_fatal_signal_handler(int sig) { std::signal(sig, on_fatal_signal); }
+}  // namespace gmasim::cli
+
 int main(int argc, char** argv) {
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP}) gmasim::cli::install_fatal_signal_handler(sig);
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{
       "gmasim: temperature-dependent simulator of giant magnetostrictive actuators (the MCTD "
       "model; built-in model: the MDMA prototype). SI units inside; units are named in every "
@@ -78,8 +147,9 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   // "gmasim 0.1.0", plus the git describe of the source tree at configure time if it had one.
   const std::string git_describe = GMASIM_GIT_DESCRIBE;
-  app.set_version_flag("--version", std::string("gmasim " GMASIM_VERSION) +
-                                        (git_describe.empty() ? "" : " (" + git_describe + ")"),
+  app.set_version_flag("--version",
+                       std::string("gmasim " GMASIM_VERSION) +
+                           (git_describe.empty() ? "" : " (" + git_describe + ")"),
                        "Print the version and exit");
   std::vector<gmasim::cli::Runner> runners;
   runners.push_back(gmasim::cli::add_simulate(app));
@@ -105,8 +175,10 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     // Every parse error is a usage error, exit 1 (CLI11's own codes are 100+), with the
-    // message clipped so that a hostile value is not echoed whole.
-    gmasim::cli::print_error(gmasim::clip_error_message(e.what()));
+    // message clipped so that a hostile value is not echoed whole; an unknown word gets the
+    // nearest command or flag suggested, a value that is not a number the unit it takes.
+    gmasim::cli::print_error(
+        gmasim::clip_error_message(gmasim::cli::parse_error_message(app, e, argc, argv)));
     std::fprintf(stderr, "Run with --help for more information.\n");
     return 1;
   } catch (const gmasim::InputError& e) {
@@ -120,12 +192,20 @@ int main(int argc, char** argv) {
       if (rc >= 0) return rc;
     }
     return 1;
+  } catch (const gmasim::cli::UsageError& e) {
+    gmasim::cli::print_error(e.what());
+    return 1;
   } catch (const gmasim::InputError& e) {
     gmasim::cli::print_error(e.what());
     return 2;
   } catch (const gmasim::DivergenceError& e) {
     gmasim::cli::print_error(e.what());
     return 3;
+  } catch (const std::bad_alloc&) {
+    gmasim::cli::print_error(
+        "out of memory: the run needs more memory than the system gives it (MemAvailable, "
+        "ulimit -v); record less often (--record-every), shorten the run or lower --threads");
+    return 2;
   } catch (const std::exception& e) {
     gmasim::cli::print_error(fmt::format("internal error: {}", e.what()));
     return 4;

@@ -16,6 +16,13 @@
  * A handle is not thread-safe; different sims may be used from different threads at once,
  * and one model may feed sims in several threads (a sim keeps its model alive, so the model
  * handle may be freed before the sims made from it).
+ *
+ * Ownership (docs/c_api.md, "Handles"): the caller owns every handle a create or load returns
+ * and frees it exactly once with its _free function. A handle is a generation-counted token,
+ * not an address: after its free, the same value (a double free, a use after free), a handle
+ * of the other type, or any value the API did not return is refused with GMASIM_E_ARGUMENT
+ * ("not a live ... handle"); nothing is read through it. Freeing a handle while another
+ * thread uses it is the caller's race.
  */
 #ifndef GMASIM_GMASIM_C_H
 #define GMASIM_GMASIM_C_H
@@ -37,15 +44,18 @@ enum gmasim_status {
                             or time step out of range, ...: the message names value and rule */
   GMASIM_E_DIVERGED = 2, /* the step diverged (the message names time, rod and quantity); the
                             sim refuses further steps until gmasim_sim_reset */
-  GMASIM_E_ARGUMENT = 3, /* a NULL handle or output pointer, a rod index out of range, or a
-                            non-finite number (NaN, +-Inf) */
+  GMASIM_E_ARGUMENT = 3, /* a NULL handle or output pointer, a handle that is not live (freed
+                            already, or never returned by the API), a rod index out of range,
+                            or a non-finite number (NaN, +-Inf) */
   GMASIM_E_INTERNAL = 4  /* out of memory or a bug: the message says what */
 };
 
 /* Rods a model may have (stack.rods): the size of the per-rod arrays of gmasim_outputs. */
 #define GMASIM_MAX_RODS 8
 
-/* Largest time step a sim accepts [s]: 0 < dt_s <= GMASIM_MAX_DT_S. */
+/* Time steps a sim accepts [s]: GMASIM_MIN_DT_S <= dt_s <= GMASIM_MAX_DT_S. Below the minimum
+ * the step no longer holds the state at constant current (docs/model.md, "Time step"). */
+#define GMASIM_MIN_DT_S 1e-12
 #define GMASIM_MAX_DT_S 1e-3
 /* Largest coil current magnitude [A] (kMaxCurrent_A of gmasim/simulate.hpp). */
 #define GMASIM_MAX_CURRENT_A 1000.0
@@ -103,9 +113,12 @@ GMASIM_API int gmasim_model_load(const char* path, gmasim_model** out);
  * "<string>") names it in messages. */
 GMASIM_API int gmasim_model_load_string(const char* toml_text, const char* source_name,
                                         gmasim_model** out);
-/* Frees a model handle; NULL is ignored. Sims created from it stay valid. */
-GMASIM_API void gmasim_model_free(gmasim_model* model);
-/* The message of the last failed call on this model handle, "" if none; "" for NULL. */
+/* Frees a model handle: GMASIM_OK (NULL is ignored), or GMASIM_E_ARGUMENT if the handle is not
+ * live (freed already: a double free is an error code, not undefined behaviour). Sims created
+ * from it stay valid. */
+GMASIM_API int gmasim_model_free(gmasim_model* model);
+/* The message of the last failed call on this model handle, "" if none; "" for NULL; a static
+ * "not a live gmasim_model handle ..." for a freed or unknown handle. */
 GMASIM_API const char* gmasim_model_last_error(const gmasim_model* model);
 /* The number of rods of the model (1..GMASIM_MAX_RODS). */
 GMASIM_API int gmasim_model_rod_count(const gmasim_model* model, int* out);
@@ -116,15 +129,15 @@ GMASIM_API int gmasim_model_rod_name(const gmasim_model* model, int rod, const c
 
 /* A new sim of `model` at temperature_C [degC] (below the model's Curie point, above absolute
  * zero), at rest under current_A [A] (|current_A| <= GMASIM_MAX_CURRENT_A), stepped by dt_s
- * [s] (0 < dt_s <= GMASIM_MAX_DT_S). t = 0. Free it with gmasim_sim_free. GMASIM_E_ARGUMENT
- * for a NULL model/out or a non-finite number, GMASIM_E_INPUT for a value out of range,
- * GMASIM_E_DIVERGED if no initial equilibrium is found. Allocates. */
+ * [s] (GMASIM_MIN_DT_S <= dt_s <= GMASIM_MAX_DT_S). t = 0. Free it with gmasim_sim_free.
+ * GMASIM_E_ARGUMENT for a NULL model/out or a non-finite number, GMASIM_E_INPUT for a value out of
+ * range, GMASIM_E_DIVERGED if no initial equilibrium is found. Allocates. */
 GMASIM_API int gmasim_sim_create(const gmasim_model* model, double temperature_C, double dt_s,
                                  double current_A, gmasim_sim** out);
-/* Frees a sim; NULL is ignored. */
-GMASIM_API void gmasim_sim_free(gmasim_sim* sim);
-/* The message of the last failed call on this sim, "" if none; "" for NULL. Valid until the
- * next failed call on the sim. */
+/* Frees a sim: GMASIM_OK (NULL is ignored), or GMASIM_E_ARGUMENT if the handle is not live. */
+GMASIM_API int gmasim_sim_free(gmasim_sim* sim);
+/* The message of the last failed call on this sim, "" if none; "" for NULL; a static text for a
+ * freed or unknown handle. Valid until the next failed call on the sim. */
 GMASIM_API const char* gmasim_sim_last_error(const gmasim_sim* sim);
 
 /* Back to t = 0, at rest under current_A [A], at the sim's present temperature; clears a

@@ -91,9 +91,9 @@ struct MeasurementSet {
 };
 
 // One CSV "[t_s,]current_A|field_A_per_m,displacement_um|strain_ppm[,flux_T]" with its
-// condition in "# key = value" header comments and/or the sidecar <name>.toml. Throws InputError "file:line: ..." for an
-// empty file, a bad header, mismatched columns, non-numeric cells, NaN/Inf, duplicate or
-// decreasing time, fewer than 4 rows, a missing or contradictory condition.
+// condition in "# key = value" header comments and/or the sidecar <name>.toml. Throws InputError
+// "file:line: ..." for an empty file, a bad header, mismatched columns, non-numeric cells, NaN/Inf,
+// duplicate or decreasing time, fewer than 4 rows, a missing or contradictory condition.
 Measurement load_measurement_csv(const std::string& path);
 // The manifest (TOML, [[measurement]] file + weight); every file is loaded and checked.
 MeasurementSet load_manifest(const std::string& path);
@@ -109,7 +109,7 @@ void write_measurement_set(const MeasurementSet& set, const std::string& dir);
 enum class ParamScale { Linear, Log };
 
 struct FitParameter {
-  std::string name;  // dotted model name; unit suffix optional ("rod1.ja.k0")
+  std::string name;  // dotted model name with its unit suffix ("rod1.ja.k0_A_per_m")
   double lower = 0.0, upper = 0.0;
   ParamScale scale = ParamScale::Linear;
   bool has_start = false;  // start value given in the spec (else: the model's value)
@@ -185,6 +185,10 @@ struct ObjectiveSettings {
   // (tests/test_identify_records.cpp).
   double quasi_static_increments = 500.0;
 };
+// The rules of ObjectiveSettings (steps per period in [8, 1e6], dt >= 0, target periods in
+// [1, 1e4], flux weight in [0, 1e6], quasi-static increments in [10, 1e6]): one check for
+// identify and `identify synthesize` (issue 19, item 6). Throws InputError naming the flag.
+void validate(const ObjectiveSettings& s);
 
 // Per-condition outcome at one parameter vector.
 struct ConditionFit {
@@ -294,6 +298,9 @@ struct SyntheticRequest {
   double response_offset = 0.0;  // [um or ppm], with OffsetMode::Fitted
   long precycles = 0;            // written as the records' precycles key
 };
+// Every record it writes is one identify accepts (issue 19, item 6): the same settings rules
+// (validate(ObjectiveSettings)), currents p-p in (0, 2000] A, frequencies in (0, 1 MHz],
+// samples per period >= 8. Throws InputError naming the flag before any work.
 MeasurementSet synthesize_measurements(const Model& truth, const SyntheticRequest& r);
 
 // =======================================================================================

@@ -29,9 +29,10 @@ ModelSpec builtin_model_spec();
 Model load_model(const std::string& path);
 
 // Applies "name=value" assignments (the --set flag of every command; Python
-// Model.with_params): a number to a parameter by its dotted name (or a unique suffix of it,
-// under ModelSpec::set's rules), or a word to an option ("options.magnetic_state=printed",
-// under ModelSpec::set_option's). `flag` names the source in messages. Throws InputError.
+// Model.with_params): a number to a parameter by its dotted name with its unit suffix
+// (ModelSpec::key_of: a dimensional key without it is refused), or a word to an option
+// ("options.magnetic_state=printed", under ModelSpec::set_option's). `flag` names the source in
+// messages. Throws InputError.
 ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assignments,
                             std::string_view flag = "--set");
 
@@ -65,15 +66,44 @@ void write_file_atomic(const std::string& path, const std::string& content);
 // Writes several files as one: every temporary file is written and flushed first, then all
 // are renamed, so a run killed before the renames leaves the previous set untouched and one
 // killed between them leaves each file complete (a reader pairs them by the run stamp they
-// carry, e.g. metrics.json's "steps"). Same checks as write_file_atomic.
+// carry, e.g. metrics.json's "steps"). The renames hold an exclusive flock() on their
+// directory, so two processes writing a set into one directory never leave a mix of both
+// (issue 19, item 5). Same checks as write_file_atomic.
 void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& path_content);
+
+// Removes the temporaries of every write in progress (issue 19, item 5). Async-signal-safe
+// (unlink(2) only): the CLI calls it from its SIGINT/SIGTERM/SIGHUP handler before the signal
+// ends the process, so a killed run leaves no "<file>.tmp.<pid>" behind. A temporary that a
+// SIGKILL left is removed by the next write of the same file (its process is gone).
+void remove_pending_temporaries() noexcept;
 
 // Reads a user's input file whole: at most kMaxInputBytes (gmasim/validate.hpp), else an
 // InputError "<path>: <what> is larger than ..."; `what` names the file in messages.
 std::string read_input_file(const std::string& path, const std::string& what);
 
-// Creates the directory (and parents) if needed and checks it is writable.
+// Creates the directory (and parents) if needed and checks it is writable. An empty name is
+// refused (InputError "output directory '': ..."), never taken for the current directory.
 void ensure_output_dir(const std::string& dir);
+
+// No output may overwrite an input (issue 19, item 1; docs/reliability.md, "Outputs"). A file
+// a command reads or writes, and the flag that names it in messages ("--out", "--data").
+struct FileArg {
+  std::string path;
+  std::string flag;
+};
+// Throws InputError if an output is one of the inputs, or two outputs of different flags are
+// one file: the same existing file (device and inode: hard links, symbolic links and other
+// spellings of a path are caught), else the same absolute path with the symbolic links of its
+// existing part resolved. An output whose file name holds '*' (DIR/sweep_*.csv: a family of
+// files a command writes) matches every input it globs. An input with an empty path is skipped.
+// Pairs of flags in `allowed` are exempt (identify's --resume and --checkpoint: a run continues
+// the checkpoint it resumed). Every command calls it before any work.
+void require_outputs_distinct(const std::vector<FileArg>& inputs,
+                              const std::vector<FileArg>& outputs,
+                              const std::vector<std::pair<std::string, std::string>>& allowed = {});
+// DIR/name for each name, all under one flag (a command's files in its output directory).
+std::vector<FileArg> files_in(const std::string& dir, const std::vector<std::string>& names,
+                              const std::string& flag);
 
 std::string timeseries_csv(const TimeSeries& ts);
 

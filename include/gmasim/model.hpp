@@ -108,9 +108,10 @@ struct ModelSpec {
   const ParamDef* def_of(const std::string& key) const;
   std::string unit_of(const std::string& key) const;
   long line_of(const std::string& dotted) const;
-  // The full key a dotted name resolves to: the name itself, or the unique
-  // "<name>_<unit suffix>" ("rod1.ja.k0" -> "rod1.ja.k0_A_per_m"); throws InputError if
-  // unknown or ambiguous, as get() does.
+  // The full key a dotted name resolves to: the name itself, or the unique dimensionless
+  // "<name>_<rest>" ("material.lambda" -> "material.lambda_s"); throws InputError if unknown,
+  // ambiguous, or a dimensional key without its unit suffix ("rod1.ja.k0": write
+  // "rod1.ja.k0_A_per_m"; issue 19, item 9), as get() and set() do.
   std::string key_of(const std::string& dotted) const;
 };
 
@@ -220,6 +221,12 @@ struct ThermalExpansionModel {
   double sleeve_length_m = 0, sleeve_alpha_per_K = 0;
 };
 
+// Where the model was validated ([validity], every key defaulted; issue 19, item 8). Outside
+// it a run is allowed but warned about (gmasim/validity.hpp, temperature_warning).
+struct ValidityModel {
+  double validated_min_C = 20.0, validated_max_C = 150.0;
+};
+
 struct ChainLink {  // one member of a rod's load chain
   enum Kind { Element, Sleeve, Rod } kind;
   int index;
@@ -243,6 +250,7 @@ struct Model {
   SensorMountModel sensor_mount;
   ThermalNetworkModel thermal_network;
   ThermalExpansionModel thermal_expansion;
+  ValidityModel validity;
   // eq. (21) alpha*l products of the stack [m/K], from thermal_expansion and the rods
   double xT_rod_m_per_K = 0, xT_magnetizer_m_per_K = 0, xT_output_rod_m_per_K = 0,
          xT_sleeve_m_per_K = 0;

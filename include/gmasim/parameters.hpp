@@ -56,7 +56,8 @@ enum class Group {
   Branch,            // [[circuit.branches]] (numbers optional, absent = 0)
   Reluctance,        // [circuit.reluctances_per_H] (free names)
   ThermalExpansion,  // [thermal_expansion] (optional, every key defaulted)
-  ThermalNetwork     // [thermal_network] (optional, every key defaulted)
+  ThermalNetwork,    // [thermal_network] (optional, every key defaulted)
+  Validity           // [validity] (optional, every key defaulted)
 };
 
 // Whether a group's table must be in the file.

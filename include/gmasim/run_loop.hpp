@@ -19,7 +19,9 @@
 // inlines both, and allocates nothing (tests/test_run_loop.cpp counts). It owns the step
 // times, sets State::t_s to the grid time after each step (no drift from repeated addition),
 // and checks that the drive current and the outputs y and B are finite (DivergenceError
-// naming the time and the quantity). step() checks every rod's H, M and x itself.
+// naming the time and the quantity), and that every rod's state is physically possible
+// (check_physical_validity: strain, displacement, flux density within their bounds; issue 19).
+// step() checks every rod's H, M and x itself.
 #pragma once
 
 #include <cmath>
@@ -29,6 +31,7 @@
 #include <utility>
 
 #include "gmasim/model.hpp"
+#include "gmasim/validity.hpp"
 
 namespace gmasim {
 
@@ -154,6 +157,7 @@ inline void advance(const Model& m, const Conditions& c, State& st, const StepPo
     throw_not_finite(p.t_s, "output y [m]", st.y_m);
   if (!std::isfinite(st.B_T)) [[unlikely]]
     throw_not_finite(p.t_s, "flux density B [T] of the induction coil", st.B_T);
+  check_physical_validity(m, c, st, p.t_s);  // gmasim/validity.hpp (issue 19, item 3)
   record(std::as_const(st), p);
 }
 }  // namespace run_loop_detail

@@ -8,13 +8,15 @@
 #include <string>
 
 #include "gmasim/model.hpp"
+#include "gmasim/validate.hpp"
 
 namespace gmasim {
 
-// Time steps a Stepper accepts [s]: 0 < dt_s <= kMaxStepperDt_s. step() is exact for the
-// eddy-current and mechanical updates, but a step longer than a millisecond resolves neither the
-// eddy time constants nor the 7-20 kHz mechanical modes (docs/model.md, "Time step").
-inline constexpr double kMaxStepperDt_s = 1e-3;
+// Time steps a Stepper accepts [s]: kMinStepDt_s <= dt_s <= kMaxStepperDt_s (gmasim/validate.hpp).
+// step() is exact for the eddy-current and mechanical updates, but a step longer than a
+// millisecond resolves neither the eddy time constants nor the 7-20 kHz mechanical modes, and one
+// shorter than 1e-12 s no longer holds the state (docs/model.md, "Time step").
+inline constexpr double kMaxStepperDt_s = kMaxStepDt_s;
 
 class Stepper {
  public:

@@ -14,6 +14,12 @@ adds plotting helpers (``gmasim.plots``). Units are SI and named in every key
     y_um = st.step(1.5)
     s = gmasim.sensitivity(m, params=["material.Ms_A_per_m"], claims=["stroke_drop_8A"])
     s["derivative"]   # (quantities x parameters): d claim / d ln parameter
+
+Errors: gmasim.InputError (a ValueError: a value out of range, with the rule), TypeError (an
+argument of the wrong type, named), gmasim.DivergenceError (an ArithmeticError: the run
+diverged; simulate() and Stepper.step() both raise it, and simulate's exception carries the
+partial run as its ``result`` attribute). Values far outside Terfenol-D's known range and
+temperatures outside a model's validated range give a UserWarning.
 """
 from ._gmasim import *  # noqa: F401,F403
 from ._gmasim import (FREEZE_LAWS, DivergenceError, InputError, Model, Stepper, ablate, claims,  # noqa: F401
@@ -22,6 +28,13 @@ from ._gmasim import (FREEZE_LAWS, DivergenceError, InputError, Model, Stepper, 
 from ._gmasim import __git_describe__, __version__  # noqa: F401
 from . import plots  # noqa: F401
 from ._sensitivity import fit_parameters, sensitivity  # noqa: F401
+from ._arguments import checked as _checked
+
+# Every function of the extension module checks its arguments' types first, so that a wrong
+# one is a TypeError naming the argument and the expected type (issue 19, item 11).
+simulate, sweep, frf, track, compensate, ablate, params_vs_temperature, thermal_expansion, claims = (
+    _checked(f) for f in (simulate, sweep, frf, track, compensate, ablate, params_vs_temperature,
+                          thermal_expansion, claims))
 
 __all__ = ["Model", "Stepper", "simulate", "sweep", "frf", "track", "compensate", "ablate",
            "params_vs_temperature", "parameter_table",

@@ -1,5 +1,6 @@
 // pybind11 bindings: gmasim._gmasim. Thin: models, simulate; arrays out as numpy.
 // Experiments are bound in experiments.cpp. No physics here.
+#include <fmt/format.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -10,6 +11,7 @@
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
 #include "gmasim/simulate.hpp"
+#include "gmasim/validity.hpp"
 
 namespace py = pybind11;
 using namespace gmasim;
@@ -83,17 +85,92 @@ namespace {
 
 using namespace gmasim::py_bind;
 
+// A 1-D array of numbers from a Python sequence or array; TypeError naming the argument and
+// the expected type otherwise (issue 19, item 11: not "Unable to cast Python instance").
+std::vector<double> numbers_1d(const py::handle& o, const char* what) {
+  if (py::isinstance<py::str>(o) || py::isinstance<py::bytes>(o))
+    throw py::type_error(fmt::format("{}: expected a 1-D array of numbers, not a string", what));
+  py::array_t<double, py::array::forcecast> a;
+  try {
+    a = py::array_t<double, py::array::forcecast>::ensure(o);
+  } catch (const py::error_already_set&) {
+  }
+  if (!a)
+    throw py::type_error(
+        fmt::format("{}: expected a 1-D array of numbers, not {}", what,
+                    py::str(py::type::of(o).attr("__name__")).cast<std::string>()));
+  if (a.ndim() != 1)
+    throw py::type_error(
+        fmt::format("{}: expected a 1-D array of numbers, not a {}-D array", what, a.ndim()));
+  return std::vector<double>(a.data(), a.data() + a.shape(0));
+}
+
+Waveform table_waveform(const py::object& waveform) {
+  const char* shape =
+      "waveform: expected a pair (t_s, current_A) of equally long 1-D arrays of numbers [s, A]";
+  if (!py::isinstance<py::sequence>(waveform) || py::isinstance<py::str>(waveform) ||
+      py::len(waveform) != 2)
+    throw py::type_error(fmt::format(
+        "{}, not {}", shape, py::str(py::type::of(waveform).attr("__name__")).cast<std::string>()));
+  const py::sequence pair = waveform.cast<py::sequence>();
+  Waveform w;
+  w.kind = WaveformKind::Table;
+  w.table_t_s = numbers_1d(pair[0], "waveform[0] (t_s)");
+  w.table_current_A = numbers_1d(pair[1], "waveform[1] (current_A)");
+  w.table_source = "<python>";
+  if (w.table_t_s.size() < 2 || w.table_t_s.size() != w.table_current_A.size())
+    throw InputError(fmt::format("{}, of at least 2 samples (got {} and {})", shape,
+                                 w.table_t_s.size(), w.table_current_A.size()));
+  for (std::size_t i = 1; i < w.table_t_s.size(); ++i)
+    if (!(w.table_t_s[i] > w.table_t_s[i - 1]))
+      throw InputError("waveform: time must increase strictly (sample " + std::to_string(i) + ")");
+  return w;
+}
+
+double optional_number(const py::object& o, const char* what) {
+  if (py::isinstance<py::bool_>(o) ||
+      !(py::isinstance<py::float_>(o) || py::isinstance<py::int_>(o) ||
+        py::hasattr(o, "__float__")) ||
+      py::isinstance<py::str>(o))
+    throw py::type_error(
+        fmt::format("{}: expected a number or None, not {}", what,
+                    py::str(py::type::of(o).attr("__name__")).cast<std::string>()));
+  return py::float_(o).cast<double>();
+}
+
+// A UserWarning (issue 19, items 3 and 8: values far outside the material's range, a
+// temperature outside the validated range); an error if the warnings filter says so.
+void warn(const std::string& message) {
+  if (PyErr_WarnEx(PyExc_UserWarning, message.c_str(), 2) != 0) throw py::error_already_set();
+}
+
+std::shared_ptr<Model> checked_model(Model m) {
+  for (const auto& w : model_warnings(m)) warn(w);
+  return std::make_shared<Model>(std::move(m));
+}
+
+// simulate() on a run that diverged raises gmasim.DivergenceError, as Stepper.step does (issue
+// 19, item 11: one behaviour); the exception's `result` holds the partial run's dict.
+[[noreturn]] void raise_divergence(const std::string& message, const py::dict& partial) {
+  const py::object type = py::module_::import("gmasim._gmasim").attr("DivergenceError");
+  py::object e = type(message);
+  e.attr("result") = partial;
+  PyErr_SetObject(type.ptr(), e.ptr());
+  throw py::error_already_set();
+}
+
 py::dict simulate_py(const Model& m, double temperature_C, double current_pp_A, double frequency_Hz,
                      double periods, double current_min_A, double dt_s, int record_every,
                      const std::string& kind, py::object waveform, double duration_s,
                      const std::vector<std::string>& freeze,
                      const std::vector<std::string>& quantities, bool self_heating,
                      double thermal_step_s, py::object ambient_C) {
+  if (auto w = temperature_warning(m, temperature_C)) warn(*w);
   SimulationSettings s;
   s.energy_ledger = true;
   s.self_heating.enabled = self_heating;
   s.self_heating.thermal_step_s = thermal_step_s;
-  if (!ambient_C.is_none()) s.self_heating.ambient_C = ambient_C.cast<double>();
+  if (!ambient_C.is_none()) s.self_heating.ambient_C = optional_number(ambient_C, "ambient_C");
   s.temperature_C = temperature_C;
   s.periods = periods;
   s.dt_s = dt_s;
@@ -101,20 +178,7 @@ py::dict simulate_py(const Model& m, double temperature_C, double current_pp_A, 
   s.duration_s = duration_s;
   s.freeze = parse_freeze(freeze);
   if (!waveform.is_none()) {
-    auto tup = waveform.cast<std::pair<std::vector<double>, std::vector<double>>>();
-    Waveform w;
-    w.kind = WaveformKind::Table;
-    w.table_t_s = tup.first;
-    w.table_current_A = tup.second;
-    w.table_source = "<python>";
-    if (w.table_t_s.size() < 2 || w.table_t_s.size() != w.table_current_A.size())
-      throw InputError(
-          "waveform: need two equally long arrays (t_s, current_A) of at least 2 samples");
-    for (std::size_t i = 1; i < w.table_t_s.size(); ++i)
-      if (!(w.table_t_s[i] > w.table_t_s[i - 1]))
-        throw InputError("waveform: time must increase strictly (sample " + std::to_string(i) +
-                         ")");
-    s.waveform = w;
+    s.waveform = table_waveform(waveform);
   } else if (kind == "sine") {
     s.waveform = biased_sine(current_pp_A, frequency_Hz, current_min_A);
   } else if (kind == "dc") {
@@ -155,20 +219,14 @@ py::dict simulate_py(const Model& m, double temperature_C, double current_pp_A, 
     q[py::str(qs.name)] = e;
   }
   d["quantities"] = q;
+  if (r.diverged) raise_divergence(r.error, d);
   return d;
 }
 
-}  // namespace
-
-PYBIND11_MODULE(_gmasim, mod) {
-  mod.doc() =
-      "gmasim: temperature-dependent giant magnetostrictive actuator simulator (MCTD model)";
-  py::register_exception<InputError>(mod, "InputError", PyExc_ValueError);
-  py::register_exception<DivergenceError>(mod, "DivergenceError", PyExc_ArithmeticError);
-
+// gmasim.Model: load, parameters, ranges, changed copies, save.
+void bind_model(py::module_& mod) {
   py::class_<Model, std::shared_ptr<Model>>(mod, "Model", "A compiled, immutable model")
-      .def(py::init(
-               [](const std::string& path) { return std::make_shared<Model>(load_model(path)); }),
+      .def(py::init([](const std::string& path) { return checked_model(load_model(path)); }),
            py::arg("path") = std::string(), "Load a model file (TOML); empty path = built-in MDMA")
       .def_property_readonly("source", [](const Model& m) { return m.spec.source; })
       .def_property_readonly("rods",
@@ -190,6 +248,22 @@ PYBIND11_MODULE(_gmasim, mod) {
           "get", [](const Model& m, const std::string& name) { return m.spec.get(name); },
           py::arg("name"))
       .def(
+          "temperature_ranges",
+          [](const Model& m) {
+            py::dict d;
+            const auto c = computable_range(m);
+            d["computable_C"] = c ? py::object(py::make_tuple(c->min_C, c->max_C)) : py::none();
+            const auto v = validated_range(m);
+            d["validated_C"] = py::make_tuple(v.min_C, v.max_C);
+            return d;
+          },
+          "{'computable_C': (min, max) where the laws can be evaluated (outside: InputError; "
+          "the max may be T_c itself, excluded), 'validated_C': (min, max) where the model was "
+          "validated (outside: a UserWarning)}")
+      .def(
+          "warnings", [](const Model& m) { return model_warnings(m); },
+          "Values far outside Terfenol-D's known range (also issued as UserWarning on load)")
+      .def(
           "with_params",
           [](const Model& m, const py::dict& values) {
             ModelSpec spec = m.spec;
@@ -198,12 +272,19 @@ PYBIND11_MODULE(_gmasim, mod) {
               const std::string name = py::str(k);
               if (py::isinstance<py::str>(v)) {
                 words.push_back(name + "=" + v.cast<std::string>());
+              } else if (py::isinstance<py::bool_>(v) ||
+                         !(py::isinstance<py::float_>(v) || py::isinstance<py::int_>(v) ||
+                           py::hasattr(v, "__float__"))) {
+                throw py::type_error(fmt::format(
+                    "with_params: '{}' = {}: expected a number (in the parameter's unit) or, for "
+                    "an option, a word (str)",
+                    name, py::repr(v).cast<std::string>()));
               } else {
                 spec.set(name, v.cast<double>());
               }
             }
             if (!words.empty()) spec = apply_assignments(std::move(spec), words, "with_params");
-            return std::make_shared<Model>(compile(spec));
+            return checked_model(compile(spec));
           },
           py::arg("values"),
           "A new model with some parameters changed: {dotted name: number in the file's units} "
@@ -220,6 +301,17 @@ PYBIND11_MODULE(_gmasim, mod) {
           },
           py::arg("path"), py::arg("why") = "Python Model.save",
           "Write the model file (see toml()) atomically; Model(path) loads it back unchanged");
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_gmasim, mod) {
+  mod.doc() =
+      "gmasim: temperature-dependent giant magnetostrictive actuator simulator (MCTD model)";
+  py::register_exception<InputError>(mod, "InputError", PyExc_ValueError);
+  py::register_exception<DivergenceError>(mod, "DivergenceError", PyExc_ArithmeticError);
+
+  bind_model(mod);
 
   mod.def("simulate", &simulate_py, py::arg("model"), py::arg("temperature_C") = 20.0,
           py::arg("current_pp_A") = 8.0, py::arg("frequency_Hz") = 10.0, py::arg("periods") = 3.0,

@@ -49,9 +49,9 @@ def lib():
         "gmasim_status_name": ([I], ctypes.c_char_p),
         "gmasim_model_load": ([ctypes.c_char_p, ctypes.POINTER(P)], I),
         "gmasim_model_load_string": ([ctypes.c_char_p, ctypes.c_char_p, ctypes.POINTER(P)], I),
-        "gmasim_model_free": ([P], None),
+        "gmasim_model_free": ([P], I),
         "gmasim_sim_create": ([P, D, D, D, ctypes.POINTER(P)], I),
-        "gmasim_sim_free": ([P], None),
+        "gmasim_sim_free": ([P], I),
         "gmasim_sim_last_error": ([P], ctypes.c_char_p),
         "gmasim_sim_step": ([P, D], I),
         "gmasim_sim_reset": ([P, D], I),
@@ -169,6 +169,22 @@ def test_divergence_is_sticky_until_reset(lib):
         del sim
     finally:
         lib.gmasim_model_free(m)
+
+
+def test_double_free_is_an_error_code(lib):
+    # Issue 19, item 12: a freed handle is refused, never undefined behaviour.
+    m = ctypes.c_void_p()
+    assert lib.gmasim_model_load(None, ctypes.byref(m)) == OK
+    sim = ctypes.c_void_p()
+    assert lib.gmasim_sim_create(m, 20.0, 1e-5, 0.0, ctypes.byref(sim)) == OK
+    assert lib.gmasim_model_free(m) == OK
+    assert lib.gmasim_model_free(m) == E_ARGUMENT
+    assert b"not a live gmasim_model handle" in lib.gmasim_last_error()
+    assert lib.gmasim_sim_step(sim, 1.0) == OK
+    assert lib.gmasim_sim_free(sim) == OK
+    assert lib.gmasim_sim_step(sim, 1.0) == E_ARGUMENT
+    assert lib.gmasim_sim_free(sim) == E_ARGUMENT
+    assert lib.gmasim_sim_free(None) == OK
 
 
 @pytest.mark.skipif(shutil.which("nm") is None, reason="nm (binutils) not installed")

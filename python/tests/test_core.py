@@ -40,7 +40,7 @@ def test_with_params_changes_the_model(mdma):
     assert stiff.get("preload.force_N") == 900.0
     assert gmasim.simulate(stiff, periods=2)["metrics"]["stroke_um"] != pytest.approx(base, rel=1e-3)
     # prefix resolution of unit-suffixed names
-    assert mdma.with_params({"rod1.ja.k0": 2500.0}).get("rod1.ja.k0_A_per_m") == 2500.0
+    assert mdma.with_params({"rod1.ja.k0_A_per_m": 2500.0}).get("rod1.ja.k0_A_per_m") == 2500.0
 
 
 def test_parameter_table_describes_every_parameter(mdma):
@@ -84,7 +84,7 @@ def test_bad_requests_raise_clear_errors(mdma):
     (dict(periods=float("nan")), "periods"),
     (dict(frequency_Hz=1e-300), "too many"),
     (dict(frequency_Hz=float("inf")), "frequency"),
-    (dict(dt_s=1e-300), "too many"),
+    (dict(dt_s=1e-300), r"dt = 1e-300 s \(--dt, dt_s\): must be in \[1e-12, 0.001\] s"),  # issue 19
     (dict(temperature_C=float("nan")), "temperature"),
     (dict(current_pp_A=1e300), "current peak-to-peak = 1e\\+300 A"),
 ])
@@ -95,7 +95,7 @@ def test_every_number_is_checked_before_it_becomes_a_count(mdma, kwargs, message
 
 
 def test_experiment_requests_are_validated(mdma):
-    with pytest.raises(gmasim.InputError, match=r"reference amplitude = 1e\+300 um"):
+    with pytest.raises(gmasim.InputError, match=r"reference amplitude \(--amplitudes\) = 1e\+300 um"):
         gmasim.track(mdma, temperatures_C=[20], amplitudes_um=[1e300])
     with pytest.raises(gmasim.InputError, match="frequency points"):
         gmasim.frf(mdma, temperatures_C=[20], points=2_000_000_000)

@@ -1,5 +1,6 @@
 // The C API (gmasim/gmasim_c.h) over gmasim::Stepper: status codes instead of exceptions, error
-// messages in fixed buffers (setting one allocates nothing), no exception crosses the boundary.
+// messages in fixed buffers (setting one allocates nothing), no exception crosses the boundary,
+// and generation-counted handles (capi/handles.hpp): a freed or unknown handle is an error code.
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -14,8 +15,10 @@
 #include "gmasim/simulate.hpp"
 #include "gmasim/stepper.hpp"
 #include "gmasim/version.h"
+#include "handles.hpp"  // src/capi/, beside this file
 
 static_assert(GMASIM_MAX_DT_S == gmasim::kMaxStepperDt_s, "gmasim_c.h: GMASIM_MAX_DT_S");
+static_assert(GMASIM_MIN_DT_S == gmasim::kMinStepDt_s, "gmasim_c.h: GMASIM_MIN_DT_S");
 static_assert(GMASIM_MAX_CURRENT_A == gmasim::kMaxCurrent_A, "gmasim_c.h: GMASIM_MAX_CURRENT_A");
 
 namespace {
@@ -31,17 +34,45 @@ thread_local ErrorText t_last_error;
 
 }  // namespace
 
-struct gmasim_model {
+namespace {
+
+// What a handle stands for. gmasim_model and gmasim_sim themselves stay incomplete types: a
+// handle is a value of the tables below, never the address of one of these.
+struct ModelObject {
   std::shared_ptr<const gmasim::Model> model;
   mutable ErrorText error;
 };
 
-struct gmasim_sim {
+struct SimObject {
   gmasim::Stepper stepper;
   mutable ErrorText error;
 };
 
-namespace {
+using ModelTable = gmasim::capi_detail::HandleTable<ModelObject, 1>;
+using SimTable = gmasim::capi_detail::HandleTable<SimObject, 2>;
+
+// Never destroyed: a handle freed by a static destructor of the program after ours ran must
+// still find its table.
+ModelTable& models() {
+  static ModelTable* t = new ModelTable;
+  return *t;
+}
+SimTable& sims() {
+  static SimTable* t = new SimTable;
+  return *t;
+}
+
+std::uintptr_t value_of(const void* h) { return reinterpret_cast<std::uintptr_t>(h); }
+const ModelObject* object_of(const gmasim_model* h) { return models().get(value_of(h)); }
+SimObject* object_of(const gmasim_sim* h) { return sims().get(value_of(h)); }
+gmasim_model* model_handle(std::uintptr_t v) { return reinterpret_cast<gmasim_model*>(v); }
+gmasim_sim* sim_handle(std::uintptr_t v) { return reinterpret_cast<gmasim_sim*>(v); }
+
+// Text of a handle that is no live handle (static storage).
+constexpr const char* kDeadModel =
+    "not a live gmasim_model handle (freed already, or not made by gmasim_model_load*)";
+constexpr const char* kDeadSim =
+    "not a live gmasim_sim handle (freed already, or not made by gmasim_sim_create)";
 
 // Writes "<fn>: <message>" into the thread's buffer and, if given, the handle's.
 void set_error(ErrorText* handle, const char* fn, const char* format, ...)
@@ -58,12 +89,12 @@ void set_error(ErrorText* handle, const char* fn, const char* format, ...) {
   if (handle) std::snprintf(handle->text, kErrorBuffer, "%s", t);
 }
 
-ErrorText* error_of(const gmasim_model* m) { return m ? &m->error : nullptr; }
-ErrorText* error_of(const gmasim_sim* s) { return s ? &s->error : nullptr; }
+ErrorText* error_of(const ModelObject* m) { return m ? &m->error : nullptr; }
+ErrorText* error_of(const SimObject* s) { return s ? &s->error : nullptr; }
 
 // Runs f() and turns every exception into a status code and a message.
-template <class Handle, class F>
-int guarded(const Handle* h, const char* fn, F&& f) noexcept {
+template <class Object, class F>
+int guarded(const Object* h, const char* fn, F&& f) noexcept {
   try {
     return f();
   } catch (const gmasim::InputError& e) {
@@ -84,21 +115,28 @@ int guarded(const Handle* h, const char* fn, F&& f) noexcept {
   }
 }
 
-template <class Handle>
-int null_argument(const Handle* h, const char* fn, const char* what) {
+template <class Object>
+int null_argument(const Object* h, const char* fn, const char* what) {
   set_error(error_of(h), fn, "%s is NULL", what);
   return GMASIM_E_ARGUMENT;
 }
 
+// A handle argument that is NULL or no live handle: GMASIM_E_ARGUMENT, with the message in the
+// thread's buffer only (a dead handle has no buffer of its own).
+int bad_handle(const void* h, const char* fn, const char* what, const char* dead) {
+  if (!h) return null_argument<ModelObject>(nullptr, fn, what);
+  set_error(nullptr, fn, "%s = %p: %s", what, h, dead);
+  return GMASIM_E_ARGUMENT;
+}
+
 // A finite number, else GMASIM_E_ARGUMENT naming it.
-int check_finite(const gmasim_sim* h, const char* fn, const char* what, const char* unit,
-                 double v) {
+int check_finite(const SimObject* h, const char* fn, const char* what, const char* unit, double v) {
   if (std::isfinite(v)) return GMASIM_OK;
   set_error(error_of(h), fn, "%s = %g %s: must be a finite number", what, v, unit);
   return GMASIM_E_ARGUMENT;
 }
 
-int check_rod(const gmasim_sim* s, const char* fn, int rod) {
+int check_rod(const SimObject* s, const char* fn, int rod) {
   const int n = s->stepper.rod_count();
   if (rod >= 0 && rod < n) return GMASIM_OK;
   set_error(error_of(s), fn, "rod index %d: out of range [0, %d) (the model has %d rods)", rod, n,
@@ -106,18 +144,20 @@ int check_rod(const gmasim_sim* s, const char* fn, int rod) {
   return GMASIM_E_ARGUMENT;
 }
 
-// Getter boilerplate: sim and out non-NULL, then *out = value(stepper).
+// Getter boilerplate: a live sim, out non-NULL, then *out = value(stepper).
 template <class T, class F>
-int get(const gmasim_sim* s, T* out, const char* fn, F&& value) {
-  if (!s) return null_argument(s, fn, "sim");
+int get(const gmasim_sim* h, T* out, const char* fn, F&& value) {
+  const SimObject* s = object_of(h);
+  if (!s) return bad_handle(h, fn, "sim", kDeadSim);
   if (!out) return null_argument(s, fn, "out");
   *out = value(s->stepper);
   return GMASIM_OK;
 }
 
 template <class F>
-int get_rod(const gmasim_sim* s, int rod, double* out, const char* fn, F&& value) {
-  if (!s) return null_argument(s, fn, "sim");
+int get_rod(const gmasim_sim* h, int rod, double* out, const char* fn, F&& value) {
+  const SimObject* s = object_of(h);
+  if (!s) return bad_handle(h, fn, "sim", kDeadSim);
   if (!out) return null_argument(s, fn, "out");
   if (const int rc = check_rod(s, fn, rod)) return rc;
   *out = value(s->stepper.state().rods[static_cast<std::size_t>(rod)]);
@@ -126,14 +166,22 @@ int get_rod(const gmasim_sim* s, int rod, double* out, const char* fn, F&& value
 
 int load(std::shared_ptr<const gmasim::Model> (*make)(const char*, const char*), const char* a,
          const char* b, gmasim_model** out, const char* fn) {
-  if (!out) return null_argument<gmasim_model>(nullptr, fn, "out");
+  if (!out) return null_argument<ModelObject>(nullptr, fn, "out");
   *out = nullptr;
-  return guarded<gmasim_model>(nullptr, fn, [&] {
-    auto h = std::make_unique<gmasim_model>();
+  return guarded<ModelObject>(nullptr, fn, [&] {
+    auto h = std::make_unique<ModelObject>();
     h->model = make(a, b);
-    *out = h.release();
+    *out = model_handle(models().add(std::move(h)));
     return GMASIM_OK;
   });
+}
+
+// Frees a handle of `table`: NULL is ignored (GMASIM_OK); a dead handle is GMASIM_E_ARGUMENT.
+template <class Table>
+int free_handle(Table& table, const void* h, const char* fn, const char* what, const char* dead) {
+  if (!h) return GMASIM_OK;
+  if (table.remove(value_of(h))) return GMASIM_OK;
+  return bad_handle(h, fn, what, dead);
 }
 
 }  // namespace
@@ -175,7 +223,7 @@ int gmasim_model_load(const char* path, gmasim_model** out) {
 
 int gmasim_model_load_string(const char* toml_text, const char* source_name, gmasim_model** out) {
   const char* fn = "gmasim_model_load_string";
-  if (!toml_text) return null_argument<gmasim_model>(nullptr, fn, "toml_text");
+  if (!toml_text) return null_argument<ModelObject>(nullptr, fn, "toml_text");
   return load(
       [](const char* text, const char* name) -> std::shared_ptr<const gmasim::Model> {
         const std::string source = name && *name ? name : "<string>";
@@ -185,31 +233,37 @@ int gmasim_model_load_string(const char* toml_text, const char* source_name, gma
       toml_text, source_name, out, fn);
 }
 
-void gmasim_model_free(gmasim_model* model) { delete model; }
+int gmasim_model_free(gmasim_model* model) {
+  return free_handle(models(), model, "gmasim_model_free", "model", kDeadModel);
+}
 
 const char* gmasim_model_last_error(const gmasim_model* model) {
-  return model ? model->error.text : "";
+  if (!model) return "";
+  const ModelObject* m = object_of(model);
+  return m ? m->error.text : kDeadModel;
 }
 
 int gmasim_model_rod_count(const gmasim_model* model, int* out) {
   const char* fn = "gmasim_model_rod_count";
-  if (!model) return null_argument(model, fn, "model");
-  if (!out) return null_argument(model, fn, "out");
-  *out = model->model->rod_count();
+  const ModelObject* m = object_of(model);
+  if (!m) return bad_handle(model, fn, "model", kDeadModel);
+  if (!out) return null_argument(m, fn, "out");
+  *out = m->model->rod_count();
   return GMASIM_OK;
 }
 
 int gmasim_model_rod_name(const gmasim_model* model, int rod, const char** out) {
   const char* fn = "gmasim_model_rod_name";
-  if (!model) return null_argument(model, fn, "model");
-  if (!out) return null_argument(model, fn, "out");
-  const int n = model->model->rod_count();
+  const ModelObject* m = object_of(model);
+  if (!m) return bad_handle(model, fn, "model", kDeadModel);
+  if (!out) return null_argument(m, fn, "out");
+  const int n = m->model->rod_count();
   if (rod < 0 || rod >= n) {
-    set_error(&model->error, fn, "rod index %d: out of range [0, %d) (the model has %d rods)", rod,
-              n, n);
+    set_error(&m->error, fn, "rod index %d: out of range [0, %d) (the model has %d rods)", rod, n,
+              n);
     return GMASIM_E_ARGUMENT;
   }
-  *out = model->model->rods[static_cast<std::size_t>(rod)].name.c_str();
+  *out = m->model->rods[static_cast<std::size_t>(rod)].name.c_str();
   return GMASIM_OK;
 }
 
@@ -218,57 +272,67 @@ int gmasim_model_rod_name(const gmasim_model* model, int rod, const char** out) 
 int gmasim_sim_create(const gmasim_model* model, double temperature_C, double dt_s,
                       double current_A, gmasim_sim** out) {
   const char* fn = "gmasim_sim_create";
-  if (!out) return null_argument<gmasim_sim>(nullptr, fn, "out");
+  if (!out) return null_argument<SimObject>(nullptr, fn, "out");
   *out = nullptr;
-  if (!model) return null_argument<gmasim_sim>(nullptr, fn, "model");
+  const ModelObject* m = object_of(model);
+  if (!m) return bad_handle(model, fn, "model", kDeadModel);
   if (int rc = check_finite(nullptr, fn, "temperature", "degC", temperature_C)) return rc;
   if (int rc = check_finite(nullptr, fn, "time step dt", "s", dt_s)) return rc;
   if (int rc = check_finite(nullptr, fn, "coil current", "A", current_A)) return rc;
-  return guarded<gmasim_sim>(nullptr, fn, [&] {
-    auto h = std::unique_ptr<gmasim_sim>(
-        new gmasim_sim{gmasim::Stepper(model->model, temperature_C, dt_s, current_A), {}});
-    *out = h.release();
+  return guarded<SimObject>(nullptr, fn, [&] {
+    auto h = std::unique_ptr<SimObject>(
+        new SimObject{gmasim::Stepper(m->model, temperature_C, dt_s, current_A), {}});
+    *out = sim_handle(sims().add(std::move(h)));
     return GMASIM_OK;
   });
 }
 
-void gmasim_sim_free(gmasim_sim* sim) { delete sim; }
+int gmasim_sim_free(gmasim_sim* sim) {
+  return free_handle(sims(), sim, "gmasim_sim_free", "sim", kDeadSim);
+}
 
-const char* gmasim_sim_last_error(const gmasim_sim* sim) { return sim ? sim->error.text : ""; }
+const char* gmasim_sim_last_error(const gmasim_sim* sim) {
+  if (!sim) return "";
+  const SimObject* s = object_of(sim);
+  return s ? s->error.text : kDeadSim;
+}
 
 int gmasim_sim_reset(gmasim_sim* sim, double current_A) {
   const char* fn = "gmasim_sim_reset";
-  if (!sim) return null_argument(sim, fn, "sim");
-  if (int rc = check_finite(sim, fn, "coil current", "A", current_A)) return rc;
-  return guarded(sim, fn, [&] {
-    sim->stepper.reset(current_A);
+  SimObject* s = object_of(sim);
+  if (!s) return bad_handle(sim, fn, "sim", kDeadSim);
+  if (int rc = check_finite(s, fn, "coil current", "A", current_A)) return rc;
+  return guarded(s, fn, [&] {
+    s->stepper.reset(current_A);
     return GMASIM_OK;
   });
 }
 
 int gmasim_sim_step(gmasim_sim* sim, double current_A) {
   const char* fn = "gmasim_sim_step";
-  if (!sim) return null_argument(sim, fn, "sim");
-  if (int rc = check_finite(sim, fn, "coil current", "A", current_A)) return rc;
-  if (sim->stepper.diverged()) {
-    set_error(&sim->error, fn,
+  SimObject* s = object_of(sim);
+  if (!s) return bad_handle(sim, fn, "sim", kDeadSim);
+  if (int rc = check_finite(s, fn, "coil current", "A", current_A)) return rc;
+  if (s->stepper.diverged()) {
+    set_error(&s->error, fn,
               "refused: the sim diverged earlier (%s); call gmasim_sim_reset before stepping "
               "again",
-              sim->stepper.divergence_message().c_str());
+              s->stepper.divergence_message().c_str());
     return GMASIM_E_DIVERGED;
   }
-  return guarded(sim, fn, [&] {
-    sim->stepper.step(current_A);
+  return guarded(s, fn, [&] {
+    s->stepper.step(current_A);
     return GMASIM_OK;
   });
 }
 
 int gmasim_sim_set_temperature(gmasim_sim* sim, double temperature_C) {
   const char* fn = "gmasim_sim_set_temperature";
-  if (!sim) return null_argument(sim, fn, "sim");
-  if (int rc = check_finite(sim, fn, "temperature", "degC", temperature_C)) return rc;
-  return guarded(sim, fn, [&] {
-    sim->stepper.set_temperature(temperature_C);
+  SimObject* s = object_of(sim);
+  if (!s) return bad_handle(sim, fn, "sim", kDeadSim);
+  if (int rc = check_finite(s, fn, "temperature", "degC", temperature_C)) return rc;
+  return guarded(s, fn, [&] {
+    s->stepper.set_temperature(temperature_C);
     return GMASIM_OK;
   });
 }
@@ -334,9 +398,10 @@ int gmasim_sim_rod_magnetisation_A_per_m(const gmasim_sim* sim, int rod, double*
 
 int gmasim_sim_outputs(const gmasim_sim* sim, gmasim_outputs* out) {
   const char* fn = "gmasim_sim_outputs";
-  if (!sim) return null_argument(sim, fn, "sim");
-  if (!out) return null_argument(sim, fn, "out");
-  const gmasim::Stepper& st = sim->stepper;
+  const SimObject* so = object_of(sim);
+  if (!so) return bad_handle(sim, fn, "sim", kDeadSim);
+  if (!out) return null_argument(so, fn, "out");
+  const gmasim::Stepper& st = so->stepper;
   const gmasim::State& s = st.state();
   *out = gmasim_outputs{};
   out->t_s = s.t_s;

@@ -2,9 +2,13 @@
 #include "gmasim/validate.hpp"
 
 #include <fmt/format.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include "gmasim/errors.hpp"
 
@@ -12,8 +16,15 @@ namespace gmasim {
 
 namespace {
 
+// {:g}, unless it rounds v to another number (1000.0001 is not "1000": issue 19, item 11).
+std::string shown(double v) {
+  std::string s = fmt::format("{:g}", v);
+  if (std::isfinite(v) && std::strtod(s.c_str(), nullptr) != v) s = fmt::format("{}", v);
+  return s;
+}
+
 std::string with_unit(double v, std::string_view unit) {
-  return unit.empty() ? fmt::format("{:g}", v) : fmt::format("{:g} {}", v, unit);
+  return unit.empty() ? shown(v) : fmt::format("{} {}", shown(v), unit);
 }
 
 [[noreturn]] void fail(double v, std::string_view what, std::string_view unit,
@@ -76,6 +87,44 @@ long checked_step_count(double duration_s, double dt_s, std::string_view what) {
         "shorten the run",
         what, n, dt_s, duration_s, kMaxSteps));
   return std::max(1L, std::lround(n));
+}
+
+std::optional<MemoryAvailable> memory_available() {
+  std::optional<MemoryAvailable> best;
+  if (std::FILE* f = std::fopen("/proc/meminfo", "r")) {
+    char line[256];
+    while (std::fgets(line, sizeof line, f)) {
+      unsigned long long kb = 0;
+      if (std::sscanf(line, "MemAvailable: %llu kB", &kb) == 1) {
+        best = MemoryAvailable{static_cast<double>(kb) * 1024.0, "MemAvailable in /proc/meminfo"};
+        break;
+      }
+    }
+    std::fclose(f);
+  }
+  struct rlimit rl {};
+  if (::getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY) {
+    double used = 0.0;  // the address space in use: the first field of statm, in pages
+    if (std::FILE* f = std::fopen("/proc/self/statm", "r")) {
+      unsigned long long pages = 0;
+      if (std::fscanf(f, "%llu", &pages) == 1)
+        used = static_cast<double>(pages) * static_cast<double>(::sysconf(_SC_PAGESIZE));
+      std::fclose(f);
+    }
+    const double left = std::max(0.0, static_cast<double>(rl.rlim_cur) - used);
+    if (!best || left < best->bytes) best = MemoryAvailable{left, "RLIMIT_AS (ulimit -v)"};
+  }
+  return best;
+}
+
+void require_memory(double bytes, std::string_view what, std::string_view remedy) {
+  const auto avail = memory_available();
+  if (!avail || bytes <= avail->bytes) return;
+  auto human = [](double b) {
+    return b >= 1e9 ? fmt::format("{:.1f} GB", b / 1e9) : fmt::format("{:.0f} MB", b / 1e6);
+  };
+  throw InputError(fmt::format("{} needs about {} of memory; {} are available ({}): {}", what,
+                               human(bytes), human(avail->bytes), avail->source, remedy));
 }
 
 std::string clip_for_message(std::string_view s, std::size_t max_chars) {

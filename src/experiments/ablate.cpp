@@ -35,7 +35,7 @@ void check_request(const Model& m, const AblateRequest& r) {
   if (r.frequencies_Hz.empty()) throw InputError("ablate: no frequency given");
   for (double f : r.frequencies_Hz)
     if (!(f > 0.0) || !std::isfinite(f))
-      throw InputError(fmt::format("frequency {} Hz: must be > 0", f));
+      throw InputError(fmt::format("frequency (--frequencies) = {} Hz: must be > 0", f));
   if (!(r.current_pp_A >= 0.0) || !std::isfinite(r.current_pp_A))
     throw InputError(fmt::format("current peak-to-peak {} A: must be >= 0", r.current_pp_A));
   if (!(r.periods >= 1.0) || !std::isfinite(r.periods))

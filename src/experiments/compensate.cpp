@@ -66,20 +66,26 @@ Run run_drive(const Model& m, const CompensateRequest& r, double T, double x) {
 }
 
 void validate_request(const Model& m, const CompensateRequest& r) {
-  require_finite(r.reference_temperature_C, "reference temperature", "degC");
-  require_in(r.max_current_A, 0.0, kMaxCurrent_A, "maximum current", "A");
-  if (!(r.max_current_A > 0.0)) throw InputError("maximum current: must be > 0 A");
-  require_in(r.current_min_A, -r.max_current_A, r.max_current_A, "current minimum", "A");
-  require_in(r.reference_current_pp_A, 0.0, 2.0 * kMaxCurrent_A, "reference current p-p", "A");
+  require_finite(r.reference_temperature_C, "reference temperature (--reference-temperature)",
+                 "degC");
+  require_in(r.max_current_A, 0.0, kMaxCurrent_A, "maximum current (--max-current)", "A");
+  if (!(r.max_current_A > 0.0))
+    throw InputError("maximum current (--max-current) = 0 A: must be > 0 A");
+  require_in(r.current_min_A, -r.max_current_A, r.max_current_A, "current minimum (--current-min)",
+             "A");
+  require_in(r.reference_current_pp_A, 0.0, 2.0 * kMaxCurrent_A,
+             "reference current p-p (--reference-current-pp)", "A");
   if (!(r.reference_current_pp_A > 0.0))
-    throw InputError("reference current peak-to-peak 0 A: must be > 0");
+    throw InputError("reference current peak-to-peak (--reference-current-pp) = 0 A: must be > 0");
   if (std::fabs(r.current_min_A + r.reference_current_pp_A) > r.max_current_A)
     throw InputError(fmt::format(
         "reference drive {} A + {} A p-p peaks at {} A, beyond the maximum current {} A",
         r.current_min_A, r.reference_current_pp_A, r.current_min_A + r.reference_current_pp_A,
         r.max_current_A));
-  require_in(r.target_stroke_um, 0.0, kMaxTrackAmplitude_um, "target stroke", "um");
-  if (r.temperatures_C.empty()) throw InputError("compensate: no temperature given");
+  require_in(r.target_stroke_um, 0.0, kMaxTrackAmplitude_um, "target stroke (--target-stroke)",
+             "um");
+  if (r.temperatures_C.empty())
+    throw InputError("compensate: no temperature given (--temperatures): give at least one");
   if (static_cast<double>(r.temperatures_C.size()) > kMaxListValues)
     throw InputError(fmt::format("compensate: {} temperatures (limit {:g})",
                                  r.temperatures_C.size(), kMaxListValues));
@@ -90,12 +96,12 @@ void validate_request(const Model& m, const CompensateRequest& r) {
                                    r.temperatures_C[k], r.temperatures_C[k - 1]));
   }
   (void)make_conditions(m, r.reference_temperature_C);
-  require_positive(r.frequency_Hz, "frequency", "Hz");
-  require_in(r.frequency_Hz, 0.0, kMaxFrequency_Hz, "frequency", "Hz");
-  require_in(r.periods, 1.0, kMaxPeriods, "periods");
-  require_in(r.tolerance_um, 1e-9, 1e3, "stroke tolerance", "um");
+  require_positive(r.frequency_Hz, "frequency (--frequency)", "Hz");
+  require_in(r.frequency_Hz, 0.0, kMaxFrequency_Hz, "frequency (--frequency)", "Hz");
+  require_in(r.periods, 1.0, kMaxPeriods, "periods (--periods)");
+  require_in(r.tolerance_um, 1e-9, 1e3, "stroke tolerance (--tolerance)", "um");
   if (!(r.dt_s >= 0.0) || !std::isfinite(r.dt_s))
-    throw InputError(fmt::format("dt {} s: must be > 0 (or 0 for the automatic rule)", r.dt_s));
+    throw InputError(fmt::format("dt = {} s (--dt): must be >= 0 (0: the automatic rule)", r.dt_s));
   // Every drive the search may try is a valid run (step counts, currents).
   SimulationSettings s;
   s.waveform = drive(r, max_drive(r));
@@ -211,7 +217,9 @@ CompensateResult run_compensate(const Model& m, const CompensateRequest& r,
   res.reference = ref.metrics;
   res.target_stroke_um = r.target_stroke_um > 0.0 ? r.target_stroke_um : ref.metrics.stroke_um;
   if (!(res.target_stroke_um > 0.0))
-    throw InputError("compensate: the reference drive gives no stroke (0 um): no target");
+    throw InputError(
+        "compensate: the reference drive (--reference-current-pp, --current-min) gives no stroke "
+        "(0 um): no target; give a drive that moves the actuator");
 
   res.points.resize(r.temperatures_C.size());
   res.threads = resolve_thread_count(r.threads, r.temperatures_C.size());

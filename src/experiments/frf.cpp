@@ -356,31 +356,36 @@ double find_bandwidth_3dB_Hz(const std::vector<double>& f, const std::vector<dou
 namespace {
 
 void check_request(const FrfRequest& r) {
-  if (r.temperatures_C.empty()) throw InputError("frf: no temperature given");
+  if (r.temperatures_C.empty())
+    throw InputError("frf: no temperature given (--temperatures): give at least one");
   if (!(r.f_min_Hz > 0.0) || !std::isfinite(r.f_min_Hz))
-    throw InputError(fmt::format("frequency {} Hz: must be > 0", r.f_min_Hz));
+    throw InputError(fmt::format("lowest frequency (--f-min) = {} Hz: must be > 0", r.f_min_Hz));
   if (!(r.f_max_Hz > r.f_min_Hz) || !std::isfinite(r.f_max_Hz))
-    throw InputError(fmt::format("frequency range {} .. {} Hz: the maximum must exceed the minimum",
-                                 r.f_min_Hz, r.f_max_Hz));
-  if (r.points < 2) throw InputError(fmt::format("points {}: need at least 2", r.points));
+    throw InputError(fmt::format(
+        "frequency range (--f-min .. --f-max) {} .. {} Hz: the maximum must exceed the minimum",
+        r.f_min_Hz, r.f_max_Hz));
+  if (r.points < 2)
+    throw InputError(fmt::format("points (--points) = {}: need at least 2", r.points));
   if (!(r.amplitude_A > 0.0) || !std::isfinite(r.amplitude_A))
-    throw InputError(fmt::format("amplitude {} A: must be > 0", r.amplitude_A));
-  if (!std::isfinite(r.bias_A)) throw InputError("bias current: not a finite number");
+    throw InputError(fmt::format("amplitude (--amplitude) = {} A: must be > 0", r.amplitude_A));
+  if (!std::isfinite(r.bias_A)) throw InputError("bias current (--bias): not a finite number");
   if (r.min_steps_per_period < 20)
     throw InputError(fmt::format("steps per period {}: need at least 20", r.min_steps_per_period));
   if (r.settle_periods < 1 || r.measure_periods < 1)
-    throw InputError(fmt::format("settle periods {} / measure periods {}: must be >= 1",
-                                 r.settle_periods, r.measure_periods));
+    throw InputError(
+        fmt::format("settle periods (--settle-periods) {} / measure periods (--measure-periods) "
+                    "{}: must be >= 1",
+                    r.settle_periods, r.measure_periods));
   if (!r.stepped_sine && !r.small_signal)
     throw InputError("frf: neither the stepped sine nor the small-signal method is selected");
-  for (double T : r.temperatures_C) require_finite(T, "temperature", "degC");
+  for (double T : r.temperatures_C) require_finite(T, "temperature (--temperatures)", "degC");
   if (static_cast<double>(r.temperatures_C.size()) > kMaxListValues)
     throw InputError(fmt::format("frf: {} temperatures: too many (limit {:g})",
                                  r.temperatures_C.size(), kMaxListValues));
-  require_in(r.f_max_Hz, 0.0, kMaxFrequency_Hz, "maximum frequency", "Hz");
-  (void)checked_count(r.points, kMaxFrfPoints, "frequency points");
-  require_in(r.amplitude_A, 0.0, kMaxCurrent_A, "amplitude", "A");
-  require_in(r.bias_A, -kMaxCurrent_A, kMaxCurrent_A, "bias current", "A");
+  require_in(r.f_max_Hz, 0.0, kMaxFrequency_Hz, "maximum frequency (--f-max)", "Hz");
+  (void)checked_count(r.points, kMaxFrfPoints, "frequency points (--points)");
+  require_in(r.amplitude_A, 0.0, kMaxCurrent_A, "amplitude (--amplitude)", "A");
+  require_in(r.bias_A, -kMaxCurrent_A, kMaxCurrent_A, "bias current (--bias)", "A");
   require_int_in(r.settle_periods, 1, 1000000, "settle periods");
   require_int_in(r.measure_periods, 1, 1000000, "measure periods");
   if (r.stepped_sine) {

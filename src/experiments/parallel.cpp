@@ -1,17 +1,26 @@
 #include "experiments/parallel.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <exception>
 #include <limits>
 #include <mutex>
+#include <system_error>
 #include <thread>
 #include <vector>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/validate.hpp"
 
 namespace gmasim {
 
 int resolve_thread_count(int requested, std::size_t work) {
+  if (requested < 0 || requested > kMaxThreads)
+    throw InputError(fmt::format("threads = {} (--threads): must be 0 (all cores) or in [1, {}]",
+                                 requested, kMaxThreads));
   int n = requested;
   if (n <= 0) {
     const unsigned hw = std::thread::hardware_concurrency();
@@ -54,7 +63,15 @@ void parallel_for(std::size_t n, int threads, const std::function<void(std::size
   } else {
     std::vector<std::thread> pool;
     pool.reserve(static_cast<std::size_t>(t));
-    for (int k = 0; k < t; ++k) pool.emplace_back(worker);
+    try {
+      for (int k = 0; k < t; ++k) pool.emplace_back(worker);
+    } catch (const std::system_error& e) {  // the system refused a thread: run with those we have
+      if (pool.empty()) {
+        stop.store(true);
+        throw InputError(
+            fmt::format("cannot start a worker thread ({}); lower --threads", e.what()));
+      }
+    }
     for (auto& th : pool) th.join();
   }
   if (failure) std::rethrow_exception(failure);

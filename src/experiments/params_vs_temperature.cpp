@@ -31,9 +31,11 @@ double mean_of(const std::vector<double>& v, std::size_t b, std::size_t e) {
 }
 
 void check_request(const ParamsVsTemperatureRequest& r) {
-  if (r.temperatures_C.empty()) throw InputError("params-vs-temperature: no temperature given");
+  if (r.temperatures_C.empty())
+    throw InputError(
+        "params-vs-temperature: no temperature given (--temperatures): give at least one");
   if (!(r.frequency_Hz > 0.0) || !std::isfinite(r.frequency_Hz))
-    throw InputError(fmt::format("frequency {} Hz: must be > 0", r.frequency_Hz));
+    throw InputError(fmt::format("frequency (--frequency) = {} Hz: must be > 0", r.frequency_Hz));
   for (double pp : r.retention_currents_pp_A)
     if (!(pp >= 0.0) || !std::isfinite(pp))
       throw InputError(fmt::format("current peak-to-peak {} A: must be >= 0", pp));

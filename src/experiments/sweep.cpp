@@ -19,7 +19,7 @@ void check_list(const std::vector<double>& v, const char* what, const char* unit
         fmt::format("empty grid: no {} given (need at least one value in {})", what, unit));
   for (double x : v)
     if (!std::isfinite(x))
-      throw InputError(fmt::format("{} {} {}: not a finite number", what, x, unit));
+      throw InputError(fmt::format("{} = {} {}: not a finite number", what, x, unit));
   if (static_cast<double>(v.size()) > kMaxListValues)
     throw InputError(
         fmt::format("{} {} values: too many (limit {:g})", v.size(), what, kMaxListValues));
@@ -30,16 +30,19 @@ struct Job {
 };
 
 void check_request(const Model& m, const SweepRequest& r) {
-  check_list(r.temperatures_C, "temperature", "degC");
-  check_list(r.currents_pp_A, "current peak-to-peak", "A");
-  check_list(r.frequencies_Hz, "frequency", "Hz");
+  check_list(r.temperatures_C, "temperature (--temperatures)", "degC");
+  check_list(r.currents_pp_A, "current peak-to-peak (--currents)", "A");
+  check_list(r.frequencies_Hz, "frequency (--frequencies)", "Hz");
   for (double f : r.frequencies_Hz)
-    if (!(f > 0.0)) throw InputError(fmt::format("frequency {} Hz: must be > 0", f));
+    if (!(f > 0.0))
+      throw InputError(fmt::format("frequency (--frequencies) = {} Hz: must be > 0", f));
   for (double pp : r.currents_pp_A)
-    if (!(pp >= 0.0)) throw InputError(fmt::format("current peak-to-peak {} A: must be >= 0", pp));
+    if (!(pp >= 0.0))
+      throw InputError(fmt::format("current peak-to-peak (--currents) = {} A: must be >= 0", pp));
   if (!(r.periods >= 1.0) || !std::isfinite(r.periods))
-    throw InputError(fmt::format("periods {}: must be >= 1", r.periods));
-  require_finite(r.reference_temperature_C, "reference temperature", "degC");
+    throw InputError(fmt::format("periods (--periods) = {}: must be >= 1", r.periods));
+  require_finite(r.reference_temperature_C, "reference temperature (--reference-temperature)",
+                 "degC");
   const double runs = static_cast<double>(r.temperatures_C.size() + 1) *
                       static_cast<double>(r.currents_pp_A.size()) *
                       static_cast<double>(r.frequencies_Hz.size());
@@ -47,9 +50,10 @@ void check_request(const Model& m, const SweepRequest& r) {
     throw InputError(
         fmt::format("sweep grid of {:.4g} runs: too many (limit {:g})", runs, kMaxGridRuns));
   if (!(r.dt_s >= 0.0) || !std::isfinite(r.dt_s))
-    throw InputError(fmt::format("dt {} s: must be > 0 (or 0 for the automatic rule)", r.dt_s));
+    throw InputError(fmt::format("dt = {} s (--dt): must be >= 0 (0: the automatic rule)", r.dt_s));
   if (!std::isfinite(r.current_min_A))
-    throw InputError(fmt::format("current minimum {} A: not a finite number", r.current_min_A));
+    throw InputError(fmt::format("current minimum (--current-min) = {} A: not a finite number",
+                                 r.current_min_A));
   // Every point's settings must be valid (currents, frequency, run length: simulate's
   // validate()) and every temperature must give valid conditions (T < T_c, ...): fail before
   // any run, not in the middle of the grid.

@@ -90,36 +90,39 @@ struct Job {
 };
 
 void check_positive_list(const std::vector<double>& v, const char* what, const char* unit) {
-  if (v.empty()) throw InputError(fmt::format("track: no {} given", what));
+  if (v.empty()) throw InputError(fmt::format("track: no {} given: give at least one", what));
   for (double x : v)
     if (!(x > 0.0) || !std::isfinite(x))
-      throw InputError(fmt::format("{} {} {}: must be > 0", what, x, unit));
+      throw InputError(fmt::format("{} = {} {}: must be > 0", what, x, unit));
   if (static_cast<double>(v.size()) > kMaxListValues)
     throw InputError(
         fmt::format("{} {} values: too many (limit {:g})", v.size(), what, kMaxListValues));
 }
 
 void check_request(const TrackRequest& r) {
-  if (r.temperatures_C.empty()) throw InputError("track: no temperature given");
-  for (double T : r.temperatures_C) require_finite(T, "temperature", "degC");
-  check_positive_list(r.amplitudes_um, "reference amplitude", "um");
-  check_positive_list(r.frequencies_Hz, "reference frequency", "Hz");
+  if (r.temperatures_C.empty())
+    throw InputError("track: no temperature given (--temperatures): give at least one");
+  for (double T : r.temperatures_C) require_finite(T, "temperature (--temperatures)", "degC");
+  check_positive_list(r.amplitudes_um, "reference amplitude (--amplitudes)", "um");
+  check_positive_list(r.frequencies_Hz, "reference frequency (--frequencies)", "Hz");
   // A reference beyond 10 mm is no actuator's stroke: refuse it rather than report a
   // saturated loop with astronomically large errors.
   for (double A : r.amplitudes_um)
-    require_in(A, 0.0, kMaxTrackAmplitude_um, "reference amplitude", "um");
+    require_in(A, 0.0, kMaxTrackAmplitude_um, "reference amplitude (--amplitudes)", "um");
   for (double f : r.frequencies_Hz)
-    require_in(f, 0.0, kMaxFrequency_Hz, "reference frequency", "Hz");
-  require_in(r.sample_rate_Hz, 0.0, 1e3 * kMaxFrequency_Hz, "PID sample rate", "Hz");
-  require_in(r.bias_A, -kMaxCurrent_A, kMaxCurrent_A, "bias current", "A");
-  require_in(r.current_limit_A, 0.0, kMaxCurrent_A, "current limit", "A");
-  require_in(r.amplifier_A_per_unit, 1e-6, 1e6, "amplifier gain", "A per unit");
-  for (double g : {r.gains.kp, r.gains.ki, r.gains.kd}) require_finite(g, "PID gain");
+    require_in(f, 0.0, kMaxFrequency_Hz, "reference frequency (--frequencies)", "Hz");
+  require_in(r.sample_rate_Hz, 0.0, 1e3 * kMaxFrequency_Hz, "PID sample rate (--sample-rate)",
+             "Hz");
+  require_in(r.bias_A, -kMaxCurrent_A, kMaxCurrent_A, "bias current (--bias)", "A");
+  require_in(r.current_limit_A, 0.0, kMaxCurrent_A, "current limit (--current-limit)", "A");
+  for (double g : {r.gains.kp, r.gains.ki, r.gains.kd})
+    require_finite(g, "PID gain (--kp, --ki, --kd)");
+  require_in(r.amplifier_A_per_unit, 1e-6, 1e6, "amplifier gain (--amplifier-gain)", "A per unit");
   // The gains are per sample at this rate (Pid): a rate of 4.9e-324 Hz would scale kd by
   // 1e300+ (found by the mutation campaign).
-  require_in(r.gains.reference_rate_Hz, 1e-3, 1e9, "PID gain reference rate", "Hz");
-  require_in(r.sensor_noise_um, 0.0, kMaxTrackAmplitude_um, "sensor noise", "um");
-  require_in(r.periods, 1.0, kMaxPeriods, "periods");
+  require_in(r.gains.reference_rate_Hz, 1e-3, 1e9, "PID gain reference rate (--gain-rate)", "Hz");
+  require_in(r.sensor_noise_um, 0.0, kMaxTrackAmplitude_um, "sensor noise (--sensor-noise)", "um");
+  require_in(r.periods, 1.0, kMaxPeriods, "periods (--periods)");
   const double runs = static_cast<double>(r.temperatures_C.size()) *
                       static_cast<double>(r.amplitudes_um.size()) *
                       static_cast<double>(r.frequencies_Hz.size());
@@ -127,24 +130,29 @@ void check_request(const TrackRequest& r) {
     throw InputError(
         fmt::format("track grid of {:.4g} runs: too many (limit {:g})", runs, kMaxGridRuns));
   if (!(r.sample_rate_Hz > 0.0) || !std::isfinite(r.sample_rate_Hz))
-    throw InputError(fmt::format("PID sample rate {} Hz: must be > 0", r.sample_rate_Hz));
+    throw InputError(
+        fmt::format("PID sample rate (--sample-rate) = {} Hz: must be > 0", r.sample_rate_Hz));
   for (double f : r.frequencies_Hz)
     if (r.sample_rate_Hz < 2.0 * f)
       throw InputError(fmt::format(
-          "PID sample rate {} Hz is below twice the reference frequency {} Hz (Nyquist): the "
+          "PID sample rate (--sample-rate) = {} Hz is below twice the reference frequency {} Hz "
+          "(Nyquist): the "
           "controller cannot see the reference; raise --sample-rate to at least {} Hz",
           r.sample_rate_Hz, f, 2.0 * f));
   if (!(r.current_limit_A > 0.0) || !std::isfinite(r.current_limit_A))
-    throw InputError(fmt::format("current limit {} A: must be > 0", r.current_limit_A));
+    throw InputError(
+        fmt::format("current limit (--current-limit) = {} A: must be > 0", r.current_limit_A));
   if (!(std::fabs(r.bias_A) < r.current_limit_A))
-    throw InputError(fmt::format("bias current {} A: must lie inside the current limit +-{} A",
-                                 r.bias_A, r.current_limit_A));
+    throw InputError(fmt::format(
+        "bias current (--bias) = {} A: must lie inside the current limit (--current-limit) +-{} A",
+        r.bias_A, r.current_limit_A));
   if (!(r.sensor_noise_um >= 0.0) || !std::isfinite(r.sensor_noise_um))
-    throw InputError(fmt::format("sensor noise {} um: must be >= 0", r.sensor_noise_um));
+    throw InputError(
+        fmt::format("sensor noise (--sensor-noise) = {} um: must be >= 0", r.sensor_noise_um));
   if (!(r.periods >= 1.0) || !std::isfinite(r.periods))
     throw InputError(fmt::format("periods {}: must be >= 1", r.periods));
   if (!(r.dt_s >= 0.0) || !std::isfinite(r.dt_s))
-    throw InputError(fmt::format("dt {} s: must be > 0 (or 0 for the automatic rule)", r.dt_s));
+    throw InputError(fmt::format("dt = {} s (--dt): must be >= 0 (0: the automatic rule)", r.dt_s));
   check_feedforward(r.feedforward);
   Pid probe(r.gains, r.sample_rate_Hz, -1.0, 1.0);  // validates the gains' reference rate
   (void)probe;

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -24,6 +25,7 @@
 #include <pagmo/topologies/ring.hpp>
 #include <pagmo/topology.hpp>
 #include <pagmo/types.hpp>
+#include <system_error>
 #include <utility>
 
 #include "gmasim/errors.hpp"
@@ -33,12 +35,24 @@
 namespace gmasim::identify_detail {
 namespace {
 
+// Thrown by an island's fitness once a stop was requested (SIGINT/SIGTERM): the evaluation in
+// progress finishes, every later one of the batch or generation throws at once, so a stop during
+// the first population or a long generation takes effect within one evaluation (issue 19,
+// item 4). pagmo keeps an island's population when its evolution throws.
+struct SearchStopped : std::exception {
+  const char* what() const noexcept override { return "the search was stopped"; }
+};
+
 // The pagmo user-defined problem: minimise the weighted RMS error [%] over u in [0, 1]^n.
-// Copied into every island; the copies share only the immutable Objective.
+// Copied into every island; the copies share only the immutable Objective. `stop` (the
+// islands' copies only; null for the checkpoint's re-evaluation) makes an evaluation throw
+// SearchStopped once it is set.
 struct GmaProblem {
   std::shared_ptr<const Objective> obj;
+  const std::atomic<bool>* stop = nullptr;
 
   pagmo::vector_double fitness(const pagmo::vector_double& u) const {
+    if (stop && stop->load(std::memory_order_relaxed)) throw SearchStopped{};
     return {obj ? obj->rms_pct(u) : Objective::kPenalty};
   }
   std::pair<pagmo::vector_double, pagmo::vector_double> get_bounds() const {
@@ -206,13 +220,27 @@ class GaRun {
         ranks_(comm.size()),
         n_(obj.dim()),
         fp_(fingerprints(obj, o, ranks_)),
-        prob_{GmaProblem{std::make_shared<const Objective>(obj)}} {}
+        prob_{GmaProblem{std::make_shared<const Objective>(obj)}},
+        island_prob_{GmaProblem{std::make_shared<const Objective>(obj), o.stop}} {}
 
   GaOutcome run(const std::vector<double>& start_u, double start_f) {
     out_.best_u = start_u;
     out_.best_f = start_f;
-    const std::vector<std::vector<IslandPopulation>> restored = resume();
-    build_islands(start_u, start_f, restored);
+    // A stop while the first populations are evaluated ends the search at once, with the start
+    // model as the best so far and no checkpoint (there is no generation to keep); every rank
+    // leaves together.
+    bool stopped = false;
+    try {
+      const std::vector<std::vector<IslandPopulation>> restored = resume();
+      build_islands(start_u, start_f, restored);
+    } catch (const SearchStopped&) {
+      stopped = true;
+    }
+    if (any_rank(comm_, stopped)) {
+      out_.interrupted = true;
+      out_.wall_s = seconds_since(t_start_);
+      return out_;
+    }
     record_start();
     t_epoch_ = Clock::now();
     while (out_.generation < o_.generations) {
@@ -255,9 +283,16 @@ class GaRun {
     for (int i = 0; i < o_.islands; ++i) {
       const unsigned s = mix_seed(o_.seed, rank_, i, out_.generation);
       seeds_.push_back(s);
-      archi_.push_back(pagmo::thread_island{}, make_algorithm(o_.algorithm, current_gen_, n_, s),
-                       island_population(i, s, start_u, start_f, restored),
-                       pagmo::fair_replace{migrants}, pagmo::select_best{migrants});
+      pagmo::population pop = island_population(i, s, start_u, start_f, restored);
+      try {  // each island is a thread: the system may refuse one
+        archi_.push_back(pagmo::thread_island{}, make_algorithm(o_.algorithm, current_gen_, n_, s),
+                         std::move(pop), pagmo::fair_replace{migrants},
+                         pagmo::select_best{migrants});
+      } catch (const std::system_error& e) {
+        throw InputError(fmt::format(
+            "--islands {}: the system refused the thread of island {} ({}); lower --islands",
+            o_.islands, i + 1, e.what()));
+      }
     }
   }
 
@@ -267,12 +302,12 @@ class GaRun {
       int i, unsigned seed, const std::vector<double>& start_u, double start_f,
       const std::vector<std::vector<IslandPopulation>>& restored) const {
     if (!out_.resumed) {
-      pagmo::population pop{prob_, pagmo::bfe{pagmo::thread_bfe{}},
+      pagmo::population pop{island_prob_, pagmo::bfe{pagmo::thread_bfe{}},
                             static_cast<pagmo::pop_size_t>(o_.population), seed};
       if (i == 0) pop.set_xf(pop.worst_idx(), start_u, {start_f});  // seed the start model
       return pop;
     }
-    pagmo::population pop{prob_, 0u, seed};
+    pagmo::population pop{island_prob_, 0u, seed};
     const auto& ip = restored[static_cast<std::size_t>(rank_)][static_cast<std::size_t>(i)];
     for (std::size_t k = 0; k < ip.x.size(); ++k) pop.push_back(ip.x[k], {ip.f[k]});
     return pop;
@@ -325,8 +360,13 @@ class GaRun {
     }
     const auto before = fevals(archi_);
     archi_.evolve(1);  // each island: immigrants from its ring neighbour, `gens` generations
-    archi_.wait_check();
-    out_.generation += gens;
+    bool cut = false;  // a stop cut the epoch short: its generations do not count
+    try {
+      archi_.wait_check();
+    } catch (const SearchStopped&) {
+      cut = true;
+    }
+    if (!any_rank(comm_, cut)) out_.generation += gens;
     const long epoch_evals = sum_ranks(comm_, static_cast<long>(fevals(archi_) - before));
     out_.evaluations += epoch_evals;
     out_.run_evaluations += epoch_evals;
@@ -380,7 +420,8 @@ class GaRun {
   const int rank_, ranks_;
   const std::size_t n_;
   const Fingerprints fp_;
-  const pagmo::problem prob_;
+  const pagmo::problem prob_;         // the checkpoint's re-evaluation: never stopped
+  const pagmo::problem island_prob_;  // the islands': stops with o.stop
   GaOutcome out_;
   double wall_before_ = 0.0;  // GA wall time of the run(s) before a resume
   pagmo::archipelago archi_{pagmo::topology{pagmo::ring{}}};

@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/validate.hpp"
 #include "internal.hpp"
 
 namespace gmasim {
@@ -30,6 +31,28 @@ void check_options(const IdentifyOptions& o) {
   positive(o.migrants, "--migrants");
   if (o.population < 8)
     throw InputError(fmt::format("--population {}: must be >= 8", o.population));
+  // Counts that become threads, memory and time (issue 19, item 4): each island is a thread,
+  // each individual an evaluation per generation.
+  if (o.islands > kMaxIslands)
+    throw InputError(fmt::format(
+        "--islands {}: at most {} per rank (each island is a thread); use MPI ranks for more",
+        o.islands, kMaxIslands));
+  if (o.population > kMaxPopulation)
+    throw InputError(fmt::format("--population {}: at most {} individuals per island", o.population,
+                                 kMaxPopulation));
+  if (static_cast<double>(o.islands) * o.population * std::max(1, o.generations) >
+      kMaxGaEvaluations)
+    throw InputError(fmt::format(
+        "--islands {} x --population {} x --generations {} = {:.3g} evaluations per rank: more "
+        "than {:g} (days of work); lower one of them",
+        o.islands, o.population, o.generations,
+        static_cast<double>(o.islands) * o.population * std::max(1, o.generations),
+        kMaxGaEvaluations));
+  if (o.generations > kMaxGenerations)
+    throw InputError(fmt::format("--generations {}: at most {}", o.generations, kMaxGenerations));
+  if (o.threads < 0 || o.threads > kMaxThreads)
+    throw InputError(
+        fmt::format("--threads {}: must be 0 (all cores) or in [1, {}]", o.threads, kMaxThreads));
   if (o.migrants >= o.population)
     throw InputError(
         fmt::format("--migrants {}: must be < the population {}", o.migrants, o.population));
@@ -43,13 +66,15 @@ void check_options(const IdentifyOptions& o) {
 // The start model must evaluate: a search from a model that cannot be simulated under
 // these settings would penalise every candidate alike and end "successfully" with nothing
 // determined (issue 8). A candidate that fails later is penalised; the start is not.
-void check_start_evaluates(const Objective& obj, const std::vector<double>& u_start,
-                           double f_start) {
+void check_start_evaluates(const Objective& obj, const std::vector<double>& u_start, double f_start,
+                           const std::string& source) {
   if (f_start < Objective::kPenalty) return;
   const std::string why = obj.failure_reason(u_start);
-  throw InputError(fmt::format("the start model cannot be evaluated: {}{}",
-                               why.empty() ? "its error is not finite" : why,
-                               "; fix the start model or the settings before searching"));
+  throw InputError(fmt::format(
+      "the start model {} (--model) cannot be evaluated on the data and targets (--data, "
+      "--fit): {}{}",
+      source, why.empty() ? "its error is not finite" : why,
+      "; fix the start model or the settings before searching"));
 }
 
 // Levenberg-Marquardt from the GA's best (u, f), which it replaces when it is better; its
@@ -138,7 +163,7 @@ IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, cons
   const std::vector<double> u_start = obj.start_unit();
   const double f_start = obj.rms_pct(u_start);
   res.start_rms_pct = f_start;
-  check_start_evaluates(obj, u_start, f_start);
+  check_start_evaluates(obj, u_start, f_start, start.source);
 
   // ---- global search, local refinement ------------------------------------------------
   const GaOutcome ga = run_ga(obj, o, comm, u_start, f_start);

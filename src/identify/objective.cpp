@@ -27,18 +27,7 @@ using identify_detail::TargetData;
 
 void check_settings(const ObjectiveSettings& settings, const MeasurementSet& data,
                     const FitSpec& fit) {
-  if (!(settings.steps_per_period >= 8.0))
-    throw InputError(fmt::format("steps per period {:g}: must be >= 8", settings.steps_per_period));
-  if (!(settings.dt_s >= 0.0) || !std::isfinite(settings.dt_s))
-    throw InputError(fmt::format("dt {:g} s: must be >= 0", settings.dt_s));
-  if (!(settings.flux_weight >= 0.0))
-    throw InputError(fmt::format("flux weight {:g}: must be >= 0", settings.flux_weight));
-  if (!(settings.target_periods >= 1.0))
-    throw InputError(fmt::format("target periods {:g}: must be >= 1", settings.target_periods));
-  require_in(settings.steps_per_period, 8.0, 1e6, "steps per period");
-  require_in(settings.target_periods, 1.0, 1e4, "target periods");
-  require_in(settings.flux_weight, 0.0, 1e6, "flux weight");
-  require_in(settings.quasi_static_increments, 10.0, 1e6, "quasi-static increments per range");
+  validate(settings);
   if (fit.parameters.empty()) throw InputError(located(fit.source, 0, "no parameter to fit"));
   if (data.items.empty() && fit.targets.empty()) {
     throw InputError(
@@ -46,6 +35,31 @@ void check_settings(const ObjectiveSettings& settings, const MeasurementSet& dat
         "in the fit spec");
   }
 }
+
+}  // namespace
+
+void validate(const ObjectiveSettings& settings) {
+  if (!(settings.steps_per_period >= 8.0))
+    throw InputError(fmt::format("steps per period {:g} (--steps-per-period): must be >= 8",
+                                 settings.steps_per_period));
+  if (!(settings.dt_s >= 0.0) || !std::isfinite(settings.dt_s))
+    throw InputError(fmt::format("dt {:g} s (--dt): must be >= 0", settings.dt_s));
+  if (settings.dt_s > 0.0 && (settings.dt_s < kMinStepDt_s || settings.dt_s > kMaxStepDt_s))
+    throw InputError(fmt::format("dt {:g} s (--dt): must be in [{:g}, {:g}] s, or 0", settings.dt_s,
+                                 kMinStepDt_s, kMaxStepDt_s));
+  if (!(settings.flux_weight >= 0.0))
+    throw InputError(
+        fmt::format("flux weight {:g} (--flux-weight): must be >= 0", settings.flux_weight));
+  if (!(settings.target_periods >= 1.0))
+    throw InputError(fmt::format("target periods {:g} (--target-periods): must be >= 1",
+                                 settings.target_periods));
+  require_in(settings.steps_per_period, 8.0, 1e6, "steps per period");
+  require_in(settings.target_periods, 1.0, 1e4, "target periods");
+  require_in(settings.flux_weight, 0.0, 1e6, "flux weight");
+  require_in(settings.quasi_static_increments, 10.0, 1e6, "quasi-static increments per range");
+}
+
+namespace {
 
 // One fitted parameter: its full key, unit, scale and bounds (both valid model values).
 Param make_param(const ModelSpec& start, const FitSpec& fit, const FitParameter& fp,

@@ -202,8 +202,15 @@ class RecordRun {
   void run(State& st) {
     // A field record starts at rest at zero current and ramps quasi-statically to its first
     // field, as a current record starts at rest at its first current (make_state).
-    if (field_drive_ && field(st) != meas_.drive.front())
-      travel(st, field(st), meas_.drive.front());
+    if (field_drive_ && field(st) != meas_.drive.front()) {
+      try {
+        travel(st, field(st), meas_.drive.front());
+      } catch (const DivergenceError& e) {
+        throw DivergenceError(fmt::format("{}: the ramp from rest to data row 1 ({} = {:g}): {}",
+                                          meas_.path, meas_.drive_column(), meas_.drive.front(),
+                                          e.what()));
+      }
+    }
     if (meas_.condition.quasi_static) {
       run_quasi_static(st);
     } else {
@@ -244,7 +251,14 @@ class RecordRun {
       if (pass > 0) travel(st, at, drive.front());
       at = drive.front();
       for (std::size_t i = 0; i < drive.size(); ++i) {
-        if (i > 0) travel(st, at, drive[i]);
+        try {
+          if (i > 0) travel(st, at, drive[i]);
+        } catch (const DivergenceError& e) {
+          // A quasi-static record has no time: name the sample (issue 19, item 11), not "t = 0".
+          throw DivergenceError(fmt::format(
+              "{}: quasi-static record, moving to data row {} ({} = {:g}, pass {} of {}): {}",
+              meas_.path, i + 1, meas_.drive_column(), drive[i], pass + 1, passes, e.what()));
+        }
         at = drive[i];
         if (pass + 1 == passes) store(i, st);
       }

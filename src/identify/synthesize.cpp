@@ -15,7 +15,10 @@ namespace gmasim {
 namespace {
 
 void check_request(const SyntheticRequest& r) {
-  if (r.samples_per_period < 8) throw InputError("samples per period: must be >= 8");
+  validate(r.objective);  // the rules identify applies to the same settings
+  if (r.samples_per_period < 8)
+    throw InputError(fmt::format("samples per period {} (--samples-per-period): must be >= 8",
+                                 r.samples_per_period));
   if (r.precycles == 0 && !(r.periods >= 1.5))
     throw InputError("periods: must be >= 1.5 (the first is not compared)");
   if (!(r.periods >= 1.0)) throw InputError("periods: must be >= 1 (one whole loop)");
@@ -27,8 +30,12 @@ void check_request(const SyntheticRequest& r) {
   if (r.precycles < 0 || r.precycles > kMaxPrecycles)
     throw InputError(fmt::format("precycles {}: must be in [0, {}]", r.precycles, kMaxPrecycles));
   for (double T : r.temperatures_C) require_finite(T, "temperature", "degC");
-  for (double pp : r.currents_pp_A)
-    require_in(pp, 0.0, 2.0 * kMaxCurrent_A, "current peak-to-peak", "A");
+  for (double pp : r.currents_pp_A)  // identify refuses a record of 0 A p-p: so must this
+    if (!(pp > 0.0 && pp <= 2.0 * kMaxCurrent_A))
+      throw InputError(fmt::format(
+          "current peak-to-peak {:g} A (--currents): must be in (0, {:g}] A (identify refuses "
+          "a record without current)",
+          pp, 2.0 * kMaxCurrent_A));
   for (double f : r.frequencies_Hz) {
     require_positive(f, "frequency", "Hz");
     require_in(f, 0.0, kMaxFrequency_Hz, "frequency", "Hz");

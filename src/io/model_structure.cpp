@@ -34,6 +34,7 @@ void ModelLoader::read_root(const toml::table& root) {
   read_mechanics(root);
   read_group_table(root, Group::ThermalExpansion, 1);
   read_group_table(root, Group::ThermalNetwork, 1);
+  read_group_table(root, Group::Validity, 1);
 }
 
 void ModelLoader::check_top_level(const toml::table& root) {

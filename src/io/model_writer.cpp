@@ -102,7 +102,11 @@ ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assi
     if (io_detail::parse_finite(value, v) != io_detail::CellError::None)
       throw InputError(
           fmt::format("{} '{}': the value '{}' is not a finite number", flag, shown, value));
-    spec.set(name, v);
+    try {
+      spec.set(name, v);
+    } catch (const InputError& e) {  // name the flag too (issue 19, item 11)
+      throw InputError(fmt::format("{} '{}': {}", flag, shown, e.what()));
+    }
   }
   if (!options.empty()) spec.set_options(options);
   return spec;

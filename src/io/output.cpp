@@ -1,9 +1,14 @@
 // Output files: atomic writes, the output directory, timeseries.csv and metrics.json.
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <signal.h>
+#include <sys/file.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -11,6 +16,8 @@
 #include <cstring>
 #include <filesystem>
 #include <iterator>
+#include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -48,13 +55,97 @@ void require_regular_destination(const std::string& path) {
                                        kind)));
 }
 
-// Writes content to a fresh temporary next to path, flushed and synced; returns its name.
+// The temporaries being written, for remove_pending_temporaries() (a signal handler): fixed
+// slots, a path is complete before its slot is marked used (issue 19, item 5).
+constexpr int kPendingSlots = 64;
+struct PendingSlot {
+  std::atomic<bool> used{false};
+  char path[4096] = {};
+};
+PendingSlot g_pending[kPendingSlots];
+std::mutex g_pending_mu;
+
+class PendingTemporary {
+ public:
+  explicit PendingTemporary(const std::string& path) {
+    if (path.size() >= sizeof(g_pending[0].path)) return;
+    const std::lock_guard<std::mutex> lock(g_pending_mu);
+    for (int i = 0; i < kPendingSlots; ++i) {
+      if (g_pending[i].used.load(std::memory_order_relaxed)) continue;
+      std::memcpy(g_pending[i].path, path.c_str(), path.size() + 1);
+      g_pending[i].used.store(true, std::memory_order_release);
+      slot_ = i;
+      return;
+    }
+  }
+  ~PendingTemporary() { release(); }
+  void release() {
+    if (slot_ < 0) return;
+    const std::lock_guard<std::mutex> lock(g_pending_mu);
+    g_pending[slot_].used.store(false, std::memory_order_release);
+    slot_ = -1;
+  }
+  PendingTemporary(const PendingTemporary&) = delete;
+  PendingTemporary& operator=(const PendingTemporary&) = delete;
+
+ private:
+  int slot_ = -1;
+};
+
+// Temporaries "<name>.tmp.<pid>" of `path` left by a process that no longer exists (killed
+// with SIGKILL, or by the power): removed before a new one is written (issue 19, item 5).
+void remove_stale_temporaries(const std::string& path) {
+  namespace fs = std::filesystem;
+  const fs::path p(path);
+  const std::string prefix = p.filename().string() + ".tmp.";
+  std::error_code ec;
+  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (!name.starts_with(prefix) || name.size() == prefix.size()) continue;
+    // "<pid>" (older gmasim) or "<pid>.<n>"
+    const std::string rest = name.substr(prefix.size());
+    const std::string digits = rest.substr(0, rest.find('.'));
+    const std::string tail = rest.substr(digits.size());
+    if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos ||
+        digits.size() > 9 ||
+        (!tail.empty() &&
+         (tail.size() < 2 || tail.find_first_not_of("0123456789", 1) != std::string::npos)))
+      continue;
+    const long pid = std::stol(digits);
+    if (pid == static_cast<long>(::getpid())) continue;
+    if (::kill(static_cast<pid_t>(pid), 0) == -1 && errno == ESRCH) {
+      std::error_code rm;
+      fs::remove(it->path(), rm);
+    }
+  }
+}
+
+// "(File too large: the file size limit, ulimit -f, is 102400 bytes)" and the like.
+std::string write_error_text(int err) {
+  if (err != EFBIG) return std::strerror(err);
+  struct rlimit rl {};
+  if (::getrlimit(RLIMIT_FSIZE, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY)
+    return fmt::format("{}: the file size limit (ulimit -f) is {} bytes", std::strerror(err),
+                       static_cast<unsigned long long>(rl.rlim_cur));
+  return std::strerror(err);
+}
+
+// Writes content to a fresh temporary next to path, flushed and synced; returns its name. The
+// temporary is registered while it is written, so that a signal handler can remove it.
 std::string write_temporary(const std::string& path, const std::string& content) {
-  const std::string tmp = fmt::format("{}.tmp.{}", path, static_cast<long>(::getpid()));
+  remove_stale_temporaries(path);
+  // "<path>.tmp.<pid>.<n>": unique per process and per call, so that threads writing the same
+  // file at once never share a temporary.
+  static std::atomic<unsigned long> counter{0};
+  const std::string tmp = fmt::format("{}.tmp.{}.{}", path, static_cast<long>(::getpid()),
+                                      counter.fetch_add(1, std::memory_order_relaxed));
+  PendingTemporary pending(tmp);
   auto fail = [&](int err, std::FILE* f) {
     if (f) std::fclose(f);
     std::remove(tmp.c_str());
-    throw InputError(located(path, 0, fmt::format("cannot write output ({})", std::strerror(err))));
+    throw InputError(
+        located(path, 0, fmt::format("cannot write output ({})", write_error_text(err))));
   };
   std::FILE* f = std::fopen(tmp.c_str(), "wbx");  // x: never follow or reuse an existing name
   if (!f && errno == EEXIST) {
@@ -87,15 +178,52 @@ void write_file_atomic(const std::string& path, const std::string& content) {
   write_files_atomic({{path, content}});
 }
 
+// An exclusive flock() on each directory the set is renamed into, held while the temporaries
+// are renamed: two runs writing one set into one directory (two `simulate --out o`) rename
+// theirs one after the other, so the set that stays is one run's, never a mix (issue 19,
+// item 5). A directory that cannot be opened is not locked (the renames report the problem).
+class DirectoryLocks {
+ public:
+  explicit DirectoryLocks(const std::vector<std::pair<std::string, std::string>>& files) {
+    std::vector<std::string> dirs;
+    for (const auto& f : files) {
+      std::filesystem::path d = std::filesystem::path(f.first).parent_path();
+      dirs.push_back(d.empty() ? "." : d.string());
+    }
+    std::sort(dirs.begin(), dirs.end());  // one order for every process: no deadlock
+    dirs.erase(std::unique(dirs.begin(), dirs.end()), dirs.end());
+    for (const auto& d : dirs) {
+      const int fd = ::open(d.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+      if (fd < 0) continue;
+      while (::flock(fd, LOCK_EX) != 0 && errno == EINTR) {
+      }
+      fds_.push_back(fd);
+    }
+  }
+  ~DirectoryLocks() {
+    for (const int fd : fds_) ::close(fd);  // closing releases the lock
+  }
+  DirectoryLocks(const DirectoryLocks&) = delete;
+  DirectoryLocks& operator=(const DirectoryLocks&) = delete;
+
+ private:
+  std::vector<int> fds_;
+};
+
 void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& files) {
   for (const auto& [path, content] : files) require_regular_destination(path);
   std::vector<std::string> tmps;
+  std::vector<std::unique_ptr<PendingTemporary>> pending;  // until renamed or removed
   try {
-    for (const auto& [path, content] : files) tmps.push_back(write_temporary(path, content));
+    for (const auto& [path, content] : files) {
+      tmps.push_back(write_temporary(path, content));
+      pending.push_back(std::make_unique<PendingTemporary>(tmps.back()));
+    }
   } catch (...) {
     for (const auto& t : tmps) std::remove(t.c_str());
     throw;
   }
+  const DirectoryLocks locks(files);
   for (std::size_t i = 0; i < files.size(); ++i) {
     if (std::rename(tmps[i].c_str(), files[i].first.c_str()) != 0) {
       const int err = errno;
@@ -103,8 +231,14 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
       throw InputError(
           located(files[i].first, 0, fmt::format("cannot write output ({})", std::strerror(err))));
     }
+    pending[i]->release();
   }
   for (const auto& f : files) sync_directory_of(f.first);
+}
+
+void remove_pending_temporaries() noexcept {
+  for (auto& slot : g_pending)
+    if (slot.used.load(std::memory_order_acquire)) ::unlink(slot.path);
 }
 
 std::string read_input_file(const std::string& path, const std::string& what) {
@@ -113,7 +247,10 @@ std::string read_input_file(const std::string& path, const std::string& what) {
 
 void ensure_output_dir(const std::string& dir) {
   namespace fs = std::filesystem;
-  const fs::path p = dir.empty() ? fs::path(".") : fs::path(dir);
+  if (dir.empty())
+    throw InputError(
+        "output directory '' (empty): name a directory (--out DIR; '.' for the current one)");
+  const fs::path p(dir);
   auto fail = [&](const std::string& reason) {
     throw InputError(located(dir, 0, fmt::format("output directory is not writable ({})", reason)));
   };
@@ -344,16 +481,15 @@ std::string metrics_json(const Result& r, const SimulationSettings& s, const Mod
 std::vector<std::string> write_report_files(const std::string& dir, const std::string& stem,
                                             const Report& r) {
   namespace fs = std::filesystem;
-  std::vector<std::string> paths;
+  std::vector<std::pair<std::string, std::string>> files;  // one set: renamed together
   for (std::size_t i = 0; i < r.tables.size(); ++i) {
     const std::string name = i == 0 ? stem + ".csv" : stem + "_" + r.tables[i].name + ".csv";
-    const std::string path = (fs::path(dir) / name).string();
-    write_file_atomic(path, table_csv(r.tables[i]));
-    paths.push_back(path);
+    files.emplace_back((fs::path(dir) / name).string(), table_csv(r.tables[i]));
   }
-  const std::string json = (fs::path(dir) / (stem + ".json")).string();
-  write_file_atomic(json, report_json(r));
-  paths.push_back(json);
+  files.emplace_back((fs::path(dir) / (stem + ".json")).string(), report_json(r));
+  write_files_atomic(files);
+  std::vector<std::string> paths;
+  for (const auto& f : files) paths.push_back(f.first);
   return paths;
 }
 

@@ -1,6 +1,7 @@
 // Waveform CSV: "t_s,current_A" then numeric rows with strictly increasing time.
 #include <fmt/format.h>
 
+#include <cmath>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -8,8 +9,31 @@
 #include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
+#include "gmasim/simulate.hpp"
 
 namespace gmasim {
+
+namespace {
+
+// A parsed row (v: t_s, current_A) appended to the table, after the rules that need the line:
+// the current within the coil limit (issue 19, item 11: with file:line and the value as
+// written), time increasing.
+void append_row(const std::string& path, long line_no, std::string_view current_cell,
+                const double (&v)[2], Waveform& w) {
+  if (!(std::fabs(v[1]) <= kMaxCurrent_A))
+    throw InputError(
+        located(path, line_no,
+                fmt::format("current_A = {} A: must be in [{:g}, {:g}] A (the coil current limit)",
+                            current_cell, -kMaxCurrent_A, kMaxCurrent_A)));
+  if (!w.table_t_s.empty() && !(v[0] > w.table_t_s.back()))
+    throw InputError(located(
+        path, line_no,
+        fmt::format("time {:g} s does not increase (previous {:g} s)", v[0], w.table_t_s.back())));
+  w.table_t_s.push_back(v[0]);
+  w.table_current_A.push_back(v[1]);
+}
+
+}  // namespace
 
 Waveform load_waveform_csv(const std::string& path) {
   const std::string text = io_detail::read_text_file(path, "waveform file");
@@ -73,13 +97,7 @@ Waveform load_waveform_csv(const std::string& path) {
               located(path, line_no, fmt::format("Inf in column {} ('{}')", kColumns[c], cell)));
       }
     }
-    if (!w.table_t_s.empty() && !(v[0] > w.table_t_s.back())) {
-      throw InputError(located(path, line_no,
-                               fmt::format("time {:g} s does not increase (previous {:g} s)", v[0],
-                                           w.table_t_s.back())));
-    }
-    w.table_t_s.push_back(v[0]);
-    w.table_current_A.push_back(v[1]);
+    append_row(path, line_no, cells[1], v, w);
   }
   if (!header_seen) throw InputError(located(path, 1, "empty file"));
   if (w.table_t_s.size() < 2) {

@@ -8,6 +8,7 @@
 
 #include "gmasim/errors.hpp"
 #include "gmasim/model.hpp"
+#include "gmasim/validity.hpp"
 #include "model/schema.hpp"
 
 namespace gmasim {
@@ -89,6 +90,7 @@ void build_circuit(const ModelSpec& spec, Model& m) {
                        b.name, name, spec.reference_node));
     return k;
   };
+  std::vector<const SpecBranch*> branch_of_rod(spec.rods.size(), nullptr);
   for (std::size_t k = 0; k < spec.branches.size(); ++k) {
     const SpecBranch& b = spec.branches[k];
     CircuitBranch& cb = c.branches[k];
@@ -100,11 +102,25 @@ void build_circuit(const ModelSpec& spec, Model& m) {
         fail(spec, b.line,
              fmt::format("circuit branch '{}' names rod '{}', which is not in stack.rods", b.name,
                          b.rod));
+      // Each rod in exactly one branch, said with names and lines (issue 19, item 11).
+      const SpecBranch*& first = branch_of_rod[static_cast<std::size_t>(cb.rod)];
+      if (first)
+        fail(spec, b.line,
+             fmt::format("circuit branch '{}' carries rod '{}', which branch '{}' (line {}) "
+                         "already carries: each rod of stack.rods is in exactly one branch",
+                         b.name, b.rod, first->name, first->line));
+      first = &b;
     } else {
       for (const auto& s : b.series)
         cb.fixed_reluctance_per_H += spec.get("circuit.reluctances_per_H." + s);
     }
   }
+  for (std::size_t r = 0; r < spec.rods.size(); ++r)
+    if (!branch_of_rod[r])
+      fail(spec, spec.line_of("stack.rods"),
+           fmt::format("rod '{}' of stack.rods is in no circuit branch: add a "
+                       "[[circuit.branches]] with rod = \"{}\"",
+                       spec.rods[r], spec.rods[r]));
   finalize_circuit(c, m.rod_count(), spec.source);
 }
 
@@ -191,6 +207,7 @@ Model compile(const ModelSpec& spec) {
   build_flux_sensor(spec, m);
   build_chains(spec, m);
   derive(spec, m);
+  check_model_validity(m);  // gmasim/validity.hpp: no rod under a crushing prestress
   return m;
 }
 

@@ -5,11 +5,14 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <string_view>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/model.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/mechanics.hpp"
+#include "gmasim/validity.hpp"
+#include "model/conditions_detail.hpp"
 
 namespace gmasim {
 namespace {
@@ -95,13 +98,29 @@ struct Offsets {
   double of(bool frozen) const { return frozen ? 0.0 : dT; }
 };
 
+// The factor 1 + alpha dT of thermal expansion: lengths and radii must stay > 0 (issue 19, item
+// 11: a large alpha at a low temperature made "nodal matrix = 0" out of a negative length).
+// `kind` is "rod" or "sleeve"; `key` the coefficient's parameter (a sleeve's: under its table).
+double expansion_factor(double alpha_per_K, double dT, const char* kind, const std::string& name,
+                        const char* key) {
+  const double g = 1.0 + alpha_per_K * dT;
+  if (!(g > 0.0))
+    throw InputError(fmt::format(
+        "at {:+g} K from the reference the thermal expansion of {} '{}' ({}{} = {:g} 1/K) "
+        "makes its length {:g} times the reference: lengths must stay > 0",
+        dT, kind, name, std::string_view(kind) == "sleeve" ? "mechanics.sleeves." + name + "." : "",
+        key, alpha_per_K, g));
+  return g;
+}
+
 // Eq. (19): the sleeves' stiffness at E_t^T, with expanded lengths and areas.
 void sleeve_conditions(const Model& m, const Offsets& d, Conditions& c) {
   for (const auto& s : m.sleeves) {
     std::array<double, 3> l{}, a{};
     for (std::size_t i = 0; i < 3; ++i) {
+      const double g = expansion_factor(s.alpha_thermal_per_K, d.dT_geom, "sleeve", s.name,
+                                        "alpha_thermal_per_K");
       l[i] = expanded_length(s.lengths_m[i], s.alpha_thermal_per_K, d.dT_geom);
-      const double g = 1.0 + s.alpha_thermal_per_K * d.dT_geom;
       a[i] = s.areas_m2[i] * g * g;
     }
     c.sleeve_stiffness_N_per_m.push_back(sleeve_stiffness(c.Et_Pa, l, a));
@@ -110,7 +129,8 @@ void sleeve_conditions(const Model& m, const Offsets& d, Conditions& c) {
 
 // A rod's geometry at T (l^T, r^T, A^T) and its prestress.
 void rod_geometry(const Model& m, const RodModel& rod, const Offsets& d, RodConditions& rc) {
-  const double g = 1.0 + m.material.alpha_thermal_per_K * d.dT_geom;
+  const double g = expansion_factor(m.material.alpha_thermal_per_K, d.dT_geom, "rod", rod.name,
+                                    "material.alpha_thermal_per_K");
   rc.length_m = rod.length_m * g;
   rc.r_outer_m = 0.5 * rod.outer_diameter_m * g;
   rc.r_inner_m = 0.5 * rod.inner_diameter_m * g;
@@ -211,7 +231,9 @@ void rod_chain(const Model& m, std::size_t i, const Conditions& c, RodConditions
 
 }  // namespace
 
-Conditions make_conditions(const Model& m, double temperature_C, const Freeze& fz) {
+namespace model_detail {
+
+Conditions conditions_at(const Model& m, double temperature_C, const Freeze& fz) {
   check_temperature(m, temperature_C);
   Conditions c;
   c.temperature_C = temperature_C;
@@ -238,6 +260,24 @@ Conditions make_conditions(const Model& m, double temperature_C, const Freeze& f
     c.rods.push_back(rc);
   }
   return c;
+}
+
+}  // namespace model_detail
+
+// Where a law fails, the message also gives the range over which the model can be computed
+// (issue 19, item 8): the user learns the limit, not only the law that broke.
+Conditions make_conditions(const Model& m, double temperature_C, const Freeze& fz) {
+  try {
+    return model_detail::conditions_at(m, temperature_C, fz);
+  } catch (const InputError& e) {
+    if (!std::isfinite(temperature_C)) throw;
+    const auto range = computable_range(m, fz);
+    if (!range || (temperature_C >= range->min_C && temperature_C <= range->max_C)) throw;
+    throw InputError(fmt::format(
+        "temperature {:g} degC: outside the range where {} can be computed, {} (`gmasim model "
+        "show` prints it); there: {}",
+        temperature_C, m.spec.source, range_text(*range), e.what()));
+  }
 }
 
 }  // namespace gmasim

@@ -64,6 +64,10 @@ template <auto P>
 double& in_network(Model& m, std::size_t) {
   return m.thermal_network.*P;
 }
+template <auto P>
+double& in_validity(Model& m, std::size_t) {
+  return m.validity.*P;
+}
 
 // The land function and its text, from one spelling: LAND(in_rod, RodModel, length_m).
 #define LAND(fn, Struct, field) &fn<&Struct::field>, #Struct "::" #field
@@ -99,6 +103,9 @@ constexpr GroupDef kGroups[] = {
      "The stack's thermal expansion, eq. (21)"},
     {G::ThermalNetwork, "thermal_network", TableRule::Defaulted,
      "The lumped thermal network of self-heating (coil, rods, housing, ambient)"},
+    {G::Validity, "validity", TableRule::Defaulted,
+     "Where the model was validated; outside, runs are warned about (docs/model.md, "
+     "\"Physical validity\")"},
 };
 
 constexpr std::string_view kNoMagnet =
@@ -106,6 +113,8 @@ constexpr std::string_view kNoMagnet =
 constexpr std::string_view kNoMagnetizer = "default: no magnetizer in the stack";
 constexpr std::string_view kNoOutputRod = "default: no output rod in the stack";
 constexpr std::string_view kNoSleeve = "default: no sleeve in the stack";
+constexpr std::string_view kPaperRange =
+    "default: the paper's measurements, 20-150 degC (section 4)";
 
 // The rows, by group in file order. A row's default makes the key optional (Defaulted
 // tables only).
@@ -307,6 +316,14 @@ const ParamDef kParams[] = {
      "thermal conductance housing - ambient",
      LAND(in_network, ThermalNetworkModel, G_housing_ambient_W_per_K), 0.4,
      "default: estimate, natural convection ~10 W/(m^2 K) over ~0.04 m^2"},
+    // [validity]
+    {G::Validity, "validated_min_C", "degC", R::AboveAbsoluteZero,
+     "lowest temperature the model was validated at",
+     LAND(in_validity, ValidityModel, validated_min_C), 20.0, kPaperRange},
+    {G::Validity, "validated_max_C", "degC", R::AboveAbsoluteZero,
+     "highest temperature the model was validated at",
+     LAND(in_validity, ValidityModel, validated_max_C), 150.0, kPaperRange,
+     Cross{Cross::Above, "validated_min_C"}},
 };
 
 #undef LAND

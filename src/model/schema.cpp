@@ -136,8 +136,10 @@ std::vector<std::string> dependents(const ModelSpec& spec, const std::string& do
 // =======================================================================================
 namespace {
 
-// Exact name, else the unique parameter "<dotted>_<unit suffix>"; nullopt if none;
-// throws if the prefix is ambiguous.
+// Exact name, else the unique dimensionless parameter "<dotted>_<rest>" ("material.lambda" ->
+// "material.lambda_s"); nullopt if none; throws if the prefix is ambiguous, or if it names a
+// dimensional parameter without its unit suffix (issue 19, item 9: "rod1.length" would be read
+// in metres unseen; the user must write "rod1.length_m").
 std::optional<std::string> try_resolve(const ModelSpec& spec, const std::string& dotted) {
   if (spec.params.count(dotted)) return dotted;
   const std::string prefix = dotted + "_";
@@ -146,7 +148,16 @@ std::optional<std::string> try_resolve(const ModelSpec& spec, const std::string&
        it != spec.params.end() && it->first.starts_with(prefix); ++it) {
     if (it->first.find('.', prefix.size()) == std::string::npos) matches.push_back(it->first);
   }
-  if (matches.size() == 1) return matches.front();
+  if (matches.size() == 1) {
+    const std::string unit = spec.unit_of(matches.front());
+    if (unit != "-")
+      throw InputError(
+          located(spec.source, 0,
+                  fmt::format("parameter '{}' has a unit: write '{}' (the value in {}); every "
+                              "dimensional key carries its unit suffix",
+                              dotted, matches.front(), unit)));
+    return matches.front();
+  }
   if (matches.size() > 1) {
     throw InputError(located(
         spec.source, 0,

@@ -9,6 +9,7 @@
 #include "gmasim/self_heating.hpp"
 #include "gmasim/simulate.hpp"
 #include "gmasim/validate.hpp"
+#include "gmasim/validity.hpp"
 
 namespace gmasim {
 namespace {
@@ -57,30 +58,98 @@ struct RunLength {
   double duration_s = 0;
 };
 
+// A step the user gave (dt_s, --dt): within [kMinStepDt_s, kMaxStepDt_s], and for a periodic
+// run (or a chirp's highest frequency) at least kMinStepsPerPeriod steps per period.
+void check_user_dt(const SimulationSettings& s) {
+  if (s.dt_s == 0.0) return;
+  const double dt = s.dt_s;
+  if (dt < kMinStepDt_s || dt > kMaxStepDt_s)
+    throw InputError(fmt::format(
+        "dt = {:g} s (--dt, dt_s): must be in [{:g}, {:g}] s (a longer step resolves neither the "
+        "eddy currents nor the mechanical modes, a shorter one no longer holds the state; "
+        "docs/model.md, \"Time step\"); 0 = the automatic rule",
+        dt, kMinStepDt_s, kMaxStepDt_s));
+  const auto& w = s.waveform;
+  double f = 0.0;
+  if (w.periodic()) f = w.frequency_Hz;
+  if (w.kind == WaveformKind::Chirp) f = std::max(w.f0_Hz, w.f1_Hz);
+  if (f > 0.0 && 1.0 / (f * dt) < kMinStepsPerPeriod * (1.0 - 1e-9))
+    throw InputError(fmt::format(
+        "dt = {:g} s (--dt, dt_s) gives {:.4g} steps per period at {:g} Hz: at least {:g} are "
+        "needed (the loop moves by more than 1 % when dt is halved below that; docs/model.md, "
+        "\"Time step\"); lower --dt to <= {:.4g} s, or 0 for the automatic rule",
+        dt, 1.0 / (f * dt), f, kMinStepsPerPeriod, 1.0 / (f * kMinStepsPerPeriod)));
+}
+
 RunLength run_length(const SimulationSettings& s) {
   const auto& w = s.waveform;
+  check_user_dt(s);
   RunLength L;
   double dt = s.dt_s > 0.0 ? s.dt_s : auto_dt(w);
+  double per_steps = 0.0;  // periodic: steps per period
   if (w.periodic()) {
     // Whole steps per period, so the last period's window is sampled exactly.
     const double per = w.period_s();
-    dt = per / static_cast<double>(steps_to_resolve(per / dt, 0, "steps per period"));
+    const long n = steps_to_resolve(per / dt, 0, "steps per period");
+    dt = per / static_cast<double>(n);
+    per_steps = static_cast<double>(n);
     L.duration_s = s.periods * per;
   } else {
     L.duration_s = s.duration_s;
     if (L.duration_s == 0.0 && w.kind == WaveformKind::Table) L.duration_s = w.table_t_s.back();
     if (L.duration_s == 0.0 && w.kind == WaveformKind::Chirp) L.duration_s = w.duration_s;
     if (!(L.duration_s > 0.0))
-      throw InputError(fmt::format("duration {} s: must be > 0", L.duration_s));
+      throw InputError(
+          fmt::format("duration = {} s (--duration, duration_s): must be > 0", L.duration_s));
+    if (L.duration_s < dt * (1.0 - 1e-9))
+      throw InputError(fmt::format(
+          "duration = {:g} s (--duration): shorter than one time step ({:g} s); lengthen the run "
+          "or give a shorter --dt",
+          L.duration_s, dt));
   }
-  L.grid = StepGrid::covering(0.0, L.duration_s, dt, "simulation");
+  L.grid = StepGrid::covering(
+      0.0, L.duration_s, dt,
+      w.kind == WaveformKind::Table && !w.table_source.empty()
+          ? "simulation of " + clip_for_message(w.table_source) + " (its last time)"
+          : std::string("simulation (--dt, --duration or --periods)"));
   const double rows = static_cast<double>(L.grid.steps) / s.record_every + 2.0;
   if (rows > kMaxRecordedRows)
     throw InputError(fmt::format(
         "simulation: {} steps recorded every {} give {:.4g} rows (limit {:g}); record less often "
         "(record_every, --record-every) or shorten the run",
         L.grid.steps, s.record_every, rows, kMaxRecordedRows));
+  // The metrics' window (the last period, or the whole run) must hold enough recorded samples.
+  const double window_steps = w.periodic() ? per_steps : static_cast<double>(L.grid.steps);
+  const double samples = std::floor(window_steps / s.record_every) + (w.periodic() ? 0.0 : 1.0);
+  if (samples < kMinMetricSamples)
+    throw InputError(fmt::format(
+        "record_every = {} (--record-every) with {:g} steps {} records {:g} sample(s) there: the "
+        "metrics need at least {:g}; record more often{}",
+        s.record_every, window_steps, w.periodic() ? "per period" : "in the run", samples,
+        kMinMetricSamples, w.periodic() ? "" : " or lengthen the run (--duration)"));
   return L;
+}
+
+// Memory (issue 19, item 7): the recorded series (8 bytes a value) and, for the CLI, its CSV
+// text twice over (the formatting buffer and the string, ~17 characters a value): 42 bytes a
+// value. Refused before the run when that exceeds the memory available, naming the remedy.
+constexpr double kRecordBytesPerValue = 8.0 + 2.0 * 17.0;
+
+void check_record_memory(const Model& m, const SimulationSettings& s, const RunLength& L) {
+  const double rows = static_cast<double>(L.grid.steps) / s.record_every + 2.0;
+  const double columns = 6.0 + 9.0 * static_cast<double>(m.rods.size());
+  const double bytes = rows * columns * kRecordBytesPerValue;
+  if (bytes < 1e8) return;  // below 100 MB: not worth reading /proc
+  const auto avail = memory_available();
+  if (!avail || bytes <= avail->bytes) return;
+  const double factor = std::max(2.0, std::ceil(bytes / (0.5 * avail->bytes)));
+  require_memory(bytes,
+                 fmt::format("simulation: recording {:.4g} rows x {:g} columns ({} steps, every "
+                             "{}-th recorded)",
+                             rows, columns, L.grid.steps, s.record_every),
+                 fmt::format("record less often (--record-every {:g}, record_every) or shorten "
+                             "the run",
+                             static_cast<double>(s.record_every) * factor));
 }
 
 // The slower thermal clock of self-heating (gmasim/self_heating.hpp): accumulates the
@@ -114,10 +183,11 @@ struct SelfHeatingRun {
     interval_s = static_cast<double>(steps_per_interval) * L.grid.dt_s;
     const double tau = fastest_time_constant_s(*net);
     if (interval_s > tau)
-      throw InputError(fmt::format(
-          "thermal step {:.4g} s: longer than the thermal network's fastest time constant "
-          "{:.4g} s (min C/G over coil, rods, housing); shorten the thermal step",
-          interval_s, tau));
+      throw InputError(
+          fmt::format("thermal step (--thermal-step) = {:.4g} s: longer than the thermal network's "
+                      "fastest time constant "
+                      "{:.4g} s (min C/G over coil, rods, housing); shorten the thermal step",
+                      interval_s, tau));
     T = T0 = {s.temperature_C, s.temperature_C, s.temperature_C};
     r.heating.names = {"t_s",      "coil_C",         "rods_C",      "housing_C",   "P_copper_W",
                        "P_eddy_W", "P_hysteresis_W", "P_damping_W", "P_ambient_W", "stroke_um",
@@ -299,7 +369,10 @@ void validate(const Waveform& w) {
         throw InputError(fmt::format("{}: needs equally long, non-empty t_s and current_A", src));
       for (std::size_t k = 0; k < w.table_t_s.size(); ++k) {
         require_finite(w.table_t_s[k], src + ": t_s", "s");
-        current(w.table_current_A[k], "waveform current");
+        if (!(std::fabs(w.table_current_A[k]) <= kMaxCurrent_A))  // named only when it fails
+          current(w.table_current_A[k], fmt::format("{}: sample {} (t = {:g} s): waveform current",
+                                                    src, k + 1, w.table_t_s[k])
+                                            .c_str());
         if (k > 0 && !(w.table_t_s[k] > w.table_t_s[k - 1]))
           throw InputError(fmt::format("{}: time {:g} s does not increase (previous {:g} s)", src,
                                        w.table_t_s[k], w.table_t_s[k - 1]));
@@ -320,12 +393,15 @@ void validate(const SimulationSettings& s) {
   require_finite(s.temperature_C, "temperature", "degC");
   validate(s.waveform);
   if (!(s.dt_s >= 0.0) || !std::isfinite(s.dt_s))
-    throw InputError(fmt::format("dt {} s: must be > 0 (or 0 for the automatic rule)", s.dt_s));
+    throw InputError(
+        fmt::format("dt = {} s (--dt, dt_s): must be > 0 (or 0 for the automatic rule)", s.dt_s));
   if (s.record_every < 1)
-    throw InputError(fmt::format("record_every {}: must be >= 1", s.record_every));
+    throw InputError(
+        fmt::format("record_every = {} (--record-every): must be >= 1", s.record_every));
   if (s.waveform.periodic()) {
     require_finite(s.periods, "periods");
-    if (!(s.periods >= 1.0)) throw InputError(fmt::format("periods {}: must be >= 1", s.periods));
+    if (!(s.periods >= 1.0))
+      throw InputError(fmt::format("periods = {} (--periods): must be >= 1", s.periods));
     require_in(s.periods, 1.0, kMaxPeriods, "periods");
   }
   require_nonnegative(s.duration_s, "duration", "s");
@@ -336,8 +412,9 @@ void validate(const SimulationSettings& s) {
     if (!std::isnan(h.ambient_C))
       require_in(h.ambient_C, -273.15, 1e4, "ambient temperature", "degC");
     if (h.thermal_step_s > 0.0 && h.thermal_step_s < L.grid.dt_s)
-      throw InputError(fmt::format("thermal step {} s: shorter than the time step {} s",
-                                   h.thermal_step_s, L.grid.dt_s));
+      throw InputError(
+          fmt::format("thermal step = {} s (--thermal-step): shorter than the time step {} s",
+                      h.thermal_step_s, L.grid.dt_s));
   }
 }
 
@@ -345,6 +422,7 @@ Result simulate(const Model& m, const SimulationSettings& s) {
   const auto& w = s.waveform;
   validate(s);
   const RunLength L = run_length(s);
+  check_record_memory(m, s, L);
   const double duration = L.duration_s;
   const long nsteps = L.grid.steps;
 
@@ -362,6 +440,7 @@ Result simulate(const Model& m, const SimulationSettings& s) {
   try {
     State st = make_state(m, c, w.current_at(0.0));
     st.energy.enabled = energy.enabled;
+    check_physical_validity(m, c, st, 0.0);  // the rest state too (gmasim/validity.hpp)
     record(c, st, r.series);
     energy.at(m, c, st, 0, L.grid.dt_s);
     heat.begin(st, r);

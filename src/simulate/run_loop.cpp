@@ -16,6 +16,11 @@ namespace {
 void check_step(double dt_s, std::string_view what) {
   if (!(dt_s > 0.0) || !std::isfinite(dt_s))
     throw InputError(fmt::format("{}: time step {:g} s: must be finite and > 0", what, dt_s));
+  if (dt_s < kMinStepDt_s)
+    throw InputError(fmt::format(
+        "{}: time step {:g} s: must be >= {:g} s (the shortest step that holds the state; "
+        "docs/model.md, \"Time step\")",
+        what, dt_s, kMinStepDt_s));
 }
 
 }  // namespace
@@ -48,15 +53,16 @@ StepGrid StepGrid::covering(double t0_s, double duration_s, double dt_s, std::st
 StepGrid StepGrid::spanning(double t0_s, double t1_s, double steps, std::string_view what) {
   StepGrid g;
   g.steps = checked_count(steps, kMaxSteps, what);
-  if (g.steps < 1 || !std::isfinite(t0_s) || !(t1_s >= t0_s))
+  if (g.steps < 1 || !std::isfinite(t0_s) || !std::isfinite(t1_s) || !(t1_s > t0_s))
     throw InputError(
         fmt::format("{}: {} steps from {:g} s to {:g} s: need at least one step "
-                    "and an end that is not before the start",
+                    "and an end after the start",
                     what, g.steps, t0_s, t1_s));
   g.clock = StepClock::Spanning;
   g.t0_s = t0_s;
   g.t1_s = t1_s;
   g.dt_s = (t1_s - t0_s) / static_cast<double>(g.steps);
+  check_step(g.dt_s, what);
   return g;
 }
 

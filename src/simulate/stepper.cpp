@@ -10,6 +10,7 @@
 #include "gmasim/run_loop.hpp"
 #include "gmasim/simulate.hpp"
 #include "gmasim/validate.hpp"
+#include "gmasim/validity.hpp"
 
 namespace gmasim {
 namespace {
@@ -25,6 +26,11 @@ double checked_current(double current_A) {
 
 double checked_dt(double dt_s) {
   require_positive(dt_s, "time step dt", "s");
+  if (dt_s < kMinStepDt_s)
+    throw InputError(fmt::format(
+        "time step dt = {:g} s: must be >= {:g} s (the shortest step that holds the state; "
+        "docs/model.md, \"Time step\")",
+        dt_s, kMinStepDt_s));
   if (dt_s > kMaxStepperDt_s)
     throw InputError(fmt::format(
         "time step dt = {:g} s: must be <= {:g} s (a longer step resolves neither the eddy "
@@ -42,6 +48,7 @@ Stepper::Stepper(std::shared_ptr<const Model> model, double temperature_C, doubl
       conditions_(make_conditions(*model_, temperature_C, freeze_)),
       dt_s_(checked_dt(dt_s)) {
   state_ = make_state(*model_, conditions_, checked_current(current_A));
+  check_physical_validity(*model_, conditions_, state_, 0.0);
 }
 
 double Stepper::step(double current_A) {
@@ -65,6 +72,7 @@ double Stepper::step(double current_A) {
 
 void Stepper::reset(double current_A) {
   State fresh = make_state(*model_, conditions_, checked_current(current_A));
+  check_physical_validity(*model_, conditions_, fresh, 0.0);
   state_ = std::move(fresh);
   steps_ = 0;
   diverged_ = false;

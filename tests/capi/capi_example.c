@@ -104,6 +104,15 @@ static void error_paths(const gmasim_model* model) {
   CHECK_STATUS(gmasim_sim_create(model, 400.0, 1e-5, 0.0, &sim), GMASIM_E_INPUT);
   CHECK(strstr(gmasim_last_error(), "Curie") != NULL, "message: %s", gmasim_last_error());
   CHECK_STATUS(gmasim_sim_create(model, 20.0, 0.5, 0.0, &sim), GMASIM_E_INPUT);
+  /* Issue 19, item 2: below GMASIM_MIN_DT_S (1e-29 s took y to 0; a denormal step gave
+   * "nodal matrix = 0"). */
+  CHECK_STATUS(gmasim_sim_create(model, 20.0, 1e-29, 0.0, &sim), GMASIM_E_INPUT);
+  CHECK(strstr(gmasim_last_error(), "must be >= 1e-12 s") != NULL, "message: %s",
+        gmasim_last_error());
+  CHECK_STATUS(gmasim_sim_create(model, 20.0, 4.9e-324, 0.0, &sim), GMASIM_E_INPUT);
+  CHECK_STATUS(gmasim_sim_create(model, 20.0, GMASIM_MIN_DT_S, 0.0, &sim), GMASIM_OK);
+  gmasim_sim_free(sim);
+  sim = NULL;
   CHECK_STATUS(gmasim_sim_create(model, 20.0, 1e-5, 0.0, &sim), GMASIM_OK);
   if (!sim) return;
   CHECK_STATUS(gmasim_sim_step(sim, not_a_number), GMASIM_E_ARGUMENT);
@@ -118,6 +127,56 @@ static void error_paths(const gmasim_model* model) {
   gmasim_sim_free(sim);
 }
 
+/* Ownership (issue 19, item 12): a freed, foreign or forged handle is an error code, never
+ * undefined behaviour. Under the sanitizer build nothing here may read freed memory. */
+static void handle_rules(void) {
+  gmasim_model* model = NULL;
+  gmasim_model* again = NULL;
+  gmasim_sim* sim = NULL;
+  double y = 0.0;
+  int rods = 0;
+
+  CHECK_STATUS(gmasim_model_load(NULL, &model), GMASIM_OK);
+  if (!model) return;
+  CHECK_STATUS(gmasim_sim_create(model, 20.0, 1e-5, 0.0, &sim), GMASIM_OK);
+  if (!sim) return;
+  /* A sim's handle is not a model's, and the reverse. */
+  CHECK_STATUS(gmasim_model_rod_count((const gmasim_model*)(const void*)sim, &rods),
+               GMASIM_E_ARGUMENT);
+  CHECK(strstr(gmasim_last_error(), "not a live gmasim_model handle") != NULL, "message: %s",
+        gmasim_last_error());
+  CHECK_STATUS(gmasim_sim_step((gmasim_sim*)(void*)model, 1.0), GMASIM_E_ARGUMENT);
+  /* The model may go first: the sim keeps what it needs. */
+  CHECK_STATUS(gmasim_model_free(model), GMASIM_OK);
+  CHECK_STATUS(gmasim_model_free(model), GMASIM_E_ARGUMENT); /* a double free */
+  CHECK(strstr(gmasim_last_error(), "gmasim_model_free: model = ") != NULL &&
+            strstr(gmasim_last_error(), "freed already") != NULL,
+        "message: %s", gmasim_last_error());
+  CHECK_STATUS(gmasim_model_rod_count(model, &rods), GMASIM_E_ARGUMENT); /* use after free */
+  CHECK(strstr(gmasim_model_last_error(model), "not a live") != NULL, "message: %s",
+        gmasim_model_last_error(model));
+  CHECK_STATUS(gmasim_sim_create(model, 20.0, 1e-5, 0.0, &sim), GMASIM_E_ARGUMENT);
+  CHECK(sim == NULL, "a refused create returned a handle");
+  /* A new model may reuse the slot; the old handle stays dead. */
+  CHECK_STATUS(gmasim_model_load(NULL, &again), GMASIM_OK);
+  CHECK(again != model, "a freed handle came back as a new one");
+  CHECK_STATUS(gmasim_model_rod_count(model, &rods), GMASIM_E_ARGUMENT);
+  CHECK_STATUS(gmasim_model_rod_count(again, &rods), GMASIM_OK);
+  CHECK_STATUS(gmasim_sim_create(again, 20.0, 1e-5, 0.0, &sim), GMASIM_OK);
+  CHECK_STATUS(gmasim_sim_step(sim, 1.0), GMASIM_OK);
+  CHECK_STATUS(gmasim_sim_free(sim), GMASIM_OK);
+  CHECK_STATUS(gmasim_sim_step(sim, 1.0), GMASIM_E_ARGUMENT);
+  CHECK_STATUS(gmasim_sim_y_um(sim, &y), GMASIM_E_ARGUMENT);
+  CHECK_STATUS(gmasim_sim_free(sim), GMASIM_E_ARGUMENT);
+  CHECK(strstr(gmasim_sim_last_error(sim), "not a live gmasim_sim handle") != NULL, "message: %s",
+        gmasim_sim_last_error(sim));
+  /* A value the API never returned. */
+  CHECK_STATUS(gmasim_sim_free((gmasim_sim*)(void*)&y), GMASIM_E_ARGUMENT);
+  CHECK_STATUS(gmasim_model_free(again), GMASIM_OK);
+  CHECK_STATUS(gmasim_model_free(NULL), GMASIM_OK);
+  CHECK_STATUS(gmasim_sim_free(NULL), GMASIM_OK);
+}
+
 int main(void) {
   gmasim_model* model = NULL;
   printf("gmasim %s%s%s\n", gmasim_version(), gmasim_git_describe()[0] ? " " : "",
@@ -126,7 +185,8 @@ int main(void) {
   if (!model) return 1;
   run_sine(model);
   error_paths(model);
-  gmasim_model_free(model);
+  handle_rules();
+  CHECK_STATUS(gmasim_model_free(model), GMASIM_OK);
   if (failures)
     fprintf(stderr, "%d check(s) failed\n", failures);
   else
