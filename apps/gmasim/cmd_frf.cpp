@@ -41,6 +41,26 @@ void print_resonance_change(const FrfResult& res) {
       c0.first_resonance_mag_um_per_A, c1.first_resonance_mag_um_per_A);
 }
 
+// One temperature's response table: stepped sine and linearisation side by side.
+void print_response_table(const FrfCurve& c) {
+  fmt::print("  {:>10} {:>12} {:>10} {:>12} {:>10} {:>9}\n", "f Hz", "|Y/I| step", "phase",
+             "|Y/I| lin", "phase", "mismatch");
+  for (std::size_t k = 0; k < c.f_Hz.size(); ++k) {
+    const bool s = k < c.stepped_mag_um_per_A.size(), l = k < c.linear_mag_um_per_A.size();
+    std::string mis = "-";
+    if (s && l) {
+      const auto Ys = std::polar(c.stepped_mag_um_per_A[k], c.stepped_phase_deg[k] * kDeg);
+      const auto Yl = std::polar(c.linear_mag_um_per_A[k], c.linear_phase_deg[k] * kDeg);
+      mis = fmt::format("{:.3f}%", std::abs(Ys - Yl) / std::abs(Yl) * 100.0);
+    }
+    fmt::print("  {:10.2f} {:>12} {:>10} {:>12} {:>10} {:>9}\n", c.f_Hz[k],
+               s ? fmt::format("{:.5f}", c.stepped_mag_um_per_A[k]) : "-",
+               s ? fmt::format("{:.2f}", c.stepped_phase_deg[k]) : "-",
+               l ? fmt::format("{:.5f}", c.linear_mag_um_per_A[k]) : "-",
+               l ? fmt::format("{:.2f}", c.linear_phase_deg[k]) : "-", mis);
+  }
+}
+
 int run_frf_cmd(FrfArgs& a) {
   const Model model = load_model_args(a.model);
   a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
@@ -62,22 +82,7 @@ int run_frf_cmd(FrfArgs& a) {
   for (const auto& c : res.curves) {
     fmt::print("\n  T = {:.1f} degC   y at bias {:.3f} um   static gain {:.4f} um/A\n",
                c.temperature_C, c.y_bias_um, c.static_gain_um_per_A);
-    fmt::print("  {:>10} {:>12} {:>10} {:>12} {:>10} {:>9}\n", "f Hz", "|Y/I| step", "phase",
-               "|Y/I| lin", "phase", "mismatch");
-    for (std::size_t k = 0; k < c.f_Hz.size(); ++k) {
-      const bool s = k < c.stepped_mag_um_per_A.size(), l = k < c.linear_mag_um_per_A.size();
-      std::string mis = "-";
-      if (s && l) {
-        const auto Ys = std::polar(c.stepped_mag_um_per_A[k], c.stepped_phase_deg[k] * kDeg);
-        const auto Yl = std::polar(c.linear_mag_um_per_A[k], c.linear_phase_deg[k] * kDeg);
-        mis = fmt::format("{:.3f}%", std::abs(Ys - Yl) / std::abs(Yl) * 100.0);
-      }
-      fmt::print("  {:10.2f} {:>12} {:>10} {:>12} {:>10} {:>9}\n", c.f_Hz[k],
-                 s ? fmt::format("{:.5f}", c.stepped_mag_um_per_A[k]) : "-",
-                 s ? fmt::format("{:.2f}", c.stepped_phase_deg[k]) : "-",
-                 l ? fmt::format("{:.5f}", c.linear_mag_um_per_A[k]) : "-",
-                 l ? fmt::format("{:.2f}", c.linear_phase_deg[k]) : "-", mis);
-    }
+    print_response_table(c);
     auto hz = [](double f) { return f > 0 ? fmt::format("{:.1f} Hz", f) : std::string("none"); };
     fmt::print(
         "  first resonance (largest |Y/I| peak in {}-{} Hz): {}, |Y/I| {:.4g} um/A   (paper, "
