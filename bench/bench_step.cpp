@@ -33,6 +33,25 @@ void BM_FullModelStep(benchmark::State& bs) {
 }
 BENCHMARK(BM_FullModelStep)->Arg(0)->Arg(1);
 
+// The same step of the built-in model with the energy ledgers booked (gmasim/energy.hpp:
+// every branch of the circuit solved, each rod's dissipation along the step's path and its
+// oscillator's power by Gauss-Legendre), against BM_FullModelStep/0 (issue 18).
+void BM_FullModelStepWithLedger(benchmark::State& bs) {
+  const Model& m = mdma();
+  const Conditions c = make_conditions(m, 70.0);
+  const Waveform w = biased_sine(8.0, 400.0);
+  State s = make_state(m, c, w.current_at(0.0));
+  s.energy.enabled = true;
+  const double dt = auto_dt(w);
+  long k = 0;
+  for (auto _ : bs) {
+    ++k;
+    step(m, c, s, {w.current_at(static_cast<double>(k) * dt), dt});
+    benchmark::DoNotOptimize(s.y_m);
+  }
+}
+BENCHMARK(BM_FullModelStepWithLedger);
+
 // One period of the biased sine with the production step at the automatic dt (the step
 // the convergence test validates to 0.1 %).
 void BM_PeriodExact(benchmark::State& bs) {

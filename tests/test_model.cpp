@@ -329,6 +329,12 @@ TEST(Numerics, StepAllocatesNothing) {
   for (int k = 2; k < 20000; ++k) step(m, c, s, {w.current_at(k * 1e-6), 1e-6});
   g_counting = false;
   EXPECT_EQ(g_allocations.load(), 0);
+  // With the energy ledgers booked (gmasim/energy.hpp) too.
+  s.energy.enabled = true;
+  g_counting = true;
+  for (int k = 20000; k < 24000; ++k) step(m, c, s, {w.current_at(k * 1e-6), 1e-6});
+  g_counting = false;
+  EXPECT_EQ(g_allocations.load(), 0);
   // The counter works: a vector allocation is seen.
   g_counting = true;
   std::vector<double>* v = new std::vector<double>(10);
