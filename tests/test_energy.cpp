@@ -273,7 +273,6 @@ TEST(Numerics, StrokeAndHysteresisConvergeAtSecondOrder) {
     }
 }
 
-
 // docs/model.md's time-step table is the output of `gmasim model check --dt-table` on the
 // built-in model (between its markers): regenerate it when the model or the step change.
 TEST(DocsTimeStepTable, IsCurrent) {

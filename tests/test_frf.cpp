@@ -195,7 +195,7 @@ TEST(Frf, ResonanceAndBandwidthOfBothReadings) {
   for (const auto& cv : built_in.curves) {
     EXPECT_NEAR(cv.first_resonance_Hz, 1270.0, 0.01 * 1270.0) << cv.temperature_C;
     EXPECT_NEAR(cv.first_resonance_Hz, fn, 0.03 * fn) << cv.temperature_C;  // the mount's
-    EXPECT_GT(cv.bandwidth_3dB_Hz, cv.first_resonance_Hz);                     // antiresonance
+    EXPECT_GT(cv.bandwidth_3dB_Hz, cv.first_resonance_Hz);                  // antiresonance
     EXPECT_LT(cv.bandwidth_3dB_Hz, 1.1 * cv.first_resonance_Hz);
     EXPECT_GT(cv.first_resonance_mag_um_per_A, cv.static_gain_um_per_A);
   }

@@ -9,14 +9,13 @@
 #include <map>
 #include <random>
 
+#include "alloc_counter.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
 #include "gmasim/model.hpp"
 #include "gmasim/physics/jiles_atherton.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/simulate.hpp"
-
-#include "alloc_counter.hpp"
 
 using gmasim_test::g_allocations;
 using gmasim_test::g_counting;

@@ -30,8 +30,7 @@ struct FrfArgs {
 void print_resonance_change(const FrfResult& res) {
   const auto& c0 = res.curves.front();
   const auto& c1 = res.curves.back();
-  if (res.curves.size() < 2 || !(c0.first_resonance_Hz > 0) || !(c1.first_resonance_Hz > 0))
-    return;
+  if (res.curves.size() < 2 || !(c0.first_resonance_Hz > 0) || !(c1.first_resonance_Hz > 0)) return;
   fmt::print(
       "\n  {:g} -> {:g} degC: first resonance {:+.3f} % in frequency, {:+.1f} % in amplitude "
       "(|Y/I| {:.4g} -> {:.4g} um/A)\n",

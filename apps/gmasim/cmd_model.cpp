@@ -64,9 +64,10 @@ int run_params(bool markdown) {
 int run_check(ModelArgs args, const std::string& file, bool dt_table) {
   if (!file.empty()) {
     if (!args.path.empty() && args.path != file)
-      throw InputError(fmt::format("model check: the file '{}' and --model '{}' name two models; "
-                                   "give one",
-                                   file, args.path));
+      throw InputError(
+          fmt::format("model check: the file '{}' and --model '{}' name two models; "
+                      "give one",
+                      file, args.path));
     args.path = file;
   }
   const std::string path = model_label(args);

@@ -29,14 +29,14 @@ std::string parse_error_message(const CLI::App& app, const CLI::ParseError& e, i
 Runner add_simulate(CLI::App& app);
 Runner add_model(CLI::App& app);
 Runner add_reproduce(CLI::App& app);
-Runner add_identify(CLI::App& app);    // cmd_identify.cpp: identify, identify synthesize
-Runner add_sweep(CLI::App& app);       // cmd_sweep.cpp
-Runner add_frf(CLI::App& app);         // cmd_frf.cpp
-Runner add_track(CLI::App& app);       // cmd_track.cpp
-Runner add_ablate(CLI::App& app);      // cmd_ablate.cpp
-Runner add_params(CLI::App& app);      // cmd_params.cpp: params-vs-temperature
-Runner add_thermal(CLI::App& app);     // cmd_params.cpp: thermal
-Runner add_compensate(CLI::App& app);  // cmd_compensate.cpp
+Runner add_identify(CLI::App& app);     // cmd_identify.cpp: identify, identify synthesize
+Runner add_sweep(CLI::App& app);        // cmd_sweep.cpp
+Runner add_frf(CLI::App& app);          // cmd_frf.cpp
+Runner add_track(CLI::App& app);        // cmd_track.cpp
+Runner add_ablate(CLI::App& app);       // cmd_ablate.cpp
+Runner add_params(CLI::App& app);       // cmd_params.cpp: params-vs-temperature
+Runner add_thermal(CLI::App& app);      // cmd_params.cpp: thermal
+Runner add_compensate(CLI::App& app);   // cmd_compensate.cpp
 Runner add_sensitivity(CLI::App& app);  // cmd_sensitivity.cpp
 
 // --model FILE and --set name=value (repeatable), on every command that runs a model.

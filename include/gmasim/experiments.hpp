@@ -243,10 +243,10 @@ struct TrackRequest {
   // sampling Nyquist frequency, against Fig. 16's stable loop at every temperature; 0.5 keeps
   // it stable from 20 to 70 degC (docs/experiments.md, "Closed-loop tracking").
   double amplifier_A_per_unit = 0.5;
-  double sensor_noise_um = 0.0;     // RMS white noise of the displacement sensor
-  std::uint64_t noise_seed = 1;     // seed of the sensor-noise generator (per point)
-  double periods = 4.0;             // errors over the last period
-  double dt_s = 0.0;                // plant step; 0: <= 10 us, <= T/2000, divides 1/fs
+  double sensor_noise_um = 0.0;  // RMS white noise of the displacement sensor
+  std::uint64_t noise_seed = 1;  // seed of the sensor-noise generator (per point)
+  double periods = 4.0;          // errors over the last period
+  double dt_s = 0.0;             // plant step; 0: <= 10 us, <= T/2000, divides 1/fs
   int threads = 0;
   TemperatureFeedforward feedforward;
 };

@@ -127,7 +127,7 @@ enum class TargetKind {
   BppChangePct,         // the same for B p-p [%]
   RetentionPct,         // 100 stroke(T) / stroke(T_ref) [%]
   ResonanceHz,          // lowest natural frequency of eq. (15) at (T, bias current) [Hz]
-  FrfPeakHz,   // peak of the small-signal |Y/I| at (T, bias) (FrfCurve::first_resonance_Hz) [Hz]
+  FrfPeakHz,    // peak of the small-signal |Y/I| at (T, bias) (FrfCurve::first_resonance_Hz) [Hz]
   BandwidthHz,  // -3 dB point of the small-signal |Y/I| at (T, bias) [Hz]
   ModulusGPa    // mean over the rods of the Delta-E modulus E_G (eq. 13) at rest at (T, bias)
                 // [GPa]: Table 6's k_i = E A / l say about 30 GPa (READING-NOTES)
@@ -426,11 +426,11 @@ IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, cons
 // Outputs
 // =======================================================================================
 struct FitProvenance {
-  std::string command;      // the command line
-  std::string data;         // manifest path
-  std::string fit;          // fit spec source
-  std::string report_dir;   // where the fit report is
-  std::string start_model;  // start model label
+  std::string command;                     // the command line
+  std::string data;                        // manifest path
+  std::string fit;                         // fit spec source
+  std::string report_dir;                  // where the fit report is
+  std::string start_model;                 // start model label
   std::vector<std::string> fitted_claims;  // fitted_claims(the fit spec): the [calibration] table
 };
 

@@ -30,7 +30,7 @@ struct Claim {
   // The model was fitted to it (its [calibration] fitted_claims: a target of the calibration,
   // or set by a chosen constant); otherwise it is a prediction.
   bool fitted = false;
-  double rel_diff() const;   // (ours - paper)/|paper|, NaN if not applicable
+  double rel_diff() const;  // (ours - paper)/|paper|, NaN if not applicable
 };
 
 struct ReproduceOptions {
@@ -44,8 +44,8 @@ struct ReproduceOptions {
 // least-squares slope against current of the paper's values of one claim kind at 6/8/10/12 A
 // and of ours (issue 18: the paper's flux drop falls with current, 5.6 -> 4.2 %).
 struct TrendCheck {
-  std::string kind;   // "stroke_drop_pct", "hysteresis_drop_pct", "flux_drop_pct"
-  std::string what;   // "stroke drop 20 -> 70 degC at 10 Hz"
+  std::string kind;  // "stroke_drop_pct", "hysteresis_drop_pct", "flux_drop_pct"
+  std::string what;  // "stroke drop 20 -> 70 degC at 10 Hz"
   std::vector<double> currents_pp_A, paper, ours;
   double paper_slope = 0, ours_slope = 0;  // per ampere, in the claims' unit
   bool pass = false;                       // the same sign (both 0 counts as the same)
@@ -74,7 +74,7 @@ struct ReproduceResult {
   std::vector<Claim> claims;
   double wall_time_s = 0.0;
   std::string model_source;
-  std::string model_readings;  // the options in force, e.g. "eq10: mean_field, kelvin"
+  std::string model_readings;      // the options in force, e.g. "eq10: mean_field, kelvin"
   std::vector<TrendCheck> trends;  // the sign of each trend across current (trend_checks)
 };
 

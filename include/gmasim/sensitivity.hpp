@@ -46,7 +46,7 @@ std::vector<Claim> run_claims(const Model& m, const ReproduceOptions& o,
 // frequency_Hz and temperature_C, 3 periods, measured over the last (the sweep's settings,
 // SweepRequest's defaults).
 struct MetricQuantity {
-  std::string name;        // e.g. "stroke_um@20C_8A_10Hz"
+  std::string name;                   // e.g. "stroke_um@20C_8A_10Hz"
   std::string unit;                   // of the value
   double (*read)(const Result& run);  // the value, from a simulate run with the energy ledger
   double temperature_C, current_pp_A, frequency_Hz;

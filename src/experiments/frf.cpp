@@ -494,7 +494,8 @@ void fill_curve(FrfCurve& cv, const SmallSignalModel& lin, const cd* stepped,
     cv.first_resonance_Hz = cv.stepped_first_resonance_Hz;
     cv.bandwidth_3dB_Hz = cv.stepped_bandwidth_3dB_Hz;
     for (std::size_t k = 0; k < f.size(); ++k)
-      if (f[k] == cv.first_resonance_Hz) cv.first_resonance_mag_um_per_A = cv.stepped_mag_um_per_A[k];
+      if (f[k] == cv.first_resonance_Hz)
+        cv.first_resonance_mag_um_per_A = cv.stepped_mag_um_per_A[k];
     return;
   }
   // Resonance and bandwidth of the linear model on a dense grid (cheap to evaluate).

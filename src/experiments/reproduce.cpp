@@ -149,9 +149,9 @@ void mark_fitted(std::vector<Claim>& claims, const ModelSpec& spec) {
     const auto it =
         std::find_if(claims.begin(), claims.end(), [&](const Claim& c) { return c.id == id; });
     if (it == claims.end())
-      throw InputError(fmt::format(
-          "{}:{}: calibration.fitted_claims: '{}' is not a claim of the claims scored", spec.source,
-          spec.line_of("calibration.fitted_claims"), id));
+      throw InputError(
+          fmt::format("{}:{}: calibration.fitted_claims: '{}' is not a claim of the claims scored",
+                      spec.source, spec.line_of("calibration.fitted_claims"), id));
     it->fitted = true;
   }
 }
@@ -237,12 +237,12 @@ std::string claims_markdown(const std::vector<Claim>& claims) {
   int n = 0;
   for (const auto& c : claims) {
     const double rd = c.rel_diff();
-    md += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", ++n,
-                      md_cell(c.claim), md_cell(c.source), md_number(c.paper), md_number(c.ours),
-                      c.unit, std::isfinite(rd) ? fmt::format("{:+.1f} %", 100 * rd) : "-",
-                      md_cell(c.tolerance),
-                      !c.applicable ? "-" : (c.fitted ? "fitted" : "predicted"),
-                      !c.applicable ? "n/a" : (c.pass ? "PASS" : "FAIL"), md_cell(c.note));
+    md +=
+        fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", ++n,
+                    md_cell(c.claim), md_cell(c.source), md_number(c.paper), md_number(c.ours),
+                    c.unit, std::isfinite(rd) ? fmt::format("{:+.1f} %", 100 * rd) : "-",
+                    md_cell(c.tolerance), !c.applicable ? "-" : (c.fitted ? "fitted" : "predicted"),
+                    !c.applicable ? "n/a" : (c.pass ? "PASS" : "FAIL"), md_cell(c.note));
   }
   const ClaimCount k = count_claims(claims);
   md += fmt::format(

@@ -332,14 +332,15 @@ std::pair<std::string, std::string> read_by_construction(const toml::table& t,
   if (!id || id->empty())
     throw InputError(located(src, line, "[[by_construction]]: claim = \"<id>\" is required"));
   if (!reason || reason->empty())
-    throw InputError(located(
-        src, line, fmt::format("[[by_construction]] claim '{}': reason = \"...\" is required "
-                               "(which constant sets it, and how)",
-                               *id)));
+    throw InputError(
+        located(src, line,
+                fmt::format("[[by_construction]] claim '{}': reason = \"...\" is required "
+                            "(which constant sets it, and how)",
+                            *id)));
   if (!claims.find(*id))
-    throw InputError(located(src, line,
-                             fmt::format("[[by_construction]]: unknown claim '{}' (not in {})",
-                                         *id, claims.source)));
+    throw InputError(located(
+        src, line,
+        fmt::format("[[by_construction]]: unknown claim '{}' (not in {})", *id, claims.source)));
   return {*id, *reason};
 }
 

@@ -37,8 +37,7 @@ void book_rod_magnetic(const Model& m, const RodConditions& rc, const StepStart&
   else  // printed: the lag's eddy field H_c - H against the material's dB
     e.eddy_J += V * 0.5 * ((a.Hc - a.H) + (r.Hc_A_per_m - r.H_A_per_m)) * dB;
   // Eq. (9)'s dissipation over the step along the path H, M linear (physics::ja_step_dissipation).
-  e.hysteresis_J +=
-      V * ja_step_dissipation(a.H, a.M, r.H_A_per_m, r.M_A_per_m, rc.MsT_ja, rc.ja);
+  e.hysteresis_J += V * ja_step_dissipation(a.H, a.M, r.H_A_per_m, r.M_A_per_m, rc.MsT_ja, rc.ja);
 }
 
 // The mechanical terms of rod i over one step: the oscillator's exact update (F linear, K

@@ -31,7 +31,7 @@ inline void check(double value, double t, const std::string& rod, const char* qu
 void finish_outputs(const Model& m, const Conditions& c, State& s) {
   double y = 0.0;
   for (const auto& r : s.rods) y += r.x_m;
-  s.y_stack_m = y;  // eq. (20)
+  s.y_stack_m = y;                                 // eq. (20)
   if (m.sensor_mount.enabled) y += s.z_m - s.q_m;  // the probe's deflection u = q - z
   if (m.options.thermal_expansion_in_output) y += c.thermal_expansion_m;
   s.y_m = y;
@@ -246,8 +246,14 @@ void energy_start(State& s, std::array<StepStart, 8>& start) {
   std::copy(s.circuit.phi.begin(), s.circuit.phi.end(), s.energy.phi_prev_Wb.begin());
   for (std::size_t i = 0; i < s.rods.size(); ++i) {
     const auto& r = s.rods[i];
-    start[i] = {r.H_A_per_m, r.Hc_A_per_m, r.M_A_per_m, r.Mirr_A_per_m,
-                flux_density(r.H_A_per_m, r.M_A_per_m), r.x_m, r.v_m_per_s, r.F_N,
+    start[i] = {r.H_A_per_m,
+                r.Hc_A_per_m,
+                r.M_A_per_m,
+                r.Mirr_A_per_m,
+                flux_density(r.H_A_per_m, r.M_A_per_m),
+                r.x_m,
+                r.v_m_per_s,
+                r.F_N,
                 r.K_osc_N_per_m};
   }
 }

@@ -29,14 +29,13 @@ MagneticStateCheck check_magnetic_state(const Model& m) {
               std::max(r.energy.magnetic_residual_rel, r.energy.mechanical_residual_rel);
           if (res > out.energy_residual_rel || !std::isfinite(res)) {
             out.energy_residual_rel = res;
-            out.where_energy = fmt::format("{:g} degC, {:g} A, {:g} Hz ({} ledger)", T, I, f,
-                                           r.energy.magnetic_residual_rel >=
-                                                   r.energy.mechanical_residual_rel
-                                               ? "magnetic"
-                                               : "mechanical");
+            out.where_energy = fmt::format(
+                "{:g} degC, {:g} A, {:g} Hz ({} ledger)", T, I, f,
+                r.energy.magnetic_residual_rel >= r.energy.mechanical_residual_rel ? "magnetic"
+                                                                                   : "mechanical");
           }
-          out.max_coupling_fraction = std::max(out.max_coupling_fraction,
-                                               std::fabs(r.energy.coupling_fraction));
+          out.max_coupling_fraction =
+              std::max(out.max_coupling_fraction, std::fabs(r.energy.coupling_fraction));
         }
         const auto& t = r.series.column("t_s");
         const auto& B = r.series.column("B_T");

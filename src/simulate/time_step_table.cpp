@@ -24,7 +24,8 @@ Pair metrics_at(const Model& m, double f_Hz, double dt_s) {
   s.dt_s = dt_s;
   const Result r = simulate(m, s);
   if (r.diverged || !r.has_metrics)
-    throw DivergenceError(fmt::format("time-step table: {} Hz, dt {:g} s: {}", f_Hz, dt_s, r.error));
+    throw DivergenceError(
+        fmt::format("time-step table: {} Hz, dt {:g} s: {}", f_Hz, dt_s, r.error));
   return {r.metrics.stroke_um, r.metrics.hysteresis_um};
 }
 
@@ -62,8 +63,9 @@ std::string time_step_table_markdown(const Model& m) {
       order(stroke, 0), order(stroke, 1), order(hyst, 0), order(hyst, 1));
   if (m.options.magnetic_state == MagneticState::Consistent) {
     const Conditions c = make_conditions(m, m.T_ref_C);
-    md += "\nThe trapezoidal eddy field rings (an oscillating, decaying error) only for steps "
-          "above 2 mu0 kappa (the eddy lag with mu_r = 1, its smallest), at 20 degC:";
+    md +=
+        "\nThe trapezoidal eddy field rings (an oscillating, decaying error) only for steps "
+        "above 2 mu0 kappa (the eddy lag with mu_r = 1, its smallest), at 20 degC:";
     for (std::size_t i = 0; i < c.rods.size(); ++i)
       md += fmt::format(" {} {:.3g} us{}", m.rods[i].name,
                         2.0 * physics::kMu0 * c.rods[i].eddy_geometry_s_m_per_H * 1e6,

@@ -26,7 +26,6 @@ double coil_resistance_ohm(const ThermalNetworkModel& n, double T_ref_C, double 
   return n.coil_resistance_ohm * (1.0 + n.coil_alpha_per_K * (coil_C - T_ref_C));
 }
 
-
 double thermal_network_step(const ThermalNetworkModel& n, NodeTemperatures& T, double P_coil_W,
                             double P_rods_W, double ambient_C, double dt_s) {
   // (C/dt + G) T+ = C/dt T + P + g_a T_a e_h
