@@ -74,12 +74,12 @@ struct EnergyBalance {
   double hysteresis_J = 0, eddy_J = 0;
   std::vector<double> rod_hysteresis_J, rod_eddy_J;
   double magnetic_residual_J = 0;    // input - (stored change + losses)
-  double magnetic_residual_rel = 0;  // |residual| / |input|
+  double magnetic_residual_rel = 0;  // |residual| / max(|input|, gross flows, 1e-3 stored)
   // mechanical
   double force_work_J = 0, stiffness_work_J = 0;
   double d_kinetic_J = 0, d_elastic_J = 0, damping_J = 0;
   double mechanical_residual_J = 0;
-  double mechanical_residual_rel = 0;  // |residual| / max(|force + stiffness work|, gross scale)
+  double mechanical_residual_rel = 0;  // same scale rule as the magnetic ledger
   // The mechanical input the one-way model does not draw from the coil, over the magnetic
   // input: (force + stiffness work) / (coil + magnet work).
   double coupling_fraction = 0;

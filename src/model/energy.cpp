@@ -2,6 +2,7 @@
 // and the balance between two snapshots. docs/model.md, "Energy ledgers".
 #include "gmasim/energy.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "gmasim/model.hpp"
@@ -145,11 +146,27 @@ EnergyBalance energy_balance(const EnergySnapshot& a, const EnergySnapshot& b) {
   const double in = e.coil_J + e.magnet_J;
   e.magnetic_residual_J =
       in - (e.d_circuit_J + e.d_series_J + e.d_material_J + e.hysteresis_J + e.eddy_J);
-  e.magnetic_residual_rel = std::fabs(e.magnetic_residual_J) / std::fabs(in);
+  // The scale a residual is judged against: the larger of the input, the gross flows, and a
+  // thousandth of the energy stored at the window's end. The last matters only when nothing
+  // flows (a held current): there the input is round-off and |residual| / |input| would be
+  // a ratio of two round-off errors.
+  const double stored_mag = std::fabs(b.stored.circuit_J) + std::fabs(b.stored.series_J) +
+                            std::fabs(b.stored.material_J);
+  const double mag_scale = std::max(
+      {std::fabs(in),
+       std::fabs(e.d_circuit_J) + std::fabs(e.d_series_J) + std::fabs(e.d_material_J) +
+           std::fabs(e.hysteresis_J) + std::fabs(e.eddy_J),
+       1e-3 * stored_mag});
+  e.magnetic_residual_rel = std::fabs(e.magnetic_residual_J) / mag_scale;
   const double mech_in = e.force_work_J + e.stiffness_work_J;
   e.mechanical_residual_J = mech_in - (e.d_kinetic_J + e.d_elastic_J + e.damping_J);
-  e.mechanical_residual_rel = std::fabs(e.mechanical_residual_J) / std::fabs(mech_in);
-  e.coupling_fraction = mech_in / in;
+  const double stored_mech = std::fabs(b.stored.kinetic_J) + std::fabs(b.stored.elastic_J);
+  const double mech_scale =
+      std::max({std::fabs(mech_in),
+                std::fabs(e.d_kinetic_J) + std::fabs(e.d_elastic_J) + std::fabs(e.damping_J),
+                1e-3 * stored_mech});
+  e.mechanical_residual_rel = std::fabs(e.mechanical_residual_J) / mech_scale;
+  e.coupling_fraction = mech_in / mag_scale;
   return e;
 }
 

@@ -267,19 +267,16 @@ struct SelfHeatingRun {
 struct EnergyWindow {
   bool enabled = false;
   long start_step = 0;  // the snapshot is taken after this step (0: before the first)
-  EnergySnapshot from;
+  long end_step = 0;    // ... and after this one, before self-heating updates the Conditions
+  EnergySnapshot from, to;
   long n = 0;
   double R_ohm = 0, i_prev = 0;
   double sum_i2 = 0, sum_v2 = 0, v_peak = 0, p_peak = 0, copper_J = 0, dt_s = 0;
 
+  // After step k, before self-heating may replace the Conditions: books the coil's terms and,
+  // at the window's end, the closing snapshot.
   void at(const Model& m, const Conditions& c, const State& st, long k, double dt) {
-    if (!enabled) return;
-    if (k == start_step) {
-      from = energy_snapshot(m, c, st);
-      i_prev = st.current_A;
-      return;
-    }
-    if (k < start_step) return;
+    if (!enabled || k <= start_step) return;
     const double i_mid = 0.5 * (i_prev + st.current_A);
     const double v = i_mid * R_ohm + st.energy.coil_emf_V;
     sum_i2 += i_mid * i_mid;
@@ -290,11 +287,20 @@ struct EnergyWindow {
     i_prev = st.current_A;
     dt_s = dt;
     ++n;
+    if (k == end_step) to = energy_snapshot(m, c, st);
   }
 
-  void finish(const Model& m, const Conditions& c, const State& st, Result& r) const {
+  // After step k and the self-heating update: the opening snapshot, with the Conditions the
+  // window's steps use.
+  void open(const Model& m, const Conditions& c, const State& st, long k) {
+    if (!enabled || k != start_step) return;
+    from = energy_snapshot(m, c, st);
+    i_prev = st.current_A;
+  }
+
+  void finish(Result& r) const {
     if (!enabled || n == 0) return;
-    r.energy = energy_balance(from, energy_snapshot(m, c, st));
+    r.energy = energy_balance(from, to);
     const double span = r.energy.duration_s, N = static_cast<double>(n);
     auto& e = r.coil;
     e.resistance_ohm = R_ohm;
@@ -324,6 +330,7 @@ struct SimulationRecorder {
     const long k = p.k;
     energy.at(m, c, st, k, p.dt_s);
     if (heat.enabled) heat.after_step(m, s, c, st, p.dt_s, k == nsteps, r);
+    energy.open(m, c, st, k);
     if (k % s.record_every == 0 || k == nsteps) record(c, st, r.series);
     r.steps = k;
     if (s.progress && (k % report_every == 0 || k == nsteps))
@@ -435,6 +442,7 @@ Result simulate(const Model& m, const SimulationSettings& s) {
   EnergyWindow energy;
   energy.enabled = s.energy_ledger || s.self_heating.enabled;
   if (w.periodic()) energy.start_step = nsteps - std::lround(w.period_s() / L.grid.dt_s);
+  energy.end_step = nsteps;
   energy.R_ohm = coil_resistance_ohm(m.thermal_network, m.T_ref_C, s.temperature_C);
   const auto wall0 = std::chrono::steady_clock::now();
   try {
@@ -442,12 +450,12 @@ Result simulate(const Model& m, const SimulationSettings& s) {
     st.energy.enabled = energy.enabled;
     check_physical_validity(m, c, st, 0.0);  // the rest state too (gmasim/validity.hpp)
     record(c, st, r.series);
-    energy.at(m, c, st, 0, L.grid.dt_s);
+    energy.open(m, c, st, 0);
     heat.begin(st, r);
     run_loop(
         m, c, st, L.grid, [&w](double t) { return w.current_at(t); },
         SimulationRecorder{m, s, c, heat, energy, r, nsteps, std::max(1L, nsteps / 100)});
-    energy.finish(m, c, st, r);
+    energy.finish(r);
   } catch (const DivergenceError& e) {
     r.diverged = true;
     r.error = e.what();
