@@ -27,18 +27,6 @@ struct TrackArgs {
               controllers = "pid,pid_temperature,pid_inverse";
 };
 
-std::vector<PlantMismatch> parse_mismatch(const std::string& word) {
-  if (word == "all") return plant_mismatches();
-  if (word == "none") return {perfect_plant()};
-  if (word == "both") {
-    auto v = plant_mismatches();
-    v.insert(v.begin(), perfect_plant());
-    return v;
-  }
-  throw InputError("--mismatch '" + clip_for_message(word) +
-                   "': must be all (the 16 combinations), none (the plant is the model) or both");
-}
-
 std::vector<TrackController> parse_controllers(const std::string& text) {
   std::vector<TrackController> out;
   std::size_t start = 0;
@@ -55,7 +43,7 @@ int run_feedforward_cmd(TrackArgs& a, const Model& model) {
   FeedforwardEvaluationRequest r;
   r.track = a.req;
   r.track.inverse.dynamic = a.feedforward == "inverse";
-  r.mismatches = parse_mismatch(a.mismatch);
+  r.mismatches = parse_plant_mismatches(a.mismatch);
   r.controllers = parse_controllers(a.controllers);
   prepare_output_dir(a.out, {"track"}, model_inputs(a.model));
   const FeedforwardEvaluation res =

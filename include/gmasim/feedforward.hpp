@@ -106,6 +106,9 @@ struct PlantMismatch {
 // digits (+ before -).
 std::vector<PlantMismatch> plant_mismatches(double fraction = 0.10, double offset_C = 10.0);
 PlantMismatch perfect_plant();  // "none": the plant is the model
+// "all": plant_mismatches(); "none": {perfect_plant()}; "both": the perfect plant, then the 16.
+// Throws InputError naming the words for any other.
+std::vector<PlantMismatch> parse_plant_mismatches(const std::string& word);
 // The model with the mismatch's factors (ModelSpec::set, then compile). Throws InputError if a
 // scaled value breaks a rule of the parameter table.
 Model mismatched_plant(const Model& m, const PlantMismatch& mismatch);

@@ -119,6 +119,18 @@ std::vector<PlantMismatch> plant_mismatches(double fraction, double offset_C) {
 
 PlantMismatch perfect_plant() { return {"none", 1.0, 1.0, 1.0, 0.0}; }
 
+std::vector<PlantMismatch> parse_plant_mismatches(const std::string& word) {
+  if (word == "all") return plant_mismatches();
+  if (word == "none") return {perfect_plant()};
+  if (word == "both") {
+    auto v = plant_mismatches();
+    v.insert(v.begin(), perfect_plant());
+    return v;
+  }
+  throw InputError("mismatch '" + clip_for_message(word) +
+                   "': must be all (the 16 combinations), none (the plant is the model) or both");
+}
+
 Model mismatched_plant(const Model& m, const PlantMismatch& x) {
   ModelSpec spec = m.spec;
   auto scale = [&](const std::string& key, double f) { spec.set(key, spec.get(key) * f); };
