@@ -53,13 +53,15 @@ int run_feedforward_cmd(TrackArgs& a, const Model& model) {
   fmt::print("  {} runs ({} plants x {} controllers) on {} threads in {:.1f} s\n", res.runs.size(),
              r.mismatches.size(), r.controllers.size(), res.threads, res.wall_time_s);
   for (std::size_t i = 0; i < res.inverses.size(); ++i)
-    fmt::print("  linear inverse at {:g} degC: a1 {:.4g} s, a2 {:.4g} s^2, a3 {:.4g} s^3 (fit to "
-               "{:g} Hz, residual {:.2g})\n",
-               r.track.temperatures_C[i], res.inverses[i].a[0], res.inverses[i].a[1],
-               res.inverses[i].a[2], res.inverses[i].band_Hz, res.inverses[i].max_residual);
-  fmt::print("  RMS(pid) / RMS(controller) over the plants:\n  {:>6} {:>7} {:>7} {:>16} {:>8} "
-             "{:>8} {:>8}\n",
-             "T degC", "f Hz", "A um", "controller", "median", "min", "max");
+    fmt::print(
+        "  linear inverse at {:g} degC: a1 {:.4g} s, a2 {:.4g} s^2, a3 {:.4g} s^3 (fit to "
+        "{:g} Hz, residual {:.2g})\n",
+        r.track.temperatures_C[i], res.inverses[i].a[0], res.inverses[i].a[1], res.inverses[i].a[2],
+        res.inverses[i].band_Hz, res.inverses[i].max_residual);
+  fmt::print(
+      "  RMS(pid) / RMS(controller) over the plants:\n  {:>6} {:>7} {:>7} {:>16} {:>8} "
+      "{:>8} {:>8}\n",
+      "T degC", "f Hz", "A um", "controller", "median", "min", "max");
   for (const auto& q : res.ratios)
     fmt::print("  {:6.1f} {:7.1f} {:7.1f} {:>16} {:8.2f} {:8.2f} {:8.2f}\n", q.temperature_C,
                q.frequency_Hz, q.amplitude_um, track_controller_name(q.controller), q.median, q.min,

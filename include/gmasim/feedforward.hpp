@@ -141,7 +141,7 @@ struct FeedforwardEvaluation {
   std::vector<FeedforwardRun> runs;  // order: temperature, amplitude, frequency, mismatch,
                                      // controller
   std::vector<FeedforwardRatio> ratios;
-  std::vector<LinearInverse> inverses;  // per temperature of the request
+  std::vector<LinearInverse> inverses;             // per temperature of the request
   TemperatureFeedforward temperature_feedforward;  // the pid_temperature schedule
   double wall_time_s = 0;
   int threads = 0;

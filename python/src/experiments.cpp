@@ -111,10 +111,10 @@ void bind_frf(py::module_& mod) {
 // track(): closed-loop PID tracking (Fig. 16); with feedforward="inverse" the inverse-model
 // feed-forward evaluated against mismatched plants (gmasim/feedforward.hpp).
 py::dict track_feedforward(const Model& m, const TrackRequest& r, const std::string& feedforward,
-                           const std::string& mismatch, const std::vector<std::string>& controllers) {
+                           const std::string& mismatch,
+                           const std::vector<std::string>& controllers) {
   if (feedforward != "inverse" && feedforward != "inverse_static")
-    throw InputError("feedforward '" + feedforward +
-                     "': must be none, inverse or inverse_static");
+    throw InputError("feedforward '" + feedforward + "': must be none, inverse or inverse_static");
   FeedforwardEvaluationRequest q;
   q.track = r;
   q.track.inverse.dynamic = feedforward == "inverse";
@@ -145,7 +145,8 @@ void bind_track(py::module_& mod) {
         r.periods = periods;
         r.threads = threads;
         r.inverse.band_Hz = feedforward_band_Hz;
-        if (feedforward != "none") return track_feedforward(m, r, feedforward, mismatch, controllers);
+        if (feedforward != "none")
+          return track_feedforward(m, r, feedforward, mismatch, controllers);
         const TrackResult res = without_gil([&] { return run_track(m, r); });
         return report_dict(track_report(m, r, res));
       },

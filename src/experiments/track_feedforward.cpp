@@ -235,8 +235,9 @@ Report feedforward_report(const Model& m, const FeedforwardEvaluationRequest& re
   r.meta.emplace_back("mismatch",
                       "the plant: M_s, k (every rod), lambda_s times (1 +- 0.1); its temperature "
                       "the loop's +- 10 degC; the feed-forward's model at the loop's temperature");
-  r.meta.emplace_back("goal", "at 100 Hz, 20 um, 20 and 70 degC: RMS(pid)/RMS(pid_inverse) "
-                              "median >= 5 and min >= 2 over the 16 combinations (issue 20)");
+  r.meta.emplace_back("goal",
+                      "at 100 Hz, 20 um, 20 and 70 degC: RMS(pid)/RMS(pid_inverse) "
+                      "median >= 5 and min >= 2 over the 16 combinations (issue 20)");
   r.meta.emplace_back("threads", res.threads);
   r.meta.emplace_back("wall_time_s", res.wall_time_s);
   Table runs{"runs",
@@ -248,9 +249,9 @@ Report feedforward_report(const Model& m, const FeedforwardEvaluationRequest& re
   for (const auto& x : res.runs) {
     const TrackPoint& p = x.point;
     runs.rows.push_back({p.temperature_C, p.frequency_Hz, p.amplitude_um, x.mismatch,
-                         track_controller_name(x.controller), x.plant_temperature_C,
-                         p.error_rms_um, p.error_peak_um, p.error_rms_pct, p.current_min_A,
-                         p.current_max_A, p.feedforward_min_A, p.feedforward_max_A, p.saturated,
+                         track_controller_name(x.controller), x.plant_temperature_C, p.error_rms_um,
+                         p.error_peak_um, p.error_rms_pct, p.current_min_A, p.current_max_A,
+                         p.feedforward_min_A, p.feedforward_max_A, p.saturated,
                          p.diverged ? "diverged" : "ok", p.error});
   }
   Table ratio{"ratios",
