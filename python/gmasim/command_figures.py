@@ -173,7 +173,8 @@ def track_feedforward(out):
         ax.set_ylabel("RMS tracking error (µm)")
         ax.set_title(f"loop at {T:g} °C, {A0:g} µm, {f0:g} Hz", fontsize=9)
         ax.grid(alpha=0.3, which="both")
-    axes[0].legend(fontsize=7, loc="upper left")
+    handles, names = axes[0].get_legend_handles_labels()
+    fig.legend(handles, names, loc="upper center", ncol=3, fontsize=8, bbox_to_anchor=(0.5, 0.95))
     r = axes[-1]
     sel_c = q["controller"] == "pid_inverse"
     for T in temps:
@@ -191,7 +192,7 @@ def track_feedforward(out):
     r.grid(alpha=0.3, which="both")
     r.legend(fontsize=7)
     fig.suptitle("Inverse-model feed-forward against plants that differ from the model")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 0.9))
     return fig
 
 
