@@ -25,6 +25,7 @@ struct TrackArgs {
   // --feedforward inverse: the evaluation against mismatched plants (gmasim/feedforward.hpp)
   std::string feedforward = "none", mismatch = "all",
               controllers = "pid,pid_temperature,pid_inverse";
+  std::vector<CLI::Option*> feedforward_only;  // refused without --feedforward inverse*
 };
 
 std::vector<TrackController> parse_controllers(const std::string& text) {
@@ -85,6 +86,12 @@ int run_track_cmd(TrackArgs& a) {
   a.req.amplitudes_um = parse_list(a.amplitudes, "--amplitudes", "um");
   a.req.frequencies_Hz = parse_list(a.frequencies, "--frequencies", "Hz");
   if (a.feedforward != "none") return run_feedforward_cmd(a, model);
+  for (const CLI::Option* o : a.feedforward_only)
+    if (o->count() > 0)
+      throw InputError(o->get_name() +
+                       " applies to the feed-forward evaluation: add --feedforward inverse (or "
+                       "inverse_static), or drop " +
+                       o->get_name());
   prepare_output_dir(a.out, {"track"}, model_inputs(a.model));
   const TrackResult res = run_track(model, a.req, stderr_progress("track", a.progress));
   auto files = write_report(a.out, "track", track_report(model, a.req, res));
@@ -193,16 +200,18 @@ Runner add_track(CLI::App& app) {
                   "quasi-static inverse alone. docs/experiments.md")
       ->check(CLI::IsMember({"none", "inverse", "inverse_static"}))
       ->capture_default_str();
-  sub->add_option("--mismatch", a->mismatch,
-                  "With --feedforward: the plants: all (M_s, k, lambda_s x (1 +- 0.1), "
-                  "temperature +-10 degC: 16), none (the model itself), both (17)")
-      ->capture_default_str();
-  sub->add_option("--controllers", a->controllers,
-                  "With --feedforward: pid, pid_temperature, pid_inverse (comma-separated)")
-      ->capture_default_str();
-  sub->add_option("--feedforward-band", a->req.inverse.band_Hz,
-                  "Fit band of the linear part's inverse [Hz]")
-      ->capture_default_str();
+  a->feedforward_only.push_back(
+      sub->add_option("--mismatch", a->mismatch,
+                      "With --feedforward: the plants: all (M_s, k, lambda_s x (1 +- 0.1), "
+                      "temperature +-10 degC: 16), none (the model itself), both (17)")
+          ->capture_default_str());
+  a->feedforward_only.push_back(
+      sub->add_option("--controllers", a->controllers,
+                      "With --feedforward: pid, pid_temperature, pid_inverse (comma-separated)")
+          ->capture_default_str());
+  a->feedforward_only.push_back(sub->add_option("--feedforward-band", a->req.inverse.band_Hz,
+                                                "Fit band of the linear part's inverse [Hz]")
+                                    ->capture_default_str());
   sub->add_flag("--progress", a->progress, "Progress on stderr even when it is not a terminal");
   sub->add_flag("--plot", a->plot, "Also draw <out>/track.png and .svg (matplotlib)");
   sub->add_option("--out", a->out, "Output directory")->capture_default_str();

@@ -164,8 +164,7 @@ void detail::check_track_request(const TrackRequest& r) {
   if (r.inverse.enabled && r.feedforward.enabled())
     throw InputError(
         "track: the inverse and the temperature feed-forward cannot be combined: choose one");
-  if (r.inverse.enabled)
-    require_in(r.inverse.band_Hz, 0.0, 1e5, "feed-forward band (--feedforward-band)", "Hz");
+  require_in(r.inverse.band_Hz, 0.0, 1e5, "feed-forward band (--feedforward-band)", "Hz");
   Pid probe(r.gains, r.sample_rate_Hz, -1.0, 1.0);  // validates the gains' reference rate
   (void)probe;
 }
