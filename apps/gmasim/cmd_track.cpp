@@ -8,7 +8,9 @@
 #include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
+#include "gmasim/feedforward.hpp"
 #include "gmasim/io.hpp"
+#include "gmasim/validate.hpp"
 
 namespace gmasim::cli {
 namespace {
@@ -20,7 +22,62 @@ struct TrackArgs {
               frequencies = "10,100";
   TrackRequest req;
   bool progress = false;
+  // --feedforward inverse: the evaluation against mismatched plants (gmasim/feedforward.hpp)
+  std::string feedforward = "none", mismatch = "all",
+              controllers = "pid,pid_temperature,pid_inverse";
+  std::vector<CLI::Option*> feedforward_only;  // refused without --feedforward inverse*
 };
+
+std::vector<TrackController> parse_controllers(const std::string& text) {
+  std::vector<TrackController> out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    out.push_back(parse_track_controller(text.substr(start, end - start)));
+    start = end + 1;
+  }
+  return out;
+}
+
+// --feedforward inverse: every controller on every plant; the ratios RMS(pid) / RMS(c).
+int run_feedforward_cmd(TrackArgs& a, const Model& model) {
+  FeedforwardEvaluationRequest r;
+  r.track = a.req;
+  r.track.inverse.dynamic = a.feedforward == "inverse";
+  r.mismatches = parse_plant_mismatches(a.mismatch);
+  r.controllers = parse_controllers(a.controllers);
+  prepare_output_dir(a.out, {"track"}, model_inputs(a.model));
+  const FeedforwardEvaluation res =
+      run_feedforward_evaluation(model, r, stderr_progress("track", a.progress));
+  auto files = write_report(a.out, "track", feedforward_report(model, r, res));
+  fmt::print("gmasim track --feedforward {}  model: {}\n", a.feedforward, model_label(a.model));
+  fmt::print("  {} runs ({} plants x {} controllers) on {} threads in {:.1f} s\n", res.runs.size(),
+             r.mismatches.size(), r.controllers.size(), res.threads, res.wall_time_s);
+  for (std::size_t i = 0; i < res.inverses.size(); ++i)
+    fmt::print(
+        "  linear inverse at {:g} degC: a1 {:.4g} s, a2 {:.4g} s^2, a3 {:.4g} s^3 (fit to "
+        "{:g} Hz, residual {:.2g})\n",
+        r.track.temperatures_C[i], res.inverses[i].a[0], res.inverses[i].a[1], res.inverses[i].a[2],
+        res.inverses[i].band_Hz, res.inverses[i].max_residual);
+  fmt::print(
+      "  RMS(pid) / RMS(controller) over the plants:\n  {:>6} {:>7} {:>7} {:>16} {:>8} "
+      "{:>8} {:>8}\n",
+      "T degC", "f Hz", "A um", "controller", "median", "min", "max");
+  for (const auto& q : res.ratios)
+    fmt::print("  {:6.1f} {:7.1f} {:7.1f} {:>16} {:8.2f} {:8.2f} {:8.2f}\n", q.temperature_C,
+               q.frequency_Hz, q.amplitude_um, track_controller_name(q.controller), q.median, q.min,
+               q.max);
+  int diverged = 0;
+  for (const auto& x : res.runs) diverged += x.point.diverged ? 1 : 0;
+  if (a.plot) files.push_back(render_plot("track_feedforward", a.out));
+  fmt::print("  wrote {}\n", fmt::join(files, ", "));
+  if (diverged > 0) {
+    print_error(fmt::format("{} of {} runs diverged (status column of track.csv)", diverged,
+                            res.runs.size()));
+    return 3;
+  }
+  return 0;
+}
 
 int run_track_cmd(TrackArgs& a) {
   const Model model = load_model_args(a.model);
@@ -28,6 +85,13 @@ int run_track_cmd(TrackArgs& a) {
   warn_temperatures(model, a.req.temperatures_C, "--temperatures");
   a.req.amplitudes_um = parse_list(a.amplitudes, "--amplitudes", "um");
   a.req.frequencies_Hz = parse_list(a.frequencies, "--frequencies", "Hz");
+  if (a.feedforward != "none") return run_feedforward_cmd(a, model);
+  for (const CLI::Option* o : a.feedforward_only)
+    if (o->count() > 0)
+      throw InputError(o->get_name() +
+                       " applies to the feed-forward evaluation: add --feedforward inverse (or "
+                       "inverse_static), or drop " +
+                       o->get_name());
   prepare_output_dir(a.out, {"track"}, model_inputs(a.model));
   const TrackResult res = run_track(model, a.req, stderr_progress("track", a.progress));
   auto files = write_report(a.out, "track", track_report(model, a.req, res));
@@ -128,6 +192,26 @@ Runner add_track(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--threads", a->req.threads, "Worker threads [-]; 0 = all cores")
       ->capture_default_str();
+  sub->add_option("--feedforward", a->feedforward,
+                  "none: the PID alone (track.csv per point); inverse: the inverse-model "
+                  "feed-forward evaluated against plants that differ from the model (track.csv "
+                  "per run: temperature_C, frequency_Hz, amplitude_um, mismatch, controller, "
+                  "rms_error_um; track_ratios.csv); inverse_static: the same with the "
+                  "quasi-static inverse alone. docs/experiments.md")
+      ->check(CLI::IsMember({"none", "inverse", "inverse_static"}))
+      ->capture_default_str();
+  a->feedforward_only.push_back(
+      sub->add_option("--mismatch", a->mismatch,
+                      "With --feedforward: the plants: all (M_s, k, lambda_s x (1 +- 0.1), "
+                      "temperature +-10 degC: 16), none (the model itself), both (17)")
+          ->capture_default_str());
+  a->feedforward_only.push_back(
+      sub->add_option("--controllers", a->controllers,
+                      "With --feedforward: pid, pid_temperature, pid_inverse (comma-separated)")
+          ->capture_default_str());
+  a->feedforward_only.push_back(sub->add_option("--feedforward-band", a->req.inverse.band_Hz,
+                                                "Fit band of the linear part's inverse [Hz]")
+                                    ->capture_default_str());
   sub->add_flag("--progress", a->progress, "Progress on stderr even when it is not a terminal");
   sub->add_flag("--plot", a->plot, "Also draw <out>/track.png and .svg (matplotlib)");
   sub->add_option("--out", a->out, "Output directory")->capture_default_str();

@@ -80,6 +80,13 @@ struct CompensatedTrack {
   CompensateResult loop_schedule;   // the Swing schedule about the bias
   double static_gain_um_per_A = 0;  // stroke / pp of that drive at the reference temperature
 };
+// The temperature feed-forward of run_compensated_track (the Swing schedule about the track
+// bias at the track temperatures, with its static gain); the schedule itself in *schedule if
+// given. Throws InputError if no temperature reaches the target.
+TemperatureFeedforward loop_temperature_feedforward(const Model& m, const CompensateRequest& creq,
+                                                    const TrackRequest& treq,
+                                                    CompensateResult* schedule = nullptr,
+                                                    const ProgressFn& progress = {});
 CompensatedTrack run_compensated_track(const Model& m, const CompensateRequest& creq,
                                        TrackRequest treq, const ProgressFn& progress = {});
 

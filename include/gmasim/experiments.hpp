@@ -207,6 +207,9 @@ class Pid {
   Pid(const PidGains& g, double sample_rate_Hz, double u_min, double u_max);
   double update(double error);  // one sample; returns u
   void reset();
+  // New output limits from the next update on (the inverse feed-forward moves them with its
+  // current, so that anti-windup acts where the coil current clips).
+  void set_limits(double u_min, double u_max);
   double integral_sum() const { return sum_; }
 
  private:
@@ -229,6 +232,16 @@ struct TemperatureFeedforward {
   double gain_at(double temperature_C) const;  // 1 when off
 };
 
+// Inverse-model feed-forward (gmasim/feedforward.hpp): the current the model at the loop's
+// temperature says produces the reference, added ahead of the PID:
+//   i = clip(i_ff(t) + a u_PID, +-current_limit_A),  the PID's limits following i_ff.
+// Off unless `enabled`; not combined with the temperature feed-forward.
+struct InverseFeedforwardRequest {
+  bool enabled = false;
+  double band_Hz = 500.0;  // fit band of the linear part's inverse
+  bool dynamic = true;     // false: the quasi-static inverse alone
+};
+
 struct TrackRequest {
   std::vector<double> temperatures_C{20, 30, 40, 50, 60, 70};
   std::vector<double> amplitudes_um{10, 20};
@@ -249,6 +262,7 @@ struct TrackRequest {
   double dt_s = 0.0;             // plant step; 0: <= 10 us, <= T/2000, divides 1/fs
   int threads = 0;
   TemperatureFeedforward feedforward;
+  InverseFeedforwardRequest inverse;
 };
 
 struct TrackPoint {
@@ -260,6 +274,8 @@ struct TrackPoint {
   double current_min_A = 0, current_max_A = 0;  // coil current over the last period
   bool saturated = false;                       // the current hit +-current_limit_A
   double feedforward_gain = 1.0;                // g(T) of the temperature feed-forward
+  // The inverse feed-forward's current over the whole run (0 when it is off) [A].
+  double feedforward_min_A = 0, feedforward_max_A = 0;
   bool diverged = false;
   std::string error;
 };

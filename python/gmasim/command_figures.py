@@ -145,6 +145,57 @@ def track(out):
     return fig
 
 
+_CONTROLLERS = {"pid": ("PID alone", "o"), "pid_temperature": ("PID + temperature feed-forward", "s"),
+                "pid_inverse": ("PID + inverse-model feed-forward", "^")}
+
+
+def track_feedforward(out):
+    """``track --feedforward inverse``: RMS error on every mismatched plant (one panel per loop
+    temperature, at the grid point the issue's goal names if present) and RMS(PID)/RMS(PID +
+    feed-forward) against frequency (median, with the min..max range)."""
+    t = read_csv(pathlib.Path(out) / "track.csv")
+    q = read_csv(pathlib.Path(out) / "track_ratios.csv")
+    temps = sorted(set(t["temperature_C"]))
+    f0 = 100.0 if np.any(np.isclose(t["frequency_Hz"], 100.0)) else float(t["frequency_Hz"][0])
+    A0 = 20.0 if np.any(np.isclose(t["amplitude_um"], 20.0)) else float(t["amplitude_um"][0])
+    fig, axes = plt.subplots(1, len(temps) + 1, figsize=(4.2 * (len(temps) + 1), 4.6))
+    labels = list(dict.fromkeys(t["mismatch"]))
+    for ax, T in zip(axes, temps):
+        for c, (name, marker) in _CONTROLLERS.items():
+            sel = (t["controller"] == c) & np.isclose(t["temperature_C"], T) & \
+                np.isclose(t["frequency_Hz"], f0) & np.isclose(t["amplitude_um"], A0)
+            if sel.any():
+                x = [labels.index(m) for m in t["mismatch"][sel]]
+                ax.semilogy(x, t["rms_error_um"][sel], marker, label=name, alpha=0.8)
+        ax.set_xticks(range(len(labels)))
+        ax.set_xticklabels(labels, rotation=90, fontsize=6)
+        ax.set_xlabel("plant (M_s, k, λ_s ±10 %, temperature ±10 °C)")
+        ax.set_ylabel("RMS tracking error (µm)")
+        ax.set_title(f"loop at {T:g} °C, {A0:g} µm, {f0:g} Hz", fontsize=9)
+        ax.grid(alpha=0.3, which="both")
+    handles, names = axes[0].get_legend_handles_labels()
+    fig.legend(handles, names, loc="upper center", ncol=3, fontsize=8, bbox_to_anchor=(0.5, 0.95))
+    r = axes[-1]
+    sel_c = q["controller"] == "pid_inverse"
+    for T in temps:
+        sel = sel_c & np.isclose(q["temperature_C"], T) & np.isclose(q["amplitude_um"], A0)
+        if sel.any():
+            f = q["frequency_Hz"][sel]
+            line, = r.loglog(f, q["ratio_median"][sel], "o-", label=f"{T:g} °C median")
+            r.fill_between(f, q["ratio_min"][sel], q["ratio_max"][sel], color=line.get_color(),
+                           alpha=0.15)
+    r.axhline(5.0, color="k", ls="--", lw=0.8, label="goal: median 5")
+    r.axhline(2.0, color="k", ls=":", lw=0.8, label="goal: min 2")
+    r.set_xlabel("reference frequency (Hz)")
+    r.set_ylabel("RMS(PID) / RMS(PID + inverse) (-)")
+    r.set_title(f"error ratio over the plants, {A0:g} µm (band: min..max)", fontsize=9)
+    r.grid(alpha=0.3, which="both")
+    r.legend(fontsize=7)
+    fig.suptitle("Inverse-model feed-forward against plants that differ from the model")
+    fig.tight_layout(rect=(0, 0, 1, 0.9))
+    return fig
+
+
 def compensate(out):
     s = read_csv(pathlib.Path(out) / "compensate.csv")
     meta = _meta(out, "compensate")
@@ -281,6 +332,7 @@ def sensitivity(out):
 # A renderer returns the command's figure (saved as OUT/<command>.png|svg) or yields
 # (stem, figure) pairs (OUT/<stem>.png|svg), each saved and closed before the next is drawn.
 RENDERERS = {"simulate": simulate, "frf": bode_db, "sweep": sweep, "track": track,
+             "track_feedforward": track_feedforward,
              "compensate": compensate, "ablate": ablate, "params": params, "identify": identify,
              "sensitivity": sensitivity}
 

@@ -7,6 +7,7 @@
 #include "bindings.hpp"
 #include "gmasim/compensate.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/feedforward.hpp"
 #include "gmasim/reproduce.hpp"
 
 namespace py = pybind11;
@@ -107,14 +108,31 @@ void bind_frf(py::module_& mod) {
       "of eq. 15");
 }
 
-// track(): closed-loop PID tracking (Fig. 16).
+// track(): closed-loop PID tracking (Fig. 16); with feedforward="inverse" the inverse-model
+// feed-forward evaluated against mismatched plants (gmasim/feedforward.hpp).
+py::dict track_feedforward(const Model& m, const TrackRequest& r, const std::string& feedforward,
+                           const std::string& mismatch,
+                           const std::vector<std::string>& controllers) {
+  if (feedforward != "inverse" && feedforward != "inverse_static")
+    throw InputError("feedforward '" + feedforward + "': must be none, inverse or inverse_static");
+  FeedforwardEvaluationRequest q;
+  q.track = r;
+  q.track.inverse.dynamic = feedforward == "inverse";
+  q.mismatches = parse_plant_mismatches(mismatch);
+  q.controllers.clear();
+  for (const auto& c : controllers) q.controllers.push_back(parse_track_controller(c));
+  const FeedforwardEvaluation res = without_gil([&] { return run_feedforward_evaluation(m, q); });
+  return report_dict(feedforward_report(m, q, res));
+}
+
 void bind_track(py::module_& mod) {
   mod.def(
       "track",
       [](const Model& m, std::vector<double> temperatures_C, std::vector<double> amplitudes_um,
          std::vector<double> frequencies_Hz, double kp, double ki, double kd, double sample_rate_Hz,
          double bias_A, double sensor_noise_um, double periods, int threads,
-         double amplifier_A_per_unit) {
+         double amplifier_A_per_unit, const std::string& feedforward, const std::string& mismatch,
+         const std::vector<std::string>& controllers, double feedforward_band_Hz) {
         TrackRequest r;
         r.amplifier_A_per_unit = amplifier_A_per_unit;
         r.temperatures_C = std::move(temperatures_C);
@@ -126,6 +144,9 @@ void bind_track(py::module_& mod) {
         r.sensor_noise_um = sensor_noise_um;
         r.periods = periods;
         r.threads = threads;
+        r.inverse.band_Hz = feedforward_band_Hz;
+        if (feedforward != "none")
+          return track_feedforward(m, r, feedforward, mismatch, controllers);
         const TrackResult res = without_gil([&] { return run_track(m, r); });
         return report_dict(track_report(m, r, res));
       },
@@ -135,7 +156,17 @@ void bind_track(py::module_& mod) {
       py::arg("ki") = 0.03, py::arg("kd") = 0.007, py::arg("sample_rate_Hz") = 10000.0,
       py::arg("bias_A") = 1.0, py::arg("sensor_noise_um") = 0.0, py::arg("periods") = 4.0,
       py::arg("threads") = 0, py::arg("amplifier_A_per_unit") = TrackRequest{}.amplifier_A_per_unit,
-      "Closed-loop tracking with the discrete PID (Fig. 16); gains' units in docs/experiments.md");
+      py::arg("feedforward") = "none", py::arg("mismatch") = "all",
+      py::arg("controllers") = std::vector<std::string>{"pid", "pid_temperature", "pid_inverse"},
+      py::arg("feedforward_band_Hz") = InverseFeedforwardRequest{}.band_Hz,
+      "Closed-loop tracking with the discrete PID (Fig. 16); gains' units in docs/experiments.md.\n"
+      "feedforward='inverse' (or 'inverse_static': the quasi-static inverse alone) adds the "
+      "inverse-model feed-forward and evaluates it against plants that differ from the model "
+      "(mismatch='all': M_s, k, lambda_s x (1 +- 0.1) and the temperature +-10 degC, 16 plants; "
+      "'none': the model itself; 'both'), for each of `controllers` (pid, pid_temperature, "
+      "pid_inverse): tables 'runs' (one row per run, rms_error_um), 'ratios' (RMS(pid) / "
+      "RMS(controller) over the plants: median, min, max) and 'inverse' (the linear part's "
+      "fitted inverse per temperature). docs/experiments.md, 'Inverse-model feed-forward'");
 }
 
 // compensate(): the drive schedule that restores the stroke, and its tracking.

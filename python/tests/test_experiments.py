@@ -88,3 +88,30 @@ def test_compensate_restores_the_stroke_and_feedforward_removes_the_growth():
         assert t["error_rms_um_ff"][k] < t["error_rms_um_pid"][k]
     with pytest.raises(ValueError, match="adjust"):
         gmasim.compensate(m, adjust="nope")
+
+
+def test_track_inverse_feedforward_and_its_figure(mdma, tmp_path):
+    """track(feedforward="inverse"): with the plant equal to the model the feed-forward cuts the
+    100 Hz error by more than 10x (observed about 22x at 20 degC); the figure reads alone."""
+    import csv
+
+    from gmasim import command_figures
+    from test_plots import _check_axes
+
+    r = gmasim.track(mdma, temperatures_C=[20], amplitudes_um=[20], frequencies_Hz=[100],
+                     feedforward="inverse", mismatch="none", controllers=["pid", "pid_inverse"],
+                     threads=1)
+    runs, ratios = r["runs"], r["ratios"]
+    assert list(runs["controller"]) == ["pid", "pid_inverse"]
+    assert list(runs["mismatch"]) == ["none", "none"]
+    assert ratios["ratio_median"][0] > 10.0
+    assert np.all(np.abs(runs["feedforward_max_A"]) <= 10.0)
+    with pytest.raises(gmasim.InputError, match="pid_temperature"):
+        gmasim.track(mdma, temperatures_C=[20], feedforward="inverse", controllers=["lqr"])
+    for name, table in (("track.csv", runs), ("track_ratios.csv", ratios)):
+        with open(tmp_path / name, "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(list(table))
+            w.writerows(zip(*[list(v) for v in table.values()]))
+    fig = command_figures.track_feedforward(tmp_path)
+    _check_axes(fig)

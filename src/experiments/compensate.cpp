@@ -247,9 +247,10 @@ double schedule_gain(const CompensateResult& r, double T) {
   return ff.gain_at(T);
 }
 
-CompensatedTrack run_compensated_track(const Model& m, const CompensateRequest& creq,
-                                       TrackRequest treq, const ProgressFn& progress) {
-  CompensatedTrack out;
+TemperatureFeedforward loop_temperature_feedforward(const Model& m, const CompensateRequest& creq,
+                                                    const TrackRequest& treq,
+                                                    CompensateResult* schedule,
+                                                    const ProgressFn& progress) {
   const double half = std::min(1.0, 0.5 * treq.current_limit_A);
   CompensateRequest q = creq;
   q.adjust = CompensationAdjust::Swing;
@@ -261,18 +262,29 @@ CompensatedTrack run_compensated_track(const Model& m, const CompensateRequest& 
   std::sort(q.temperatures_C.begin(), q.temperatures_C.end());
   q.temperatures_C.erase(std::unique(q.temperatures_C.begin(), q.temperatures_C.end()),
                          q.temperatures_C.end());
-  out.loop_schedule = run_compensate(m, q, progress);
-  out.static_gain_um_per_A = out.loop_schedule.reference.stroke_um / q.reference_current_pp_A;
+  const CompensateResult res = run_compensate(m, q, progress);
+  TemperatureFeedforward ff;
+  for (const auto& p : res.points) {
+    if (!p.reachable || p.diverged) continue;
+    ff.temperatures_C.push_back(p.temperature_C);
+    ff.gains.push_back(p.gain);
+  }
+  if (ff.gains.empty())
+    throw InputError("compensate: no track temperature reached the target stroke: no schedule");
+  ff.static_gain_um_per_A = res.reference.stroke_um / q.reference_current_pp_A;
+  if (schedule != nullptr) *schedule = res;
+  return ff;
+}
+
+CompensatedTrack run_compensated_track(const Model& m, const CompensateRequest& creq,
+                                       TrackRequest treq, const ProgressFn& progress) {
+  CompensatedTrack out;
+  const TemperatureFeedforward ff =
+      loop_temperature_feedforward(m, creq, treq, &out.loop_schedule, progress);
+  out.static_gain_um_per_A = ff.static_gain_um_per_A;
   treq.feedforward = {};
   out.plain = run_track(m, treq, progress);
-  for (const auto& p : out.loop_schedule.points) {
-    if (!p.reachable || p.diverged) continue;
-    treq.feedforward.temperatures_C.push_back(p.temperature_C);
-    treq.feedforward.gains.push_back(p.gain);
-  }
-  if (treq.feedforward.gains.empty())
-    throw InputError("compensate: no track temperature reached the target stroke: no schedule");
-  treq.feedforward.static_gain_um_per_A = out.static_gain_um_per_A;
+  treq.feedforward = ff;
   out.compensated = run_track(m, treq, progress);
   return out;
 }

@@ -4,14 +4,18 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <random>
 
 #include "experiments/parallel.hpp"
+#include "experiments/track_loop.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
+#include "gmasim/feedforward.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/run_loop.hpp"
 #include "gmasim/simulate.hpp"
@@ -57,6 +61,11 @@ double Pid::update(double e) {
   return u;
 }
 
+void Pid::set_limits(double u_min, double u_max) {
+  u_min_ = u_min;
+  u_max_ = u_max;
+}
+
 double TemperatureFeedforward::gain_at(double T) const {
   return gains.empty() ? 1.0 : interpolate_held(temperatures_C, gains, T);
 }
@@ -85,10 +94,6 @@ void check_feedforward(const TemperatureFeedforward& ff) {
   require_in(ff.static_gain_um_per_A, 0.0, 1e6, "feed-forward static gain", "um/A");
 }
 
-struct Job {
-  double T, A, f;
-};
-
 void check_positive_list(const std::vector<double>& v, const char* what, const char* unit) {
   if (v.empty()) throw InputError(fmt::format("track: no {} given: give at least one", what));
   for (double x : v)
@@ -99,7 +104,9 @@ void check_positive_list(const std::vector<double>& v, const char* what, const c
         fmt::format("{} {} values: too many (limit {:g})", v.size(), what, kMaxListValues));
 }
 
-void check_request(const TrackRequest& r) {
+}  // namespace
+
+void detail::check_track_request(const TrackRequest& r) {
   if (r.temperatures_C.empty())
     throw InputError("track: no temperature given (--temperatures): give at least one");
   for (double T : r.temperatures_C) require_finite(T, "temperature (--temperatures)", "degC");
@@ -154,13 +161,17 @@ void check_request(const TrackRequest& r) {
   if (!(r.dt_s >= 0.0) || !std::isfinite(r.dt_s))
     throw InputError(fmt::format("dt = {} s (--dt): must be >= 0 (0: the automatic rule)", r.dt_s));
   check_feedforward(r.feedforward);
+  if (r.inverse.enabled && r.feedforward.enabled())
+    throw InputError(
+        "track: the inverse and the temperature feed-forward cannot be combined: choose one");
+  require_in(r.inverse.band_Hz, 0.0, 1e5, "feed-forward band (--feedforward-band)", "Hz");
   Pid probe(r.gains, r.sample_rate_Hz, -1.0, 1.0);  // validates the gains' reference rate
   (void)probe;
 }
 
 // The plant steps per controller sample: dt divides the sample period, dt <= 10 us and
 // dt <= T_ref/2000 (docs/model.md rule). Every run's length is checked here, before any run.
-long plant_substeps(const TrackRequest& r) {
+long detail::track_substeps(const TrackRequest& r) {
   const double Ts = 1.0 / r.sample_rate_Hz;
   double f_max = 0.0;
   for (double f : r.frequencies_Hz) f_max = std::max(f_max, f);
@@ -173,10 +184,17 @@ long plant_substeps(const TrackRequest& r) {
   return sub;
 }
 
+namespace {
+
 // The reference y_bias + A sin(w t) [um].
 struct Reference {
   double y_bias_um, A_um, w_rad_per_s;
   double at(double t) const { return y_bias_um + A_um * std::sin(w_rad_per_s * t); }
+  // The deviation from y_bias and its first three time derivatives at t [um/s^n].
+  std::array<double, 4> derivatives(double t) const {
+    const double w = w_rad_per_s, s = A_um * std::sin(w * t), c = A_um * std::cos(w * t);
+    return {s, w * c, -w * w * s, -w * w * w * c};
+  }
 };
 
 // The controller as the run loop's drive: at the first plant step of each sample it reads the
@@ -191,14 +209,30 @@ struct SampledController {
   double g;
   std::mt19937_64 rng;
   TimeSeries* example;
+  InverseFeedforward* inverse;
   std::normal_distribution<double> noise{0.0, 1.0};
-  double I = 0.0;
+  double I = 0.0, ff_min = 0.0, ff_max = 0.0;
+
+  // With the inverse feed-forward: i = clip(i_ff + a u); the PID's limits follow i_ff.
+  double with_inverse(double tk, double e) {
+    const double lim = r.current_limit_A, a = r.amplifier_A_per_unit;
+    const double i_ff = inverse->current_A(ref.derivatives(tk + 0.5 * grid.sample_s));
+    ff_min = tk == 0.0 ? i_ff : std::min(ff_min, i_ff);
+    ff_max = tk == 0.0 ? i_ff : std::max(ff_max, i_ff);
+    pid.set_limits((-lim - i_ff) / a, (lim - i_ff) / a);
+    return std::clamp(i_ff + a * pid.update(e), -lim, lim);
+  }
 
   double operator()(const State& s, const StepPoint& p) {
     if (p.substep != 1) return I;
     const double tk = grid.sample_time(p.sample);
     const double y_meas =
         s.y_m * 1e6 + r.sensor_noise_um * (r.sensor_noise_um > 0.0 ? noise(rng) : 0.0);
+    if (inverse != nullptr) {
+      I = with_inverse(tk, ref.at(tk) - y_meas);
+      log(s, tk);
+      return I;
+    }
     const double u = pid.update(ref.at(tk) - y_meas);
     const double K_ref = r.feedforward.static_gain_um_per_A;
     const double ff = K_ref > 0.0 ? (ref.at(tk) - ref.y_bias_um) / K_ref : 0.0;
@@ -206,15 +240,18 @@ struct SampledController {
     I = r.feedforward.enabled()
             ? std::clamp(r.bias_A + g * (a * u + ff), -r.current_limit_A, r.current_limit_A)
             : r.bias_A + a * u;
-    if (example) {
-      auto& col = example->columns;
-      col[0].push_back(tk);
-      col[1].push_back(ref.at(tk));
-      col[2].push_back(s.y_m * 1e6);
-      col[3].push_back(I);
-      col[4].push_back(ref.at(tk) - s.y_m * 1e6);
-    }
+    log(s, tk);
     return I;
+  }
+
+  void log(const State& s, double tk) {
+    if (!example) return;
+    auto& col = example->columns;
+    col[0].push_back(tk);
+    col[1].push_back(ref.at(tk));
+    col[2].push_back(s.y_m * 1e6);
+    col[3].push_back(I);
+    col[4].push_back(ref.at(tk) - s.y_m * 1e6);
   }
 };
 
@@ -236,10 +273,12 @@ struct ErrorOverLastPeriod {
   }
 };
 
-// One closed-loop run: the actuator at rest under the bias, the reference centred on its
-// output there, `periods` periods of the reference.
-void track_point(const Model& m, const Conditions& c, const TrackRequest& r, const Job& j, long sub,
-                 std::uint64_t seed, TrackPoint& p, TimeSeries* example) {
+}  // namespace
+
+void detail::track_run(const TrackPlant& plant, const TrackRequest& r, const TrackJob& j, long sub,
+                       std::uint64_t seed, TrackPoint& p, TimeSeries* example) {
+  const Model& m = plant.model;
+  const Conditions& c = plant.conditions;
   p.temperature_C = j.T;
   p.amplitude_um = j.A;
   p.frequency_Hz = j.f;
@@ -264,7 +303,9 @@ void track_point(const Model& m, const Conditions& c, const TrackRequest& r, con
                                 (r.current_limit_A - r.bias_A) / ga),
                             g,
                             std::mt19937_64(seed),
-                            example};
+                            example,
+                            plant.inverse};
+    if (plant.inverse != nullptr) plant.inverse->reset();
     ErrorOverLastPeriod err{ref, (t_end - period) + 1e-12 * period};
     run_loop(m, c, s, grid, drive, err);
     p.error_rms_um = std::sqrt(err.ss / static_cast<double>(std::max(err.n, 1L)));
@@ -273,6 +314,8 @@ void track_point(const Model& m, const Conditions& c, const TrackRequest& r, con
     p.current_min_A = err.Imin;
     p.current_max_A = err.Imax;
     p.saturated = err.Imax >= r.current_limit_A - 1e-12 || err.Imin <= -r.current_limit_A + 1e-12;
+    p.feedforward_min_A = drive.ff_min;
+    p.feedforward_max_A = drive.ff_max;
   } catch (const DivergenceError& e) {
     p.diverged = true;
     p.error = e.what();
@@ -280,19 +323,22 @@ void track_point(const Model& m, const Conditions& c, const TrackRequest& r, con
   }
 }
 
-}  // namespace
-
 TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& progress) {
-  check_request(r);
+  detail::check_track_request(r);
   std::vector<Conditions> conds;
   for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
+  const InverseFeedforwardSettings inv{r.bias_A, r.current_limit_A, r.sample_rate_Hz,
+                                       r.inverse.band_Hz, r.inverse.dynamic};
+  std::vector<LinearInverse> linear;  // one fit per temperature
+  if (r.inverse.enabled)
+    for (const auto& c : conds) linear.push_back(fit_linear_inverse(m, c, r.bias_A, inv.band_Hz));
 
-  std::vector<Job> jobs;
+  std::vector<detail::TrackJob> jobs;
   for (double T : r.temperatures_C)
     for (double A : r.amplitudes_um)
       for (double f : r.frequencies_Hz) jobs.push_back({T, A, f});
   const std::size_t per_T = r.amplitudes_um.size() * r.frequencies_Hz.size();
-  const long sub = plant_substeps(r);
+  const long sub = detail::track_substeps(r);
 
   TrackResult res;
   res.plant_dt_s = 1.0 / r.sample_rate_Hz / static_cast<double>(sub);
@@ -307,8 +353,11 @@ TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& p
           ex.names = {"t_s", "reference_um", "y_um", "current_A", "error_um"};
           ex.columns.assign(ex.names.size(), {});
         }
-        track_point(m, conds[idx / per_T], r, jobs[idx], sub, r.noise_seed + idx, res.points[idx],
-                    idx == 0 ? &ex : nullptr);
+        std::optional<InverseFeedforward> ff;
+        if (r.inverse.enabled) ff.emplace(m, jobs[idx].T, inv, &linear[idx / per_T]);
+        const detail::TrackPlant plant{m, conds[idx / per_T], ff ? &*ff : nullptr};
+        detail::track_run(plant, r, jobs[idx], sub, r.noise_seed + idx, res.points[idx],
+                          idx == 0 ? &ex : nullptr);
         if (idx == 0) res.example = std::move(ex);
       },
       progress);

@@ -59,6 +59,12 @@ check "self-heating" 0 "energy: in .* J = stored .* J \+ to ambient" "$B" simula
 check "thermal step too long" 2 "fastest time constant" "$B" simulate --self-heating --set thermal_network.coil_heat_capacity_J_per_K=0.01 --periods 2 --out "$T/heat2"
 check "compensate" 0 "70.0 +4\.[0-9]+ +-3.0000" "$B" compensate --temperatures 20,70 --reference-current-pp 4 --no-track --periods 2 --out "$T/comp"
 check "compensate bad list" 2 "temperatures must increase" "$B" compensate --temperatures 70,20 --no-track --out "$T/comp2"
+# Inverse-model feed-forward (issue 20): the evaluation's table and the refused words.
+check "feedforward" 0 "100.0 +20.0 +pid_inverse" "$B" track --feedforward inverse --mismatch none --controllers pid,pid_inverse --temperatures 20 --amplitudes 20 --frequencies 100 --out "$T/ff"
+head -1 "$T/ff/track.csv" | grep -q '^temperature_C,frequency_Hz,amplitude_um,mismatch,controller,plant_temperature_C,rms_error_um' && [[ -s "$T/ff/track_ratios.csv" ]] && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: feedforward track.csv"; }
+check "feedforward bad mismatch" 2 "must be all .*, none .* or both" "$B" track --feedforward inverse --mismatch some --temperatures 20 --out "$T/ff2"
+check "feedforward-only flag" 2 "--mismatch applies to the feed-forward evaluation" "$B" track --mismatch none --temperatures 20 --out "$T/ff3"
+check "feedforward bad controller" 2 "controller 'lqr': must be pid, pid_temperature or pid_inverse" "$B" track --feedforward inverse --controllers pid,lqr --temperatures 20 --out "$T/ff2"
 check "step metrics" 0 "step +y .* rise \(10-90 %\)" "$B" simulate --waveform-kind step --level 0 --step-to 4 --step-time 0.002 --duration 0.01 --out "$T/step"
 # --plot needs the Python package of this build (absent in the sanitize-native build).
 if compgen -G "$(dirname "$B")/../python/gmasim/_gmasim*.so" >/dev/null; then
