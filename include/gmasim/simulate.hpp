@@ -138,7 +138,11 @@ struct Result {
   double wall_time_s = 0;
   bool diverged = false;
   std::string error;  // DivergenceError message when diverged
+  // The stack's thermal expansion x_T (eq. 21, relative to T_ref) at the end of the run, and
+  // at its start: they differ when the actuator heats itself. The offset drift of the output
+  // beside its stroke (whether or not y includes it: options.thermal_expansion_in_output).
   double thermal_expansion_um = 0;
+  double thermal_expansion_start_um = 0;
   // The energy ledgers over the metrics window (SimulationSettings::energy_ledger).
   bool has_energy = false;
   EnergyBalance energy;

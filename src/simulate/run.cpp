@@ -436,7 +436,7 @@ Result simulate(const Model& m, const SimulationSettings& s) {
   Conditions c = make_conditions(m, s.temperature_C, s.freeze);
   Result r;
   r.dt_s = L.grid.dt_s;
-  r.thermal_expansion_um = c.thermal_expansion_m * 1e6;
+  r.thermal_expansion_start_um = r.thermal_expansion_um = c.thermal_expansion_m * 1e6;
   make_columns(m, r.series, static_cast<std::size_t>(nsteps / s.record_every + 2));
   SelfHeatingRun heat(m, s, L, r);
   EnergyWindow energy;
@@ -461,6 +461,8 @@ Result simulate(const Model& m, const SimulationSettings& s) {
     r.error = e.what();
   }
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  // Self-heating moves the expansion: the value at the end of the run (the last row's xT_um).
+  if (r.series.rows() > 0) r.thermal_expansion_um = r.series.column("xT_um").back();
   if (!r.diverged && w.periodic()) {
     const double per = w.period_s();
     r.metrics = compute_metrics(r.series, duration - per, duration);
