@@ -68,9 +68,12 @@ std::string shipped_models_dir() {
   if (const char* env = std::getenv("GMASIM_MODELS_DIR"); env && *env) return env;
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) return "";
-  const fs::path dir = exe.parent_path().parent_path() / "share" / "gmasim" / "models";
-  return fs::is_directory(dir, ec) ? dir.string() : std::string();
+  const fs::path dir =
+      ec ? fs::path() : exe.parent_path().parent_path() / "share" / "gmasim" / "models";
+  if (fs::is_directory(dir, ec)) return dir.string();
+  // A binary of the build tree: the source's models.
+  return fs::is_directory(GMASIM_SOURCE_MODELS_DIR, ec) ? std::string(GMASIM_SOURCE_MODELS_DIR)
+                                                        : std::string();
 }
 
 std::string resolve_model_path(const std::string& path) {
