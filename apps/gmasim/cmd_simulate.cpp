@@ -408,7 +408,9 @@ Runner add_simulate(CLI::App& app) {
                   "Arbitrary current waveform, CSV with header t_s,current_A [s, A]");
   sub->add_option("--dt", a->dt_s, "Time step [s]; 0 = automatic rule (T/2000, at most 10 us)")
       ->capture_default_str();
-  sub->add_option("--record-every", a->record_every, "Record every N-th step [-]")
+  sub->add_option("--record-every", a->record_every,
+                  "Record every N-th step [-]; not given, a run over 100000 rows writes one "
+                  "row in ceil(rows/100000) to timeseries.csv (the metrics use every step)")
       ->capture_default_str();
   sub->add_option(
       "--quantity", a->quantities,
@@ -420,7 +422,7 @@ Runner add_simulate(CLI::App& app) {
       ->delimiter(',');
   sub->add_flag("--progress", a->progress,
                 "Progress with ETA on stderr even when it is not a terminal (a terminal gets it "
-                "for runs over 2 s)");
+                "for runs over 2 s), a line every 2 s at most");
   sub->add_flag("--self-heating", a->self_heating,
                 "Let the actuator heat itself: coil copper loss and rod eddy/hysteresis losses "
                 "drive the [thermal_network] (coil, rods, housing, ambient); the rods' "
