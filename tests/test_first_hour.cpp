@@ -169,6 +169,12 @@ TEST(SelfHeatingReport, ThermalExpansionIsTheEndValue) {
   const auto& xT = r.series.column("xT_um");
   EXPECT_EQ(r.thermal_expansion_um, xT.back());
   EXPECT_GT(r.thermal_expansion_um, 1e-4);  // the rods warmed
+  // self_heating.csv holds the drift per thermal step: x_T over the last step is the end value
+  const auto& hx = r.heating.column("xT_um");
+  EXPECT_EQ(hx.front(), 0.0);
+  EXPECT_EQ(hx.back(), r.thermal_expansion_um);
+  for (std::size_t k = 1; k < hx.size(); ++k) EXPECT_GE(hx[k], hx[k - 1]);  // heating only
+  EXPECT_EQ(r.heating.column("y_mean_um").size(), hx.size());
   const std::string json = metrics_json(r, s, m, "");
   const auto key = json.find("\"thermal_expansion_um\": ");
   ASSERT_NE(key, std::string::npos);

@@ -66,7 +66,10 @@ class StageProgress {
     while (!wake_.wait_for(lock, kEvery, [this] { return stop_; })) {
       const double el =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
-      fmt::print(stderr, "reproduce: {}/{} stages done, {:.0f} s elapsed\n", done_, total_, el);
+      if (total_ == 0)
+        fmt::print(stderr, "reproduce: the first stage is running, {:.0f} s elapsed\n", el);
+      else
+        fmt::print(stderr, "reproduce: {}/{} stages done, {:.0f} s elapsed\n", done_, total_, el);
       std::fflush(stderr);
     }
   }

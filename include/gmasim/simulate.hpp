@@ -149,8 +149,9 @@ struct Result {
   CoilElectrical coil;
   // Self-heating: one row per thermal step (t_s, coil_C, rods_C, housing_C, P_copper_W,
   // P_eddy_W, P_hysteresis_W, P_damping_W (the rods' losses from the ledger), P_ambient_W,
-  // stroke_um over the step, E_in_J, E_stored_J, E_out_J cumulative) and the run's heat
-  // balance.
+  // stroke_um over the step, E_in_J, E_stored_J, E_out_J cumulative, xT_um (eq. 21 at the
+  // step's end) and y_mean_um (the output's mean over it): the drift beside the stroke) and the
+  // run's heat balance.
   TimeSeries heating;
   double energy_in_J = 0, energy_stored_J = 0, energy_out_J = 0;
 };
