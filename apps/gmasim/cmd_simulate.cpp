@@ -163,9 +163,10 @@ void prepare_simulate_out(const SimulateArgs& a) {
 }
 
 // A run longer than this many recorded rows writes every k-th row to timeseries.csv unless
-// --record-every is given (a 60 s self-heating run at 10 Hz has 1.2 million steps, 24 MB); the
-// metrics are computed from every recorded step all the same.
-constexpr std::size_t kCsvRows = 100000;
+// --record-every is given (a row of the MDMA is ~400 bytes: 60 s of self-heating at 10 Hz,
+// 1.2 million steps, would be ~480 MB; thinned, ~4 MB); the metrics are computed from every
+// recorded step all the same.
+constexpr std::size_t kCsvRows = 10000;
 
 // Every k-th row of ts, and its last row.
 TimeSeries thinned(const TimeSeries& ts, std::size_t k) {
@@ -409,8 +410,8 @@ Runner add_simulate(CLI::App& app) {
   sub->add_option("--dt", a->dt_s, "Time step [s]; 0 = automatic rule (T/2000, at most 10 us)")
       ->capture_default_str();
   sub->add_option("--record-every", a->record_every,
-                  "Record every N-th step [-]; not given, a run over 100000 rows writes one "
-                  "row in ceil(rows/100000) to timeseries.csv (the metrics use every step)")
+                  "Record every N-th step [-]; not given, a run over 10000 rows writes one "
+                  "row in ceil(rows/10000) to timeseries.csv (the metrics use every step)")
       ->capture_default_str();
   sub->add_option(
       "--quantity", a->quantities,
