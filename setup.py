@@ -7,7 +7,11 @@ an already configured build directory (build/ci), it only builds _gmasim there (
 is up to date) and packages it: what the ctest python_pip_install does.
 
     /usr/bin/python3 -m venv --system-site-packages /tmp/v
-    /tmp/v/bin/python -m pip install --no-build-isolation .
+    /tmp/v/bin/python -m pip install -v --no-build-isolation .
+
+pip shows a build backend's output only with -v: then every step below is printed as it runs
+("setup.py: ..." lines and CMake's [n/N] build progress); without -v pip prints only "still
+running..." for the ~100 s of a fresh build.
 """
 import os
 import pathlib
@@ -22,8 +26,13 @@ from setuptools.command.build_ext import build_ext
 
 ROOT = pathlib.Path(__file__).resolve().parent
 REUSE_DIR = os.environ.get("GMASIM_CMAKE_BUILD_DIR", "")
-# setuptools' own build tree (and egg-info) lives under build/, never beside the sources.
-BUILD_BASE = (pathlib.Path(REUSE_DIR).resolve() / "setuptools") if REUSE_DIR else ROOT / "build" / "setuptools"
+# setuptools' own build tree, the CMake build and the egg-info live outside the source tree:
+# under the reused CMake build, else under $GMASIM_PIP_BUILD_DIR, else the user's cache
+# (${XDG_CACHE_HOME:-~/.cache}/gmasim/pip-build), kept so that a second install rebuilds only
+# what changed. Nothing is written into the sources.
+CACHE = pathlib.Path(os.environ.get("XDG_CACHE_HOME") or pathlib.Path.home() / ".cache")
+BUILD_BASE = ((pathlib.Path(REUSE_DIR).resolve() / "setuptools") if REUSE_DIR else
+              pathlib.Path(os.environ.get("GMASIM_PIP_BUILD_DIR") or CACHE / "gmasim" / "pip-build").resolve())
 
 
 def cmake_project_version():
@@ -36,6 +45,7 @@ def cmake_project_version():
 
 def run(cmd, **kw):
     print("setup.py:", " ".join(str(c) for c in cmd), flush=True)
+    sys.stdout.flush()
     subprocess.run([str(c) for c in cmd], check=True, **kw)
 
 

@@ -112,6 +112,9 @@ TEST(ParameterTable, EveryRowOfAFixedTableIsInTheBuiltInModel) {
       for (const auto& s : spec.sleeve_names) tables.push_back("mechanics.sleeves." + s);
     }
     for (const auto& t : tables) {
+      // One key of a pair (preload.force_N | preload.prestress_MPa): the other is given.
+      if (!row.alternative.empty() && spec.params.count(t + "." + std::string(row.alternative)))
+        continue;
       EXPECT_EQ(spec.params.count(t + "." + std::string(row.key)), 1u) << t << "." << row.key;
       ++checked;
     }
@@ -185,6 +188,7 @@ TEST(ParameterTable, UnitsAgreeWithKeySuffixes) {
                                                                     {"_ohm", "ohm"},
                                                                     {"_m2", "m^2"},
                                                                     {"_kg", "kg"},
+                                                                    {"_MPa", "MPa"},
                                                                     {"_Pa", "Pa"},
                                                                     {"_At", "A-turns"},
                                                                     {"_m", "m"},

@@ -57,6 +57,13 @@ void print_track(const CompensatedTrack& t) {
       "feed-forward\n  (i = bias + g(T) (u_PID + (r - y_bias)/K_ref); g(T): the swing schedule "
       "about the bias, K_ref = {:.4f} um/A at the reference temperature):\n",
       t.static_gain_um_per_A);
+  const double T0 = t.plain.points.empty() ? 0.0 : t.plain.points.front().temperature_C;
+  bool several = false;
+  for (const auto& p : t.plain.points) several = several || p.temperature_C != T0;
+  fmt::print("  growth: the change of e_rms from the same amplitude and frequency at {:g} degC{}\n",
+             T0,
+             several ? " (the first tracking temperature)"
+                     : ": one tracking temperature, so no growth to show");
   fmt::print("  {:>6} {:>6} {:>6} {:>12} {:>12} {:>10} {:>10} {:>6}\n", "T degC", "A um", "f Hz",
              "e_rms PID", "e_rms FF", "growth PID", "growth FF", "g");
   for (std::size_t i = 0; i < t.plain.points.size(); ++i) {

@@ -150,7 +150,8 @@ Runner add_model(CLI::App& app) {
       "check",
       "Validate a model (default: the built-in one) and explain each problem; run it over "
       "20/70/150 degC x 6/12 A x 10/400 Hz: flux densities, consistency and the energy ledgers");
-  check->add_option("file", *check_path, "Model file (TOML); same as --model");
+  check->add_option("file", *check_path, "Model file (TOML); same as --model")
+      ->transform(model_path_transform());
   add_model_options(check, *check_model);
   auto dt_table = std::make_shared<bool>(false);
   check->add_flag("--dt-table", *dt_table,

@@ -1,10 +1,15 @@
 // gmasim reproduce: the whole study of the paper, the claims table, the report.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <mutex>
+#include <thread>
 
 #include "commands.hpp"
 #include "experiment_cli.hpp"
@@ -23,6 +28,58 @@ struct ReproduceArgs {
   std::vector<std::string> compare;  // other model files (readings) scored on the same claims
   int threads = 0;
   bool quick = false, no_figures = false;
+};
+
+// Progress of the stages on stderr. A terminal gets one updating line per stage; a pipe or a
+// file (a CI log) a line every kEverySeconds while the study runs, from a heartbeat thread,
+// so a log never sits silent for the 15 s of a stage, without one line per update.
+class StageProgress {
+ public:
+  static constexpr auto kEvery = std::chrono::seconds(3);
+  StageProgress() : tty_(isatty(fileno(stderr)) != 0), t0_(std::chrono::steady_clock::now()) {
+    if (!tty_) beat_ = std::thread([this] { heartbeat(); });
+  }
+  ~StageProgress() {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    if (beat_.joinable()) beat_.join();
+  }
+  StageProgress(const StageProgress&) = delete;
+  StageProgress& operator=(const StageProgress&) = delete;
+  ProgressFn fn() {
+    return [this](std::size_t done, std::size_t total) {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      done_ = done;
+      total_ = total;
+      if (!tty_) return;
+      fmt::print(stderr, "\rreproduce: stage {}/{}", done, total);
+      if (done == total) fmt::print(stderr, "\n");
+    };
+  }
+
+ private:
+  void heartbeat() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (!wake_.wait_for(lock, kEvery, [this] { return stop_; })) {
+      const double el =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+      if (total_ == 0)
+        fmt::print(stderr, "reproduce: the first stage is running, {:.0f} s elapsed\n", el);
+      else
+        fmt::print(stderr, "reproduce: {}/{} stages done, {:.0f} s elapsed\n", done_, total_, el);
+      std::fflush(stderr);
+    }
+  }
+  bool tty_;
+  std::chrono::steady_clock::time_point t0_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stop_ = false;
+  std::size_t done_ = 0, total_ = 0;
+  std::thread beat_;
 };
 
 int run_reproduce_cmd(const ReproduceArgs& a) {
@@ -50,11 +107,11 @@ int run_reproduce_cmd(const ReproduceArgs& a) {
   if (!a.doc.empty()) outputs.push_back({a.doc, "--doc"});
   require_outputs_distinct(inputs, outputs);
   ensure_output_dir(a.out);
-  const bool tty = isatty(fileno(stderr)) != 0;
-  const ReproduceResult r = run_reproduce(model, o, [tty](std::size_t done, std::size_t total) {
-    if (tty) fmt::print(stderr, "\rreproduce: stage {}/{}", done, total);
-    if (tty && done == total) fmt::print(stderr, "\n");
-  });
+  ReproduceResult r;
+  {
+    StageProgress progress;
+    r = run_reproduce(model, o, progress.fn());
+  }
   write_reproduce_outputs(model, r, a.out, a.no_figures ? std::string() : a.python,
                           python_package_path());
   std::vector<ComparedModel> compared;
@@ -70,6 +127,11 @@ int run_reproduce_cmd(const ReproduceArgs& a) {
   fmt::print("  {}\n", fitted_predicted_line(n));
   fmt::print("  {} of {} applicable claims pass ({} claims); study took {:.1f} s\n", n.pass,
              n.applicable, r.claims.size(), r.wall_time_s);
+  if (const auto failing = unexplained_failures(r.claims, {}); !failing.empty())
+    fmt::print("  failing: {}; why each fails: {} (its '### <claim id>' sections){}\n",
+               fmt::join(failing, ", "),
+               a.doc_notes.empty() ? std::string("docs/failing_claims.md") : a.doc_notes,
+               a.doc.empty() ? "" : ", and in " + a.doc);
   for (const auto& t : r.trends)
     fmt::print("  trend: {} {} ({:+.3g} /A, paper {:+.3g} /A)\n", t.what, t.pass ? "PASS" : "FAIL",
                t.ours_slope, t.paper_slope);

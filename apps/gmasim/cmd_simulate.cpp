@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -50,7 +51,10 @@ void print_energy(const Result& r, bool periodic) {
 struct SimulateArgs {
   ModelArgs model;
   std::string waveform_csv, kind = "sine", out = "out/simulate";
-  double temperature_C = 20.0, pp_A = 8.0, min_A = -3.0, frequency_Hz = 10.0, periods = 3.0;
+  std::string temperatures = "20";  // one or several (comma list, start:step:stop) [degC]
+  double temperature_C = 20.0;      // the one of this run
+  bool record_every_given = false, current_min_given = false;
+  double pp_A = 8.0, min_A = -3.0, frequency_Hz = 10.0, periods = 3.0;
   double dt_s = 0.0, level_A = 0.0, step_to_A = 0.0, step_time_s = 0.0;
   double f0_Hz = 1.0, f1_Hz = 1000.0, amplitude_A = 1.0, offset_A = 0.0, duration_s = 0.0;
   int record_every = 1;
@@ -158,37 +162,90 @@ void prepare_simulate_out(const SimulateArgs& a) {
   ensure_output_dir(a.out);
 }
 
-int run_simulate(const SimulateArgs& a) {
-  const Model model = load_model_args(a.model);
-  warn_temperatures(model, {a.temperature_C}, "--temperature");
-  if (a.self_heating && !std::isnan(a.ambient_C))
-    warn_temperatures(model, {a.ambient_C}, "--ambient");
-  const SimulationSettings s = settings_of(a);
-  prepare_simulate_out(a);
-  Result r = simulate(model, s);
-  if (!r.diverged && !a.quantities.empty()) add_quantity_stats(r, a.quantities);
-  const std::filesystem::path dir(a.out);
-  // One set: both temporaries are complete before either is renamed, and metrics.json
-  // (renamed last) names the hash of its timeseries.csv.
-  const std::string csv = timeseries_csv(r.series);
-  std::vector<std::pair<std::string, std::string>> files = {
-      {(dir / "timeseries.csv").string(), csv}};
-  if (s.self_heating.enabled)
-    files.emplace_back((dir / "self_heating.csv").string(), timeseries_csv(r.heating));
-  files.emplace_back((dir / "metrics.json").string(), metrics_json(r, s, model, csv));
-  write_files_atomic(files);
+// A run longer than this many recorded rows writes every k-th row to timeseries.csv unless
+// --record-every is given (a row of the MDMA is ~400 bytes: 60 s of self-heating at 10 Hz,
+// 1.2 million steps, would be ~480 MB; thinned, ~4 MB); the metrics are computed from every
+// recorded step all the same.
+constexpr std::size_t kCsvRows = 10000;
 
-  fmt::print("gmasim simulate  model: {}\n", model_label(a.model));
+// Every k-th row of ts, and its last row.
+TimeSeries thinned(const TimeSeries& ts, std::size_t k) {
+  TimeSeries out;
+  out.names = ts.names;
+  out.columns.resize(ts.columns.size());
+  const std::size_t n = ts.rows();
+  for (std::size_t c = 0; c < ts.columns.size(); ++c) {
+    for (std::size_t i = 0; i < n; i += k) out.columns[c].push_back(ts.columns[c][i]);
+    if ((n - 1) % k != 0) out.columns[c].push_back(ts.columns[c][n - 1]);
+  }
+  return out;
+}
+
+// A biased sine that crosses 0 A in a model without a bias magnet: the strain follows |M| and
+// doubles the frequency (a butterfly), which a 0-6 A drive given as --current-pp 6 alone
+// (default --current-min -3 A, the paper's Fig. 11) would produce unseen.
+void warn_zero_crossing(const Model& m, const SimulateArgs& a, const Waveform& w) {
+  if (w.kind != WaveformKind::BiasedSine || !(w.min_A < 0.0 && w.min_A + w.pp_A > 0.0)) return;
+  for (const auto& b : m.circuit.branches)
+    if (b.pm_mmf_At != 0.0) return;
+  print_warning(fmt::format(
+      "the drive {:g} .. {:g} A crosses 0 A and {} has no bias magnet: the strain follows |M| "
+      "and doubles the frequency (a butterfly loop){}; for a unipolar drive give --current-min 0",
+      w.min_A, w.min_A + w.pp_A, m.spec.source,
+      a.current_min_given ? "" : " (--current-min defaults to -3 A, the paper's Fig. 11 bias)"));
+}
+
+void print_metrics(const Result& r, const SimulationSettings& s, const Model& model) {
+  const char* window = s.waveform.periodic() ? "over the last period" : "over the whole run";
+  fmt::print("  stroke      {:9.3f} um   (peak-to-peak of y {})\n", r.metrics.stroke_um, window);
+  fmt::print("  hysteresis  {:9.3f} um   (widest rising/falling gap at equal current)\n",
+             r.metrics.hysteresis_um);
+  fmt::print("  B p-p       {:9.4f} T    (induction coil)\n", r.metrics.B_pp_T);
+  fmt::print("  y mean      {:9.3f} um\n", r.metrics.y_mean_um);
+  fmt::print(
+      "  drift       {:9.3f} um   (thermal offset x_T vs T_ref {:g} degC at the end, {} y; "
+      "{:+.3f} um over the run)\n",
+      r.thermal_expansion_um, model.T_ref_C,
+      model.options.thermal_expansion_in_output ? "included in" : "not in",
+      r.thermal_expansion_um - r.thermal_expansion_start_um);
+  if (r.metrics.stroke_um > 0.0 && std::fabs(r.thermal_expansion_um) > r.metrics.stroke_um)
+    print_warning(fmt::format(
+        "the thermal offset drift {:.3f} um exceeds the stroke {:.3f} um ({:.1f} x) at {:g} "
+        "degC: a sensor on the housing reads it; compensate it or hold the temperature",
+        r.thermal_expansion_um, r.metrics.stroke_um,
+        std::fabs(r.thermal_expansion_um) / r.metrics.stroke_um, s.temperature_C));
+}
+
+void print_heating(const Result& r, const SimulateArgs& a) {
+  const auto& h = r.heating;
+  const std::size_t n = h.rows() - 1;
+  // The first thermal step holds the virgin magnetisation curve: the drift is read from the
+  // second one on when there is one.
+  const std::size_t b = n >= 2 ? 2 : 1;
+  const double balance = r.energy_in_J - r.energy_stored_J - r.energy_out_J;
+  fmt::print(
+      "  self-heating over {:.1f} s (thermal step {:.3g} s, ambient {:.1f} degC):\n"
+      "    coil {:.2f} degC, rods {:.2f} degC, housing {:.2f} degC at the end\n"
+      "    losses at the end: copper {:.3f} W, eddy {:.4f} W, hysteresis {:.4f} W, damping "
+      "{:.4f} W\n"
+      "    stroke {:.3f} um over thermal step {}, {:.3f} um over the last ({:+.2f} %)\n"
+      "    thermal expansion {:.3f} -> {:.3f} um ({:+.3f} um drift of the output offset)\n"
+      "    energy: in {:.2f} J = stored {:.2f} J + to ambient {:.2f} J (residual {:.2e} J)\n",
+      h.columns[0][n], h.columns[0][1], std::isnan(a.ambient_C) ? a.temperature_C : a.ambient_C,
+      h.column("coil_C")[n], h.column("rods_C")[n], h.column("housing_C")[n],
+      h.column("P_copper_W")[n], h.column("P_eddy_W")[n], h.column("P_hysteresis_W")[n],
+      h.column("P_damping_W")[n], h.column("stroke_um")[b], b, h.column("stroke_um")[n],
+      (h.column("stroke_um")[n] / h.column("stroke_um")[b] - 1.0) * 100.0,
+      r.thermal_expansion_start_um, r.thermal_expansion_um,
+      r.thermal_expansion_um - r.thermal_expansion_start_um, r.energy_in_J, r.energy_stored_J,
+      r.energy_out_J, balance);
+}
+
+void print_result(const Result& r, const SimulationSettings& s, const Model& model,
+                  const SimulateArgs& a) {
   fmt::print("  temperature {:.1f} degC, dt {:.4g} us, {} steps, wall time {:.3f} s\n",
              s.temperature_C, r.dt_s * 1e6, r.steps, r.wall_time_s);
-  if (r.has_metrics) {
-    const char* window = s.waveform.periodic() ? "over the last period" : "over the whole run";
-    fmt::print("  stroke      {:9.3f} um   (peak-to-peak of y {})\n", r.metrics.stroke_um, window);
-    fmt::print("  hysteresis  {:9.3f} um   (widest rising/falling gap at equal current)\n",
-               r.metrics.hysteresis_um);
-    fmt::print("  B p-p       {:9.4f} T    (induction coil)\n", r.metrics.B_pp_T);
-    fmt::print("  y mean      {:9.3f} um\n", r.metrics.y_mean_um);
-  }
+  if (r.has_metrics) print_metrics(r, s, model);
   if (r.step.valid)
     fmt::print(
         "  step        y {:.3f} -> {:.3f} um, rise (10-90 %) {:.4g} ms, overshoot {:.2f} %, "
@@ -199,31 +256,40 @@ int run_simulate(const SimulateArgs& a) {
     fmt::print("  {:<22} rms {:.6g}  peak {:.6g}  p-p {:.6g}  mean {:.6g}\n", q.name, q.rms, q.peak,
                q.pp, q.mean);
   if (r.has_energy) print_energy(r, s.waveform.periodic());
-  fmt::print("  thermal expansion {:.3f} um ({} the output y)\n", r.thermal_expansion_um,
-             model.options.thermal_expansion_in_output ? "included in" : "not in");
-  if (r.heating.rows() > 1) {
-    const auto& h = r.heating;
-    const std::size_t n = h.rows() - 1;
-    // The first thermal step holds the virgin magnetisation curve: the drift is read from the
-    // second one on when there is one.
-    const std::size_t b = n >= 2 ? 2 : 1;
-    const double balance = r.energy_in_J - r.energy_stored_J - r.energy_out_J;
-    fmt::print(
-        "  self-heating over {:.1f} s (thermal step {:.3g} s, ambient {:.1f} degC):\n"
-        "    coil {:.2f} degC, rods {:.2f} degC, housing {:.2f} degC at the end\n"
-        "    losses at the end: copper {:.3f} W, eddy {:.4f} W, hysteresis {:.4f} W, damping "
-        "{:.4f} W\n"
-        "    stroke {:.3f} um over thermal step {}, {:.3f} um over the last ({:+.2f} %)\n"
-        "    energy: in {:.2f} J = stored {:.2f} J + to ambient {:.2f} J (residual {:.2e} J)\n",
-        h.columns[0][n], h.columns[0][1], std::isnan(a.ambient_C) ? a.temperature_C : a.ambient_C,
-        h.column("coil_C")[n], h.column("rods_C")[n], h.column("housing_C")[n],
-        h.column("P_copper_W")[n], h.column("P_eddy_W")[n], h.column("P_hysteresis_W")[n],
-        h.column("P_damping_W")[n], h.column("stroke_um")[b], b, h.column("stroke_um")[n],
-        (h.column("stroke_um")[n] / h.column("stroke_um")[b] - 1.0) * 100.0, r.energy_in_J,
-        r.energy_stored_J, r.energy_out_J, balance);
-  }
+  if (!r.has_metrics)
+    fmt::print("  thermal expansion {:.3f} um ({} the output y)\n", r.thermal_expansion_um,
+               model.options.thermal_expansion_in_output ? "included in" : "not in");
+  if (r.heating.rows() > 1) print_heating(r, a);
+}
+
+// One temperature: the run, its output set in a.out, the console summary.
+int run_one(const Model& model, const SimulateArgs& a) {
+  const SimulationSettings s = settings_of(a);
+  prepare_simulate_out(a);
+  Result r = simulate(model, s);
+  if (!r.diverged && !a.quantities.empty()) add_quantity_stats(r, a.quantities);
+  const std::filesystem::path dir(a.out);
+  const std::size_t rows = r.series.rows();
+  const std::size_t k =
+      a.record_every_given || rows <= kCsvRows ? 1 : (rows + kCsvRows - 1) / kCsvRows;
+  // One set: both temporaries are complete before either is renamed, and metrics.json
+  // (renamed last) names the hash of its timeseries.csv.
+  const std::string csv = timeseries_csv(k > 1 ? thinned(r.series, k) : r.series);
+  std::vector<std::pair<std::string, std::string>> files = {
+      {(dir / "timeseries.csv").string(), csv}};
+  if (s.self_heating.enabled)
+    files.emplace_back((dir / "self_heating.csv").string(), timeseries_csv(r.heating));
+  files.emplace_back((dir / "metrics.json").string(), metrics_json(r, s, model, csv));
+  write_files_atomic(files);
+  print_result(r, s, model, a);
   fmt::print("  wrote {}/timeseries.csv{} and {}/metrics.json\n", a.out,
              s.self_heating.enabled ? fmt::format(", {}/self_heating.csv", a.out) : "", a.out);
+  if (k > 1)
+    fmt::print(
+        "  timeseries.csv holds one row in {} of the {} recorded ({} rows): a run over {} "
+        "rows is thinned by default (--record-every N sets the recording, 1 keeps every "
+        "step); the metrics use every step\n",
+        k, rows, (rows - 1) / k + 1 + ((rows - 1) % k != 0 ? 1 : 0), kCsvRows);
   if (a.plot && r.steps > 0) fmt::print("  wrote {}\n", render_plot("simulate", a.out));
   if (r.diverged) {
     print_error(r.error +
@@ -233,6 +299,74 @@ int run_simulate(const SimulateArgs& a) {
   return 0;
 }
 
+// The loops of several temperatures on one figure (python/gmasim/simulate_overlay.py).
+std::string render_overlay(const std::string& out, const std::vector<std::string>& dirs) {
+  PythonCommand c;
+  c.python_path = python_package_path();
+  c.module = "gmasim.simulate_overlay";
+  c.args = {out};
+  c.args.insert(c.args.end(), dirs.begin(), dirs.end());
+  const int rc = run_python(c);
+  if (rc != 0)
+    throw InputError(
+        fmt::format("--plot: the overlay figure failed ({}); the data files are "
+                    "written",
+                    c.text()));
+  return (std::filesystem::path(out) / "simulate_temperatures.png").string();
+}
+
+// --temperature 20,150: one output set per temperature in <out>/T<temperature>C, and with
+// --plot their loops overlaid in <out>/simulate_temperatures.png.
+// The words of --temperature as usage errors, as CLI11 reports a number flag's ("80C": not a
+// number; "nan": not finite); then the list (comma-separated, or start:step:stop).
+std::vector<double> parse_temperatures(const std::string& text) {
+  std::string word;
+  for (std::size_t i = 0; i <= text.size(); ++i) {
+    if (i < text.size() && text[i] != ',' && text[i] != ':') {
+      word += text[i];
+      continue;
+    }
+    char* end = nullptr;
+    const double v = std::strtod(word.c_str(), &end);
+    if (word.empty() || end != word.c_str() + word.size())
+      throw UsageError(fmt::format("--temperature '{}': not a number (in degC, without the unit)",
+                                   clip_for_message(word)));
+    if (!std::isfinite(v))
+      throw UsageError(
+          fmt::format("--temperature {}: must be a finite number", clip_for_message(word)));
+    word.clear();
+  }
+  return parse_list(text, "--temperature", "degC");
+}
+
+int run_simulate(const SimulateArgs& a) {
+  const std::vector<double> temps = parse_temperatures(a.temperatures);
+  if (temps.empty()) throw InputError("--temperature: give at least one temperature [degC]");
+  const Model model = load_model_args(a.model);
+  warn_temperatures(model, temps, "--temperature");
+  if (a.self_heating && !std::isnan(a.ambient_C))
+    warn_temperatures(model, {a.ambient_C}, "--ambient");
+  warn_zero_crossing(model, a, make_waveform(a));
+  fmt::print("gmasim simulate  model: {}\n", model_label(a.model));
+  if (temps.size() == 1) {
+    SimulateArgs one = a;
+    one.temperature_C = temps.front();
+    return run_one(model, one);
+  }
+  int rc = 0;
+  std::vector<std::string> dirs;
+  for (const double T : temps) {
+    SimulateArgs one = a;
+    one.temperature_C = T;
+    one.out = (std::filesystem::path(a.out) / fmt::format("T{:g}C", T)).string();
+    one.plot = false;
+    rc = std::max(rc, run_one(model, one));
+    dirs.push_back(one.out);
+  }
+  if (a.plot && rc == 0) fmt::print("  wrote {}\n", render_overlay(a.out, dirs));
+  return rc;
+}
+
 }  // namespace
 
 Runner add_simulate(CLI::App& app) {
@@ -240,7 +374,9 @@ Runner add_simulate(CLI::App& app) {
   auto* sub = app.add_subcommand(
       "simulate", "Run the model in the time domain; writes timeseries.csv and metrics.json");
   add_model_options(sub, a->model);
-  sub->add_option("--temperature", a->temperature_C, "Operating temperature [degC]")
+  sub->add_option("--temperature", a->temperatures,
+                  "Operating temperature [degC]; several (20,150 or 20:65:150) run one after "
+                  "the other, each into <out>/T<temperature>C, loops overlaid with --plot")
       ->capture_default_str();
   sub->add_option("--waveform-kind", a->kind,
                   "Current waveform: sine (biased, Fig. 11), dc, step, chirp")
@@ -273,7 +409,9 @@ Runner add_simulate(CLI::App& app) {
                   "Arbitrary current waveform, CSV with header t_s,current_A [s, A]");
   sub->add_option("--dt", a->dt_s, "Time step [s]; 0 = automatic rule (T/2000, at most 10 us)")
       ->capture_default_str();
-  sub->add_option("--record-every", a->record_every, "Record every N-th step [-]")
+  sub->add_option("--record-every", a->record_every,
+                  "Record every N-th step [-]; not given, a run over 10000 rows writes one "
+                  "row in ceil(rows/10000) to timeseries.csv (the metrics use every step)")
       ->capture_default_str();
   sub->add_option(
       "--quantity", a->quantities,
@@ -285,7 +423,7 @@ Runner add_simulate(CLI::App& app) {
       ->delimiter(',');
   sub->add_flag("--progress", a->progress,
                 "Progress with ETA on stderr even when it is not a terminal (a terminal gets it "
-                "for runs over 2 s)");
+                "for runs over 2 s), a line every 2 s at most");
   sub->add_flag("--self-heating", a->self_heating,
                 "Let the actuator heat itself: coil copper loss and rod eddy/hysteresis losses "
                 "drive the [thermal_network] (coil, rods, housing, ambient); the rods' "
@@ -300,6 +438,8 @@ Runner add_simulate(CLI::App& app) {
   return [a, sub]() -> int {
     if (!sub->parsed()) return -1;
     check_waveform_flags(*sub, *a);
+    a->record_every_given = sub->count("--record-every") > 0;
+    a->current_min_given = sub->count("--current-min") > 0;
     return run_simulate(*a);
   };
 }

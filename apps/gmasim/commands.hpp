@@ -59,6 +59,14 @@ std::vector<FileArg> model_inputs(const ModelArgs& a);
 void prepare_output_dir(const std::string& dir, const std::vector<std::string>& stems,
                         const std::vector<FileArg>& inputs);
 
+// The shipped model files (docs/model.md, "Model files"): $GMASIM_MODELS_DIR, else the
+// installed <prefix>/share/gmasim/models beside the executable's bin/; "" if neither.
+std::string shipped_models_dir();
+// A --model value that names no file here but a shipped model ("mdma_printed.toml",
+// "models/mdma_printed.toml"): the shipped file's path; any other value unchanged.
+std::string resolve_model_path(const std::string& path);
+CLI::Validator model_path_transform();  // resolve_model_path as a CLI11 transform
+
 // Shared helpers.
 std::string model_label(const std::string& path);  // "models/mdma.toml (built-in)" or path
 void print_error(const std::string& what);

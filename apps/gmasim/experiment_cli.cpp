@@ -81,15 +81,21 @@ ProgressFn stderr_progress(const std::string& label, bool force) {
   const auto t0 = std::chrono::steady_clock::now();
   // Shown only for runs that last: nothing before 2 s have passed (unless forced), then the
   // count, the elapsed time and the remaining time extrapolated from the rate so far.
-  return [label, tty, force, t0](std::size_t done, std::size_t total) {
+  // Throttled: a terminal's line is redrawn at most every 0.2 s, a pipe or file gets a line
+  // at most every kPipeEvery_s (and the first and last), not one per 1 % of the run.
+  constexpr double kPipeEvery_s = 2.0;
+  auto shown = std::make_shared<double>(-1e9);
+  return [label, tty, force, t0, shown](std::size_t done, std::size_t total) {
     const double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (total <= 1) return;  // one job: nothing between start and end to show
     if (!force && el < 2.0 && done < total) return;
-    const double eta = done > 0 ? el * static_cast<double>(total - done) / static_cast<double>(done)
-                                : 0.0;
-    const std::string text = fmt::format("{}: {}/{} ({:.0f} %), {:.1f} s elapsed, ETA {:.1f} s",
-                                         label, done, total,
-                                         total ? 100.0 * static_cast<double>(done) / total : 100.0,
-                                         el, eta);
+    if (done < total && el - *shown < (tty ? 0.2 : kPipeEvery_s)) return;
+    *shown = el;
+    const double eta =
+        done > 0 ? el * static_cast<double>(total - done) / static_cast<double>(done) : 0.0;
+    const std::string text =
+        fmt::format("{}: {}/{} ({:.0f} %), {:.1f} s elapsed, ETA {:.1f} s", label, done, total,
+                    total ? 100.0 * static_cast<double>(done) / total : 100.0, el, eta);
     // Serialised by the caller; a terminal gets one updating line, a pipe one line each.
     if (tty)
       std::fprintf(stderr, "\r%s\033[K%s", text.c_str(), done == total ? "\n" : "");

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <filesystem>
 #include <new>
 #include <vector>
 
@@ -48,12 +49,52 @@ void check_options(const CLI::App& app) {
 
 void require_finite_numbers(const CLI::App& app) { check_options(app); }
 
+CLI::Validator model_path_transform() {
+  return CLI::Validator(
+      [](std::string& path) {
+        path = resolve_model_path(path);
+        return std::string();
+      },
+      "", "shipped model");
+}
+
 std::string model_label(const std::string& path) {
-  return path.empty() ? std::string("models/mdma.toml (built-in)") : path;
+  return path.empty() ? std::string("the built-in MDMA model (models/mdma.toml, compiled in)")
+                      : path;
+}
+
+std::string shipped_models_dir() {
+  namespace fs = std::filesystem;
+  if (const char* env = std::getenv("GMASIM_MODELS_DIR"); env && *env) return env;
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  const fs::path dir =
+      ec ? fs::path() : exe.parent_path().parent_path() / "share" / "gmasim" / "models";
+  if (fs::is_directory(dir, ec)) return dir.string();
+  // A binary of the build tree: the source's models.
+  return fs::is_directory(GMASIM_SOURCE_MODELS_DIR, ec) ? std::string(GMASIM_SOURCE_MODELS_DIR)
+                                                        : std::string();
+}
+
+std::string resolve_model_path(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (path.empty() || fs::exists(path, ec)) return path;
+  const fs::path p(path);
+  const bool bare = !p.has_parent_path() || p.parent_path() == "models";
+  const std::string dir = shipped_models_dir();
+  if (!bare || dir.empty()) return path;
+  const fs::path shipped = fs::path(dir) / p.filename();
+  return fs::is_regular_file(shipped, ec) ? shipped.string() : path;
 }
 
 void add_model_options(CLI::App* sub, ModelArgs& a, const std::string& what) {
-  sub->add_option("--model", a.path, what);
+  sub->add_option("--model", a.path,
+                  what +
+                      ". A shipped model's name (mdma_printed.toml, models/single_rod.toml) "
+                      "that is no file here is read from the installed models directory "
+                      "(<prefix>/share/gmasim/models, or $GMASIM_MODELS_DIR)")
+      ->transform(model_path_transform());
   sub->add_option("--set", a.sets,
                   "Change a model parameter for this run: name=value in the file's units (e.g. "
                   "--set material.Ms_A_per_m=7e5 --set options.magnetic_state=printed); "

@@ -12,6 +12,7 @@
 
 #include <atomic>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -66,6 +67,10 @@ struct MeasurementCondition {
   long precycles = 0;  // passes of the record's own drive before the compared pass
   OffsetMode offset = OffsetMode::Absolute;       // of displacement_um / strain_ppm
   OffsetMode flux_offset = OffsetMode::Absolute;  // of flux_T
+  // The prestress the record was measured at [MPa]: the stress in the first rod of
+  // stack.rods; the record is simulated with the preload that gives it (its force replaces
+  // the model's preload). NaN: the model's own preload.
+  double prestress_MPa = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct Measurement {

@@ -115,6 +115,15 @@ struct ModelSpec {
   std::string key_of(const std::string& dotted) const;
 };
 
+// The preload of a spec (docs/model.md, "Preload"): a file gives preload.force_N or
+// preload.prestress_MPa, the compressive stress of the first rod of stack.rods at T_ref.
+// preload_area_m2: that rod's cross-section pi (r_1^2 - r_2^2) at T_ref [m^2].
+double preload_area_m2(const ModelSpec& spec);
+// The preload force [N]: force_N, or prestress_MPa x 1e6 x preload_area_m2.
+double preload_force_N(const ModelSpec& spec);
+// "preload.force_N" or "preload.prestress_MPa": the key the spec holds.
+std::string preload_key(const ModelSpec& spec);
+
 // One switch per temperature law: a frozen law is evaluated at the reference
 // temperature T_r (20 degC) whatever the operating temperature. Used by ablation.
 struct Freeze {

@@ -98,6 +98,9 @@ struct ParamDef {
   std::optional<double> default_value = std::nullopt;  // Defaulted tables only
   std::string_view default_provenance = {};            // shown by `model show` for a default
   CrossRule cross = {};
+  // A key of the same table that may stand in for this one (preload.force_N and
+  // preload.prestress_MPa): a file gives exactly one of the two; the spec holds the one given.
+  std::string_view alternative = {};
 };
 
 // One value of an option: its word in the file and what it means.

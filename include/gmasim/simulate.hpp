@@ -138,15 +138,20 @@ struct Result {
   double wall_time_s = 0;
   bool diverged = false;
   std::string error;  // DivergenceError message when diverged
+  // The stack's thermal expansion x_T (eq. 21, relative to T_ref) at the end of the run, and
+  // at its start: they differ when the actuator heats itself. The offset drift of the output
+  // beside its stroke (whether or not y includes it: options.thermal_expansion_in_output).
   double thermal_expansion_um = 0;
+  double thermal_expansion_start_um = 0;
   // The energy ledgers over the metrics window (SimulationSettings::energy_ledger).
   bool has_energy = false;
   EnergyBalance energy;
   CoilElectrical coil;
   // Self-heating: one row per thermal step (t_s, coil_C, rods_C, housing_C, P_copper_W,
   // P_eddy_W, P_hysteresis_W, P_damping_W (the rods' losses from the ledger), P_ambient_W,
-  // stroke_um over the step, E_in_J, E_stored_J, E_out_J cumulative) and the run's heat
-  // balance.
+  // stroke_um over the step, E_in_J, E_stored_J, E_out_J cumulative, xT_um (eq. 21 at the
+  // step's end) and y_mean_um (the output's mean over it): the drift beside the stroke) and the
+  // run's heat balance.
   TimeSeries heating;
   double energy_in_J = 0, energy_stored_J = 0, energy_out_J = 0;
 };

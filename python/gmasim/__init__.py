@@ -7,7 +7,9 @@ adds plotting helpers (``gmasim.plots``). Units are SI and named in every key
     import gmasim
     m = gmasim.Model()                       # the built-in MDMA model
     r = gmasim.simulate(m, temperature_C=70, current_pp_A=8, frequency_Hz=10)
-    r["metrics"]["stroke_um"], r["series"]["y_um"]
+    r["metrics"]["stroke_um"], r["series"]["y_um"]   # print(r): a one-line summary
+    r = gmasim.simulate(m, current_A=i_samples, current_dt_s=1e-4)  # a sampled current [A, s]
+    r = gmasim.simulate(m, waveform=(t_s, current_A))               # or a (t, i) pair [s, A]
     s = gmasim.sweep(m, temperatures_C=[20, 70])   # {'meta', 'points': {column: ndarray}}
     gmasim.plots.sweep_vs_temperature(s["points"])
     st = gmasim.Stepper(m, temperature_C=20, dt_s=1e-5)  # sample by sample (docs/c_api.md)
@@ -29,14 +31,16 @@ from ._gmasim import __git_describe__, __version__  # noqa: F401
 from . import plots  # noqa: F401
 from ._sensitivity import fit_parameters, sensitivity  # noqa: F401
 from ._arguments import checked as _checked
+from ._results import SimulationResult, as_result as _as_result  # noqa: F401
 
 # Every function of the extension module checks its arguments' types first, so that a wrong
 # one is a TypeError naming the argument and the expected type (issue 19, item 11).
 simulate, sweep, frf, track, compensate, ablate, params_vs_temperature, thermal_expansion, claims = (
     _checked(f) for f in (simulate, sweep, frf, track, compensate, ablate, params_vs_temperature,
                           thermal_expansion, claims))
+simulate = _as_result(simulate)
 
 __all__ = ["Model", "Stepper", "simulate", "sweep", "frf", "track", "compensate", "ablate",
            "params_vs_temperature", "parameter_table",
            "thermal_expansion", "claims", "sensitivity", "fit_parameters", "plots", "InputError",
-           "DivergenceError", "FREEZE_LAWS"]
+           "DivergenceError", "FREEZE_LAWS", "SimulationResult"]

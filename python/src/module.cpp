@@ -5,6 +5,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <memory>
 
 #include "bindings.hpp"
@@ -127,6 +128,59 @@ Waveform table_waveform(const py::object& waveform) {
   return w;
 }
 
+double optional_number(const py::object& o, const char* what);
+
+// current_A=array sampled every current_dt_s seconds from t = 0: the Table waveform
+// t_k = k dt (linear interpolation between samples, held after the last).
+Waveform sampled_waveform(const py::object& current_A, double dt_s) {
+  Waveform w;
+  w.kind = WaveformKind::Table;
+  w.table_current_A = numbers_1d(current_A, "current_A");
+  w.table_source = "<python current_A>";
+  if (w.table_current_A.size() < 2)
+    throw InputError(
+        fmt::format("current_A: at least 2 samples are needed (got {})", w.table_current_A.size()));
+  if (!(dt_s > 0.0) || !std::isfinite(dt_s))
+    throw InputError(
+        fmt::format("current_dt_s = {:g} s: must be > 0 (the spacing of the "
+                    "current_A samples)",
+                    dt_s));
+  for (std::size_t k = 0; k < w.table_current_A.size(); ++k)
+    w.table_t_s.push_back(static_cast<double>(k) * dt_s);
+  return w;
+}
+
+// The current of a run: waveform=(t_s, current_A), current_A=array with current_dt_s, or the
+// biased sine / dc of `kind`.
+Waveform drive_of(const py::object& waveform, const py::object& current_A,
+                  const py::object& current_dt_s, const std::string& kind, double current_pp_A,
+                  double frequency_Hz, double current_min_A) {
+  if (!current_A.is_none()) {
+    if (!waveform.is_none())
+      throw InputError("give waveform=(t_s, current_A) or current_A= with current_dt_s=, not both");
+    if (current_dt_s.is_none())
+      throw InputError("current_A= needs current_dt_s= (the sample spacing [s])");
+    return sampled_waveform(current_A, optional_number(current_dt_s, "current_dt_s"));
+  }
+  if (!current_dt_s.is_none()) throw InputError("current_dt_s= goes with current_A=");
+  if (!waveform.is_none()) {
+    if (py::isinstance<py::array>(waveform) && waveform.cast<py::array>().ndim() == 1)
+      throw py::type_error(
+          "waveform: expected a pair (t_s, current_A); for a current sampled at a fixed "
+          "spacing pass current_A=array, current_dt_s=spacing instead");
+    return table_waveform(waveform);
+  }
+  if (kind == "sine") return biased_sine(current_pp_A, frequency_Hz, current_min_A);
+  if (kind == "dc") {
+    Waveform w;
+    w.kind = WaveformKind::DC;
+    w.level_A = current_pp_A;
+    return w;
+  }
+  throw InputError("kind '" + kind +
+                   "': use 'sine' or 'dc', or pass waveform=(t_s, current_A) or current_A=");
+}
+
 double optional_number(const py::object& o, const char* what) {
   if (py::isinstance<py::bool_>(o) ||
       !(py::isinstance<py::float_>(o) || py::isinstance<py::int_>(o) ||
@@ -164,7 +218,8 @@ py::dict simulate_py(const Model& m, double temperature_C, double current_pp_A, 
                      const std::string& kind, py::object waveform, double duration_s,
                      const std::vector<std::string>& freeze,
                      const std::vector<std::string>& quantities, bool self_heating,
-                     double thermal_step_s, py::object ambient_C) {
+                     double thermal_step_s, py::object ambient_C, py::object current_A,
+                     py::object current_dt_s) {
   if (auto w = temperature_warning(m, temperature_C)) warn(*w);
   SimulationSettings s;
   s.energy_ledger = true;
@@ -177,22 +232,17 @@ py::dict simulate_py(const Model& m, double temperature_C, double current_pp_A, 
   s.record_every = record_every;
   s.duration_s = duration_s;
   s.freeze = parse_freeze(freeze);
-  if (!waveform.is_none()) {
-    s.waveform = table_waveform(waveform);
-  } else if (kind == "sine") {
-    s.waveform = biased_sine(current_pp_A, frequency_Hz, current_min_A);
-  } else if (kind == "dc") {
-    s.waveform.kind = WaveformKind::DC;
-    s.waveform.level_A = current_pp_A;
-  } else {
-    throw InputError("kind '" + kind + "': use 'sine' or 'dc', or pass waveform=(t_s, current_A)");
-  }
+  s.waveform =
+      drive_of(waveform, current_A, current_dt_s, kind, current_pp_A, frequency_Hz, current_min_A);
   Result r;
   {
     py::gil_scoped_release release;
     r = simulate(m, s);
   }
-  if (!r.diverged && !quantities.empty()) add_quantity_stats(r, quantities);
+  // The statistics of the requested columns, by default of the drive, the output and B.
+  if (!r.diverged)
+    add_quantity_stats(
+        r, quantities.empty() ? std::vector<std::string>{"current_A", "y_um", "B_T"} : quantities);
   py::dict d;
   d["series"] = series_dict(r.series);
   if (r.has_metrics) d["metrics"] = metrics_dict(r.metrics);
@@ -202,6 +252,7 @@ py::dict simulate_py(const Model& m, double temperature_C, double current_pp_A, 
   d["diverged"] = r.diverged;
   d["error"] = r.error;
   d["thermal_expansion_um"] = r.thermal_expansion_um;
+  d["thermal_expansion_start_um"] = r.thermal_expansion_start_um;
   if (r.has_energy) d["energy"] = energy_dict(m, r);
   if (self_heating) {
     d["heating"] = series_dict(r.heating);
@@ -320,7 +371,22 @@ PYBIND11_MODULE(_gmasim, mod) {
           py::arg("freeze") = std::vector<std::string>{},
           py::arg("quantities") = std::vector<std::string>{}, py::arg("self_heating") = false,
           py::arg("thermal_step_s") = 0.0, py::arg("ambient_C") = py::none(),
-          "Time-domain run. Returns {'series': {column: ndarray}, 'metrics': {...}, ...}; with "
+          py::arg("current_A") = py::none(), py::arg("current_dt_s") = py::none(),
+          "Time-domain run.\n\n"
+          "The coil current is one of:\n"
+          "  * kind='sine' (default): the biased sine of Fig. 11, current_min_A + current_pp_A/2 "
+          "(1 - cos 2 pi f t), run for `periods` periods;\n"
+          "  * kind='dc': a constant current_pp_A for duration_s;\n"
+          "  * current_A=ndarray, current_dt_s=spacing: samples at t = 0, dt, 2 dt, ... [A, s] "
+          "(linear between samples, held after the last; the run lasts to the last sample "
+          "unless duration_s is given);\n"
+          "  * waveform=(t_s, current_A): a pair of equally long 1-D arrays, t_s strictly "
+          "increasing from 0 [s, A].\n\n"
+          "Returns a dict (printed as a short summary): 'series' {column: ndarray}, 'metrics' "
+          "(stroke_um, hysteresis_um, B_pp_T, y_mean_um over the last period or the whole run), "
+          "'quantities' {column: {rms, peak, pp, mean}} (default: current_A, y_um, B_T; or the "
+          "columns named in quantities=), 'thermal_expansion_um' (eq. 21 at the end of the run; "
+          "'thermal_expansion_start_um' at its start), 'energy', dt_s, steps; with "
           "self_heating=True also 'heating' (one row per thermal step: node temperatures, losses, "
           "stroke) and the energy balance (energy_in_J = energy_stored_J + energy_out_J)");
   // The names freeze=[...] takes (simulate, Stepper, sweep), from the C++ table.

@@ -14,6 +14,7 @@
 #include "common/toml_io.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/validate.hpp"
+#include "gmasim/validity.hpp"
 
 namespace gmasim {
 namespace identify_detail {
@@ -48,6 +49,7 @@ constexpr ConditionKey kConditionKeys[] = {
     {"precycles", KeyType::Number},
     {"offset", KeyType::Text},
     {"flux_offset", KeyType::Text},
+    {"prestress_MPa", KeyType::Number},
 };
 
 constexpr std::pair<OffsetMode, std::string_view> kOffsetNames[] = {
@@ -398,6 +400,12 @@ MeasurementCondition make_condition(const KeyMap& keys, const Measurement& m,
   if (m.condition.quasi_static) check_untimed_keys(k);
   read_periodic_keys(k, m, c);
   read_current_keys(k, c);
+  if (k.has("prestress_MPa")) {  // the stress in the first rod of stack.rods (docs/data.md)
+    c.prestress_MPa = k.number("prestress_MPa");
+    if (!(c.prestress_MPa >= 0.0 && c.prestress_MPa <= kMaxPrestress_Pa * 1e-6))
+      k.fail("prestress_MPa", fmt::format("prestress_MPa = {:g}: must be in [0, {:g}] MPa",
+                                          c.prestress_MPa, kMaxPrestress_Pa * 1e-6));
+  }
   c.label = k.has("label") ? k.text("label") : fs::path(path).stem().string();
   c.quasi_static = m.condition.quasi_static;
   read_record_keys(k, m, c);

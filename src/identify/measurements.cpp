@@ -277,6 +277,8 @@ std::string measurement_csv(const Measurement& m) {
     s += fmt::format("# offset = {}\n", offset_mode_name(c.offset));
   if (c.flux_offset != OffsetMode::Absolute)
     s += fmt::format("# flux_offset = {}\n", offset_mode_name(c.flux_offset));
+  if (!std::isnan(c.prestress_MPa))
+    s += fmt::format("# prestress_MPa = {:.17g}\n", c.prestress_MPa);
   const bool flux = !m.flux_T.empty();
   if (!c.quasi_static) s += "t_s,";
   s += fmt::format("{},{}{}\n", m.drive_column(), m.response_column(), flux ? ",flux_T" : "");

@@ -91,9 +91,8 @@ struct Objective::Impl {
     std::vector<double> y, B;
     for (const auto& cd : conds) {
       const Measurement& meas = data.items[cd.index];
-      const auto& [c, st] =
-          starts.get(meas.condition.temperature_C, identify_detail::record_initial_current(meas));
-      identify_detail::run_record(model, c, st, meas, settings, y, cd.flux ? &B : nullptr);
+      identify_detail::run_record_from_start(model, starts, meas, settings, y,
+                                             cd.flux ? &B : nullptr);
       identify_detail::apply_offset(meas.condition.offset, meas.response, cd.compare_begin, y);
       if (cd.flux)
         identify_detail::apply_offset(meas.condition.flux_offset, meas.flux_T, cd.compare_begin, B);

@@ -99,14 +99,26 @@ double lowest_resonance_Hz(const Model& m, const ResonanceRun& run) {
   return f;
 }
 
+void run_record_from_start(const Model& m, StartCache& starts, const Measurement& meas,
+                           const ObjectiveSettings& s, std::vector<double>& response,
+                           std::vector<double>* B_T) {
+  const double T = meas.condition.temperature_C, I0 = record_initial_current(meas);
+  if (std::isnan(meas.condition.prestress_MPa)) {
+    const auto& [c, st] = starts.get(T, I0);
+    run_record(m, c, st, meas, s, response, B_T);
+    return;
+  }
+  const Model mp = with_record_preload(m, meas.condition);
+  const Conditions c = make_conditions(mp, T);
+  run_record(mp, c, make_state(mp, c, I0), meas, s, response, B_T);
+}
+
 }  // namespace identify_detail
 
 void simulate_measurement(const Model& m, const Measurement& meas, const ObjectiveSettings& s,
                           std::vector<double>& y_um, std::vector<double>* B_T) {
   identify_detail::StartCache starts(m);
-  const auto& [c, st] =
-      starts.get(meas.condition.temperature_C, identify_detail::record_initial_current(meas));
-  identify_detail::run_record(m, c, st, meas, s, y_um, B_T);
+  identify_detail::run_record_from_start(m, starts, meas, s, y_um, B_T);
 }
 
 }  // namespace gmasim

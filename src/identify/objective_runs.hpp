@@ -62,4 +62,11 @@ struct ResonanceRun {
 // The value of a target computed at rest or from the small-signal response (no sine run).
 double lowest_resonance_Hz(const Model& m, const ResonanceRun& run);
 
+// run_record() from the record's start state: the cached one, or for a record measured at its
+// own prestress (condition key prestress_MPa) the model with that preload (record_run.hpp,
+// with_record_preload), started afresh.
+void run_record_from_start(const Model& m, StartCache& starts, const Measurement& meas,
+                           const ObjectiveSettings& s, std::vector<double>& response,
+                           std::vector<double>* B_T);
+
 }  // namespace gmasim::identify_detail

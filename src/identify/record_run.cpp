@@ -13,6 +13,7 @@
 #include "gmasim/errors.hpp"
 #include "gmasim/run_loop.hpp"
 #include "gmasim/validate.hpp"
+#include "gmasim/validity.hpp"
 
 namespace gmasim::identify_detail {
 namespace {
@@ -326,6 +327,15 @@ class RecordRun {
 };
 
 }  // namespace
+
+Model with_record_preload(const Model& m, const MeasurementCondition& c) {
+  if (std::isnan(c.prestress_MPa))
+    throw InputError(fmt::format("record '{}': no prestress_MPa condition", c.label));
+  Model mp = m;
+  mp.preload_N = c.prestress_MPa * 1e6 * preload_area_m2(m.spec);
+  check_model_validity(mp);
+  return mp;
+}
 
 void run_record(const Model& m, const Conditions& c, State st, const Measurement& meas,
                 const ObjectiveSettings& s, std::vector<double>& response, std::vector<double>* B_T,

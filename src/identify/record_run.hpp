@@ -33,6 +33,12 @@ void run_record(const Model& m, const Conditions& c, State st, const Measurement
                 const ObjectiveSettings& s, std::vector<double>& response, std::vector<double>* B_T,
                 std::vector<double>* H_A_per_m = nullptr);
 
+// The model a record measured at its own prestress (condition key prestress_MPa) is simulated
+// with: m with the preload force that gives the first rod of stack.rods that stress at T_ref
+// (force = prestress x A_1, as the model key preload.prestress_MPa). Its preload replaces the
+// model's, free fit parameter or not. Throws InputError if the record has no prestress.
+Model with_record_preload(const Model& m, const MeasurementCondition& c);
+
 // Shifts `simulated` by the record's offset rule so that simulated - measured is the
 // residual: FirstSample aligns the first samples, Fitted removes the least-squares constant
 // over the compared samples [begin, n).

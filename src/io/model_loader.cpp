@@ -237,7 +237,9 @@ void ModelLoader::read_group(const toml::table& t, Group g, const std::string& t
   for (const auto& row : parameter_table()) {
     if (row.group != g) continue;
     const std::string dotted = table_name + "." + std::string(row.key);
-    if (const toml::node* node = t.get(row.key)) {
+    if (!row.alternative.empty()) {
+      read_alternative(t, row, table_name);
+    } else if (const toml::node* node = t.get(row.key)) {
       store_number(*node, dotted);
     } else if (row.default_value) {
       store_default(dotted, row);
@@ -245,6 +247,25 @@ void ModelLoader::read_group(const toml::table& t, Group g, const std::string& t
       (void)required(t, row.key, table_name, tl);  // reports the missing key
     }
   }
+}
+
+// One of a pair of keys (preload.force_N | preload.prestress_MPa): the one given is stored;
+// neither is a missing key, both are refused at the second one's line.
+void ModelLoader::read_alternative(const toml::table& t, const ParamDef& row,
+                                   const std::string& table_name) {
+  const toml::node* node = t.get(row.key);
+  const toml::node* other = t.get(row.alternative);
+  if (node && !other) store_number(*node, table_name + "." + std::string(row.key));
+  if (!node && !other && row.key < row.alternative)
+    problem(node_line(t), fmt::format("missing key '{}' (or '{}') in [{}]", row.key,
+                                      row.alternative, table_name));
+  if (!node || !other || row.key > row.alternative) return;  // the pair is checked once
+  const long a = node_line(*node), b = node_line(*other);
+  problem(std::max(a, b),
+          fmt::format("[{}]: give {}.{} or {}.{}, not both (lines {} and {}): the force is "
+                      "derived from the prestress of the first rod of stack.rods",
+                      table_name, table_name, row.key, table_name, row.alternative, std::min(a, b),
+                      std::max(a, b)));
 }
 
 void ModelLoader::read_group_table(const toml::table& parent, Group g, long missing_line,

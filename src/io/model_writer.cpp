@@ -74,6 +74,27 @@ void replace_value(std::vector<std::string>& lines, long line_no, std::string_vi
   }
 }
 
+// A key of a pair (preload.force_N | preload.prestress_MPa) set in place of the other, which
+// the source text holds: the other's line becomes this key's.
+void replace_alternative(std::vector<std::string>& lines, const ModelSpec& original,
+                         const std::string& name, double value, const std::string& why) {
+  const ParamDef* def = find_param_def(original, name);
+  const std::string table = name.substr(0, name.rfind('.'));
+  const std::string leaf = name.substr(name.rfind('.') + 1);
+  const auto other = def && !def->alternative.empty()
+                         ? original.params.find(table + "." + std::string(def->alternative))
+                         : original.params.end();
+  if (other == original.params.end() || other->second.line < 1 ||
+      other->second.line > static_cast<long>(lines.size()))
+    throw InputError(
+        fmt::format("{}: parameter '{}' is not in its source text", original.source, name));
+  std::string& line = lines[static_cast<std::size_t>(other->second.line - 1)];
+  const auto at = line.find(def->alternative);
+  line = fmt::format("{}{} = {}  # set: {}; was {} = {}", line.substr(0, at), leaf,
+                     schema::toml_float(value), why, def->alternative,
+                     schema::toml_float(other->second.value));
+}
+
 }  // namespace
 
 ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assignments,
@@ -122,14 +143,14 @@ std::string model_toml(const ModelSpec& spec, const std::string& why) {
   std::map<std::string, std::vector<std::string>> added;  // table -> new "key = value" lines
   for (const auto& [name, pv] : spec.params) {
     const auto it = original.params.find(name);
-    if (it == original.params.end())
-      throw InputError(
-          fmt::format("{}: parameter '{}' is not in its source text", spec.source, name));
+    if (it == original.params.end()) {
+      replace_alternative(lines, original, name, pv.value, why);
+      continue;
+    }
     const ParamValue& was = it->second;
     if (std::bit_cast<std::uint64_t>(was.value) == std::bit_cast<std::uint64_t>(pv.value)) continue;
-    const std::string comment =
-        fmt::format("set: {}; was {}{}", why, schema::toml_float(was.value),
-                    was.provenance.empty() ? "" : fmt::format(" ({})", was.provenance));
+    // The old comment described the old value ("about 6 MPa"): it is not kept.
+    const std::string comment = fmt::format("set: {}; was {}", why, schema::toml_float(was.value));
     if (was.line == 0) {  // a defaulted key the file does not hold: added below
       added[name.substr(0, name.rfind('.'))].push_back(
           fmt::format("{} = {}  # {}", leaf_of(name), schema::toml_float(pv.value), comment));

@@ -464,7 +464,16 @@ std::string metrics_json(const Result& r, const SimulationSettings& s, const Mod
     }
     w.end_object();
   }
+  // The thermal offset of the output (eq. 21, vs T_ref) at the end and start of the run, its
+  // change over the run, and the offset drift against the stroke (gmasim simulate warns when
+  // the drift exceeds the stroke).
   w.key("thermal_expansion_um").number(r.thermal_expansion_um);
+  w.key("thermal_expansion_start_um").number(r.thermal_expansion_start_um);
+  w.key("thermal_drift_over_run_um").number(r.thermal_expansion_um - r.thermal_expansion_start_um);
+  if (r.has_metrics)
+    w.key("drift_to_stroke")
+        .number(r.metrics.stroke_um > 0.0 ? std::fabs(r.thermal_expansion_um) / r.metrics.stroke_um
+                                          : 0.0);
   if (r.has_energy) write_energy(w, m, r);
   if (r.heating.rows() > 0) write_self_heating(w, r);
   if (!timeseries_csv_text.empty()) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/model.hpp"
@@ -56,6 +57,7 @@ void land_parameters(const ModelSpec& spec, Model& m) {
   for (const ParamDef& row : parameter_table()) {
     if (row.lands == nullptr) continue;  // [circuit.reluctances_per_H]: summed per branch
     const TableRule table = group_def(row.group).table;
+    const bool alternative = !row.alternative.empty();  // absent: its alternative is given
     const auto instances = schema::group_instances(spec, row.group);
     for (std::size_t i = 0; i < instances.size(); ++i) {
       const std::string name =
@@ -65,7 +67,7 @@ void land_parameters(const ModelSpec& spec, Model& m) {
         row.lands(m, i) = it->second.value;
       else if (row.default_value)
         row.lands(m, i) = *row.default_value;
-      else if (table != TableRule::KeysOptional)
+      else if (table != TableRule::KeysOptional && !alternative)
         row.lands(m, i) = spec.get(name);  // throws: unknown parameter
     }
   }
@@ -196,6 +198,28 @@ void derive(const ModelSpec& spec, Model& m) {
 
 }  // namespace
 
+double preload_area_m2(const ModelSpec& spec) {
+  if (spec.rods.empty()) fail(spec, 0, "stack.rods is empty: at least one rod is required");
+  const std::string& rod = spec.rods.front();
+  const double ro = spec.get(rod + ".outer_diameter_m") / 2.0;
+  const double ri = spec.get(rod + ".inner_diameter_m") / 2.0;
+  return std::numbers::pi * (ro * ro - ri * ri);
+}
+
+std::string preload_key(const ModelSpec& spec) {
+  return spec.params.count("preload.prestress_MPa") ? "preload.prestress_MPa" : "preload.force_N";
+}
+
+double preload_force_N(const ModelSpec& spec) {
+  const auto it = spec.params.find("preload.prestress_MPa");
+  if (it == spec.params.end()) return spec.get("preload.force_N");
+  if (spec.params.count("preload.force_N"))
+    fail(spec, it->second.line,
+         "[preload]: give preload.force_N or preload.prestress_MPa, not both (the force is "
+         "derived from the prestress)");
+  return it->second.value * 1e6 * preload_area_m2(spec);
+}
+
 Model compile(const ModelSpec& spec) {
   check_spec(spec);
   Model m;
@@ -203,6 +227,7 @@ Model compile(const ModelSpec& spec) {
   m.options = spec.options;
   size_instances(spec, m);
   land_parameters(spec, m);
+  m.preload_N = preload_force_N(spec);
   build_circuit(spec, m);
   build_flux_sensor(spec, m);
   build_chains(spec, m);

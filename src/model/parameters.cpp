@@ -155,10 +155,30 @@ const ParamDef kParams[] = {
      "thermal expansion coefficient of the rods, eq. (21) and l^T, A^T",
      LAND(in_material, Material, alpha_thermal_per_K)},
     // [preload]
-    {G::Preload, "force_N", "N", R::NonNegative,
+    {G::Preload,
+     "force_N",
+     "N",
+     R::NonNegative,
      "preload F_pre through the rods in series; each rod's prestress is F_pre / A_i^T (its "
-     "area at temperature), eq. (3), (6), (11), (13)",
-     LAND(in_model, Model, preload_N)},
+     "area at temperature), eq. (3), (6), (11), (13). Give this or prestress_MPa",
+     LAND(in_model, Model, preload_N),
+     std::nullopt,
+     {},
+     {},
+     "prestress_MPa"},
+    {G::Preload,
+     "prestress_MPa",
+     "MPa",
+     R::NonNegative,
+     "the preload as the compressive prestress of the first rod of stack.rods at T_ref; the "
+     "force is derived, F_pre = prestress x A_1 (A_1 = pi (r_1^2 - r_2^2) at T_ref). Give this "
+     "or force_N",
+     nullptr,
+     "Model::preload_N (derived: prestress x A_1)",
+     std::nullopt,
+     {},
+     {},
+     "force_N"},
     // [magnet]
     {G::Magnet, "alpha_pm1_per_K", "1/K", R::Any, "first-order coefficient of F_pm^T, eq. (1)",
      LAND(in_model, Model, alpha_pm1_per_K), 0.0, kNoMagnet},

@@ -213,7 +213,33 @@ double ModelSpec::get(const std::string& dotted) const {
   return params.at(resolve(*this, dotted)).value;
 }
 
+namespace {
+
+// Setting one of a pair of alternative keys (preload.force_N | preload.prestress_MPa) that
+// the spec does not hold replaces the other: the spec holds one of them.
+bool swap_alternative(ModelSpec& spec, const std::string& dotted, double value) {
+  if (spec.params.count(dotted)) return false;
+  const ParamDef* def = find_param_def(spec, dotted);
+  if (!def || def->alternative.empty()) return false;
+  const std::string other =
+      dotted.substr(0, dotted.rfind('.')) + "." + std::string(def->alternative);
+  const auto it = spec.params.find(other);
+  if (it == spec.params.end()) return false;
+  ParamValue pv = it->second;
+  if (auto problem = schema::check_value(spec, dotted, value))
+    throw InputError(located(spec.source, pv.line,
+                             fmt::format("cannot set {} = {:g}: {}", dotted, value, *problem)));
+  pv.value = value;
+  pv.provenance = fmt::format("set in place of {}", other);
+  spec.params.erase(it);
+  spec.params[dotted] = std::move(pv);
+  return true;
+}
+
+}  // namespace
+
 void ModelSpec::set(const std::string& dotted, double value) {
+  if (swap_alternative(*this, dotted, value)) return;
   const std::string key = resolve(*this, dotted);
   ParamValue& pv = params.at(key);
   const double old = pv.value;

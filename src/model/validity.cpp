@@ -57,7 +57,7 @@ void check_model_validity(const Model& m) {
     const double sigma = m.preload_N / area;
     if (sigma > kMaxPrestress_Pa)
       throw InputError(located(
-          m.spec.source, m.spec.line_of("preload.force_N"),
+          m.spec.source, m.spec.line_of(preload_key(m.spec)),
           fmt::format("preload.force_N = {:g} N gives rod '{}' a prestress of {:.4g} MPa: above "
                       "{:g} MPa, beyond the compressive strength of Terfenol-D (305-880 MPa), "
                       "the rod would be crushed",
@@ -115,7 +115,7 @@ std::vector<std::string> model_warnings(const Model& m) {
   }
   if (worst > kWarnPrestress_Pa)
     out.push_back(located(
-        spec.source, spec.line_of("preload.force_N"),
+        spec.source, spec.line_of(preload_key(spec)),
         fmt::format("preload.force_N = {:g} N: a prestress of up to {:.4g} MPa (rod '{}'), far "
                     "above what actuators use (5-20 MPa; at most ~{:g} MPa)",
                     m.preload_N, worst * 1e-6, where, kWarnPrestress_Pa * 1e-6)));

@@ -162,7 +162,7 @@ struct SelfHeatingRun {
   double interval_s = 0, ambient_C = 0, T_ref_C = 20;
   const ThermalNetworkModel* net = nullptr;
   NodeTemperatures T, T0;
-  double E_copper = 0, y_min = 0, y_max = 0, i_prev = 0;
+  double E_copper = 0, y_min = 0, y_max = 0, y_sum = 0, i_prev = 0;
   // The ledger's running sums of the rods' losses at the start of the interval [J].
   double E_eddy0 = 0, E_hyst0 = 0, E_damp0 = 0;
 
@@ -191,18 +191,21 @@ struct SelfHeatingRun {
     T = T0 = {s.temperature_C, s.temperature_C, s.temperature_C};
     r.heating.names = {"t_s",      "coil_C",         "rods_C",      "housing_C",   "P_copper_W",
                        "P_eddy_W", "P_hysteresis_W", "P_damping_W", "P_ambient_W", "stroke_um",
-                       "E_in_J",   "E_stored_J",     "E_out_J"};
+                       "E_in_J",   "E_stored_J",     "E_out_J",     "xT_um",       "y_mean_um"};
     r.heating.columns.assign(r.heating.names.size(), {});
     const double rows =
         static_cast<double>(L.grid.steps) / static_cast<double>(steps_per_interval) + 2;
     for (auto& col : r.heating.columns) col.reserve(static_cast<std::size_t>(rows));
   }
 
+  static constexpr std::size_t kXtColumn = 13;  // xT_um in r.heating.names
+  // A row of self_heating.csv; xT_um (eq. 21 at the row's rods temperature) and y_mean_um (the
+  // output's mean over it) are the offset drift beside the stroke (issue 20).
   void push_row(Result& r, double t, double Pc, double Pe, double Ph, double Pd, double Pa,
-                double stroke) {
+                double stroke, double xT_um, double y_mean_um) {
     const double row[] = {
-        t,      T.coil_C,      T.rods_C,          T.housing_C,   Pc, Pe, Ph, Pd, Pa,
-        stroke, r.energy_in_J, r.energy_stored_J, r.energy_out_J};
+        t,      T.coil_C,      T.rods_C,          T.housing_C,    Pc,    Pe,       Ph, Pd, Pa,
+        stroke, r.energy_in_J, r.energy_stored_J, r.energy_out_J, xT_um, y_mean_um};
     for (std::size_t j = 0; j < r.heating.columns.size(); ++j)
       r.heating.columns[j].push_back(row[j]);
   }
@@ -216,12 +219,12 @@ struct SelfHeatingRun {
     }
   }
 
-  void begin(const State& st, Result& r) {
+  void begin(const Conditions& c, const State& st, Result& r) {
     if (!enabled) return;
     i_prev = st.current_A;
     y_min = y_max = st.y_m;
     rod_losses(st, E_eddy0, E_hyst0, E_damp0);
-    push_row(r, st.t_s, 0, 0, 0, 0, 0, 0);
+    push_row(r, st.t_s, 0, 0, 0, 0, 0, 0, c.thermal_expansion_m * 1e6, st.y_m * 1e6);
   }
 
   void after_step(const Model& m, const SimulationSettings& s, Conditions& c, const State& st,
@@ -231,6 +234,7 @@ struct SelfHeatingRun {
     i_prev = st.current_A;
     y_min = std::min(y_min, st.y_m);
     y_max = std::max(y_max, st.y_m);
+    y_sum += st.y_m;
     if (++in_interval < steps_per_interval && !last) return;
     // One thermal step: the interval's mean powers heat the network. The rods' losses are the
     // energy ledger's hysteresis, eddy-current and damping terms (gmasim/energy.hpp), each
@@ -244,7 +248,9 @@ struct SelfHeatingRun {
     r.energy_in_J += (Pc + Pe + Ph + Pd) * span;
     r.energy_out_J += E_out;
     r.energy_stored_J = stored_heat_J(*net, T, T0);
-    push_row(r, st.t_s, Pc, Pe, Ph, Pd, E_out / span, (y_max - y_min) * 1e6);
+    push_row(r, st.t_s, Pc, Pe, Ph, Pd, E_out / span, (y_max - y_min) * 1e6,
+             c.thermal_expansion_m * 1e6, y_sum / static_cast<double>(in_interval) * 1e6);
+    y_sum = 0;
     in_interval = 0;
     E_copper = 0;
     E_eddy0 = eddy;
@@ -253,6 +259,8 @@ struct SelfHeatingRun {
     y_min = y_max = st.y_m;
     try {
       c = make_conditions(m, T.rods_C, s.freeze);
+      // x_T of the row: at the rods' temperature of its end, as the series records it.
+      r.heating.columns[kXtColumn].back() = c.thermal_expansion_m * 1e6;
     } catch (const InputError& e) {
       throw DivergenceError(fmt::format(
           "self-heating: at t = {:.6g} s the rods reached {:.2f} degC, where the model is not "
@@ -436,7 +444,7 @@ Result simulate(const Model& m, const SimulationSettings& s) {
   Conditions c = make_conditions(m, s.temperature_C, s.freeze);
   Result r;
   r.dt_s = L.grid.dt_s;
-  r.thermal_expansion_um = c.thermal_expansion_m * 1e6;
+  r.thermal_expansion_start_um = r.thermal_expansion_um = c.thermal_expansion_m * 1e6;
   make_columns(m, r.series, static_cast<std::size_t>(nsteps / s.record_every + 2));
   SelfHeatingRun heat(m, s, L, r);
   EnergyWindow energy;
@@ -451,7 +459,7 @@ Result simulate(const Model& m, const SimulationSettings& s) {
     check_physical_validity(m, c, st, 0.0);  // the rest state too (gmasim/validity.hpp)
     record(c, st, r.series);
     energy.open(m, c, st, 0);
-    heat.begin(st, r);
+    heat.begin(c, st, r);
     run_loop(
         m, c, st, L.grid, [&w](double t) { return w.current_at(t); },
         SimulationRecorder{m, s, c, heat, energy, r, nsteps, std::max(1L, nsteps / 100)});
@@ -461,6 +469,8 @@ Result simulate(const Model& m, const SimulationSettings& s) {
     r.error = e.what();
   }
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  // Self-heating moves the expansion: the value at the end of the run (the last row's xT_um).
+  if (r.series.rows() > 0) r.thermal_expansion_um = r.series.column("xT_um").back();
   if (!r.diverged && w.periodic()) {
     const double per = w.period_s();
     r.metrics = compute_metrics(r.series, duration - per, duration);

@@ -20,8 +20,20 @@ mkdir -p "$work/elsewhere"
 "$py" -m venv --system-site-packages --without-pip "$work/venv"
 vpy="$work/venv/bin/python"
 unset PYTHONPATH
-"$vpy" -m pip install --no-build-isolation --no-index --no-cache-dir --quiet "$src"
+# -v: pip shows the build backend's output (docs/c_api.md): every step of setup.py as it runs.
+had_setuptools_dir=0
+[[ -d "$src/build/setuptools" ]] && had_setuptools_dir=1
+"$vpy" -m pip install -v --no-build-isolation --no-index --no-cache-dir "$src" >"$work/pip.log" 2>&1 ||
+  { tail -50 "$work/pip.log" >&2; exit 1; }
 echo "pip install: $((SECONDS - start)) s"
+grep -q '^ *setup.py: .*cmake --build' "$work/pip.log" ||
+  { echo "pip_install: the build's progress is not shown with -v" >&2; exit 1; }
+# No build tree in the source: no egg-info beside the sources, no build/setuptools there.
+if compgen -G "$src/*.egg-info" >/dev/null || compgen -G "$src/python/*.egg-info" >/dev/null ||
+  [[ $had_setuptools_dir -eq 0 && -d "$src/build/setuptools" ]]; then
+  echo "pip_install: pip left a build tree in the source directory $src" >&2
+  exit 1
+fi
 
 cd "$work/elsewhere"
 "$vpy" - "$work/venv" <<'PY'
