@@ -131,7 +131,12 @@ void set_parameters(const Objective& obj, BatchEvaluator& ev, const std::vector<
           "not refined: the intervals are linearised at the GA champion, which "
           "is not a minimum; refine for meaningful intervals");
     }
-    if (prof.budget == 0) oc.profile = false;  // the stage's budget is spent
+    if (prof.budget == 0 && oc.profile) {  // the stage's budget is spent
+      oc.profile = false;
+      res.notes.push_back(
+          "the profile's budget was spent before these intervals: they are linearised "
+          "(raise --profile-evaluations for profiles)");
+    }
     const long before = ev.evaluations();
     fill_covariance(obj, ev, u, f, oc, comm, res, prof);
     res.stage_evaluations.profile += prof.evaluations;
@@ -184,7 +189,6 @@ void settle_optimum(const Objective& obj, BatchEvaluator& ev, const IdentifyOpti
     if (round + 1 == kRounds) {  // the intervals at the final point, linearised only
       ProfileOutcome none;
       none.budget = 0;
-      res.notes.push_back("the intervals are linearised at the point the profile found");
       set_parameters(obj, ev, u, f, o, comm, res, none);
       return;
     }
