@@ -49,6 +49,7 @@ struct SynthArgs {
   SyntheticRequest req;
   bool no_flux = false;
   std::string drive = "current", response = "displacement", offset = "absolute";
+  std::string initial_state = "demagnetised";
 };
 
 // The command line, for provenance (Linux: /proc/self/cmdline).
@@ -136,6 +137,18 @@ void write_outputs(const IdentifyArgs& a, const IdentifyResult& r, const ModelSp
   }
 }
 
+// The offsets the record's rules added to the simulated response (and flux), with units.
+std::string offset_summary(const ConditionFit& c) {
+  std::string s;
+  if (c.condition.offset != OffsetMode::Absolute)
+    s += fmt::format("; offset ({}) {:+.6g} {}", offset_mode_name(c.condition.offset), c.offset,
+                     c.response_unit);
+  if (c.flux_rms_pct >= 0 && c.condition.flux_offset != OffsetMode::Absolute)
+    s += fmt::format("; flux offset ({}) {:+.6g} T", offset_mode_name(c.condition.flux_offset),
+                     c.flux_offset_T);
+  return s;
+}
+
 void print_summary(const IdentifyArgs& a, const IdentifyResult& r) {
   fmt::print("gmasim identify  {} parameters, {} conditions, {} targets\n", r.parameters.size(),
              r.conditions.size(), r.targets.size());
@@ -144,8 +157,9 @@ void print_summary(const IdentifyArgs& a, const IdentifyResult& r) {
              r.refine_summary);
   fmt::print("  weighted RMS error {:.4g} % of p-p (start {:.4g} %, GA {:.4g} %)\n", r.rms_pct,
              r.start_rms_pct, r.ga_rms_pct);
-  fmt::print("  {} evaluations in {:.1f} s; GA {:.1f} evaluations/s\n", r.evaluations, r.wall_s,
-             r.ga_evals_per_s);
+  fmt::print("  {} evaluations in {:.1f} s ({}); GA {:.1f} evaluations/s\n", r.evaluations,
+             r.wall_s, stage_text(r.stage_evaluations), r.ga_evals_per_s);
+  fmt::print("  the written point was found by the {}\n", r.best_found_by);
   fmt::print("  {:<34} {:>13} {:>13}  {}\n", "parameter", "start", "fitted", "95 % CI");
   for (const auto& p : r.parameters) {
     std::string ci = "not determined by the data";
@@ -161,8 +175,8 @@ void print_summary(const IdentifyArgs& a, const IdentifyResult& r) {
     if (c.failed)
       fmt::print("  {:<34} failed: {}\n", c.label, c.error);
     else
-      fmt::print("  {:<34} RMS {:8.4f} {} = {:6.3f} %\n", c.label, c.rms_um, c.response_unit,
-                 c.rms_pct);
+      fmt::print("  {:<34} RMS {:8.4f} {} = {:6.3f} %{}\n", c.label, c.rms, c.response_unit,
+                 c.rms_pct, offset_summary(c));
   }
   for (const auto& t : r.targets)
     fmt::print("  {:<34} target {:.5g}, simulated {:.5g} ({:+.2f} %)\n", t.label, t.value,
@@ -281,6 +295,9 @@ int run_synthesize(SynthArgs& a) {
   a.req.offset = a.offset == "first_sample" ? OffsetMode::FirstSample
                  : a.offset == "fitted"     ? OffsetMode::Fitted
                                             : OffsetMode::Absolute;
+  a.req.initial_state = a.initial_state == "negative_remanence"   ? InitialState::NegativeRemanence
+                        : a.initial_state == "positive_remanence" ? InitialState::PositiveRemanence
+                                                                  : InitialState::Demagnetised;
   const Model m = compile(spec);
   require_outputs_distinct(model_inputs(a.model),
                            files_in(a.out, {"manifest.toml", "truth.toml", "*.csv"}, "--out"));
@@ -313,7 +330,8 @@ void add_search_options(CLI::App* sub, IdentifyOptions& o) {
                   "Island algorithm: sga (the paper's GA), de, sade, cmaes")
       ->check(CLI::IsMember({"sga", "de", "sade", "cmaes"}))
       ->capture_default_str();
-  sub->add_option("--islands", o.islands, "Islands per rank (one thread each)")
+  sub->add_option("--islands", o.islands,
+                  "Islands per rank (fixed: the result depends on it, not on the cores)")
       ->capture_default_str();
   sub->add_option("--population", o.population, "Individuals per island")->capture_default_str();
   sub->add_option("--generations", o.generations,
@@ -328,7 +346,8 @@ void add_search_options(CLI::App* sub, IdentifyOptions& o) {
       ->capture_default_str();
   sub->add_option("--seed", o.seed, "Random seed")->capture_default_str();
   sub->add_option("--threads", o.threads,
-                  "Threads for the refinement's Jacobian batches (0: cores / ranks per node)")
+                  "Worker threads evolving the islands and evaluating the Jacobian batches "
+                  "(0: cores / ranks per node); the result does not depend on it")
       ->capture_default_str();
 }
 
@@ -337,6 +356,10 @@ void add_refine_options(CLI::App* sub, IdentifyArgs& a) {
   sub->add_flag("--no-refine", a.no_refine, "Skip the Levenberg-Marquardt refinement");
   sub->add_flag("--no-profile", a.no_profile,
                 "Linearised intervals only (no profile likelihood for parameters on a bound)");
+  sub->add_option("--profile-evaluations", a.opt.profile_evaluations,
+                  "Evaluations the profile-likelihood stage may spend (-1: as many as the "
+                  "search; 0: no limit)")
+      ->capture_default_str();
   sub->add_option("--refine-iterations", a.opt.refine_iterations,
                   "Levenberg-Marquardt iterations (max)")
       ->capture_default_str();
@@ -433,6 +456,11 @@ void add_synthetic_records(CLI::App* syn, SynthArgs& s) {
       ->capture_default_str();
   syn->add_option("--response-offset", s.req.response_offset,
                   "Constant added to the response with --offset fitted [um or ppm]")
+      ->capture_default_str();
+  syn->add_option("--initial-state", s.initial_state,
+                  "Magnetic state the records start from (written as their initial_state key): "
+                  "demagnetised, negative_remanence or positive_remanence")
+      ->check(CLI::IsMember({"demagnetised", "negative_remanence", "positive_remanence"}))
       ->capture_default_str();
   syn->add_option("--precycles", s.req.precycles,
                   "Pre-cycles written into each record (then every period is compared)")

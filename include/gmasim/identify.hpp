@@ -43,6 +43,14 @@ enum class OffsetMode {
   Fitted        // an unknown constant offset, eliminated by least squares per record
 };
 std::string offset_mode_name(OffsetMode m);
+// The magnetic state a record starts from (condition key initial_state, docs/data.md).
+enum class InitialState {
+  Demagnetised,       // at rest in the demagnetised equilibrium at the first drive value
+  NegativeRemanence,  // after a slow bipolar cycle of the record's amplitude A: 0 -> +A -> -A
+                      // -> the first drive value (at zero drive: the negative remanence)
+  PositiveRemanence   // the mirror: 0 -> -A -> +A -> the first drive value
+};
+std::string initial_state_name(InitialState s);
 
 inline constexpr double kMaxField_A_per_m = 1e7;  // |field_A_per_m| limit (saturation ~1e5)
 inline constexpr long kMaxPrecycles = 100;
@@ -54,8 +62,8 @@ struct MeasurementCondition {
   double current_pp_A = 0.0;
   double current_min_A = -3.0;  // Fig. 11; used only with current_source = "sine"
   // Samples with t_s < compare_from_s are simulated but not compared (the transient from
-  // the demagnetised start). Default: t0 + one period if periodic (and not pre-cycled),
-  // else t0.
+  // the demagnetised start). Default: t0 + one period if periodic (and neither pre-cycled
+  // nor started from a given initial_state), else t0.
   double compare_from_s = 0.0;
   std::string current_source = "measured";  // "measured" (the CSV current) or "sine"
   std::string label;                        // default: the file name without extension
@@ -65,6 +73,7 @@ struct MeasurementCondition {
   bool quasi_static = false;
   std::string rod;     // rod of the field_A_per_m / strain_ppm columns; "": the first rod
   long precycles = 0;  // passes of the record's own drive before the compared pass
+  InitialState initial_state = InitialState::Demagnetised;  // before the pre-cycles
   OffsetMode offset = OffsetMode::Absolute;       // of displacement_um / strain_ppm
   OffsetMode flux_offset = OffsetMode::Absolute;  // of flux_T
   // The prestress the record was measured at [MPa]: the stress in the first rod of
@@ -79,8 +88,11 @@ struct Measurement {
   double weight = 1.0;
   DriveInput drive_kind = DriveInput::Current;
   ResponseOutput response_kind = ResponseOutput::Displacement;
-  std::vector<double> t_s;       // [s]; quasi-static records: the sample index
-  std::vector<double> drive;     // current_A [A] or field_A_per_m [A/m] (drive_kind)
+  std::vector<double> t_s;    // [s]; quasi-static records: the sample index
+  std::vector<double> drive;  // current_A [A] or field_A_per_m [A/m] (drive_kind)
+  // The drive column as the CSV header names it: current_A, field_A_per_m or field_kA_per_m
+  // (whose values are read x 1000 into `drive`, in A/m); "" for a record built in memory.
+  std::string drive_header;
   std::vector<double> response;  // displacement_um [um] or strain_ppm [1e-6] (response_kind)
   std::vector<double> flux_T;    // empty if the file has no flux_T column
   bool periodic() const { return condition.frequency_Hz > 0.0; }
@@ -202,13 +214,19 @@ struct ConditionFit {
   MeasurementCondition condition;
   double weight = 1.0;
   std::size_t samples = 0, compared = 0;
-  // pp_um, rms_um and max_err_um are in the record's response unit (response_unit: "um",
-  // or "ppm" for strain_ppm records).
+  // pp, rms and max_err are in the record's response unit (response_unit: "um" for
+  // displacement_um, "ppm" for strain_ppm records); fit_report.json names them
+  // pp_<unit>, rms_<unit>, max_err_<unit>.
   std::string response_unit = "um";
-  double pp_um = 0.0;    // peak-to-peak of the measured displacement (compared samples)
-  double rms_um = 0.0;   // RMS of simulated - measured
-  double rms_pct = 0.0;  // rms_um / pp_um [%] (the paper's normalisation)
-  double max_err_um = 0.0;
+  double pp = 0.0;       // peak-to-peak of the measured response (compared samples)
+  double rms = 0.0;      // RMS of simulated - measured
+  double rms_pct = 0.0;  // rms / pp [%] (the paper's normalisation)
+  double max_err = 0.0;
+  // The constant added to the simulated response by the record's offset rule (offset =
+  // first_sample or fitted; 0 for absolute), in the response unit, and the same for flux_T
+  // [T] (flux_offset).
+  double offset = 0.0;
+  double flux_offset_T = 0.0;
   double flux_rms_pct = -1.0;  // -1: no flux column (or flux not fitted)
   bool failed = false;         // the simulation diverged or a value was invalid
   std::string error;
@@ -300,8 +318,9 @@ struct SyntheticRequest {
   ResponseOutput response = ResponseOutput::Displacement;
   std::string rod;  // rod of the field / strain columns ("": the first rod)
   OffsetMode offset = OffsetMode::Absolute;
-  double response_offset = 0.0;  // [um or ppm], with OffsetMode::Fitted
-  long precycles = 0;            // written as the records' precycles key
+  double response_offset = 0.0;                             // [um or ppm], with OffsetMode::Fitted
+  long precycles = 0;                                       // written as the records' precycles key
+  InitialState initial_state = InitialState::Demagnetised;  // the records' initial_state key
 };
 // Every record it writes is one identify accepts (issue 19, item 6): the same settings rules
 // (validate(ObjectiveSettings)), currents p-p in (0, 2000] A, frequencies in (0, 1 MHz],
@@ -347,17 +366,22 @@ struct IdentifyProgress {
 
 struct IdentifyOptions {
   std::string algorithm = "sga";  // sga (the paper's multi-island GA), de, sade, cmaes
-  int islands = 4;
+  int islands = 4;                // fixed, not the core count: the islands are part of the search
   int population = 24;
   int generations = 60;   // total GA generations (a resumed run continues to this)
   int migrate_every = 5;  // generations between migrations along the island ring
   int migrants = 2;       // individuals per migration
   int mpi_every = 0;      // generations between champion exchanges over MPI (0: migrate_every)
   unsigned seed = 1;
-  int threads = 0;     // threads for the refinement / Jacobian batches (0: hardware)
+  // Worker threads (0: the cores) evolving the islands and evaluating the first populations,
+  // the refinement's and the profile's Jacobian batches; the result does not depend on it.
+  int threads = 0;
   bool refine = true;  // Levenberg-Marquardt refinement of the champion
   int refine_iterations = 40;
-  bool profile = true;    // profile-likelihood intervals where the linearisation cannot hold
+  bool profile = true;  // profile-likelihood intervals where the linearisation cannot hold
+  // Evaluations the profile stage may spend: -1 (default) as many as the search spent
+  // (so the profile never costs more than the search), 0 no limit, else this many.
+  long profile_evaluations = -1;
   double fd_step = 1e-4;  // central-difference step in u-space
   std::string checkpoint_path;
   int checkpoint_every = 10;  // generations
@@ -399,6 +423,15 @@ struct HistoryEntry {
   double best_rms_pct = 0.0, wall_s = 0.0, evals_per_s = 0.0;
 };
 
+// Model evaluations per stage of identify() (all ranks); they sum to IdentifyResult::evaluations.
+struct StageEvaluations {
+  long search = 0;      // the global search, with the start model's evaluation
+  long refine = 0;      // Levenberg-Marquardt (including refits from a point the profile found)
+  long covariance = 0;  // the Jacobians of the linearised intervals
+  long profile = 0;     // the profile likelihood
+  long profile_budget = -1;  // the profile's allowance (-1: no limit)
+};
+
 struct IdentifyResult {
   ModelSpec spec;  // the start spec with the fitted values
   std::vector<FittedParameter> parameters;
@@ -413,6 +446,11 @@ struct IdentifyResult {
   std::string covariance_note;
   std::vector<HistoryEntry> history;
   long evaluations = 0;  // all ranks
+  StageEvaluations stage_evaluations;
+  // The stage that found the written point: "search" (the GA's best, or the start),
+  // "refinement" (Levenberg-Marquardt improved it) or "profile" (a profile-likelihood refit
+  // found a lower error; the point was then refined and its intervals recomputed).
+  std::string best_found_by = "search";
   double wall_s = 0, ga_evals_per_s = 0;
   int generations_done = 0, ranks = 1, islands = 0, population = 0;
   std::string algorithm;
@@ -449,5 +487,7 @@ std::string fitted_model_toml(const std::string& start_text, const ModelSpec& st
 std::string fit_report_json(const IdentifyResult& r, const FitProvenance& p);
 std::string fit_report_markdown(const IdentifyResult& r, const FitProvenance& p);
 std::string convergence_csv(const IdentifyResult& r);
+// "search N, refinement N, covariance N, profile N of M allowed": the evaluations per stage.
+std::string stage_text(const StageEvaluations& se);
 
 }  // namespace gmasim

@@ -272,7 +272,7 @@ def identify(out):
         a2.legend(loc="upper left")
         freq = c["frequency_Hz"]
         cond = f'{c["temperature_C"]:g} °C' + (f', {c["current_pp_A"]:g} A p-p, {freq:g} Hz' if freq else "")
-        fig.suptitle(f'{c["label"]}: {cond}; RMS {c["rms_um"]:.3f} {"µm" if unit == "um" else unit} '
+        fig.suptitle(f'{c["label"]}: {cond}; RMS {c.get("rms_" + unit, c.get("rms_um", float("nan"))):.3f} {"µm" if unit == "um" else unit} '
                      f'= {c["rms_pct"]:.2f} % of p-p')
         fig.tight_layout()
         yield pathlib.Path(c["overlay"]).stem, fig

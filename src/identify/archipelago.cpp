@@ -1,6 +1,7 @@
-// The global search: a pagmo2 archipelago of thread islands (one thread per island) on a
-// ring topology, one archipelago per MPI rank, champions passed along a ring of ranks every
-// mpi_every generations, checkpoints every checkpoint_every generations.
+// The global search: a ring of pagmo2 islands (islands.hpp: a fixed number of islands,
+// evolved over the worker threads, migration between epochs in island order), one ring per
+// MPI rank, champions passed along a ring of ranks every mpi_every generations, checkpoints
+// every checkpoint_every generations.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -13,23 +14,16 @@
 #include <pagmo/algorithms/de.hpp>
 #include <pagmo/algorithms/sade.hpp>
 #include <pagmo/algorithms/sga.hpp>
-#include <pagmo/archipelago.hpp>
-#include <pagmo/batch_evaluators/thread_bfe.hpp>
 #include <pagmo/bfe.hpp>
-#include <pagmo/island.hpp>
-#include <pagmo/islands/thread_island.hpp>
 #include <pagmo/population.hpp>
 #include <pagmo/problem.hpp>
-#include <pagmo/r_policies/fair_replace.hpp>
-#include <pagmo/s_policies/select_best.hpp>
-#include <pagmo/topologies/ring.hpp>
-#include <pagmo/topology.hpp>
 #include <pagmo/types.hpp>
-#include <system_error>
+#include <thread>
 #include <utility>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/io.hpp"
+#include "identify/islands.hpp"
 #include "internal.hpp"
 
 namespace gmasim::identify_detail {
@@ -92,12 +86,12 @@ pagmo::algorithm make_algorithm(const std::string& name, unsigned gen, std::size
   throw InputError(fmt::format("algorithm '{}': must be sga, de, sade or cmaes", name));
 }
 
-std::vector<IslandPopulation> snapshot(const pagmo::archipelago& archi,
+std::vector<IslandPopulation> snapshot(const IslandRing& archi,
                                        const std::vector<unsigned>& seeds) {
   std::vector<IslandPopulation> out;
   std::size_t i = 0;
   for (const auto& isl : archi) {
-    const pagmo::population pop = isl.get_population();
+    const pagmo::population& pop = isl.pop;
     IslandPopulation ip;
     ip.seed = seeds[i++];
     ip.x = pop.get_x();
@@ -107,20 +101,14 @@ std::vector<IslandPopulation> snapshot(const pagmo::archipelago& archi,
   return out;
 }
 
-unsigned long long fevals(const pagmo::archipelago& archi) {
-  unsigned long long n = 0;
-  for (const auto& isl : archi) n += isl.get_population().get_problem().get_fevals();
-  return n;
-}
-
 // The best champion of this rank's islands, (f, u); u is `fallback` when no champion's
 // fitness is below +inf.
-std::pair<double, std::vector<double>> best_champion(const pagmo::archipelago& archi,
+std::pair<double, std::vector<double>> best_champion(const IslandRing& archi,
                                                      std::vector<double> fallback) {
   double f = std::numeric_limits<double>::infinity();
   std::vector<double> u = std::move(fallback);
   for (const auto& isl : archi) {
-    const auto pop = isl.get_population();
+    const auto& pop = isl.pop;
     if (pop.champion_f()[0] < f) {
       f = pop.champion_f()[0];
       u = pop.champion_x();
@@ -131,7 +119,7 @@ std::pair<double, std::vector<double>> best_champion(const pagmo::archipelago& a
 
 // The best champion over all islands and ranks (a collective call), kept in out if it
 // improves on out.best_f.
-void update_best(const pagmo::archipelago& archi, Collective& comm, GaOutcome& out) {
+void update_best(const IslandRing& archi, Collective& comm, GaOutcome& out) {
   auto [f, u] = best_champion(archi, out.best_u);
   global_best(comm, f, u);
   if (f < out.best_f) {
@@ -142,18 +130,15 @@ void update_best(const pagmo::archipelago& archi, Collective& comm, GaOutcome& o
 
 // The ring of ranks (a collective call): this rank's best champion goes to the next rank,
 // and the one received replaces the worst individual of island 0 if it is better.
-void exchange_champions(pagmo::archipelago& archi, Collective& comm, std::size_t n) {
+void exchange_champions(IslandRing& archi, Collective& comm, std::size_t n) {
   const auto [f, u] = best_champion(archi, std::vector<double>(n, 0.0));
   std::vector<double> msg{f};
   msg.insert(msg.end(), u.begin(), u.end());
   const std::vector<double> in = comm.ring_shift(msg);
-  auto& isl = *archi.begin();
-  pagmo::population pop = isl.get_population();
+  pagmo::population& pop = archi[0].pop;
   const auto w = pop.worst_idx();
-  if (in[0] < pop.get_f()[w][0]) {
+  if (in[0] < pop.get_f()[w][0])
     pop.set_xf(w, pagmo::vector_double(in.begin() + 1, in.end()), {in[0]});
-    isl.set_population(pop);
-  }
 }
 
 // A checkpoint is not trusted (issue 8): its counts must match this run's layout, and every
@@ -161,7 +146,7 @@ void exchange_champions(pagmo::archipelago& archi, Collective& comm, std::size_t
 // gives at the stored point. One batch of evaluations, about one generation's cost; the
 // verdict is collective, so that no rank is left waiting in a collective call.
 void verify_restored(const Checkpoint& c, const pagmo::problem& prob, const IdentifyOptions& o,
-                     Collective& comm, int ranks, std::size_t n) {
+                     Collective& comm, int ranks, std::size_t n, int threads) {
   auto fail = [&](const std::string& what) {
     throw InputError(located(o.resume_path, 0, fmt::format("cannot resume: {}", what)));
   };
@@ -179,7 +164,7 @@ void verify_restored(const Checkpoint& c, const pagmo::problem& prob, const Iden
       dvs.insert(dvs.end(), ip.x[k].begin(), ip.x[k].end());
       stored.push_back(ip.f[k]);
     }
-  const pagmo::vector_double fv = pagmo::bfe{pagmo::thread_bfe{}}(prob, dvs);
+  const pagmo::vector_double fv = pagmo::bfe{PoolBfe{threads}}(prob, dvs);
   long bad = 0;
   std::size_t first_bad = 0;
   for (std::size_t k = 0; k < stored.size(); ++k) {
@@ -219,6 +204,9 @@ class GaRun {
         rank_(comm.rank()),
         ranks_(comm.size()),
         n_(obj.dim()),
+        threads_(o.threads > 0
+                     ? o.threads
+                     : std::max(1, static_cast<int>(std::thread::hardware_concurrency()))),
         fp_(fingerprints(obj, o, ranks_)),
         prob_{GmaProblem{std::make_shared<const Objective>(obj)}},
         island_prob_{GmaProblem{std::make_shared<const Objective>(obj), o.stop}} {}
@@ -260,7 +248,7 @@ class GaRun {
     if (o_.resume_path.empty()) return {};
     Checkpoint c = read_checkpoint(o_.resume_path);
     check_compatible(c, fp_, o_.resume_path);
-    verify_restored(c, prob_, o_, comm_, ranks_, n_);
+    verify_restored(c, prob_, o_, comm_, ranks_, n_, threads_);
     out_.resumed = true;
     out_.generation = c.generation;
     out_.evaluations = c.evaluations;
@@ -277,22 +265,13 @@ class GaRun {
   // generations.
   void build_islands(const std::vector<double>& start_u, double start_f,
                      const std::vector<std::vector<IslandPopulation>>& restored) {
-    const auto migrants = static_cast<pagmo::pop_size_t>(o_.migrants);
     current_gen_ = static_cast<unsigned>(
         std::min(o_.migrate_every, std::max(1, o_.generations - out_.generation)));
     for (int i = 0; i < o_.islands; ++i) {
       const unsigned s = mix_seed(o_.seed, rank_, i, out_.generation);
       seeds_.push_back(s);
       pagmo::population pop = island_population(i, s, start_u, start_f, restored);
-      try {  // each island is a thread: the system may refuse one
-        archi_.push_back(pagmo::thread_island{}, make_algorithm(o_.algorithm, current_gen_, n_, s),
-                         std::move(pop), pagmo::fair_replace{migrants},
-                         pagmo::select_best{migrants});
-      } catch (const std::system_error& e) {
-        throw InputError(fmt::format(
-            "--islands {}: the system refused the thread of island {} ({}); lower --islands",
-            o_.islands, i + 1, e.what()));
-      }
+      archi_.push_back(make_algorithm(o_.algorithm, current_gen_, n_, s), std::move(pop));
     }
   }
 
@@ -302,7 +281,7 @@ class GaRun {
       int i, unsigned seed, const std::vector<double>& start_u, double start_f,
       const std::vector<std::vector<IslandPopulation>>& restored) const {
     if (!out_.resumed) {
-      pagmo::population pop{island_prob_, pagmo::bfe{pagmo::thread_bfe{}},
+      pagmo::population pop{island_prob_, pagmo::bfe{PoolBfe{threads_}},
                             static_cast<pagmo::pop_size_t>(o_.population), seed};
       if (i == 0) pop.set_xf(pop.worst_idx(), start_u, {start_f});  // seed the start model
       return pop;
@@ -317,7 +296,7 @@ class GaRun {
   // history's generation 0 (a resumed run has its counts and history from the checkpoint).
   void record_start() {
     if (!out_.resumed) {
-      out_.evaluations = sum_ranks(comm_, static_cast<long>(fevals(archi_)));
+      out_.evaluations = sum_ranks(comm_, static_cast<long>(archi_.fevals()));
       out_.run_evaluations = out_.evaluations;
     }
     update_best(archi_, comm_, out_);
@@ -352,22 +331,21 @@ class GaRun {
   long evolve(int gens) {
     if (static_cast<unsigned>(gens) != current_gen_) {
       int i = 0;
-      for (auto& isl : archi_) {
-        isl.set_algorithm(make_algorithm(o_.algorithm, static_cast<unsigned>(gens), n_,
-                                         mix_seed(o_.seed, rank_, i++, out_.generation)));
+      for (std::size_t k = 0; k < archi_.size(); ++k) {
+        archi_[k].algo = make_algorithm(o_.algorithm, static_cast<unsigned>(gens), n_,
+                                        mix_seed(o_.seed, rank_, i++, out_.generation));
       }
       current_gen_ = static_cast<unsigned>(gens);
     }
-    const auto before = fevals(archi_);
-    archi_.evolve(1);  // each island: immigrants from its ring neighbour, `gens` generations
+    const auto before = archi_.fevals();
     bool cut = false;  // a stop cut the epoch short: its generations do not count
-    try {
-      archi_.wait_check();
+    try {              // each island: immigrants from its ring neighbour, `gens` generations
+      archi_.evolve(out_.generation);
     } catch (const SearchStopped&) {
       cut = true;
     }
     if (!any_rank(comm_, cut)) out_.generation += gens;
-    const long epoch_evals = sum_ranks(comm_, static_cast<long>(fevals(archi_) - before));
+    const long epoch_evals = sum_ranks(comm_, static_cast<long>(archi_.fevals() - before));
     out_.evaluations += epoch_evals;
     out_.run_evaluations += epoch_evals;
     return epoch_evals;
@@ -419,12 +397,13 @@ class GaRun {
   Collective& comm_;
   const int rank_, ranks_;
   const std::size_t n_;
+  const int threads_;  // worker threads of the islands' evolution and the first populations
   const Fingerprints fp_;
   const pagmo::problem prob_;         // the checkpoint's re-evaluation: never stopped
   const pagmo::problem island_prob_;  // the islands': stops with o.stop
   GaOutcome out_;
   double wall_before_ = 0.0;  // GA wall time of the run(s) before a resume
-  pagmo::archipelago archi_{pagmo::topology{pagmo::ring{}}};
+  IslandRing archi_{o_.migrants, o_.seed, rank_, threads_};
   std::vector<unsigned> seeds_;
   unsigned current_gen_ = 0;  // generations per evolve() of the islands' algorithms
   Clock::time_point t_epoch_;

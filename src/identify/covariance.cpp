@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "internal.hpp"
 
@@ -14,42 +15,76 @@ namespace gmasim::identify_detail {
 
 namespace {
 
-// Profile likelihood of parameter j: the range of u_j over which the weighted sum of squares,
-// minimised over the other parameters, stays within `thr` of its minimum `chi_opt`.
-// Marches out from the optimum to each bound (warm-started LM with u_j held), then refines
-// the crossing by two bisections and a linear interpolation. Returns the interval in u-space.
-std::pair<double, double> profile(const Objective& obj, BatchEvaluator& ev,
-                                  const std::vector<double>& u, double chi_opt, double thr,
-                                  std::size_t j, const IdentifyOptions& o, Collective& comm,
-                                  double& lowest, std::vector<double>& lowest_u) {
-  constexpr double kSteps[] = {0.04, 0.12, 0.3, 0.6, 1.0};
-  constexpr int kIterations = 20;  // warm-started; the stall rule ends converged solves early
-  const int fj = static_cast<int>(j);
-  auto chi_at = [&](std::vector<double>& warm, double uj) {
+// Profile likelihood of one parameter at a time: the range of u_j over which the weighted
+// sum of squares, minimised over the other parameters, stays within `thr` of its minimum
+// `chi_opt`. Marches out from the optimum to each bound (warm-started LM with u_j held),
+// then refines the crossing by two bisections and a linear interpolation. Every point is
+// charged to the stage's evaluation budget (ProfileOutcome); a side the budget cuts short
+// keeps its bound as the interval's edge (conservative). Remembers the lowest point seen.
+class Profiler {
+ public:
+  Profiler(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u, double chi_opt,
+           double thr, const IdentifyOptions& o, Collective& comm, ProfileOutcome& prof)
+      : obj_(obj), ev_(ev), u_(u), chi_opt_(chi_opt), thr_(thr), o_(o), comm_(comm), prof_(prof) {
+    prof_.lowest_f = std::sqrt(chi_opt);
+    prof_.lowest_u = u;
+  }
+
+  // The interval of u_j, spending at most `allowance` evaluations; `cut` is set when the
+  // allowance ended a side early.
+  std::pair<double, double> interval(std::size_t j, long allowance, bool& cut) {
+    end_ = allowance < 0 ? -1 : ev_.evaluations() + allowance;
+    cut = false;
+    double edge[2] = {0.0, 1.0};
+    for (int side = 0; side < 2; ++side) {
+      const double bound = side == 0 ? 0.0 : 1.0;
+      if (std::fabs(u_[j] - bound) < 1e-9) continue;  // the optimum is on this bound
+      const auto e = side_edge(j, side == 0 ? -1.0 : 1.0, bound);
+      if (e) {
+        edge[side] = *e;
+      } else {
+        cut = true;
+      }
+    }
+    return {edge[0], edge[1]};
+  }
+
+ private:
+  // One LM solve costs at most (2n + 1) evaluations per iteration.
+  long per_iteration() const { return 2 * static_cast<long>(obj_.dim()) + 1; }
+
+  // chi^2 at u_j = uj, the others re-fitted from `warm` (updated); nullopt when the budget
+  // does not allow a converged solve.
+  std::optional<double> chi_at(std::vector<double>& warm, std::size_t j, double uj) {
+    constexpr int kIterations = 20;  // warm-started; the stall rule ends converged solves early
+    if (end_ >= 0 && ev_.evaluations() + 2 * per_iteration() > end_) return std::nullopt;
     warm[j] = uj;
-    const RefineOutcome ro = refine_lm(obj, ev, warm, o, comm, {}, fj, kIterations);
+    const long cap = end_ < 0 ? -1 : end_ - per_iteration();
+    const RefineOutcome ro =
+        refine_lm(obj_, ev_, warm, o_, comm_, {}, static_cast<int>(j), kIterations, cap);
     warm = ro.u;
     const double chi = ro.f * ro.f;
-    if (chi < lowest) {
-      lowest = chi;
-      lowest_u = ro.u;
+    if (ro.f < prof_.lowest_f) {  // a point better than the optimum: kept even if capped
+      prof_.lowest_f = ro.f;
+      prof_.lowest_u = ro.u;
     }
+    if (ro.capped) return std::nullopt;  // not minimised over the others: no profile value
     return chi;
-  };
-  double edge[2] = {0.0, 1.0};
-  for (int side = 0; side < 2; ++side) {
-    const double bound = side == 0 ? 0.0 : 1.0;
-    const double dir = side == 0 ? -1.0 : 1.0;
-    if (std::fabs(u[j] - bound) < 1e-9) continue;  // the optimum is on this bound
-    std::vector<double> warm = u;
-    double ok_u = u[j], ok_d = 0.0;
-    std::vector<double> ok_warm = u;
+  }
+
+  // Where the profile crosses the threshold between the optimum and `bound` (u-space);
+  // the bound if it does not; nullopt if the budget ended the march first.
+  std::optional<double> side_edge(std::size_t j, double dir, double bound) {
+    constexpr double kSteps[] = {0.04, 0.12, 0.3, 0.6, 1.0};
+    std::vector<double> warm = u_, ok_warm = u_;
+    double ok_u = u_[j], ok_d = 0.0, out_u = bound, out_d = 0.0;
     bool crossed = false;
-    double out_u = bound, out_d = 0.0;
     for (double st : kSteps) {
-      const double uj = std::clamp(u[j] + dir * st, 0.0, 1.0);
-      const double d = chi_at(warm, uj) - chi_opt;
-      if (d > thr) {
+      const double uj = std::clamp(u_[j] + dir * st, 0.0, 1.0);
+      const auto chi = chi_at(warm, j, uj);
+      if (!chi) return std::nullopt;
+      const double d = *chi - chi_opt_;
+      if (d > thr_) {
         crossed = true;
         out_u = uj;
         out_d = d;
@@ -60,12 +95,14 @@ std::pair<double, double> profile(const Objective& obj, BatchEvaluator& ev,
       ok_warm = warm;
       if (uj == bound) break;
     }
-    if (!crossed) continue;  // within the threshold up to the bound
+    if (!crossed) return bound;  // within the threshold up to the bound
     for (int b = 0; b < 2; ++b) {
       const double mid = 0.5 * (ok_u + out_u);
       std::vector<double> w = ok_warm;
-      const double d = chi_at(w, mid) - chi_opt;
-      if (d > thr) {
+      const auto chi = chi_at(w, j, mid);
+      if (!chi) break;  // the crossing is between ok_u and out_u: interpolate what we have
+      const double d = *chi - chi_opt_;
+      if (d > thr_) {
         out_u = mid;
         out_d = d;
       } else {
@@ -75,11 +112,19 @@ std::pair<double, double> profile(const Objective& obj, BatchEvaluator& ev,
       }
     }
     // Linear interpolation of the excess between the last point inside and the first out.
-    const double f = out_d > ok_d ? (thr - ok_d) / (out_d - ok_d) : 0.5;
-    edge[side] = ok_u + std::clamp(f, 0.0, 1.0) * (out_u - ok_u);
+    const double f = out_d > ok_d ? (thr_ - ok_d) / (out_d - ok_d) : 0.5;
+    return ok_u + std::clamp(f, 0.0, 1.0) * (out_u - ok_u);
   }
-  return {edge[0], edge[1]};
-}
+
+  const Objective& obj_;
+  BatchEvaluator& ev_;
+  const std::vector<double>& u_;
+  double chi_opt_, thr_;
+  const IdentifyOptions& o_;
+  Collective& comm_;
+  ProfileOutcome& prof_;
+  long end_ = -1;  // ev_.evaluations() at which this parameter's allowance ends (-1: none)
+};
 
 // Parameter j at u before its interval is known: an infinite standard error, and the
 // bounds as its (linearised) interval.
@@ -200,20 +245,31 @@ void set_linearised_intervals(const Covariance& c, IdentifyResult& out) {
 }
 
 // Profile likelihood where the linearisation cannot hold: a parameter on a bound (the
-// optimum is not stationary there) or whose linearised interval leaves the bounds.
+// optimum is not stationary there) or whose linearised interval leaves the bounds. The
+// stage's budget is shared out evenly over the parameters still to profile.
 void set_profile_intervals(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u,
                            double f, double dof, const IdentifyOptions& o, Collective& comm,
-                           IdentifyResult& out) {
+                           IdentifyResult& out, ProfileOutcome& prof) {
   const double chi_opt = f * f;
   const double thr = 3.841458820694124 * chi_opt / dof;  // chi^2_1(95 %) s^2
-  double lowest = chi_opt;
-  std::vector<double> lowest_u = u;
-  std::vector<std::string> profiled;
+  const long ev0 = ev.evaluations();
+  Profiler profiler(obj, ev, u, chi_opt, thr, o, comm, prof);
+  std::vector<std::size_t> todo;
   for (std::size_t j = 0; j < out.parameters.size(); ++j) {
-    auto& fp = out.parameters[j];
+    const auto& fp = out.parameters[j];
     const bool leaves = !(fp.wald_low >= fp.lower && fp.wald_high <= fp.upper);
-    if (!fp.at_bound && !leaves) continue;
-    const auto [ulo, uhi] = profile(obj, ev, u, chi_opt, thr, j, o, comm, lowest, lowest_u);
+    if (fp.at_bound || leaves) todo.push_back(j);
+  }
+  std::string names, cut_names;
+  for (std::size_t k = 0; k < todo.size(); ++k) {
+    const std::size_t j = todo[k];
+    auto& fp = out.parameters[j];
+    const long spent = ev.evaluations() - ev0;
+    const long allowance =
+        prof.budget < 0 ? -1
+                        : std::max(0L, prof.budget - spent) / static_cast<long>(todo.size() - k);
+    bool cut = false;
+    const auto [ulo, uhi] = profiler.interval(j, allowance, cut);
     std::vector<double> a = u, b = u;
     a[j] = ulo;
     b[j] = uhi;
@@ -222,21 +278,23 @@ void set_profile_intervals(const Objective& obj, BatchEvaluator& ev, const std::
     fp.ci_high = std::max(pa, pb);
     fp.ci_method = "profile";
     fp.determined = !(ulo <= 1e-9 && uhi >= 1.0 - 1e-9);
-    profiled.push_back(fp.name);
+    names += (names.empty() ? "" : ", ") + fp.name;
+    if (cut) cut_names += (cut_names.empty() ? "" : ", ") + fp.name;
   }
-  if (!profiled.empty()) {
-    std::string names;
-    for (const auto& nm : profiled) names += (names.empty() ? "" : ", ") + nm;
+  prof.evaluations = ev.evaluations() - ev0;
+  prof.budget_hit = !cut_names.empty();
+  if (!names.empty()) {
     out.covariance_note += fmt::format(
         "; profile-likelihood intervals (the other parameters re-fitted, Delta chi^2 = 3.84 "
         "s^2) for {}",
         names);
   }
-  if (lowest < chi_opt - 0.1 * thr) {
+  if (!cut_names.empty()) {
     out.notes.push_back(fmt::format(
-        "a profile found a lower error (RMS {:.6g} % < {:.6g} %): the optimum is not the global "
-        "one; rerun with more generations or islands",
-        std::sqrt(lowest), f));
+        "the profile stage's budget ({} evaluations, --profile-evaluations) ended the profile of "
+        "{} before its crossing: that side's interval edge is the bound (conservative); raise "
+        "--profile-evaluations for the exact edge",
+        prof.budget, cut_names));
   }
 }
 
@@ -255,7 +313,10 @@ FittedParameter fitted_parameter(const Objective& obj, std::size_t j, double val
 }
 
 void fill_covariance(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u,
-                     double f, const IdentifyOptions& o, Collective& comm, IdentifyResult& out) {
+                     double f, const IdentifyOptions& o, Collective& comm, IdentifyResult& out,
+                     ProfileOutcome& prof) {
+  prof.lowest_f = f;
+  prof.lowest_u = u;
   const std::size_t n = obj.dim(), m = obj.residual_count();
   const auto p = obj.to_params(u);
   out.parameters.clear();
@@ -289,7 +350,7 @@ void fill_covariance(const Objective& obj, BatchEvaluator& ev, const std::vector
   out.covariance_note = covariance_note(m, n, out.residual_sigma, c);
   set_linearised_intervals(c, out);
   if (!o.profile || !(dof > 0)) return;
-  set_profile_intervals(obj, ev, u, f, dof, o, comm, out);
+  set_profile_intervals(obj, ev, u, f, dof, o, comm, out, prof);
 }
 
 }  // namespace gmasim::identify_detail

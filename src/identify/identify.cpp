@@ -31,11 +31,11 @@ void check_options(const IdentifyOptions& o) {
   positive(o.migrants, "--migrants");
   if (o.population < 8)
     throw InputError(fmt::format("--population {}: must be >= 8", o.population));
-  // Counts that become threads, memory and time (issue 19, item 4): each island is a thread,
+  // Counts that become memory and time (issue 19, item 4): each island holds a population,
   // each individual an evaluation per generation.
   if (o.islands > kMaxIslands)
     throw InputError(fmt::format(
-        "--islands {}: at most {} per rank (each island is a thread); use MPI ranks for more",
+        "--islands {}: at most {} per rank (each holds a population); use MPI ranks for more",
         o.islands, kMaxIslands));
   if (o.population > kMaxPopulation)
     throw InputError(fmt::format("--population {}: at most {} individuals per island", o.population,
@@ -61,6 +61,10 @@ void check_options(const IdentifyOptions& o) {
   if (o.refine_iterations < 0) throw InputError("--refine-iterations: must be >= 0");
   if (!(o.fd_step > 0.0 && o.fd_step < 0.1)) throw InputError("--fd-step: must be in (0, 0.1)");
   if (o.mpi_every < 0) throw InputError("--mpi-every: must be >= 0");
+  if (o.profile_evaluations < -1)
+    throw InputError(fmt::format(
+        "--profile-evaluations {}: must be >= 0 (0: no limit), or -1 (as many as the search)",
+        o.profile_evaluations));
 }
 
 // The start model must evaluate: a search from a model that cannot be simulated under
@@ -102,6 +106,7 @@ void refine_champion(const Objective& obj, BatchEvaluator& ev, const GaOutcome& 
     if (ro.f < f) {  // never worse than the GA champion
       f = ro.f;
       u = ro.u;
+      res.best_found_by = "refinement";
     }
   } else if (!o.refine || o.refine_iterations == 0) {
     res.refine_summary = "no refinement (--no-refine)";
@@ -111,9 +116,12 @@ void refine_champion(const Objective& obj, BatchEvaluator& ev, const GaOutcome& 
 }
 
 // The fitted parameters at the optimum (u, f) with their intervals; after an interruption
-// the values without intervals (a clean, fast stop).
+// the values without intervals (a clean, fast stop). prof.budget: the profile's allowance.
 void set_parameters(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u,
-                    double f, const IdentifyOptions& o, Collective& comm, IdentifyResult& res) {
+                    double f, const IdentifyOptions& o, Collective& comm, IdentifyResult& res,
+                    ProfileOutcome& prof) {
+  prof.lowest_f = f;
+  prof.lowest_u = u;
   if (!res.interrupted) {
     IdentifyOptions oc = o;
     if (!o.refine || o.refine_iterations == 0) {
@@ -123,10 +131,20 @@ void set_parameters(const Objective& obj, BatchEvaluator& ev, const std::vector<
           "not refined: the intervals are linearised at the GA champion, which "
           "is not a minimum; refine for meaningful intervals");
     }
-    fill_covariance(obj, ev, u, f, oc, comm, res);
+    if (prof.budget == 0 && oc.profile) {  // the stage's budget is spent
+      oc.profile = false;
+      res.notes.push_back(
+          "the profile's budget was spent before these intervals: they are linearised "
+          "(raise --profile-evaluations for profiles)");
+    }
+    const long before = ev.evaluations();
+    fill_covariance(obj, ev, u, f, oc, comm, res, prof);
+    res.stage_evaluations.profile += prof.evaluations;
+    res.stage_evaluations.covariance += ev.evaluations() - before - prof.evaluations;
     return;
   }
   const auto p = obj.to_params(u);
+  res.parameters.clear();
   for (std::size_t j = 0; j < obj.dim(); ++j) {
     FittedParameter fp = fitted_parameter(obj, j, p[j]);
     fp.std_error = std::nan("");
@@ -136,6 +154,45 @@ void set_parameters(const Objective& obj, BatchEvaluator& ev, const std::vector<
     res.parameters.push_back(fp);
   }
   res.covariance_note = "interrupted: no confidence intervals";
+}
+
+// The intervals at (u, f); when a profile refit finds a lower error, that point is refined
+// and becomes the optimum (its intervals recomputed with what is left of the profile's
+// budget), up to kRounds times: the written point is the best any stage found.
+void settle_optimum(const Objective& obj, BatchEvaluator& ev, const IdentifyOptions& o,
+                    Collective& comm, std::vector<double>& u, double& f, IdentifyResult& res) {
+  constexpr int kRounds = 3;
+  auto& se = res.stage_evaluations;
+  se.profile_budget = o.profile_evaluations < 0    ? se.search
+                      : o.profile_evaluations == 0 ? -1
+                                                   : o.profile_evaluations;
+  for (int round = 0;; ++round) {
+    ProfileOutcome prof;
+    prof.budget = se.profile_budget < 0 ? -1 : std::max(0L, se.profile_budget - se.profile);
+    set_parameters(obj, ev, u, f, o, comm, res, prof);
+    if (res.interrupted || !(prof.lowest_f < f * (1.0 - 1e-9))) return;
+    res.notes.push_back(fmt::format(
+        "the profile likelihood found a lower error (RMS {:.6g} % < {:.6g} %): that point was "
+        "refined and is the written optimum",
+        prof.lowest_f, f));
+    u = prof.lowest_u;
+    f = prof.lowest_f;
+    res.best_found_by = "profile";
+    const long before = ev.evaluations();
+    const RefineOutcome ro = refine_lm(obj, ev, u, o, comm, {});
+    se.refine += ev.evaluations() - before;
+    res.interrupted = ro.interrupted;
+    if (ro.f < f) {
+      u = ro.u;
+      f = ro.f;
+    }
+    if (round + 1 == kRounds) {  // the intervals at the final point, linearised only
+      ProfileOutcome none;
+      none.budget = 0;
+      set_parameters(obj, ev, u, f, o, comm, res, none);
+      return;
+    }
+  }
 }
 
 }  // namespace
@@ -175,13 +232,15 @@ IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, cons
   res.ga_evals_per_s = ga.wall_s > 0 ? static_cast<double>(ga.run_evaluations) / ga.wall_s : 0.0;
   std::vector<double> u = ga.best_u;
   double f = ga.best_f;
+  res.stage_evaluations.search = ga.evaluations + 1;  // with the start model's evaluation
   refine_champion(obj, ev, ga, o, comm, t0, u, f, res);
+  res.stage_evaluations.refine = ev.evaluations();
 
-  // ---- result -------------------------------------------------------------------------
+  // ---- intervals (and the best point any stage found) --------------------------------------
+  settle_optimum(obj, ev, o, comm, u, f, res);
   res.unit_optimum = u;
   res.rms_pct = f;
   res.spec = obj.spec_at(u);
-  set_parameters(obj, ev, u, f, o, comm, res);
   const auto p_start = obj.to_params(u_start);
   for (std::size_t j = 0; j < res.parameters.size(); ++j) {
     res.parameters[j].start = p_start[j];

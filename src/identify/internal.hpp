@@ -95,15 +95,17 @@ struct RefineOutcome {
   double f = 0.0;
   int iterations = 0;
   bool interrupted = false;
+  bool capped = false;  // stopped by eval_cap before converging
   std::string summary;
 };
 
 // Levenberg-Marquardt from u0 within [0, 1]^n; `fixed` >= 0 holds that component constant
-// (profile likelihood); max_iterations < 0: o.refine_iterations.
+// (profile likelihood); max_iterations < 0: o.refine_iterations; eval_cap >= 0: stops after
+// the iteration that takes ev.evaluations() beyond it (RefineOutcome::capped).
 RefineOutcome refine_lm(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u0,
                         const IdentifyOptions& o, Collective& comm,
                         const std::function<void(int, double)>& on_iteration, int fixed = -1,
-                        int max_iterations = -1);
+                        int max_iterations = -1, long eval_cap = -1);
 
 // Central-difference Jacobian at u (m x n, row-major) and the residuals at u; column `fixed`
 // (if >= 0) is left zero.
@@ -114,10 +116,20 @@ bool jacobian(const Objective& obj, BatchEvaluator& ev, const std::vector<double
 // their defaults.
 FittedParameter fitted_parameter(const Objective& obj, std::size_t j, double value);
 
+// What the profile stage spent and found.
+struct ProfileOutcome {
+  long budget = -1;         // evaluations it may spend (-1: no limit)
+  long evaluations = 0;     // evaluations it spent
+  bool budget_hit = false;  // a profile was cut short by the budget
+  double lowest_f = 0.0;    // the lowest RMS [%] of any point it evaluated, and where
+  std::vector<double> lowest_u;
+};
+
 // Linearised intervals and correlations from the Jacobian at the optimum u (RMS f); then
 // profile-likelihood intervals for the parameters at a bound or whose linearised interval
-// leaves the bounds.
+// leaves the bounds, within prof.budget evaluations (prof: what they spent and found).
 void fill_covariance(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u,
-                     double f, const IdentifyOptions& o, Collective& comm, IdentifyResult& out);
+                     double f, const IdentifyOptions& o, Collective& comm, IdentifyResult& out,
+                     ProfileOutcome& prof);
 
 }  // namespace gmasim::identify_detail

@@ -50,6 +50,13 @@ constexpr ConditionKey kConditionKeys[] = {
     {"offset", KeyType::Text},
     {"flux_offset", KeyType::Text},
     {"prestress_MPa", KeyType::Number},
+    {"initial_state", KeyType::Text},
+};
+
+constexpr std::pair<InitialState, std::string_view> kInitialStateNames[] = {
+    {InitialState::Demagnetised, "demagnetised"},
+    {InitialState::NegativeRemanence, "negative_remanence"},
+    {InitialState::PositiveRemanence, "positive_remanence"},
 };
 
 constexpr std::pair<OffsetMode, std::string_view> kOffsetNames[] = {
@@ -131,6 +138,17 @@ void read_record_keys(const ConditionKeys& keys, const Measurement& m, Measureme
   if (keys.has("flux_offset")) {
     c.flux_offset = parse_offset(keys.at("flux_offset"), "flux_offset");
     if (m.flux_T.empty()) keys.fail("flux_offset", "flux_offset: the record has no flux_T column");
+  }
+  if (keys.has("initial_state")) {
+    const auto& kv = keys.at("initial_state");
+    const auto* it = std::find_if(std::begin(kInitialStateNames), std::end(kInitialStateNames),
+                                  [&](const auto& e) { return e.second == kv.text; });
+    if (it == std::end(kInitialStateNames))
+      keys.fail("initial_state",
+                fmt::format("initial_state = '{}': must be demagnetised, negative_remanence or "
+                            "positive_remanence",
+                            kv.text));
+    c.initial_state = it->first;
   }
   if (keys.has("precycles")) {
     const double n = keys.number("precycles");
@@ -272,7 +290,9 @@ double first_compared_time(const ConditionKeys& keys, const Measurement& m,
     from = keys.number("compare_from_s");
   } else {
     // A pre-cycled record is already on its loop: everything is compared.
-    from = has_f && c.precycles == 0 ? t0 + 1.0 / c.frequency_Hz : t0;
+    from = has_f && c.precycles == 0 && c.initial_state == InitialState::Demagnetised
+               ? t0 + 1.0 / c.frequency_Hz
+               : t0;
   }
   // At least 3 compared samples.
   const auto first = std::lower_bound(m.t_s.begin(), m.t_s.end(), from - 1e-12 * (t1 - t0));
@@ -414,6 +434,12 @@ MeasurementCondition make_condition(const KeyMap& keys, const Measurement& m,
 }
 
 }  // namespace identify_detail
+
+std::string initial_state_name(InitialState s) {
+  for (const auto& [m, name] : identify_detail::kInitialStateNames)
+    if (m == s) return std::string(name);
+  return "demagnetised";
+}
 
 std::string offset_mode_name(OffsetMode mode) {
   for (const auto& [m, name] : identify_detail::kOffsetNames)

@@ -30,24 +30,29 @@ using io_detail::read_text_file;
 using io_detail::split_cells;
 using io_detail::trim;
 
-// Columns (docs/data.md): [t_s], one drive (current_A | field_A_per_m), one response
-// (displacement_um | strain_ppm), [flux_T].
-enum Col { T, I, H, Y, S, B, kCols };
+// Columns (docs/data.md): [t_s], one drive (current_A | field_A_per_m | field_kA_per_m), one
+// response (displacement_um | strain_ppm), [flux_T]. A field in kA/m is read as 1000 A/m.
+enum Col { T, I, H, HK, Y, S, B, kCols };
 constexpr std::string_view kNames[kCols] = {
-    "t_s", "current_A", "field_A_per_m", "displacement_um", "strain_ppm", "flux_T"};
+    "t_s",        "current_A", "field_A_per_m", "field_kA_per_m", "displacement_um",
+    "strain_ppm", "flux_T"};
 constexpr std::string_view kExpected =
-    "[t_s,]current_A|field_A_per_m,displacement_um|strain_ppm[,flux_T]";
+    "[t_s,]current_A|field_A_per_m|field_kA_per_m,displacement_um|strain_ppm[,flux_T]";
 
 // Where each column is (-1: absent), from the header line.
 struct CsvLayout {
-  int col_of[kCols] = {-1, -1, -1, -1, -1, -1};
+  int col_of[kCols] = {-1, -1, -1, -1, -1, -1, -1};
   std::size_t ncols = 0;
   long header_line = 0;  // 0: no header read yet
 
   bool has(Col c) const { return col_of[c] >= 0; }
-  Col drive() const { return has(H) ? H : I; }
+  Col drive() const { return has(H) ? H : has(HK) ? HK : I; }
   Col response() const { return has(S) ? S : Y; }
-  double drive_limit() const { return has(H) ? kMaxField_A_per_m : kMaxCurrent_A; }
+  // The drive column's limit in its own unit, and its factor to SI.
+  double drive_limit() const {
+    return has(H) ? kMaxField_A_per_m : has(HK) ? kMaxField_A_per_m / 1e3 : kMaxCurrent_A;
+  }
+  double drive_to_si() const { return has(HK) ? 1e3 : 1.0; }
 };
 
 CsvLayout read_header(const std::vector<std::string_view>& cells, std::string_view line,
@@ -77,7 +82,12 @@ CsvLayout read_header(const std::vector<std::string_view>& cells, std::string_vi
                                            "'{}'; expected {}",
                                            what, kNames[a], kNames[b], line, kExpected)));
   };
-  exactly_one(I, H, "drive");
+  if (lay.has(HK) && (lay.has(I) || lay.has(H)))
+    throw InputError(located(path, line_no,
+                             fmt::format("columns '{}' and '{}' are both given: a record has one "
+                                         "drive column",
+                                         kNames[HK], kNames[lay.has(I) ? I : H])));
+  if (!lay.has(HK)) exactly_one(I, H, "drive");
   exactly_one(Y, S, "response");
   lay.ncols = cells.size();
   lay.header_line = line_no;
@@ -93,7 +103,7 @@ void read_row(const CsvLayout& lay, const std::vector<std::string_view>& cells,
                              fmt::format("mismatched columns: {} cells, the header has {} ('{}')",
                                          cells.size(), lay.ncols, line)));
   }
-  double v[kCols] = {0, 0, 0, 0, 0, 0};
+  double v[kCols] = {0, 0, 0, 0, 0, 0, 0};
   for (int k = 0; k < kCols; ++k) {
     if (lay.col_of[k] < 0) continue;
     if (auto bad =
@@ -121,7 +131,7 @@ void read_row(const CsvLayout& lay, const std::vector<std::string_view>& cells,
     }
   }
   m.t_s.push_back(v[T]);
-  m.drive.push_back(v[drive]);
+  m.drive.push_back(v[drive] * lay.drive_to_si());
   m.response.push_back(v[lay.response()]);
   if (lay.has(B)) m.flux_T.push_back(v[B]);
 }
@@ -166,7 +176,8 @@ Measurement load_measurement_csv(const std::string& path) {
     const auto cells = split_cells(line);
     if (lay.header_line == 0) {
       lay = read_header(cells, line, path, line_no);
-      m.drive_kind = lay.has(H) ? DriveInput::Field : DriveInput::Current;
+      m.drive_kind = lay.has(H) || lay.has(HK) ? DriveInput::Field : DriveInput::Current;
+      m.drive_header = std::string(kNames[lay.drive()]);
       m.response_kind = lay.has(S) ? ResponseOutput::Strain : ResponseOutput::Displacement;
     } else {
       read_row(lay, cells, line, path, line_no, m);
@@ -273,6 +284,8 @@ std::string measurement_csv(const Measurement& m) {
   if (c.current_source != "measured") s += fmt::format("# current_source = {}\n", c.current_source);
   if (!c.rod.empty()) s += fmt::format("# rod = {}\n", c.rod);
   if (c.precycles > 0) s += fmt::format("# precycles = {}\n", c.precycles);
+  if (c.initial_state != InitialState::Demagnetised)
+    s += fmt::format("# initial_state = {}\n", initial_state_name(c.initial_state));
   if (c.offset != OffsetMode::Absolute)
     s += fmt::format("# offset = {}\n", offset_mode_name(c.offset));
   if (c.flux_offset != OffsetMode::Absolute)

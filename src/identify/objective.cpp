@@ -126,6 +126,34 @@ void add_parameters(Objective::Impl& I) {
   }
 }
 
+// A field record must reach fields the model's rod responds to: its largest |H| at least
+// kMinFieldOverA of the rod's anhysteretic shape field a (eq. 10 at the record's temperature,
+// ~6 kA/m for Terfenol-D; a loop is driven to several times a). A column in kA/m read as A/m
+// is 1000 times too small and fails this rule, instead of fitting a flat loop silently.
+constexpr double kMinFieldOverA = 0.05;
+
+void check_field_magnitude(const Model& start_model, const Measurement& meas) {
+  if (meas.drive_kind != DriveInput::Field) return;
+  const std::size_t rod = identify_detail::record_rod(start_model, meas);
+  const Conditions c = make_conditions(start_model, meas.condition.temperature_C);
+  const double a = c.rods[rod].ja.a_A_per_m;
+  double hmax = 0.0;
+  for (double h : meas.drive) hmax = std::max(hmax, std::fabs(h));
+  if (hmax >= kMinFieldOverA * a) return;
+  const std::string col =
+      meas.drive_header.empty() ? std::string(meas.drive_column()) : meas.drive_header;
+  const double in_col = col == "field_kA_per_m" ? hmax / 1e3 : hmax;
+  throw InputError(located(
+      meas.path, 0,
+      fmt::format("column {}: the largest |field| is {:g} {} = {:g} A/m, below {:g} x the "
+                  "anhysteretic field a = {:.4g} A/m of rod '{}' at {:g} degC (the rule: a "
+                  "record's field must reach {:g} a, or the rod barely leaves its demagnetised "
+                  "state); if the values are in kA/m, name the column field_kA_per_m (read x "
+                  "1000), or convert them to A/m",
+                  col, in_col, col == "field_kA_per_m" ? "kA/m" : "A/m", hmax, kMinFieldOverA, a,
+                  start_model.rods[rod].name, meas.condition.temperature_C, kMinFieldOverA)));
+}
+
 // One record: its compared samples and peak-to-peak values; checked against the start model.
 CondData make_cond(const Model& start_model, const Measurement& meas, std::size_t k,
                    const ObjectiveSettings& settings) {
@@ -144,6 +172,7 @@ CondData make_cond(const Model& start_model, const Measurement& meas, std::size_
   const std::size_t nc = meas.t_s.size() - cd.compare_begin;
   if (nc < 3) throw InputError(located(meas.path, 0, "fewer than 3 samples after compare_from_s"));
   (void)identify_detail::record_rod(start_model, meas);
+  check_field_magnitude(start_model, meas);
   cd.pp_um = peak_to_peak(std::span<const double>(meas.response).subspan(cd.compare_begin));
   if (!(cd.pp_um > 0.0)) {
     throw InputError(located(meas.path, 0,

@@ -42,11 +42,11 @@ void fill_fit(ConditionFit& f, const Measurement& meas, const CondData& cd,
   for (std::size_t i = cd.compare_begin; i < f.samples; ++i) {
     const double d = y[i] - meas.response[i];
     ss += d * d;
-    f.max_err_um = std::max(f.max_err_um, std::fabs(d));
+    f.max_err = std::max(f.max_err, std::fabs(d));
     if (has_flux) ssB += (B[i] - meas.flux_T[i]) * (B[i] - meas.flux_T[i]);
   }
-  f.rms_um = std::sqrt(ss / static_cast<double>(f.compared));
-  f.rms_pct = 100.0 * f.rms_um / f.pp_um;
+  f.rms = std::sqrt(ss / static_cast<double>(f.compared));
+  f.rms_pct = 100.0 * f.rms / f.pp;
   if (has_flux) {
     const double ppB = peak_to_peak(std::span<const double>(meas.flux_T).subspan(cd.compare_begin));
     if (ppB > 0.0) f.flux_rms_pct = 100.0 * std::sqrt(ssB / static_cast<double>(f.compared)) / ppB;
@@ -88,16 +88,18 @@ std::vector<ConditionFit> Objective::condition_fits(const std::vector<double>& u
     f.weight = meas.weight;
     f.samples = meas.t_s.size();
     f.compared = f.samples - cd.compare_begin;
-    f.pp_um = cd.pp_um;
+    f.pp = cd.pp_um;
     f.response_unit = std::string(meas.response_unit());
     std::vector<double> y, B;
     const bool has_flux = !meas.flux_T.empty();
     try {
       if (!model) throw InputError(model_error);
       simulate_measurement(*model, meas, I.settings, y, has_flux ? &B : nullptr);
-      identify_detail::apply_offset(meas.condition.offset, meas.response, cd.compare_begin, y);
+      f.offset =
+          identify_detail::apply_offset(meas.condition.offset, meas.response, cd.compare_begin, y);
       if (has_flux)
-        identify_detail::apply_offset(meas.condition.flux_offset, meas.flux_T, cd.compare_begin, B);
+        f.flux_offset_T = identify_detail::apply_offset(meas.condition.flux_offset, meas.flux_T,
+                                                        cd.compare_begin, B);
     } catch (const std::exception& e) {
       f.failed = true;
       f.error = e.what();

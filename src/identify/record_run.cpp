@@ -156,20 +156,36 @@ double record_initial_current(const Measurement& meas) {
   return meas.drive.front();
 }
 
+double record_drive_amplitude(const Measurement& meas) {
+  const auto& c = meas.condition;
+  if (meas.drive_kind == DriveInput::Current && c.current_source == "sine")
+    return std::max(std::fabs(c.current_min_A), std::fabs(c.current_min_A + c.current_pp_A));
+  double a = 0.0;
+  for (double v : meas.drive) a = std::max(a, std::fabs(v));
+  return a;
+}
+
 double record_step_count(const Measurement& meas, const ObjectiveSettings& s) {
   const auto& c = meas.condition;
   const double passes = 1.0 + static_cast<double>(c.precycles);
+  // The initial cycle's quasi-static increments (about 4 A / (range / increments) + 3).
+  const double initial =
+      c.initial_state == InitialState::Demagnetised
+          ? 0.0
+          : 4.0 * record_drive_amplitude(meas) /
+                    std::max(peak_to_peak(meas.drive) / s.quasi_static_increments, 1e-300) +
+                3.0;
   if (c.quasi_static) {
     const double inc = peak_to_peak(meas.drive) / s.quasi_static_increments;
     double n = std::ceil(std::fabs(meas.drive.front()) / inc);  // a field record's ramp
     for (std::size_t i = 1; i < meas.drive.size(); ++i)
       n += std::max(1.0, std::ceil(std::fabs(meas.drive[i] - meas.drive[i - 1]) / inc - 1e-9));
     n += std::ceil(std::fabs(meas.drive.front() - meas.drive.back()) / inc);
-    return passes * n;
+    return passes * n + initial;
   }
   const double span = meas.t_s.back() - meas.t_s.front();
   const double dt = objective_step(s, meas.periodic() ? 1.0 / c.frequency_Hz : 0.0);
-  return passes * std::max(1.0, std::ceil(span / dt - 1e-9));
+  return passes * std::max(1.0, std::ceil(span / dt - 1e-9)) + initial;
 }
 
 namespace {
@@ -201,9 +217,11 @@ class RecordRun {
   }
 
   void run(State& st) {
-    // A field record starts at rest at zero current and ramps quasi-statically to its first
-    // field, as a current record starts at rest at its first current (make_state).
-    if (field_drive_ && field(st) != meas_.drive.front()) {
+    if (meas_.condition.initial_state != InitialState::Demagnetised) {
+      initial_cycle(st);
+    } else if (field_drive_ && field(st) != meas_.drive.front()) {
+      // A field record starts at rest at zero current and ramps quasi-statically to its first
+      // field, as a current record starts at rest at its first current (make_state).
       try {
         travel(st, field(st), meas_.drive.front());
       } catch (const DivergenceError& e) {
@@ -242,6 +260,24 @@ class RecordRun {
     run_loop(m_, c_, st, g, [&](const State& x, const StepPoint& p) {
       return current(x, from + (to - from) * static_cast<double>(p.k) / k_n, 0.0);
     });
+  }
+
+  // initial_state: a slow bipolar cycle of the record's amplitude from the rest state,
+  // 0 -> +A -> -A -> first drive value (negative remanence; the mirror for positive).
+  void initial_cycle(State& st) {
+    const double A = record_drive_amplitude(meas_);
+    const double s = meas_.condition.initial_state == InitialState::NegativeRemanence ? 1.0 : -1.0;
+    const double first = field_drive_ ? meas_.drive.front() : record_initial_current(meas_);
+    const double path[] = {field_drive_ ? field(st) : st.current_A, s * A, -s * A, first};
+    try {
+      for (int k = 0; k < 3; ++k) travel(st, path[k], path[k + 1]);
+    } catch (const DivergenceError& e) {
+      throw DivergenceError(
+          fmt::format("{}: the initial cycle of initial_state = {} ({} to {:g}, "
+                      "{:g} and {:g}): {}",
+                      meas_.path, initial_state_name(meas_.condition.initial_state),
+                      meas_.drive_column(), s * A, -s * A, first, e.what()));
+    }
   }
 
   void run_quasi_static(State& st) {
@@ -343,15 +379,15 @@ void run_record(const Model& m, const Conditions& c, State st, const Measurement
   RecordRun(m, c, meas, s, response, B_T, H_A_per_m).run(st);
 }
 
-void apply_offset(OffsetMode mode, const std::vector<double>& measured, std::size_t begin,
-                  std::vector<double>& simulated) {
+double apply_offset(OffsetMode mode, const std::vector<double>& measured, std::size_t begin,
+                    std::vector<double>& simulated) {
   switch (mode) {
     case OffsetMode::Absolute:
-      return;
+      return 0.0;
     case OffsetMode::FirstSample: {
       const double shift = measured.front() - simulated.front();
       for (double& v : simulated) v += shift;
-      return;
+      return shift;
     }
     case OffsetMode::Fitted: {
       // The constant c minimising sum_i (sim_i + c - meas_i)^2 over the compared samples.
@@ -359,9 +395,10 @@ void apply_offset(OffsetMode mode, const std::vector<double>& measured, std::siz
       for (std::size_t i = begin; i < measured.size(); ++i) sum += measured[i] - simulated[i];
       const double shift = sum / static_cast<double>(measured.size() - begin);
       for (double& v : simulated) v += shift;
-      return;
+      return shift;
     }
   }
+  return 0.0;
 }
 
 }  // namespace gmasim::identify_detail

@@ -21,6 +21,10 @@ std::size_t record_rod(const Model& m, const Measurement& meas);
 // the sine at the first time, or 0 for a field record (which then ramps to its first field).
 double record_initial_current(const Measurement& meas);
 
+// The amplitude A of the record's initial cycle (initial_state): the largest |drive| (the
+// biased sine's largest |current| with current_source = sine).
+double record_drive_amplitude(const Measurement& meas);
+
 // Steps or quasi-static increments one simulation of the record takes (pre-cycling
 // included): checked against kMaxSteps before any evaluation.
 double record_step_count(const Measurement& meas, const ObjectiveSettings& s);
@@ -41,8 +45,8 @@ Model with_record_preload(const Model& m, const MeasurementCondition& c);
 
 // Shifts `simulated` by the record's offset rule so that simulated - measured is the
 // residual: FirstSample aligns the first samples, Fitted removes the least-squares constant
-// over the compared samples [begin, n).
-void apply_offset(OffsetMode mode, const std::vector<double>& measured, std::size_t begin,
-                  std::vector<double>& simulated);
+// over the compared samples [begin, n). Returns the constant added (0 for Absolute).
+double apply_offset(OffsetMode mode, const std::vector<double>& measured, std::size_t begin,
+                    std::vector<double>& simulated);
 
 }  // namespace gmasim::identify_detail

@@ -92,13 +92,19 @@ class FdCost final : public ceres::CostFunction {
 class Callback final : public ceres::IterationCallback {
  public:
   Callback(const IdentifyOptions& o, Collective& comm,
-           const std::function<void(int, double)>& on_iteration)
-      : o_(o), comm_(comm), on_iteration_(on_iteration) {}
+           const std::function<void(int, double)>& on_iteration, const BatchEvaluator& ev,
+           long eval_cap)
+      : o_(o), comm_(comm), on_iteration_(on_iteration), ev_(ev), eval_cap_(eval_cap) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
     if (on_iteration_) on_iteration_(s.iteration, std::sqrt(2.0 * s.cost));
     if (any_rank(comm_, o_.stop && o_.stop->load())) {
       interrupted = true;
       return ceres::SOLVER_TERMINATE_SUCCESSFULLY;  // keeps the last accepted point
+    }
+    // The evaluation budget (the same count on every rank: they stay in lockstep).
+    if (eval_cap_ >= 0 && ev_.evaluations() > eval_cap_) {
+      capped = true;
+      return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
     }
     // Stall: the last kStall successful steps together lowered the cost by less than
     // kStallTol (relative). With noisy data LM otherwise crawls along flat valleys of
@@ -112,7 +118,7 @@ class Callback final : public ceres::IterationCallback {
     }
     return ceres::SOLVER_CONTINUE;
   }
-  bool interrupted = false, stalled = false;
+  bool interrupted = false, stalled = false, capped = false;
   static constexpr std::size_t kStall = 4;
   static constexpr double kStallTol = 1e-4;
 
@@ -120,6 +126,8 @@ class Callback final : public ceres::IterationCallback {
   const IdentifyOptions& o_;
   Collective& comm_;
   const std::function<void(int, double)>& on_iteration_;
+  const BatchEvaluator& ev_;
+  long eval_cap_;
   std::vector<double> accepted_;
 };
 
@@ -128,7 +136,7 @@ class Callback final : public ceres::IterationCallback {
 RefineOutcome refine_lm(const Objective& obj, BatchEvaluator& ev, const std::vector<double>& u0,
                         const IdentifyOptions& o, Collective& comm,
                         const std::function<void(int, double)>& on_iteration, int fixed,
-                        int max_iterations) {
+                        int max_iterations, long eval_cap) {
   const std::size_t n = obj.dim();
   std::vector<double> u = u0;
   for (double& v : u) v = std::clamp(v, 0.0, 1.0);
@@ -159,7 +167,7 @@ RefineOutcome refine_lm(const Objective& obj, BatchEvaluator& ev, const std::vec
   so.num_threads = 1;  // parallelism is inside the Jacobian batch
   so.logging_type = ceres::SILENT;
   so.minimizer_progress_to_stdout = false;
-  Callback cb(o, comm, on_iteration);
+  Callback cb(o, comm, on_iteration, ev, eval_cap);
   so.callbacks.push_back(&cb);
   so.update_state_every_iteration = true;
   ceres::Solver::Summary summary;
@@ -170,6 +178,7 @@ RefineOutcome refine_lm(const Objective& obj, BatchEvaluator& ev, const std::vec
   out.f = std::sqrt(2.0 * summary.final_cost);
   out.iterations = static_cast<int>(summary.iterations.size()) - 1;
   out.interrupted = cb.interrupted;
+  out.capped = cb.capped;
   out.summary = fmt::format(
       "Ceres Levenberg-Marquardt: {} iterations, RMS {:.4g} % -> {:.4g} %, {}", out.iterations,
       std::sqrt(2.0 * summary.initial_cost), out.f,

@@ -118,10 +118,12 @@ void write_condition(JsonWriter& w, const ConditionFit& c) {
              {"weight", c.weight}});
   w.key("samples").integer(static_cast<long long>(c.samples));
   w.key("compared").integer(static_cast<long long>(c.compared));
-  w.numbers({{"pp_um", c.pp_um},
-             {"rms_um", c.rms_um},
+  // Named in the record's response unit: pp_um / pp_ppm, ...
+  const std::string& u = c.response_unit;
+  w.numbers({{"pp_" + u, c.pp},
+             {"rms_" + u, c.rms},
              {"rms_pct", c.rms_pct},
-             {"max_err_um", c.max_err_um}});
+             {"max_err_" + u, c.max_err}});
   w.key("flux_rms_pct");
   if (c.flux_rms_pct >= 0) {
     w.number(c.flux_rms_pct);
@@ -134,6 +136,12 @@ void write_condition(JsonWriter& w, const ConditionFit& c) {
   w.key("response_unit").string(c.response_unit);
   w.key("quasi_static").boolean(c.condition.quasi_static);
   w.key("offset").string(offset_mode_name(c.condition.offset));
+  // The constant the offset rule added to the simulated response (fitted or first_sample).
+  w.key("offset_" + u).number(c.offset);
+  if (c.flux_rms_pct >= 0) {
+    w.key("flux_offset").string(offset_mode_name(c.condition.flux_offset));
+    w.key("flux_offset_T").number(c.flux_offset_T);
+  }
   w.end_object();
 }
 
@@ -159,6 +167,17 @@ void write_history(JsonWriter& w, const HistoryEntry& h) {
   w.end_object();
 }
 
+}  // namespace
+
+std::string stage_text(const StageEvaluations& se) {
+  return fmt::format("search {}, refinement {}, covariance {}, profile {} of {}", se.search,
+                     se.refine, se.covariance, se.profile,
+                     se.profile_budget < 0 ? std::string("no limit")
+                                           : fmt::format("{} allowed", se.profile_budget));
+}
+
+namespace {
+
 // The fit report's head: command, inputs, the error, the search and its cost.
 std::string markdown_summary(const IdentifyResult& r, const FitProvenance& p) {
   std::string s = "# gmasim identify: fit report\n\n";
@@ -174,8 +193,9 @@ std::string markdown_summary(const IdentifyResult& r, const FitProvenance& p) {
                    r.resumed ? " (resumed from a checkpoint)" : "",
                    r.interrupted ? ", **interrupted: best so far**" : "");
   s += fmt::format("- refinement: {}\n", r.refine_summary);
-  s += fmt::format("- {} model evaluations, {:.1f} s wall, GA {:.1f} evaluations/s\n\n",
-                   r.evaluations, r.wall_s, r.ga_evals_per_s);
+  s += fmt::format("- {} model evaluations ({}), {:.1f} s wall, GA {:.1f} evaluations/s\n",
+                   r.evaluations, stage_text(r.stage_evaluations), r.wall_s, r.ga_evals_per_s);
+  s += fmt::format("- the written point was found by the {}\n\n", r.best_found_by);
   return s;
 }
 
@@ -223,25 +243,42 @@ std::string markdown_correlation(const IdentifyResult& r) {
   return s;
 }
 
+// The offsets a record's rules added, with units: "fitted -12.3 ppm", "flux fitted 0.01 T".
+std::string offset_text(const ConditionFit& c) {
+  std::string s = c.condition.offset == OffsetMode::Absolute
+                      ? std::string("-")
+                      : fmt::format("{} {:+.5g} {}", offset_mode_name(c.condition.offset), c.offset,
+                                    c.response_unit);
+  if (c.flux_rms_pct >= 0 && c.condition.flux_offset != OffsetMode::Absolute)
+    s += fmt::format("; flux {} {:+.5g} T", offset_mode_name(c.condition.flux_offset),
+                     c.flux_offset_T);
+  return s;
+}
+
 // Each condition's fit (in the record's response unit), and where its overlay is.
 std::string markdown_conditions(const IdentifyResult& r) {
   std::string s =
-      "## Conditions\n\np-p, RMS and max err are in the record's response unit: um of "
-      "displacement_um, ppm of strain_ppm. f = 0: not periodic (or quasi-static).\n\n"
+      "## Conditions\n\np-p, RMS, max err and offset are in the record's response unit: um of "
+      "displacement_um, ppm of strain_ppm. The offset is the constant the record's offset rule "
+      "added to the simulated response (`fitted`: the least-squares constant; `first_sample`: "
+      "the shift aligning the first rows; `absolute`: none). f = 0: not periodic (or "
+      "quasi-static).\n\n"
       "| condition | T [degC] | f [Hz] | I p-p [A] | weight | p-p | RMS | RMS [%] | max err | "
-      "flux RMS [%] |\n|---|---|---|---|---|---|---|---|---|---|\n";
+      "offset | flux RMS [%] |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& c : r.conditions) {
     if (c.failed) {
-      s += fmt::format("| {} | {:g} | {:g} | {:g} | {:g} | - | failed: {} | | | |\n", c.label,
+      s += fmt::format("| {} | {:g} | {:g} | {:g} | {:g} | - | failed: {} | | | | |\n", c.label,
                        c.condition.temperature_C, c.condition.frequency_Hz,
                        c.condition.current_pp_A, c.weight, c.error);
       continue;
     }
+    const std::string& u = c.response_unit;
     s += fmt::format(
-        "| {} | {:g} | {:g} | {:g} | {:g} | {:.3f} {} | {:.4f} {} | {:.3f} | {:.4f} {} | {} |\n",
+        "| {} | {:g} | {:g} | {:g} | {:g} | {:.3f} {} | {:.4f} {} | {:.3f} | {:.4f} {} | {} | {} "
+        "|\n",
         c.label, c.condition.temperature_C, c.condition.frequency_Hz, c.condition.current_pp_A,
-        c.weight, c.pp_um, c.response_unit, c.rms_um, c.response_unit, c.rms_pct, c.max_err_um,
-        c.response_unit, c.flux_rms_pct >= 0 ? fmt::format("{:.3f}", c.flux_rms_pct) : "-");
+        c.weight, c.pp, u, c.rms, u, c.rms_pct, c.max_err, u, offset_text(c),
+        c.flux_rms_pct >= 0 ? fmt::format("{:.3f}", c.flux_rms_pct) : "-");
   }
   s += "\nOverlays (measured vs simulated): `overlay_<condition>.csv`, drawn into "
        "`overlay_<condition>.png` by `python3 -m gmasim.command_figures identify <this "
@@ -364,6 +401,20 @@ std::string fit_report_json(const IdentifyResult& r, const FitProvenance& p) {
   w.key("refine").string(r.refine_summary);
   w.end_object();
   w.key("evaluations").integer(r.evaluations);
+  const StageEvaluations& se = r.stage_evaluations;
+  w.key("evaluations_by_stage").begin_object(JsonLayout::Inline);
+  w.key("search").integer(se.search);
+  w.key("refine").integer(se.refine);
+  w.key("covariance").integer(se.covariance);
+  w.key("profile").integer(se.profile);
+  w.key("profile_budget");
+  if (se.profile_budget >= 0) {
+    w.integer(se.profile_budget);
+  } else {
+    w.null();  // no limit
+  }
+  w.end_object();
+  w.key("best_found_by").string(r.best_found_by);
   w.key("wall_s").number(r.wall_s);
   w.key("ga_evals_per_s").number(r.ga_evals_per_s);
   w.key("parameters").begin_array();

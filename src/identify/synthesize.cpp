@@ -19,7 +19,7 @@ void check_request(const SyntheticRequest& r) {
   if (r.samples_per_period < 8)
     throw InputError(fmt::format("samples per period {} (--samples-per-period): must be >= 8",
                                  r.samples_per_period));
-  if (r.precycles == 0 && !(r.periods >= 1.5))
+  if (r.precycles == 0 && r.initial_state == InitialState::Demagnetised && !(r.periods >= 1.5))
     throw InputError("periods: must be >= 1.5 (the first is not compared)");
   if (!(r.periods >= 1.0)) throw InputError("periods: must be >= 1 (one whole loop)");
   require_in(r.periods, 1.0, kMaxPeriods, "periods");
@@ -77,16 +77,20 @@ Measurement record_skeleton(const SyntheticRequest& r, double T, double pp, doub
   c.quasi_static = r.quasi_static;
   c.rod = r.rod;
   c.precycles = r.precycles;
+  c.initial_state = r.initial_state;
   c.offset = r.offset;
+  // A record that starts on its loop (pre-cycled, or from a given remanence) compares every
+  // sample; one from the demagnetised state skips its first period.
+  const bool on_loop = r.precycles > 0 || r.initial_state != InitialState::Demagnetised;
   m.response_kind = r.response;
   if (r.quasi_static) {
-    c.compare_from_s = r.precycles > 0 ? 0.0 : r.samples_per_period;  // sample index
+    c.compare_from_s = on_loop ? 0.0 : r.samples_per_period;  // sample index
     c.label = fmt::format("T{:g}_I{:g}_qs", T, pp);
   } else {
     c.frequency_Hz = f;
     c.current_pp_A = pp;
     c.current_min_A = r.current_min_A;
-    c.compare_from_s = r.precycles > 0 ? 0.0 : 1.0 / f;
+    c.compare_from_s = on_loop ? 0.0 : 1.0 / f;
     c.label = fmt::format("T{:g}_I{:g}_f{:g}", T, pp, f);
   }
   m.path = c.label + ".csv";
