@@ -70,14 +70,15 @@ def _self_heating_figure(ts, h, meta):
     ax_T.set_xlabel("time (s)")
     ax_T.set_ylabel("temperature (°C)")
     ax_T.set_title("temperatures")
-    ax_T.legend(fontsize=7, loc="lower right")
+    ax_T.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=3)
     # Row 0 is the start, row 1 the virgin-curve step: the drift is measured from row 2.
     t, stroke = h["t_s"][2:], h["stroke_um"][2:]
     s0 = float(stroke[0]) if len(stroke) and stroke[0] else np.nan
     ax_d.plot(t, 100.0 * (stroke / s0 - 1.0), color="tab:red", label="stroke change")
-    if "y_mean_um" in h:
-        ax_d.plot(t, 100.0 * (h["y_mean_um"][2:] - h["y_mean_um"][2]) / s0, color="tab:blue",
-                  label="offset drift (mean y)")
+    edges = np.searchsorted(ts["t_s"], h["t_s"])
+    means = np.array([np.mean(ts["y_um"][a:b]) if b > a else np.nan for a, b in zip(edges[:-1], edges[1:])])
+    if len(means) > 2:  # the mean of y over each interval (row k: the interval ending at t_k)
+        ax_d.plot(t, 100.0 * (means[1:] - means[1]) / s0, color="tab:blue", label="offset drift (mean y)")
     if "xT_um" in ts:
         ax_d.plot(ts["t_s"], 100.0 * (ts["xT_um"] - ts["xT_um"][0]) / s0, color="tab:purple", ls="--",
                   label="thermal expansion x_T")
@@ -198,8 +199,10 @@ def bode_db(out):
         am.axvline(paper_f, color=plots.PAPER_COLOR, ls="-", lw=2.5, alpha=0.35,
                    label=f"paper (Fig. 15): first resonance {paper_f:g} Hz")
     if paper_bw:
-        am.axvspan(paper_bw, am.get_xlim()[1], color=plots.PAPER_COLOR, alpha=0.08,
+        xlim = am.get_xlim()
+        am.axvspan(paper_bw, max(xlim[1], paper_bw), color=plots.PAPER_COLOR, alpha=0.08,
                    label=f"paper: −3 dB bandwidth > {paper_bw:g} Hz")
+        am.set_xlim(xlim[0], max(xlim[1], 1.2 * paper_bw))
     plots._legend_outside(am)
     fig.tight_layout()
     return fig
@@ -339,7 +342,7 @@ def identify(out):
         a1.plot(x[cmp], o[simulated][cmp], "-", lw=1.2, label="simulated")
         a1.set_xlabel({"current_A": "current (A)", "field_A_per_m": "field H (kA/m)"}.get(drive, drive))
         a1.set_ylabel(ylabel)
-        a1.legend(loc="upper left", fontsize=7)
+        a1.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=7)
         a1.set_title("loop (compared samples)")
         t = o[t_key]
         a2.plot(t, o[measured], ".", ms=2.0, label="measured")
@@ -348,7 +351,7 @@ def identify(out):
             a2.axvspan(t[0], t[np.argmax(cmp)], color="0.9", label="not compared")
         a2.set_xlabel("time (s)" if t_key == "t_s" else "sample (-)")
         a2.set_ylabel(ylabel)
-        a2.legend(loc="upper left", fontsize=7)
+        a2.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=3, fontsize=7)
         a2.set_title("record")
         if flux:
             a3 = axes[2]
@@ -357,7 +360,7 @@ def identify(out):
             a3.set_xlabel("time (s)" if t_key == "t_s" else "sample (-)")
             a3.set_ylabel("flux density B (T)")
             a3.set_title("flux")
-            a3.legend(loc="upper left", fontsize=7)
+            a3.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=7)
         for ax in axes:
             ax.xaxis.set_major_locator(MaxNLocator(nbins=5))
             ax.grid(alpha=0.3)
@@ -376,6 +379,8 @@ def identify(out):
                 ax.semilogy(h["evaluations"][sel], h["best_rms_pct"][sel], style, ms=3, label=phase)
         ax.set_xlabel("model evaluations (all ranks)")
         ax.set_ylabel("best weighted RMS error (%)")
+        ax.set_title(f"gmasim identify: convergence ({rep.get('model', '')})" if rep.get("model")
+                     else "gmasim identify: convergence")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend()
         fig.tight_layout()

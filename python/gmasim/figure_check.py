@@ -12,7 +12,10 @@ returns one sentence per defect, using matplotlib's own text extents (every visi
 - two visible texts whose extents overlap by more than ``tolerance_px`` in both directions
   (titles, axis labels, tick labels, legend texts and titles, annotations, figure texts);
 - a legend that covers a plotted line (a sample of the line, 16 points per segment, inside the
-  legend's frame).
+  legend's frame);
+- an axis offset label ("1e-7" above the axis: the unit should be scaled instead), and an
+  annotation that runs outside its axes (into a neighbour, or clipped at the figure's edge).
+A figure of several panels needs a title above them all (suptitle); one panel, its own.
 
 :func:`check` raises :class:`FigureProblem` with all of them. :func:`gmasim.plots.save` runs
 the check before it writes anything when the environment sets ``GMASIM_FIGURE_CHECK=1``
@@ -88,8 +91,17 @@ def _label_of(ax, which):
 
 def _label_problems(fig) -> list[str]:
     out = []
-    if not (any(ax.get_title(loc=loc) for ax in fig.axes for loc in ("left", "center", "right"))
-            or (fig._suptitle is not None and fig._suptitle.get_text())):
+    panels = [ax for ax in fig.axes if ax.get_visible() and not _is_colorbar(ax) and _has_content(ax)]
+    suptitle = fig._suptitle is not None and bool(fig._suptitle.get_text())
+    titled = any(ax.get_title(loc=loc) for ax in panels for loc in ("left", "center", "right"))
+    hosts = {ax.bbox.bounds for ax in panels}  # a twin shares its host's box
+    columns = {(round(b[0]), round(b[2])) for b in hosts}
+    top = max(panels, key=lambda ax: ax.bbox.y1) if panels else None
+    if len(columns) == 1 and top is not None and top.get_title():
+        titled, hosts = True, {top.bbox.bounds}  # one column of panels (a Bode plot): the top one's title
+    if len(hosts) > 1 and not suptitle:
+        out.append("no title (a figure of several panels needs one above them all)")
+    elif not (suptitle or titled):
         out.append("no title")
     for n, ax in enumerate(fig.axes):
         if not ax.get_visible() or not ax.axison:
@@ -130,7 +142,11 @@ def _texts(fig):
 
     add(fig._suptitle, "suptitle")
     for t in fig.texts:
-        add(t, "figure text")
+        if t is not fig._suptitle and t is not getattr(fig, "_supxlabel", None) \
+                and t is not getattr(fig, "_supylabel", None):
+            add(t, "figure text")
+    add(getattr(fig, "_supxlabel", None), "x label")
+    add(getattr(fig, "_supylabel", None), "y label")
     for leg in fig.legends:
         for t in leg.get_texts():
             add(t, "legend")
@@ -158,6 +174,29 @@ def _texts(fig):
                 add(t, "legend")
             add(leg.get_title(), "legend title")
     return found
+
+
+def _layout_problems(fig, renderer) -> list[str]:
+    """Offset labels ('1e-7' above an axis: scale the unit instead) and annotations that run
+    outside their axes (into a neighbour, or clipped at the figure's edge)."""
+    out = []
+    for ax in fig.axes:
+        if not ax.get_visible():
+            continue
+        for axis, which in ((ax.xaxis, "x"), (ax.yaxis, "y")):
+            off = axis.get_offset_text()
+            if axis.get_visible() and off.get_visible() and off.get_text().strip():
+                out.append(f"{ax.get_title() or 'an axes'}: {which} axis offset label "
+                           f"'{off.get_text()}' (scale the unit instead)")
+        box = ax.get_window_extent(renderer)
+        for t in ax.texts:
+            if not t.get_visible() or not t.get_text().strip():
+                continue
+            e = t.get_window_extent(renderer)
+            if e.x0 < box.x0 - 1 or e.x1 > box.x1 + 1 or e.y0 < box.y0 - 1 or e.y1 > box.y1 + 1:
+                out.append(f"annotation '{t.get_text()[:40]}' runs outside its axes "
+                           f"'{ax.get_title() or 'an axes'}'")
+    return out
 
 
 def _overlap_problems(fig, renderer, tolerance_px) -> list[str]:
@@ -207,7 +246,7 @@ def problems(fig, tolerance_px: float = 1.0) -> list[str]:
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
     return (_label_problems(fig) + _overlap_problems(fig, renderer, tolerance_px)
-            + _legend_cover_problems(fig, renderer))
+            + _legend_cover_problems(fig, renderer) + _layout_problems(fig, renderer))
 
 
 def check(fig, name: str = "figure") -> None:

@@ -424,7 +424,8 @@ def ablation(ab: Columns, laws: Sequence[str] | None = None,
                 vals.append(ab[key][idx[0]] if idx else np.nan)
             ax.bar(x + (k - (len(freqs) - 1) / 2) * w, vals, w, label=f"{f:g} Hz")
         ax.set_xticks(x, [LAW_LABELS.get(str(n), str(n)) for n in names], fontsize=8,
-                      rotation=30 if len(names) > 5 else 0, ha="right" if len(names) > 5 else "center")
+                      rotation=60 if len(names) > 3 else 0, ha="right" if len(names) > 3 else "center",
+                      rotation_mode="anchor")
         ax.set_xlabel("law whose temperature dependence is frozen")
         ax.set_ylabel(ylabels[key])
         ax.grid(alpha=0.3, axis="y")
