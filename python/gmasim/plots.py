@@ -384,7 +384,7 @@ def params_vs_temperature(p: Columns, title="Model parameters against temperatur
                 ref = _value_at(p, "E_G_mean_GPa", temperature_C=c["reference_temperature_C"])
                 _mark_paper(ax, c["temperature_C"], ref * (1.0 + c["paper"] / 100.0), c)
     for ax in axes[len(panels):]:
-        ax.set_visible(False)
+        fig.delaxes(ax)
     h, lab = axes[0].get_legend_handles_labels()
     if claims and _claims_of(claims, "EG_rise_pct"):
         h, lab = _paper_legend(axes[0], _claims_of(claims, "EG_rise_pct"))
