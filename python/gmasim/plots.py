@@ -136,13 +136,14 @@ def _mark_paper(ax, x, y, claim, label_text=None):
     col = _claim_color(claim)
     ax.plot([x], [y], "D", ms=7, mfc="white", mec=col, mew=1.8, zorder=5)
     if claim.get("pass") is False or label_text:
-        x0, x1 = ax.get_xlim()
-        if ax.get_xscale() == "log":
-            right = np.log(x) > 0.5 * (np.log(x0) + np.log(x1))
-        else:
-            right = x > 0.5 * (x0 + x1)
-        ax.annotate(label_text or "✗", (x, y), xytext=(-5 if right else 5, 4), textcoords="offset points",
-                    fontsize=6.5, color=col, ha="right" if right else "left")
+        def upper(v, lo, hi, log):
+            return np.log(v) > 0.5 * (np.log(lo) + np.log(hi)) if log and v > 0 and lo > 0 else v > 0.5 * (lo + hi)
+
+        right = upper(x, *ax.get_xlim(), ax.get_xscale() == "log")
+        top = upper(y, *ax.get_ylim(), ax.get_yscale() == "log")
+        ax.annotate(label_text or "✗", (x, y), xytext=(-5 if right else 5, -5 if top else 5),
+                    textcoords="offset points", fontsize=6.5, color=col, ha="right" if right else "left",
+                    va="top" if top else "bottom")
 
 
 def _paper_legend(ax, claims=None):
@@ -447,7 +448,7 @@ def claims_overview(claims: Sequence[dict], title="The paper's claims: ours agai
     paper), green when the claim passes, red when it fails; rankings and bounds without a
     number are listed with their result."""
     rows = [c for c in claims if c.get("result") != "n/a"]
-    fig, ax = plt.subplots(figsize=(7.4, 0.26 * len(rows) + 1.4))
+    fig, ax = plt.subplots(figsize=(9.0, 0.26 * len(rows) + 1.4))
     y = np.arange(len(rows))[::-1]
     for yi, c in zip(y, rows):
         col = PASS_COLOR if c.get("pass") else FAIL_COLOR
@@ -462,8 +463,9 @@ def claims_overview(claims: Sequence[dict], title="The paper's claims: ours agai
                 if rc != r:
                     ax.text(rc, yi + 0.25, f"×{r:.3g} ", color=col, fontsize=6.5, ha="right" if r > 1 else "left")
                 continue
-        ax.text(1.0, yi, f" {c.get('result')}: {c.get('tolerance', '')}", color=col, fontsize=6.5,
-                va="center")
+        rule = str(c.get("tolerance", ""))
+        rule = rule if len(rule) <= 40 else rule[:39] + "…"
+        ax.text(1.0, yi, f" {c.get('result')}: {rule}", color=col, fontsize=6.5, va="center")
     ax.axvline(1.0, color="black", lw=0.8)
     ax.set_xscale("log")
     ax.set_xlim(0.1, 10.0)
@@ -472,6 +474,7 @@ def claims_overview(claims: Sequence[dict], title="The paper's claims: ours agai
         t.set_color(PASS_COLOR if c.get("pass") else FAIL_COLOR)
     npass = sum(1 for c in rows if c.get("pass"))
     ax.set_xlabel("ours / paper (log; 1 = the paper's number)")
+    ax.set_ylabel("claim (✓ passes, ✗ fails)")
     ax.set_title(f"{title}: {npass} of {len(rows)} pass")
     ax.grid(alpha=0.3, axis="x", which="both")
     fig.tight_layout()
