@@ -164,7 +164,8 @@ def bode_db(out):
     large = "large_signal" in summ and bool(np.any(summ["large_signal"] == "true"))
     stepped = bool(meta.get("stepped_sine", True))
     if bias is not None and amp is not None:
-        stim = (f"stimulus ±{amp * 1e3:g} mA, " + ("large signal" if large else "small signal")
+        amp_text = f"±{amp:g} A" if amp >= 0.1 else f"±{amp * 1e3:g} mA"
+        stim = (f"stimulus {amp_text}, " + ("large signal" if large else "small signal")
                 if stepped else "small-signal linearisation")
         title = f"Frequency response about a {bias:g} A bias ({stim})"
     else:

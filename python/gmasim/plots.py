@@ -135,6 +135,9 @@ def _mark_paper(ax, x, y, claim, label_text=None):
         return
     col = _claim_color(claim)
     ax.plot([x], [y], "D", ms=7, mfc="white", mec=col, mew=1.8, zorder=5)
+    states = getattr(ax.figure, "_gmasim_paper_states", set())
+    states.add(claim.get("pass"))
+    ax.figure._gmasim_paper_states = states  # the legend explains only the markers drawn
     if claim.get("pass") is False or label_text:
         def upper(v, lo, hi, log):
             return np.log(v) > 0.5 * (np.log(lo) + np.log(hi)) if log and v > 0 and lo > 0 else v > 0.5 * (lo + hi)
@@ -150,7 +153,9 @@ def _paper_legend(ax, claims=None):
     from matplotlib.lines import Line2D
 
     h, lab = ax.get_legend_handles_labels()
-    kinds = {c.get("pass") for c in claims} if claims else {True, False}
+    kinds = getattr(ax.figure, "_gmasim_paper_states", None)
+    if kinds is None:
+        kinds = {c.get("pass") for c in claims} if claims else {True, False}
     for state, col, text in ((True, PASS_COLOR, "paper (claim passes)"), (False, FAIL_COLOR, "paper (claim fails, ✗)"),
                              (None, PAPER_COLOR, "paper")):
         if state in kinds:
