@@ -16,6 +16,7 @@ namespace gmasim::cli {
 namespace {
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kMismatchWarnPct = 5.0;  // stepped sine vs linearisation: warn above
 
 struct FrfArgs {
   bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
@@ -42,15 +43,17 @@ void print_resonance_change(const FrfResult& res) {
 
 // One temperature's response table: stepped sine and linearisation side by side.
 void print_response_table(const FrfCurve& c) {
-  fmt::print("  {:>10} {:>12} {:>10} {:>12} {:>10} {:>9}\n", "f Hz", "|Y/I| step", "phase",
-             "|Y/I| lin", "phase", "mismatch");
+  fmt::print("  {:>10} {:>12} {:>10} {:>12} {:>10} {:>9}\n", "f", "|Y/I| step", "phase step",
+             "|Y/I| lin", "phase lin", "mismatch");
+  fmt::print("  {:>10} {:>12} {:>10} {:>12} {:>10} {:>9}\n", "(Hz)", "(um/A)", "(deg)", "(um/A)",
+             "(deg)", "(%)");
   for (std::size_t k = 0; k < c.f_Hz.size(); ++k) {
     const bool s = k < c.stepped_mag_um_per_A.size(), l = k < c.linear_mag_um_per_A.size();
     std::string mis = "-";
     if (s && l) {
       const auto Ys = std::polar(c.stepped_mag_um_per_A[k], c.stepped_phase_deg[k] * kDeg);
       const auto Yl = std::polar(c.linear_mag_um_per_A[k], c.linear_phase_deg[k] * kDeg);
-      mis = fmt::format("{:.3f}%", std::abs(Ys - Yl) / std::abs(Yl) * 100.0);
+      mis = fmt::format("{:.3f}", std::abs(Ys - Yl) / std::abs(Yl) * 100.0);
     }
     fmt::print("  {:10.2f} {:>12} {:>10} {:>12} {:>10} {:>9}\n", c.f_Hz[k],
                s ? fmt::format("{:.5f}", c.stepped_mag_um_per_A[k]) : "-",
@@ -58,6 +61,28 @@ void print_response_table(const FrfCurve& c) {
                l ? fmt::format("{:.5f}", c.linear_mag_um_per_A[k]) : "-",
                l ? fmt::format("{:.2f}", c.linear_phase_deg[k]) : "-", mis);
   }
+}
+
+// Small or large signal (docs/experiments.md): which data the markers come from, and a warning
+// on stderr when the stepped sine disagrees with the linearisation.
+void print_signal_regime(const FrfRequest& req, const FrfCurve& c) {
+  if (!req.stepped_sine) return;
+  fmt::print(
+      "  stimulus +-{:g} A: {} signal (small up to +-{:.3g} mA here: every rod's field "
+      "excursion within 10 % of its reversible range c k/(1-c)); markers from the {}\n",
+      req.amplitude_A, c.large_signal ? "large" : "small", c.small_signal_limit_A * 1e3,
+      c.markers_from);
+  if (!req.small_signal || !(c.max_mismatch_pct > kMismatchWarnPct)) return;
+  fmt::print(stderr,
+             "gmasim frf: warning: at {:g} degC the stepped sine differs from the small-signal "
+             "linearisation by up to {:.1f} % of |Y/I|{}; the linearised curve does not describe "
+             "this stimulus (markers and the -3 dB line are from the stepped sine{})\n",
+             c.temperature_C, c.max_mismatch_pct,
+             c.large_signal ? fmt::format(": the stimulus +-{:g} A is large (small-signal limit "
+                                          "+-{:.3g} mA)",
+                                          req.amplitude_A, c.small_signal_limit_A * 1e3)
+                            : " although the stimulus is small (a creeping minor loop?)",
+             c.large_signal ? "" : " only for a large stimulus");
 }
 
 int run_frf_cmd(FrfArgs& a) {
@@ -82,16 +107,18 @@ int run_frf_cmd(FrfArgs& a) {
     fmt::print("\n  T = {:.1f} degC   y at bias {:.3f} um   static gain {:.4f} um/A\n",
                c.temperature_C, c.y_bias_um, c.static_gain_um_per_A);
     print_response_table(c);
+    print_signal_regime(a.req, c);
     auto hz = [](double f) { return f > 0 ? fmt::format("{:.1f} Hz", f) : std::string("none"); };
     fmt::print(
-        "  first resonance (largest |Y/I| peak in {}-{} Hz): {}, |Y/I| {:.4g} um/A   (paper, "
-        "Fig. 15: {} Hz)\n",
-        a.req.f_min_Hz, a.req.f_max_Hz, hz(c.first_resonance_Hz), c.first_resonance_mag_um_per_A,
-        res.paper_first_resonance_Hz);
+        "  first resonance (largest |Y/I| peak of the {} in {}-{} Hz): {}, |Y/I| {:.4g} um/A   "
+        "(paper, Fig. 15: {} Hz)\n",
+        c.markers_from, a.req.f_min_Hz, a.req.f_max_Hz, hz(c.first_resonance_Hz),
+        c.first_resonance_mag_um_per_A, res.paper_first_resonance_Hz);
     if (a.req.small_signal)
       fmt::print("  |Y/I| peak of the linear model searched up to {:.0f} Hz: {}\n",
                  c.linear_peak_search_max_Hz, hz(c.linear_peak_extended_Hz));
-    fmt::print("  -3 dB bandwidth: {}   (paper: > {} Hz)\n", hz(c.bandwidth_3dB_Hz),
+    fmt::print("  -3 dB bandwidth (re |Y/I| {:.4g} um/A at {:g} Hz): {}   (paper: > {} Hz)\n",
+               c.reference_gain_um_per_A, a.req.f_min_Hz, hz(c.bandwidth_3dB_Hz),
                res.paper_bandwidth_Hz);
     if (a.req.stepped_sine && a.req.small_signal)
       fmt::print("  stepped sine vs linearisation: max |difference| {:.3f} % of |Y/I|\n",
@@ -145,7 +172,8 @@ Runner add_frf(CLI::App& app) {
   sub->add_option("--bias", a->req.bias_A, "DC bias current [A] (1 A: middle of the 8 A sine)")
       ->capture_default_str();
   sub->add_option("--amplitude", a->req.amplitude_A,
-                  "Stepped-sine current amplitude [A]; small signal needs << 1 mA here "
+                  "Stepped-sine current amplitude [A]; above the small-signal limit (printed per "
+                  "temperature, about 2 mA for the built-in model) the FRF is large-signal "
                   "(docs/experiments.md)")
       ->capture_default_str();
   sub->add_option("--method", a->method, "stepped, linear or both")
@@ -155,6 +183,10 @@ Runner add_frf(CLI::App& app) {
                   "Magnetic state at the bias: anhysteretic (after AC shake-down) or "
                   "initial-curve (virgin curve; the JA minor loop then creeps)")
       ->check(CLI::IsMember({"anhysteretic", "initial-curve"}))
+      ->capture_default_str();
+  sub->add_option("--peak-refinements", a->req.peak_refinements,
+                  "Stepped sine: golden-section evaluations refining the largest |Y/I| peak "
+                  "between its grid neighbours [-]; 0 = off")
       ->capture_default_str();
   sub->add_option("--settle-periods", a->req.settle_periods,
                   "Stepped sine: minimum settling periods [-] (also >= 10 time constants)")

@@ -86,6 +86,9 @@ struct FrfRequest {
   bool stepped_sine = true, small_signal = true;
   BiasState bias_state = BiasState::Anhysteretic;
   int threads = 0;  // stepped-sine frequencies run in parallel
+  // Stepped sine: golden-section evaluations in ln f around the largest |Y/I| of the grid (the
+  // peak refined between its grid neighbours, the points merged into the curve); 0: off.
+  int peak_refinements = 12;
 };
 
 // Small-signal model about a settled bias point (docs/experiments.md, "FRF"):
@@ -159,6 +162,16 @@ struct FrfCurve {
   double y_bias_um = 0;
   std::vector<double> eddy_tau_ms;  // per rod at the bias point
   double wall_time_s = 0;
+  // Small or large signal (docs/experiments.md, "Small or large signal"): the stimulus is small
+  // up to small_signal_limit_A (every rod's field excursion within 10 % of its reversible range
+  // c k / (1 - c), eq. 9); large_signal: a stepped sine above it. The markers (first resonance,
+  // bandwidth, the -3 dB reference gain = |Y/I| at f_min) come from the data the figure draws:
+  // markers_from "stepped sine" when the stimulus is large or the linearisation is off,
+  // "linearisation" otherwise.
+  double small_signal_limit_A = 0;
+  bool large_signal = false;
+  std::string markers_from = "linearisation";
+  double reference_gain_um_per_A = 0;
 };
 
 struct FrfResult {

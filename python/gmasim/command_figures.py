@@ -14,6 +14,7 @@ import sys
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from gmasim import plots
 from gmasim.plots import plt, read_csv
@@ -24,123 +25,245 @@ def _meta(out, stem):
     return json.loads(p.read_text())["meta"] if p.exists() else {}
 
 
+def _window(ts, m):
+    """The rows of the metrics window (the last whole period: no start-up branch)."""
+    if "window_start_s" in m and m.get("window_end_s", 0) > m["window_start_s"]:
+        keep = (ts["t_s"] >= m["window_start_s"] - 1e-12) & (ts["t_s"] <= m["window_end_s"] + 1e-12)
+        if keep.sum() > 10:
+            return {k: v[keep] for k, v in ts.items()}
+    return ts
+
+
+def _annotate_loop(ax, i, y, m):
+    """The stroke (max - min of y) and the hysteresis (max |y_rising - y_falling| at equal
+    current) as double arrows on the loop, with the values the metrics report."""
+    k_lo, k_hi = int(np.argmin(y)), int(np.argmax(y))
+    x_s = float(np.max(i)) + 0.04 * float(np.ptp(i) or 1.0)
+    arrow = dict(arrowstyle="<->", color="black", lw=0.9, shrinkA=0, shrinkB=0)
+    ax.annotate("", (x_s, y[k_lo]), xytext=(x_s, y[k_hi]), arrowprops=arrow)
+    stroke = m.get("stroke_um", float(np.ptp(y)))
+    ax.text(x_s, 0.5 * (y[k_lo] + y[k_hi]), f" stroke\n {stroke:.1f} µm", fontsize=7, va="center",
+            ha="left")
+    ax.set_xlim(ax.get_xlim()[0], x_s + 0.25 * float(np.ptp(i) or 1.0))
+    di = np.diff(i)
+    rising, falling = np.append(di > 0, di[-1:] > 0), np.append(di < 0, di[-1:] < 0)
+    if rising.sum() > 2 and falling.sum() > 2:
+        grid = np.linspace(max(i[rising].min(), i[falling].min()), min(i[rising].max(), i[falling].max()), 200)
+        o_r, o_f = np.argsort(i[rising]), np.argsort(i[falling])
+        yr = np.interp(grid, i[rising][o_r], y[rising][o_r])
+        yf = np.interp(grid, i[falling][o_f], y[falling][o_f])
+        k = int(np.argmax(np.abs(yr - yf)))
+        ax.annotate("", (grid[k], yr[k]), xytext=(grid[k], yf[k]), arrowprops=dict(arrow, color="tab:red"))
+        hyst = m.get("hysteresis_um", float(abs(yr[k] - yf[k])))
+        ax.annotate(f"hysteresis {hyst:.1f} µm", (grid[k], 0.5 * (yr[k] + yf[k])), xytext=(6, 0),
+                    textcoords="offset points", fontsize=7, color="tab:red", va="center")
+
+
+def _self_heating_figure(ts, h, meta):
+    """Drift under self-heating: the stroke's change and the output's offset drift (the mean of
+    y, and the thermal expansion x_T when recorded), both in % of the stroke at the start, on
+    one axis that includes 0, beside the temperatures."""
+    fig, (ax_T, ax_d) = plt.subplots(1, 2, figsize=(11, 4.0))
+    for col, lab in (("coil_C", "coil"), ("rods_C", "rods"), ("housing_C", "housing")):
+        if col in h:
+            ax_T.plot(h["t_s"], h[col], label=lab)
+    ax_T.set_xlabel("time (s)")
+    ax_T.set_ylabel("temperature (°C)")
+    ax_T.set_title("temperatures")
+    ax_T.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=3)
+    # Row 0 is the start, row 1 the virgin-curve step: the drift is measured from row 2.
+    t, stroke = h["t_s"][2:], h["stroke_um"][2:]
+    s0 = float(stroke[0]) if len(stroke) and stroke[0] else np.nan
+    ax_d.plot(t, 100.0 * (stroke / s0 - 1.0), color="tab:red", label="stroke change")
+    edges = np.searchsorted(ts["t_s"], h["t_s"])
+    means = np.array([np.mean(ts["y_um"][a:b]) if b > a else np.nan for a, b in zip(edges[:-1], edges[1:])])
+    if len(means) > 2:  # the mean of y over each interval (row k: the interval ending at t_k)
+        ax_d.plot(t, 100.0 * (means[1:] - means[1]) / s0, color="tab:blue", label="offset drift (mean y)")
+    if "xT_um" in ts:
+        ax_d.plot(ts["t_s"], 100.0 * (ts["xT_um"] - ts["xT_um"][0]) / s0, color="tab:purple", ls="--",
+                  label="thermal expansion x_T")
+    ax_d.axhline(0.0, color="black", lw=0.6)
+    lo, hi = ax_d.get_ylim()
+    ax_d.set_ylim(min(lo, -1.0), max(hi, 1.0))
+    ax_d.set_xlabel("time (s)")
+    ax_d.set_ylabel(f"change (% of the first stroke, {s0:.1f} µm)")
+    ax_d.set_title("drift relative to the stroke")
+    ax_d.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
+    for ax in (ax_T, ax_d):
+        ax.grid(alpha=0.3)
+    fig.suptitle(f"gmasim simulate, self-heating: {meta.get('model', '')}, from {meta.get('temperature_C', '')} °C")
+    fig.tight_layout()
+    return fig
+
+
 def simulate(out):
-    ts = read_csv(pathlib.Path(out) / "timeseries.csv")
+    """simulate.png: y and the current against time, y against current and the rods' B-H over
+    the metrics window (the last whole period, without the start-up branch; stroke and
+    hysteresis annotated), B against time; with self-heating also self_heating.png."""
+    ts_all = read_csv(pathlib.Path(out) / "timeseries.csv")
     meta = json.loads((pathlib.Path(out) / "metrics.json").read_text())
     m = meta.get("metrics") or {}
+    ts = ts_all
     if "window_start_s" in m and m["window_end_s"] > m["window_start_s"]:
         # A long run: its time traces show the last few metrics windows, not a solid band.
         t0 = m["window_end_s"] - 3 * (m["window_end_s"] - m["window_start_s"])
         keep = ts["t_s"] >= t0
         if keep.sum() > 10:
             ts = {k: v[keep] for k, v in ts.items()}
+    win = _window(ts_all, m)
     heat = pathlib.Path(out) / "self_heating.csv"
-    rows = 3 if heat.exists() else 2
-    fig = plt.figure(figsize=(10, 3.4 * rows))
-    ax_t = fig.add_subplot(rows, 2, 1)
+    fig = plt.figure(figsize=(11, 7.2))
+    ax_t = fig.add_subplot(2, 2, 1)
     ax_t.plot(ts["t_s"], ts["y_um"], lw=0.8)
     ax_t.set_xlabel("time (s)")
     ax_t.set_ylabel("displacement y (µm)")
+    ax_t.set_title("y and current against time")
     ax_i = ax_t.twinx()
     ax_i.plot(ts["t_s"], ts["current_A"], color="tab:orange", lw=0.6, alpha=0.6)
     ax_i.set_ylabel("current (A)", color="tab:orange")
-    ax_l = fig.add_subplot(rows, 2, 2)
-    ax_l.plot(ts["current_A"], ts["y_um"], lw=0.8)
+    ax_l = fig.add_subplot(2, 2, 2)
+    ax_l.plot(win["current_A"], win["y_um"], lw=1.0)
     ax_l.set_xlabel("current (A)")
     ax_l.set_ylabel("displacement y (µm)")
-    ax_l.set_title("y against current")
-    ax_b = fig.add_subplot(rows, 2, 3)
+    ax_l.set_title("y against current (last period)")
+    _annotate_loop(ax_l, win["current_A"], win["y_um"], m)
+    ax_b = fig.add_subplot(2, 2, 3)
     ax_b.plot(ts["t_s"], ts["B_T"], lw=0.8, color="tab:green")
     ax_b.set_xlabel("time (s)")
     ax_b.set_ylabel("flux density B (T)")
-    ax_h = fig.add_subplot(rows, 2, 4)
-    rods = sorted({n.split("_")[0] for n in ts if n.startswith("rod") and n.endswith("_H_A_per_m")})
+    ax_b.set_title("flux density against time")
+    ax_h = fig.add_subplot(2, 2, 4)
+    rods = sorted({n.split("_")[0] for n in win if n.startswith("rod") and n.endswith("_H_A_per_m")})
     for r in rods:
-        ax_h.plot(ts[f"{r}_H_A_per_m"] / 1e3, ts[f"{r}_B_T"], lw=0.8, label=r)
+        ax_h.plot(win[f"{r}_H_A_per_m"] / 1e3, win[f"{r}_B_T"], lw=0.8, label=r)
     ax_h.set_xlabel("field H (kA/m)")
     ax_h.set_ylabel("rod flux density φ/A (T)")
-    ax_h.legend(fontsize=7)
-    if heat.exists():
-        h = read_csv(heat)
-        ax_T = fig.add_subplot(rows, 2, 5)
-        for col, lab in (("coil_C", "coil"), ("rods_C", "rods"), ("housing_C", "housing")):
-            ax_T.plot(h["t_s"], h[col], label=lab)
-        ax_T.set_xlabel("time (s)")
-        ax_T.set_ylabel("temperature (°C)")
-        ax_T.legend(fontsize=7)
-        ax_T.set_title("self-heating")
-        ax_s = fig.add_subplot(rows, 2, 6)
-        # Row 0 is the start, row 1 the virgin-curve step: the drift is drawn from row 2.
-        ax_s.plot(h["t_s"][2:], h["stroke_um"][2:], color="tab:red")
-        ax_s.set_xlabel("time (s)")
-        ax_s.set_ylabel("stroke over the interval (µm)")
-        ax_s.set_title("stroke drift")
+    ax_h.set_title("rods' B-H (last period)")
+    if rods:
+        ax_h.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
     for ax in fig.axes:
         ax.grid(alpha=0.3)
     fig.suptitle(f"gmasim simulate: {meta.get('model', '')}, {meta.get('temperature_C', '')} °C"
                  + (", self-heating" if heat.exists() else ""))
     fig.tight_layout()
-    return fig
+    if not heat.exists():
+        return fig
+    return [("simulate", fig), ("self_heating", _self_heating_figure(ts_all, read_csv(heat), meta))]
 
 
 def bode_db(out):
-    """Bode plot in dB (re 1 µm/A) with the first resonance and the -3 dB bandwidth marked,
-    and the stimulus (bias, amplitude) in the title."""
+    """Bode plot in dB (re 1 µm/A). Every marker comes from the data drawn (frf_summary.csv:
+    markers_from): the -3 dB line 3 dB below their |Y/I| at the lowest frequency, the first
+    resonance and the bandwidth, one legend entry per temperature; the paper's 1270 Hz and
+    > 2000 Hz as grey lines. The title says small or large signal (frf_summary: large_signal,
+    the stimulus above small_signal_limit_A; docs/experiments.md)."""
     frf = read_csv(pathlib.Path(out) / "frf.csv")
     summ = read_csv(pathlib.Path(out) / "frf_summary.csv")
     meta = _meta(out, "frf")
     bias, amp = meta.get("bias_A"), meta.get("amplitude_A")
-    title = (f"Frequency response about a {bias:g} A bias, stimulus ±{amp * 1e3:g} mA (small signal)\n"
-             "(dotted horizontal: static gain -3 dB)" if bias is not None and amp is not None
-             else "Frequency response")
-    fig = plots.bode(frf, title=title, db=True)
+    large = "large_signal" in summ and bool(np.any(summ["large_signal"] == "true"))
+    stepped = bool(meta.get("stepped_sine", True))
+    if bias is not None and amp is not None:
+        amp_text = f"±{amp:g} A" if amp >= 0.1 else f"±{amp * 1e3:g} mA"
+        stim = (f"stimulus {amp_text}, " + ("large signal" if large else "small signal")
+                if stepped else "small-signal linearisation")
+        title = f"Frequency response about a {bias:g} A bias ({stim})"
+    else:
+        title = "Frequency response"
+    fig = plots.bode(frf, title=title, db=True, large_signal=large)
     am = fig.axes[0]
     temps, norm, cmap = plots._temperature_colors(frf["temperature_C"])
+    paper_f, paper_bw = meta.get("paper_first_resonance_Hz"), meta.get("paper_bandwidth_Hz_at_least")
     for T in temps:
         c = cmap(norm(T))
         s = np.isclose(summ["temperature_C"], T)
         if not np.any(s):
             continue
-        g0 = summ["static_gain_um_per_A"][s][0]
+        g0 = summ["reference_gain_um_per_A"][s][0] if "reference_gain_um_per_A" in summ else \
+            summ["static_gain_um_per_A"][s][0]
         fr = summ["first_resonance_Hz"][s][0]
         bw = summ["bandwidth_3dB_Hz"][s][0]
+        src = summ["markers_from"][s][0] if "markers_from" in summ else "linearisation"
+        parts = []
         if np.isfinite(g0) and g0 > 0:
             am.axhline(20 * np.log10(g0) - 3, color=c, ls=":", lw=0.8)
         if np.isfinite(fr) and fr > 0:
             am.axvline(fr, color=c, ls="--", lw=0.8)
-            am.annotate(f"resonance {fr:.0f} Hz", (fr, am.get_ylim()[1]), color=c, fontsize=7,
-                        rotation=90, va="top", ha="right")
+            parts.append(f"peak {fr:.0f} Hz")
         if np.isfinite(bw) and bw > 0:
             am.axvline(bw, color=c, ls=":", lw=0.8)
-            am.annotate(f"-3 dB {bw:.0f} Hz", (bw, am.get_ylim()[0]), color=c, fontsize=7,
-                        rotation=90, va="bottom", ha="right")
+            parts.append(f"−3 dB at {bw:.0f} Hz")
+        am.plot([], [], ls="--", color=c, lw=0.8,
+                label=f"{T:g} °C ({src}): " + (", ".join(parts) if parts else "no peak, no −3 dB point"))
+    am.plot([], [], ls=":", color="0.4", lw=0.8, label="−3 dB below |Y/I| at the lowest frequency")
+    if paper_f:
+        am.axvline(paper_f, color=plots.PAPER_COLOR, ls="-", lw=2.5, alpha=0.35,
+                   label=f"paper (Fig. 15): first resonance {paper_f:g} Hz")
+    if paper_bw:
+        xlim = am.get_xlim()
+        am.axvspan(paper_bw, max(xlim[1], paper_bw), color=plots.PAPER_COLOR, alpha=0.08,
+                   label=f"paper: −3 dB bandwidth > {paper_bw:g} Hz")
+        am.set_xlim(xlim[0], max(xlim[1], 1.2 * paper_bw))
+    plots._legend_outside(am)
     fig.tight_layout()
     return fig
 
 
 def sweep(out):
-    return plots.sweep_vs_temperature(read_csv(pathlib.Path(out) / "sweep.csv"))
+    """sweep.png with the paper's drops 20 -> 70 °C (Fig. 12-14) marked in grey where the sweep
+    has both temperatures and the claim's current and frequency."""
+    return plots.sweep_vs_temperature(read_csv(pathlib.Path(out) / "sweep.csv"), claims=plots.paper_claims())
 
 
 def track(out):
+    """track.png: the RMS tracking error against temperature per reference (the paper's growth
+    20 -> 70 °C of Fig. 16 marked in grey on our 20 °C error), and the first point's run: the
+    reference and y, and the error y - reference below them."""
     t = read_csv(pathlib.Path(out) / "track.csv")
     ex = read_csv(pathlib.Path(out) / "track_example.csv")
-    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4))
-    refs = sorted(set(zip(t["amplitude_um"], t["frequency_Hz"])))
-    for A, f in refs:
-        sel = np.isclose(t["amplitude_um"], A) & np.isclose(t["frequency_Hz"], f)
-        a.plot(t["temperature_C"][sel], t["error_rms_um"][sel], "o-", label=f"{A:g} µm, {f:g} Hz")
+    meta = _meta(out, "track")
+    fig = plt.figure(figsize=(12, 5.2))
+    gs = fig.add_gridspec(2, 2, height_ratios=(2, 1))
+    a = fig.add_subplot(gs[:, 0])
+    b = fig.add_subplot(gs[0, 1])
+    e = fig.add_subplot(gs[1, 1], sharex=b)
+    refs = sorted(set(zip(t["amplitude_um"], t["frequency_Hz"])), key=lambda r: (r[1], r[0]))
+    plots._plot_vs_temperature(a, t, "error_rms_um",
+                               [(np.isclose(t["amplitude_um"], A) & np.isclose(t["frequency_Hz"], f),
+                                 f"{A:g} µm, {f:g} Hz") for A, f in refs])
+    claims = plots._claims_of(plots.paper_claims(), "track_error_growth_pct")
+    marked = []
+    for c in claims:
+        ref = plots._value_at(t, "error_rms_um", temperature_C=c["reference_temperature_C"],
+                              amplitude_um=c["amplitude_um"], frequency_Hz=c["frequency_Hz"])
+        if np.isfinite(ref) and np.any(np.isclose(t["temperature_C"], c["temperature_C"])):
+            plots._mark_paper(a, c["temperature_C"], ref * (1.0 + c["paper"] / 100.0), c)
+            marked.append(c)
     a.set_xlabel("temperature (°C)")
     a.set_ylabel("RMS tracking error (µm)")
-    a.legend(fontsize=7)
-    b.plot(ex["t_s"], ex["reference_um"], label="reference")
-    b.plot(ex["t_s"], ex["y_um"], label="y")
-    b.set_xlabel("time (s)")
+    a.set_title("RMS error over the last period")
+    h, lab = plots._paper_legend(a, marked) if marked else a.get_legend_handles_labels()
+    lab = [x + ": error growth 20 → 70 °C (Fig. 16) on our 20 °C error" if x == "paper" else x for x in lab]
+    a.legend(h, lab, title="reference", fontsize=7, title_fontsize=7, loc="upper center",
+             bbox_to_anchor=(0.5, -0.13), ncol=2)
+    b.plot(ex["t_s"], ex["reference_um"], label="reference", lw=1.0)
+    b.plot(ex["t_s"], ex["y_um"], label="output y", lw=1.0, ls="--")
+    first = (f"{t['temperature_C'][0]:g} °C, {t['amplitude_um'][0]:g} µm, {t['frequency_Hz'][0]:g} Hz"
+             if len(t["temperature_C"]) else "")
+    b.set_title(f"first point ({first})")
     b.set_ylabel("displacement (µm)")
-    b.set_title("first point")
-    b.legend(fontsize=7)
-    for ax in (a, b):
+    b.tick_params(labelbottom=False)
+    plots._legend_outside(b)
+    err = ex["error_um"] if "error_um" in ex else ex["y_um"] - ex["reference_um"]
+    e.plot(ex["t_s"], err, color="tab:red", lw=0.8)
+    e.axhline(0.0, color="black", lw=0.5)
+    e.set_xlabel("time (s)")
+    e.set_ylabel("error (µm)")
+    for ax in (a, b, e):
         ax.grid(alpha=0.3)
+    gains = (f"PID kp {meta['kp_A_per_um']:g}, ki {meta['ki_A_per_um_per_sample_at_reference_rate']:g}, "
+             f"kd {meta['kd_A_per_um_per_sample_at_reference_rate']:g}" if "kp_A_per_um" in meta else "PID")
+    fig.suptitle(f"gmasim track: closed-loop tracking of a sine reference ({gains})")
     fig.tight_layout()
     return fig
 
@@ -197,28 +320,35 @@ def track_feedforward(out):
 
 
 def compensate(out):
+    """compensate.png: the solved drive (current p-p, its maximum and minimum) and the gain
+    schedule g(T) against temperature, one legend for both axes; the stroke with and without the
+    schedule against the target; with --track, the tracking errors with and without it."""
     s = read_csv(pathlib.Path(out) / "compensate.csv")
     meta = _meta(out, "compensate")
     trk = pathlib.Path(out) / "compensate_track.csv"
-    fig, axes = plt.subplots(1, 3 if trk.exists() else 2, figsize=(15 if trk.exists() else 10, 4))
+    fig, axes = plt.subplots(1, 3 if trk.exists() else 2, figsize=(16 if trk.exists() else 11.5, 4.4))
     a, b = axes[0], axes[1]
-    a.plot(s["temperature_C"], s["current_pp_A"], "o-", label="current p-p")
-    a.plot(s["temperature_C"], s["current_max_A"], "s--", label="current max")
+    a.plot(s["temperature_C"], s["current_pp_A"], "o-", label="solved current, peak to peak")
+    a.plot(s["temperature_C"], s["current_max_A"], "s--", label="solved current, maximum")
+    if "current_min_A" in s:
+        a.plot(s["temperature_C"], s["current_min_A"], "v:", label="solved current, minimum")
     a.set_xlabel("temperature (°C)")
     a.set_ylabel("current (A)")
     a2 = a.twinx()
-    a2.plot(s["temperature_C"], s["gain"], "k:", label="gain")
-    a2.set_ylabel("gain (-)")
-    a.legend(fontsize=7, loc="upper left")
-    a.set_title("gain schedule")
+    a2.plot(s["temperature_C"], s["gain"], "k-.", marker="x", label="gain g(T) (right axis)")
+    a2.set_ylabel("gain g(T) (-)")
+    h1, l1 = a.get_legend_handles_labels()
+    h2, l2 = a2.get_legend_handles_labels()
+    a.legend(h1 + h2, l1 + l2, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)
+    a.set_title("solved drive and gain schedule")
     b.plot(s["temperature_C"], s["uncompensated_stroke_um"], "o-", label="reference drive")
-    b.plot(s["temperature_C"], s["stroke_um"], "s-", label="compensated")
+    b.plot(s["temperature_C"], s["stroke_um"], "s--", label="compensated drive")
     tgt = meta.get("target_stroke_um")
     if tgt is not None:
         b.axhline(tgt, color="gray", ls=":", label=f"target {tgt:.2f} µm")
     b.set_xlabel("temperature (°C)")
     b.set_ylabel("stroke (µm)")
-    b.legend(fontsize=7)
+    b.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=3)
     b.set_title("stroke")
     if trk.exists():
         t = read_csv(trk)
@@ -231,10 +361,11 @@ def compensate(out):
                    label=f"PID + feed-forward {A:g} µm {f:g} Hz")
         c.set_xlabel("temperature (°C)")
         c.set_ylabel("RMS tracking error (µm)")
-        c.legend(fontsize=6)
+        c.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=1)
         c.set_title("tracking")
     for ax in axes:
         ax.grid(alpha=0.3)
+    fig.suptitle(f"gmasim compensate: a temperature-scheduled drive for a constant stroke ({meta.get('model', '')})")
     fig.tight_layout()
     return fig
 
@@ -255,12 +386,15 @@ def identify(out):
         cmp = o["compared"] > 0.5
         unit = c.get("response_unit", "um")
         ylabel = "strain (ppm)" if unit == "ppm" else "displacement (µm)"
-        fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
-        a1.plot(o[drive][cmp], o[measured][cmp], ".", ms=2.5, label="measured")
-        a1.plot(o[drive][cmp], o[simulated][cmp], "-", lw=1.2, label="simulated")
-        a1.set_xlabel({"current_A": "current (A)", "field_A_per_m": "field H (A/m)"}.get(drive, drive))
+        flux = "measured_flux_T" in o and np.any(np.isfinite(o["measured_flux_T"]))
+        fig, axes = plt.subplots(1, 3 if flux else 2, figsize=(16 if flux else 11, 4.2))
+        a1, a2 = axes[0], axes[1]
+        x = o[drive] / 1e3 if drive == "field_A_per_m" else o[drive]
+        a1.plot(x[cmp], o[measured][cmp], ".", ms=2.5, label="measured")
+        a1.plot(x[cmp], o[simulated][cmp], "-", lw=1.2, label="simulated")
+        a1.set_xlabel({"current_A": "current (A)", "field_A_per_m": "field H (kA/m)"}.get(drive, drive))
         a1.set_ylabel(ylabel)
-        a1.legend(loc="upper left")
+        a1.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=7)
         a1.set_title("loop (compared samples)")
         t = o[t_key]
         a2.plot(t, o[measured], ".", ms=2.0, label="measured")
@@ -269,7 +403,19 @@ def identify(out):
             a2.axvspan(t[0], t[np.argmax(cmp)], color="0.9", label="not compared")
         a2.set_xlabel("time (s)" if t_key == "t_s" else "sample (-)")
         a2.set_ylabel(ylabel)
-        a2.legend(loc="upper left")
+        a2.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=3, fontsize=7)
+        a2.set_title("record")
+        if flux:
+            a3 = axes[2]
+            a3.plot(t, o["measured_flux_T"], ".", ms=2.0, label="measured")
+            a3.plot(t, o["simulated_flux_T"], "-", lw=1.0, label="simulated")
+            a3.set_xlabel("time (s)" if t_key == "t_s" else "sample (-)")
+            a3.set_ylabel("flux density B (T)")
+            a3.set_title("flux")
+            a3.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=7)
+        for ax in axes:
+            ax.xaxis.set_major_locator(MaxNLocator(nbins=5))
+            ax.grid(alpha=0.3)
         freq = c["frequency_Hz"]
         cond = f'{c["temperature_C"]:g} °C' + (f', {c["current_pp_A"]:g} A p-p, {freq:g} Hz' if freq else "")
         fig.suptitle(f'{c["label"]}: {cond}; RMS {c.get("rms_" + unit, c.get("rms_um", float("nan"))):.3f} {"µm" if unit == "um" else unit} '
@@ -285,6 +431,8 @@ def identify(out):
                 ax.semilogy(h["evaluations"][sel], h["best_rms_pct"][sel], style, ms=3, label=phase)
         ax.set_xlabel("model evaluations (all ranks)")
         ax.set_ylabel("best weighted RMS error (%)")
+        ax.set_title(f"gmasim identify: convergence ({rep.get('model', '')})" if rep.get("model")
+                     else "gmasim identify: convergence")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend()
         fig.tight_layout()
@@ -292,7 +440,11 @@ def identify(out):
 
 
 def ablate(out):
-    return plots.ablation(read_csv(pathlib.Path(out) / "ablate.csv"))
+    meta = _meta(out, "ablate")
+    cond = (f"{meta['current_pp_A']:g} A, {meta['temperature_C']:g} °C"
+            if "current_pp_A" in meta and "temperature_C" in meta else "")
+    return plots.ablation(read_csv(pathlib.Path(out) / "ablate.csv"), condition=cond,
+                          title=f"Ablation: one temperature law frozen at {meta.get('frozen_at_C', 20):g} °C")
 
 
 def params(out):

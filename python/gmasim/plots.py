@@ -41,7 +41,31 @@ def read_csv(path) -> dict:
     return out
 
 
+_SAVE_HOOKS = []
+
+
+def add_save_hook(fn):
+    """Registers fn(fig, stem), called by :func:`save` before a figure is written (e.g. the
+    tests' :func:`gmasim.figure_check.problems` collector); returns fn (usable as a decorator)."""
+    _SAVE_HOOKS.append(fn)
+    return fn
+
+
+def remove_save_hook(fn):
+    if fn in _SAVE_HOOKS:
+        _SAVE_HOOKS.remove(fn)
+
+
 def save(fig, directory, stem: str) -> list[pathlib.Path]:
+    """Writes directory/stem.png and .svg atomically. With GMASIM_FIGURE_CHECK=1 in the
+    environment the figure is first checked (gmasim.figure_check: title, axis labels with units,
+    no overlapping texts, no legend over a line) and not written if it fails."""
+    for hook in list(_SAVE_HOOKS):
+        hook(fig, stem)
+    if os.environ.get("GMASIM_FIGURE_CHECK") == "1":
+        from . import figure_check
+
+        figure_check.check(fig, stem)
     directory = pathlib.Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     out = []
@@ -67,7 +91,7 @@ def save(fig, directory, stem: str) -> list[pathlib.Path]:
 # frequency_Hz, amplitude_um). Figures mark the paper's value as a diamond: green edge when
 # the claim passes, red edge and the claim id when it fails.
 
-PASS_COLOR, FAIL_COLOR = "#1a9641", "#d7191c"
+PASS_COLOR, FAIL_COLOR, PAPER_COLOR = "#1a9641", "#d7191c", "#555555"
 
 
 def read_claims(path) -> list[dict]:
@@ -76,6 +100,14 @@ def read_claims(path) -> list[dict]:
 
     with open(path) as f:
         return json.load(f)["tables"]["claims"]["rows"]
+
+
+def paper_claims() -> list[dict]:
+    """The paper's numbers of the built-in claims (data/claims.toml) as claim rows without our
+    values (``pass`` None): the single commands' figures mark them in grey."""
+    from . import _gmasim
+
+    return list(_gmasim.paper_claims())
 
 
 def _claims_of(claims, kind, **cond):
@@ -89,38 +121,68 @@ def _claims_of(claims, kind, **cond):
     return out
 
 
+def _claim_color(claim):
+    if claim.get("pass") is None:
+        return PAPER_COLOR
+    return PASS_COLOR if claim.get("pass") else FAIL_COLOR
+
+
 def _mark_paper(ax, x, y, claim, label_text=None):
-    """The paper's value of one claim at (x, y): a diamond, its edge the pass/fail colour."""
+    """The paper's value of one claim at (x, y): a diamond, its edge the pass/fail colour (grey
+    when the claim was not evaluated); a failing claim is labelled ✗ on the side of the point
+    that faces the middle of the axes, so the label stays inside the panel."""
     if not (np.isfinite(x) and np.isfinite(y)):
         return
-    ok = bool(claim.get("pass"))
-    col = PASS_COLOR if ok else FAIL_COLOR
+    col = _claim_color(claim)
     ax.plot([x], [y], "D", ms=7, mfc="white", mec=col, mew=1.8, zorder=5)
-    if not ok or label_text:
-        ax.annotate(label_text or f"✗ {claim['id']}", (x, y), xytext=(4, 4), textcoords="offset points",
-                    fontsize=6.5, color=col)
+    states = getattr(ax.figure, "_gmasim_paper_states", set())
+    states.add(claim.get("pass"))
+    ax.figure._gmasim_paper_states = states  # the legend explains only the markers drawn
+    if claim.get("pass") is False or label_text:
+        def upper(v, lo, hi, log):
+            return np.log(v) > 0.5 * (np.log(lo) + np.log(hi)) if log and v > 0 and lo > 0 else v > 0.5 * (lo + hi)
+
+        right = upper(x, *ax.get_xlim(), ax.get_xscale() == "log")
+        top = upper(y, *ax.get_ylim(), ax.get_yscale() == "log")
+        ax.annotate(label_text or "✗", (x, y), xytext=(-5 if right else 5, -5 if top else 5),
+                    textcoords="offset points", fontsize=6.5, color=col, ha="right" if right else "left",
+                    va="top" if top else "bottom")
 
 
-def _paper_legend(ax):
+def _paper_legend(ax, claims=None):
     from matplotlib.lines import Line2D
 
     h, lab = ax.get_legend_handles_labels()
-    h += [Line2D([], [], ls="", marker="D", mfc="white", mec=PASS_COLOR, mew=1.8),
-          Line2D([], [], ls="", marker="D", mfc="white", mec=FAIL_COLOR, mew=1.8)]
-    lab += ["paper (claim passes)", "paper (claim fails)"]
+    kinds = getattr(ax.figure, "_gmasim_paper_states", None)
+    if kinds is None:
+        kinds = {c.get("pass") for c in claims} if claims else {True, False}
+    for state, col, text in ((True, PASS_COLOR, "paper (claim passes)"), (False, FAIL_COLOR, "paper (claim fails, ✗)"),
+                             (None, PAPER_COLOR, "paper")):
+        if state in kinds:
+            h.append(Line2D([], [], ls="", marker="D", mfc="white", mec=col, mew=1.8))
+            lab.append(text)
     return h, lab
 
 
-def _finish_axes(ax, legend_title, claims, title=None):
+def _legend_outside(ax, handles=None, labels=None, title=None, fontsize=7):
+    """A legend to the right of the axes, where it cannot cover a line."""
+    if handles is None:
+        handles, labels = ax.get_legend_handles_labels()
+    return ax.legend(handles, labels, title=title, fontsize=fontsize, title_fontsize=fontsize,
+                     loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
+
+
+def _finish_axes(ax, legend_title, claims, title=None, outside=True):
     """Grid and legend of a panel (with the paper's markers explained when claims are drawn),
-    and its title if given."""
+    and its title if given. The legend sits outside the axes unless ``outside`` is False."""
     if title is not None:
         ax.set_title(title)
     ax.grid(alpha=0.3)
-    if claims:
-        ax.legend(*_paper_legend(ax), title=legend_title, fontsize=7)
+    h, lab = _paper_legend(ax, claims) if claims else ax.get_legend_handles_labels()
+    if outside:
+        _legend_outside(ax, h, lab, title=legend_title)
     else:
-        ax.legend(title=legend_title, fontsize=8)
+        ax.legend(h, lab, title=legend_title, fontsize=7, title_fontsize=7)
 
 
 def _value_at(cols, y, **cond):
@@ -137,11 +199,22 @@ def _temperature_colors(temps):
     return temps, norm, cmap
 
 
+_MARKERS = ("o", "s", "^", "D", "v", "P", "X")
+_LINESTYLES = ("-", "--", "-.", ":")
+
+
 def _plot_vs_temperature(ax, cols: Columns, y: str, groups, **style):
-    """One line of cols[y] against temperature per (row mask, label) group."""
-    for sel, label in groups:
+    """One line of cols[y] against temperature per (row mask, label) group; each group its own
+    marker and line style, later groups drawn thinner and on top, so coinciding lines stay
+    distinguishable."""
+    n = max(len(groups), 1)
+    for k, (sel, label) in enumerate(groups):
         order = np.argsort(cols["temperature_C"][sel])
-        ax.plot(cols["temperature_C"][sel][order], cols[y][sel][order], "o-", label=label, **style)
+        kw = dict(marker=_MARKERS[k % len(_MARKERS)], ls=_LINESTYLES[k % len(_LINESTYLES)],
+                  ms=max(7.0 - 4.0 * k / n, 3.0), lw=max(2.2 - 1.2 * k / n, 1.0), mfc="none" if k % 2 else None,
+                  zorder=2 + k)
+        kw.update(style)
+        ax.plot(cols["temperature_C"][sel][order], cols[y][sel][order], label=label, **kw)
 
 
 def hysteresis_loops(loops: Columns, title="Hysteresis loops coloured by temperature"):
@@ -158,7 +231,7 @@ def hysteresis_loops(loops: Columns, title="Hysteresis loops coloured by tempera
     ax.set_ylabel("output displacement y (µm)")
     ax.set_title(title)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, ncol=2, loc="upper left")
+    ax.legend(fontsize=7, ncol=min(len(temps), 5), loc="upper center", bbox_to_anchor=(0.5, -0.14))
     return fig
 
 
@@ -186,57 +259,66 @@ def sweep_vs_temperature(sweep: Columns, frequency_Hz: float | None = None,
     for ax, lab in zip(axes, ("stroke (µm)", "hysteresis (µm)", "flux density B, peak-to-peak (T)")):
         ax.set_xlabel("temperature (°C)")
         ax.set_ylabel(lab)
-        _finish_axes(ax, "current p-p", claims)
-    fig.suptitle(f"{title} ({frequency_Hz:g} Hz)")
+        ax.grid(alpha=0.3)
+    _finish_axes(axes[-1], "current p-p", claims)
+    fig.suptitle(f"{title} ({frequency_Hz:g} Hz)" + (
+        "\n◇ the paper's change from 20 °C (Fig. 12-14), drawn on our 20 °C value" if claims else ""))
     fig.tight_layout()
     return fig
 
 
-def bode(frf: Columns, title="Frequency response, current to displacement", claims=None, db=False):
+def bode(frf: Columns, title="Frequency response, current to displacement", claims=None, db=False,
+         large_signal=False):
     """Columns temperature_C, frequency_Hz, stepped_mag_um_per_A, stepped_phase_deg,
     linear_mag_um_per_A, linear_phase_deg (NaN where a method was not run).
 
     The magnitude on a log axis in µm/A, or with `db` in dB re 1 µm/A (20 log10 |Y/I|). With
     `claims`, the paper's first resonance (Fig. 15) is marked on our curve at its
-    temperature, and its bandwidth bounds as vertical lines coloured pass/fail."""
+    temperature, and its bandwidth bound as a vertical line coloured pass/fail (grey when the
+    claim was not evaluated). ``large_signal``: the linearised curves are labelled as the
+    small-signal linearisation the stepped sine departs from. Legends sit outside the axes."""
     temps, norm, cmap = _temperature_colors(frf["temperature_C"])
     freq = frf["frequency_Hz"] if "frequency_Hz" in frf else frf["f_Hz"]
-    fig, (am, ap) = plt.subplots(2, 1, figsize=(6.8, 6), sharex=True)
+    fig, (am, ap) = plt.subplots(2, 1, figsize=(8.4, 6.2), sharex=True)
 
     def magnitude(m):
         return 20 * np.log10(m) if db else m
 
     plot_mag = am.semilogx if db else am.loglog
+    lin_label = "small-signal linearisation" if large_signal else "linearised"
     for T in temps:
         sel = np.isclose(frf["temperature_C"], T)
         f = freq[sel]
         c = cmap(norm(T))
         if np.any(np.isfinite(frf["linear_mag_um_per_A"][sel])):
-            plot_mag(f, magnitude(frf["linear_mag_um_per_A"][sel]), "-", color=c, label=f"{T:g} °C, linearised")
-            ap.semilogx(f, frf["linear_phase_deg"][sel], "-", color=c)
+            plot_mag(f, magnitude(frf["linear_mag_um_per_A"][sel]), "--" if large_signal else "-", color=c,
+                     lw=1.0 if large_signal else 1.5, label=f"{T:g} °C, {lin_label}")
+            ap.semilogx(f, frf["linear_phase_deg"][sel], "--" if large_signal else "-", color=c)
         if np.any(np.isfinite(frf["stepped_mag_um_per_A"][sel])):
-            plot_mag(f, magnitude(frf["stepped_mag_um_per_A"][sel]), "o", ms=3.5, mfc="none", color=c,
-                     label=f"{T:g} °C, stepped sine")
-            ap.semilogx(f, frf["stepped_phase_deg"][sel], "o", ms=3.5, mfc="none", color=c)
-    mag = np.where(np.isfinite(frf["linear_mag_um_per_A"]), frf["linear_mag_um_per_A"],
-                   frf["stepped_mag_um_per_A"])
+            plot_mag(f, magnitude(frf["stepped_mag_um_per_A"][sel]), "o-" if large_signal else "o", ms=3.5,
+                     mfc="none", lw=0.8, color=c, label=f"{T:g} °C, stepped sine")
+            ap.semilogx(f, frf["stepped_phase_deg"][sel], "o-" if large_signal else "o", ms=3.5, mfc="none",
+                        lw=0.8, color=c)
+    drawn = frf["stepped_mag_um_per_A"] if large_signal else frf["linear_mag_um_per_A"]
+    mag = np.where(np.isfinite(drawn), drawn,
+                   frf["linear_mag_um_per_A"] if large_signal else frf["stepped_mag_um_per_A"])
     for c in _claims_of(claims, "first_resonance_Hz"):
         sel = np.isclose(frf["temperature_C"], c["temperature_C"])
         if np.any(sel):
             order = np.argsort(freq[sel])
             y = float(np.interp(c["paper"], freq[sel][order], mag[sel][order]))
-            _mark_paper(am, c["paper"], magnitude(y), c, None if not c.get("pass") else f"paper: {c['paper']:g} Hz")
+            _mark_paper(am, c["paper"], magnitude(y), c, None if c.get("pass") is False else
+                        f"paper: {c['paper']:g} Hz")
     for c in _claims_of(claims, "bandwidth_Hz"):
-        col = PASS_COLOR if c.get("pass") else FAIL_COLOR
-        am.axvline(c["paper"], color=col, ls=":", lw=1)
-        am.text(c["paper"], am.get_ylim()[0], f" {c['id']}: > {c['paper']:g} Hz" +
-                ("" if c.get("pass") else " ✗"), color=col, fontsize=6.5, va="bottom", rotation=90)
+        am.axvline(c["paper"], color=_claim_color(c), ls=":", lw=1.2,
+                   label=f"paper: −3 dB bandwidth > {c['paper']:g} Hz" + (" ✗" if c.get("pass") is False else ""))
     am.set_ylabel("|Y/I| (dB re 1 µm/A)" if db else "|Y/I| (µm/A)")
     ap.set_ylabel("phase (°)")
     ap.set_xlabel("frequency (Hz)")
     for ax in (am, ap):
         ax.grid(alpha=0.3, which="both")
-    am.legend(fontsize=7)
+    _legend_outside(am, *(_paper_legend(am, _claims_of(claims, "first_resonance_Hz"))
+                          if _claims_of(claims, "first_resonance_Hz") else (None, None)))
     am.set_title(title)
     fig.tight_layout()
     return fig
@@ -270,9 +352,7 @@ def retention(ret: Columns, title="Stroke retention against temperature (10 Hz)"
                          [(np.isclose(ret["current_pp_A"], I), f"{I:g} A") for I in sorted(set(ret["current_pp_A"]))])
     marked = _claims_of(claims, "stroke_retention_pct")
     for paper, T in sorted({(c["paper"], c["temperature_C"]) for c in marked}):
-        ax.axhline(paper, color="gray", ls=":", lw=1)
-        ax.text(ax.get_xlim()[0], paper, f" paper: ≈{paper:g} % at {T:g} °C", color="gray", fontsize=7,
-                va="bottom")
+        ax.axhline(paper, color="gray", ls=":", lw=1, label=f"paper: ≈{paper:g} % at {T:g} °C (Fig. 18)")
     for c in marked:
         _mark_paper(ax, c["temperature_C"], c["paper"], c)
     ax.set_xlabel("temperature (°C)")
@@ -282,52 +362,90 @@ def retention(ret: Columns, title="Stroke retention against temperature (10 Hz)"
 
 
 def params_vs_temperature(p: Columns, title="Model parameters against temperature (8 A, 10 Hz)", claims=None):
-    """Columns temperature_C, rod (name), mu_r_mean, rho_ohm_m, M_peak_A_per_m, E_G_mean_GPa, E_t_GPa.
-    With `claims`, the paper's E_G rise (section 4.4.4) is marked at the rods' mean E_G at
-    20 degC times (1 + rise)."""
-    panels = [("mu_r_mean", "μ_G/μ0, mean (-)"), ("rho_ohm_m", "ρ_G (Ω m)"),
-              ("M_peak_A_per_m", "M_G, peak (A/m)"), ("E_G_mean_GPa", "E_G, mean (GPa)"),
-              ("E_t_GPa", "E_t (GPa)")]
-    fig, axes = plt.subplots(1, 5, figsize=(17, 3.6))
-    for ax, (key, lab) in zip(axes, panels):
-        _plot_vs_temperature(ax, p, key, [(p["rod"] == rod, str(rod)) for rod in sorted(set(p["rod"]))], ms=3)
+    """Columns temperature_C, rod (name), mu_r_mean, rho_ohm_m, M_peak_A_per_m, (MsT_A_per_m,)
+    E_G_mean_GPa, E_t_GPa: a 2 x 3 grid, one quantity per panel, each defined in its title; ρ in
+    µΩ m and M in kA/m (no offset labels). With `claims`, the paper's E_G rise (section 4.4.4)
+    is marked at the rods' mean E_G at 20 degC times (1 + rise)."""
+    panels = [("mu_r_mean", 1.0, "μ_G/μ0 (-)", "relative permeability, mean over the loop (eq. 3)"),
+              ("rho_ohm_m", 1e6, "ρ_G (µΩ m)", "resistivity ρ_G (eq. 8)"),
+              ("M_peak_A_per_m", 1e-3, "M_G, peak (kA/m)", "magnetisation, peak |M| over the loop"),
+              ("MsT_A_per_m", 1e-3, "M_s^T (kA/m)", "saturation magnetisation M_s^T (eq. 4)"),
+              ("E_G_mean_GPa", 1.0, "E_G (GPa)", "rod modulus E_G, mean over the loop (eq. 13)"),
+              ("E_t_GPa", 1.0, "E_t (GPa)", "E_t: modulus of the steel sleeve (eq. 19)")]
+    panels = [q for q in panels if q[0] in p]
+    fig, axes = plt.subplots(2, 3, figsize=(12.5, 7.2))
+    axes = axes.ravel()
+    rods = sorted(set(p["rod"]))
+    for ax, (key, scale, lab, what) in zip(axes, panels):
+        scaled = dict(p)
+        scaled[key] = np.asarray(p[key], dtype=float) * scale
+        _plot_vs_temperature(ax, scaled, key, [(p["rod"] == rod, str(rod)) for rod in rods], ms=4)
         ax.set_xlabel("temperature (°C)")
         ax.set_ylabel(lab)
+        ax.set_title(what, fontsize=9)
+        ax.ticklabel_format(axis="y", useOffset=False, style="plain")
         ax.grid(alpha=0.3)
-    for c in _claims_of(claims, "EG_rise_pct"):
-        ref = _value_at(p, "E_G_mean_GPa", temperature_C=c["reference_temperature_C"])
-        _mark_paper(axes[3], c["temperature_C"], ref * (1.0 + c["paper"] / 100.0), c)
-    if claims:
-        axes[3].legend(*_paper_legend(axes[3]), fontsize=7)
-    axes[0].legend(fontsize=8)
+        if key == "E_G_mean_GPa":
+            for c in _claims_of(claims, "EG_rise_pct"):
+                ref = _value_at(p, "E_G_mean_GPa", temperature_C=c["reference_temperature_C"])
+                _mark_paper(ax, c["temperature_C"], ref * (1.0 + c["paper"] / 100.0), c)
+    for ax in axes[len(panels):]:
+        fig.delaxes(ax)
+    h, lab = axes[0].get_legend_handles_labels()
+    if claims and _claims_of(claims, "EG_rise_pct"):
+        h, lab = _paper_legend(axes[0], _claims_of(claims, "EG_rise_pct"))
+        lab = [t if not t.startswith("paper") else t + ": E_G rise 20 → 150 °C, on our 20 °C mean" for t in lab]
+    fig.legend(h, lab, loc="lower center", ncol=len(h), fontsize=8, bbox_to_anchor=(0.5, 0.0))
     fig.suptitle(title)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.05, 1, 1))
     return fig
 
 
+# The ablated laws (gmasim ablate, docs/experiments.md) by the quantity each freezes.
+LAW_LABELS = {"mu_G": "μ_G (eq. 3)", "rho_G": "ρ_G (eq. 8)", "M": "M_s^T (eq. 4)", "M_G": "M_G",
+              "E_G": "E_G (eq. 13)", "E_t": "E_t (eq. 19)", "F_pm": "F_pm (eq. 1)", "all": "all laws"}
+
+
 def ablation(ab: Columns, laws: Sequence[str] | None = None,
-             title="Ablation: one temperature law frozen at 20 °C"):
-    """Columns law, frequency_Hz, error_rms_um (or `laws` naming the rows in order)."""
+             title="Ablation: one temperature law frozen at 20 °C", condition="6 A, 70 °C"):
+    """Columns law, frequency_Hz, error_rms_um and (when present) error_pct_of_stroke (or `laws`
+    naming the rows in order). The change of the output in % of the stroke, as the paper gives
+    it, beside the same in µm."""
     if laws is None:
         laws = list(ab["law"])
     freqs = sorted(set(ab["frequency_Hz"]))
     names = list(dict.fromkeys(laws))
     x = np.arange(len(names))
     w = 0.8 / max(len(freqs), 1)
-    fig, ax = plt.subplots(figsize=(6.8, 4.2))
-    for k, f in enumerate(freqs):
-        vals = []
-        for n in names:
-            idx = [i for i, (law, ff) in enumerate(zip(laws, ab["frequency_Hz"])) if law == n and np.isclose(ff, f)]
-            vals.append(ab["error_rms_um"][idx[0]] if idx else np.nan)
-        ax.bar(x + (k - (len(freqs) - 1) / 2) * w, vals, w, label=f"{f:g} Hz")
-    ax.set_xticks(x, names)
-    ax.set_xlabel("law whose temperature dependence is frozen")
-    ax.set_ylabel("RMS change of the output vs full model (µm)")
-    ax.set_title(title)
-    ax.grid(alpha=0.3, axis="y")
-    ax.legend(title="excitation (6 A, 70 °C)", fontsize=8)
+    keys = [k for k in ("error_pct_of_stroke", "error_rms_um") if k in ab]
+    ylabels = {"error_pct_of_stroke": "RMS change of the output (% of the stroke)",
+               "error_rms_um": "RMS change of the output (µm)"}
+    fig, axes = plt.subplots(1, len(keys), figsize=(6.0 * len(keys) + 1.4, 4.4), squeeze=False)
+    for ax, key in zip(axes[0], keys):
+        for k, f in enumerate(freqs):
+            vals = []
+            for n in names:
+                idx = [i for i, (law, ff) in enumerate(zip(laws, ab["frequency_Hz"]))
+                       if law == n and np.isclose(ff, f)]
+                vals.append(ab[key][idx[0]] if idx else np.nan)
+            ax.bar(x + (k - (len(freqs) - 1) / 2) * w, vals, w, label=f"{f:g} Hz")
+        ax.set_xticks(x, [LAW_LABELS.get(str(n), str(n)) for n in names], fontsize=8,
+                      rotation=60 if len(names) > 3 else 0, ha="right" if len(names) > 3 else "center",
+                      rotation_mode="anchor")
+        ax.set_xlabel("law whose temperature dependence is frozen")
+        ax.set_ylabel(ylabels[key])
+        ax.grid(alpha=0.3, axis="y")
+    _legend_outside(axes[0][-1], title=f"excitation ({condition})")
+    fig.suptitle(title)
+    fig.tight_layout()
     return fig
+
+
+def _claim_label(c, width=58):
+    """A claim in words (its ``claim`` text, shortened), not its code identifier."""
+    text = str(c.get("claim") or c.get("id", "")).replace("degC", "°C").replace(" -> ", " → ")
+    text = text if len(text) <= width else text[:width - 1] + "…"
+    return text + (" (fit)" if c.get("fitted") else "")
 
 
 def claims_overview(claims: Sequence[dict], title="The paper's claims: ours against the paper"):
@@ -335,7 +453,7 @@ def claims_overview(claims: Sequence[dict], title="The paper's claims: ours agai
     paper), green when the claim passes, red when it fails; rankings and bounds without a
     number are listed with their result."""
     rows = [c for c in claims if c.get("result") != "n/a"]
-    fig, ax = plt.subplots(figsize=(7.4, 0.26 * len(rows) + 1.4))
+    fig, ax = plt.subplots(figsize=(9.0, 0.26 * len(rows) + 1.4))
     y = np.arange(len(rows))[::-1]
     for yi, c in zip(y, rows):
         col = PASS_COLOR if c.get("pass") else FAIL_COLOR
@@ -350,16 +468,18 @@ def claims_overview(claims: Sequence[dict], title="The paper's claims: ours agai
                 if rc != r:
                     ax.text(rc, yi + 0.25, f"×{r:.3g} ", color=col, fontsize=6.5, ha="right" if r > 1 else "left")
                 continue
-        ax.text(1.0, yi, f" {c.get('result')}: {c.get('tolerance', '')}", color=col, fontsize=6.5,
-                va="center")
+        rule = str(c.get("tolerance", ""))
+        rule = rule if len(rule) <= 40 else rule[:39] + "…"
+        ax.text(1.0, yi, f" {c.get('result')}: {rule}", color=col, fontsize=6.5, va="center")
     ax.axvline(1.0, color="black", lw=0.8)
     ax.set_xscale("log")
     ax.set_xlim(0.1, 10.0)
-    ax.set_yticks(y, [f"{'✓' if c.get('pass') else '✗'} {c['id']}" for c in rows], fontsize=7)
+    ax.set_yticks(y, [f"{'✓' if c.get('pass') else '✗'} {_claim_label(c)}" for c in rows], fontsize=7)
     for t, c in zip(ax.get_yticklabels(), rows):
         t.set_color(PASS_COLOR if c.get("pass") else FAIL_COLOR)
     npass = sum(1 for c in rows if c.get("pass"))
     ax.set_xlabel("ours / paper (log; 1 = the paper's number)")
+    ax.set_ylabel("claim (✓ passes, ✗ fails)")
     ax.set_title(f"{title}: {npass} of {len(rows)} pass")
     ax.grid(alpha=0.3, axis="x", which="both")
     fig.tight_layout()

@@ -16,4 +16,6 @@ void bind_experiments(pybind11::module_& mod);  // experiments.cpp
 void bind_stepper(pybind11::module_& mod);      // stepper.cpp: Stepper, __version__
 void bind_parameters(pybind11::module_& mod);   // parameters.cpp: parameter_table()
 void bind_sensitivity(pybind11::module_& mod);  // sensitivity.cpp: _sensitivity
+// paper_claims.cpp: paper_claims()
+void bind_paper_claims(pybind11::module_& mod);
 }  // namespace gmasim::py_bind

@@ -397,4 +397,5 @@ PYBIND11_MODULE(_gmasim, mod) {
   gmasim::py_bind::bind_stepper(mod);
   gmasim::py_bind::bind_parameters(mod);
   gmasim::py_bind::bind_sensitivity(mod);
+  gmasim::py_bind::bind_paper_claims(mod);
 }

@@ -20,3 +20,14 @@ def mdma():
     import gmasim
 
     return gmasim.Model()
+
+
+@pytest.fixture(scope="session")
+def reproduce_quick(gmasim_bin, tmp_path_factory):
+    """The output directory of one `gmasim reproduce --quick` (with its figures), shared by the
+    tests that read it (test_reproduce, test_figure_check)."""
+    import subprocess
+
+    out = tmp_path_factory.mktemp("reproduce") / "rep"
+    subprocess.run([gmasim_bin, "reproduce", "--quick", "--out", str(out)], check=True, capture_output=True)
+    return out

@@ -109,8 +109,12 @@ def test_paper_markers_sit_at_the_papers_number_and_flag_failures():
     assert got[0][:2] == pytest.approx((70.0, 50.0 * (1 - 0.113)), rel=1e-12)
     assert got[1][:2] == pytest.approx((70.0, 80.0 * (1 - 0.126)), rel=1e-12)
     assert got[0][2] == plots.PASS_COLOR and got[1][2] == plots.FAIL_COLOR
-    assert any("stroke_drop_8A" in t.get_text() for t in stroke.texts)  # the failure is named
-    assert not any("stroke_drop_6A" in t.get_text() for t in stroke.texts)
+    # the failure is marked ✗ beside its diamond, on the side facing the panel's middle (so the
+    # label stays inside the panel), and explained in the legend; no code identifiers (issue 20)
+    assert [t.get_text() for t in stroke.texts] == ["✗"]
+    assert stroke.texts[0].get_horizontalalignment() == "right"  # 70 degC: the right edge
+    legend = fig.axes[-1].get_legend()
+    assert any("claim fails" in t.get_text() for t in legend.get_texts())
     assert _diamonds(hyst) == []
     assert _diamonds(flux)[0][:2] == pytest.approx((70.0, 0.3 * (1 - 0.056)), rel=1e-12)
     _check_axes(fig)

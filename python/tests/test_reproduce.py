@@ -1,11 +1,9 @@
 """`gmasim reproduce` writes the report with every figure and the claims table."""
 import csv
-import subprocess
 
 
-def test_reproduce_quick_writes_report_figures_and_claims(gmasim_bin, tmp_path):
-    out = tmp_path / "rep"
-    subprocess.run([gmasim_bin, "reproduce", "--quick", "--out", str(out)], check=True, capture_output=True)
+def test_reproduce_quick_writes_report_figures_and_claims(reproduce_quick):
+    out = reproduce_quick
     report = (out / "report.md").read_text()
     for stem in ("claims", "loops_8A_10Hz", "sweep_10Hz", "frf", "track", "retention", "params_vs_temperature",
                  "ablate"):

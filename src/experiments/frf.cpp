@@ -9,6 +9,7 @@
 #include <cmath>
 #include <complex>
 
+#include "experiments/frf_internal.hpp"
 #include "experiments/parallel.hpp"
 #include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
@@ -412,12 +413,14 @@ double settling_time_s(const SmallSignalModel& lin) {
   return t_settle;
 }
 
+}  // namespace
+
 // One stepped-sine point: the sine switched on at the bias state, >= min_steps_per_period
 // steps per period with dt <= 10 us (whole steps per period); settled for settling_time_s and
 // at least settle_periods periods (low frequencies need few periods, high frequencies many),
 // then the first harmonic of y over measure_periods whole periods.
-cd stepped_sine_point(const Model& m, const Conditions& c, const State& bias,
-                      const SmallSignalModel& lin, const FrfRequest& r, double fr) {
+cd detail::stepped_sine_point(const Model& m, const Conditions& c, const State& bias,
+                              const SmallSignalModel& lin, const FrfRequest& r, double fr) {
   const long per =
       steps_to_resolve(1.0 / (fr * kMaxDt_s), r.min_steps_per_period, "steps per period");
   const double dt = 1.0 / (fr * static_cast<double>(per));
@@ -445,6 +448,8 @@ cd stepped_sine_point(const Model& m, const Conditions& c, const State& bias,
   return first_harmonic_ratio(ts, ys, is, fr);
 }
 
+namespace {
+
 // The bias point's curve: the bias output, the eddy lags, the modes, the static gain.
 FrfCurve bias_curve(const Model& m, const Conditions& c, const State& bias,
                     const SmallSignalModel& lin, double T, const std::vector<double>& f) {
@@ -464,6 +469,7 @@ FrfCurve bias_curve(const Model& m, const Conditions& c, const State& bias,
 // Magnitudes and unwrapped phases of both methods, their mismatch, resonance and bandwidth.
 void fill_curve(FrfCurve& cv, const SmallSignalModel& lin, const cd* stepped,
                 const std::vector<double>& f, const FrfRequest& r) {
+  cv.f_Hz = f;
   double prev_l = 0.0, prev_s = 0.0;
   for (std::size_t fi = 0; fi < f.size(); ++fi) {
     if (r.small_signal) {
@@ -487,17 +493,10 @@ void fill_curve(FrfCurve& cv, const SmallSignalModel& lin, const cd* stepped,
     }
   }
   if (r.stepped_sine) {
-    cv.stepped_first_resonance_Hz = find_resonance_Hz(f, cv.stepped_mag_um_per_A);
+    cv.stepped_first_resonance_Hz = detail::data_peak(f, cv.stepped_mag_um_per_A).f_Hz;
     cv.stepped_bandwidth_3dB_Hz = find_bandwidth_3dB_Hz(f, cv.stepped_mag_um_per_A);
   }
-  if (!r.small_signal) {
-    cv.first_resonance_Hz = cv.stepped_first_resonance_Hz;
-    cv.bandwidth_3dB_Hz = cv.stepped_bandwidth_3dB_Hz;
-    for (std::size_t k = 0; k < f.size(); ++k)
-      if (f[k] == cv.first_resonance_Hz)
-        cv.first_resonance_mag_um_per_A = cv.stepped_mag_um_per_A[k];
-    return;
-  }
+  if (!r.small_signal) return;  // markers from the stepped sine (detail::choose_markers)
   // Resonance and bandwidth of the linear model on a dense grid (cheap to evaluate).
   const std::vector<double> fd = log_grid(r.f_min_Hz, r.f_max_Hz, 4000);
   std::vector<double> md(fd.size());
@@ -548,14 +547,29 @@ FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progres
         n, resolve_thread_count(r.threads, n),
         [&](std::size_t idx) {
           const std::size_t ti = idx / nf, fi = idx % nf;
-          stepped[idx] = stepped_sine_point(m, conds[ti], bias[ti], lin[ti], r, f[fi]);
+          stepped[idx] = detail::stepped_sine_point(m, conds[ti], bias[ti], lin[ti], r, f[fi]);
         },
         progress);
   } else if (progress) {
     progress(nT, nT);
   }
-  for (std::size_t ti = 0; ti < nT; ++ti)
-    fill_curve(res.curves[ti], lin[ti], stepped.data() + ti * nf, f, r);
+  // The stepped sine's peak refined per temperature (golden section in ln f, frf_peak.cpp).
+  std::vector<detail::SteppedCurve> sc(nT);
+  for (std::size_t ti = 0; ti < nT; ++ti) {
+    sc[ti].f_Hz = f;
+    sc[ti].Y.assign(stepped.begin() + static_cast<std::ptrdiff_t>(ti * nf),
+                    stepped.begin() + static_cast<std::ptrdiff_t>((ti + 1) * nf));
+  }
+  if (r.stepped_sine && r.peak_refinements > 0)
+    detail::parallel_for(nT, resolve_thread_count(r.threads, nT),
+                         [&](std::size_t ti) {
+                           detail::refine_stepped_peak(m, conds[ti], bias[ti], lin[ti], r, sc[ti]);
+                         },
+                         {});
+  for (std::size_t ti = 0; ti < nT; ++ti) {
+    fill_curve(res.curves[ti], lin[ti], sc[ti].Y.data(), sc[ti].f_Hz, r);
+    detail::choose_markers(res.curves[ti], lin[ti], conds[ti], r);
+  }
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   for (auto& cv : res.curves) cv.wall_time_s = wall;

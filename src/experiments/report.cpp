@@ -57,6 +57,7 @@ Report frf_report(const Model& m, const FrfRequest& req, const FrfResult& res) {
   Report r = base("frf", m);
   r.meta.emplace_back("bias_A", req.bias_A);
   r.meta.emplace_back("amplitude_A", req.amplitude_A);
+  r.meta.emplace_back("peak_refinements", req.peak_refinements);
   r.meta.emplace_back("bias_state",
                       req.bias_state == BiasState::Anhysteretic ? "anhysteretic" : "initial_curve");
   r.meta.emplace_back("stepped_sine", req.stepped_sine);
@@ -75,7 +76,8 @@ Report frf_report(const Model& m, const FrfRequest& req, const FrfResult& res) {
             {"temperature_C", "first_resonance_Hz", "linear_peak_extended_Hz",
              "linear_peak_search_max_Hz", "bandwidth_3dB_Hz", "stepped_first_resonance_Hz",
              "stepped_bandwidth_3dB_Hz", "static_gain_um_per_A", "y_bias_um", "max_mismatch_pct",
-             "paper_first_resonance_Hz", "paper_bandwidth_Hz_at_least"},
+             "paper_first_resonance_Hz", "paper_bandwidth_Hz_at_least", "small_signal_limit_A",
+             "large_signal", "markers_from", "reference_gain_um_per_A"},
             {}};
   Table modes{"modes",
               {"temperature_C", "mode", "frequency_Hz", "damping_ratio", "damped_frequency_Hz"},
@@ -100,7 +102,9 @@ Report frf_report(const Model& m, const FrfRequest& req, const FrfResult& res) {
                         c.linear_peak_search_max_Hz, c.bandwidth_3dB_Hz,
                         c.stepped_first_resonance_Hz, c.stepped_bandwidth_3dB_Hz,
                         c.static_gain_um_per_A, c.y_bias_um, c.max_mismatch_pct,
-                        res.paper_first_resonance_Hz, res.paper_bandwidth_Hz});
+                        res.paper_first_resonance_Hz, res.paper_bandwidth_Hz,
+                        std::isfinite(c.small_signal_limit_A) ? c.small_signal_limit_A : nan,
+                        c.large_signal, c.markers_from, c.reference_gain_um_per_A});
     for (std::size_t k = 0; k < c.mode_frequencies_Hz.size(); ++k) {
       const double z = c.mode_damping_ratios[k];
       modes.rows.push_back({c.temperature_C, static_cast<int>(k + 1), c.mode_frequencies_Hz[k], z,

@@ -1,0 +1,256 @@
+"""An automated reading of a matplotlib figure: what a reader needs before the data.
+
+:func:`problems` draws the figure (the Agg canvas, as :func:`gmasim.plots.save` would) and
+returns one sentence per defect, using matplotlib's own text extents (every visible Text's
+``get_window_extent`` with the figure's renderer):
+
+- no title (an axes title or the figure's suptitle);
+- an axes without an x or y label, or whose label has no unit in parentheses, e.g.
+  "frequency (Hz)"; a categorical axis (text tick labels) needs no unit, a dimensionless
+  quantity says "(-)" or "(%)"; shared axes may carry the label on a sibling; colorbars are
+  checked for a label only;
+- two visible texts whose extents overlap by more than ``tolerance_px`` in both directions
+  (titles, axis labels, tick labels, legend texts and titles, annotations, figure texts);
+- a legend that covers a plotted line (a sample of the line, 16 points per segment, inside the
+  legend's frame);
+- an axis offset label ("1e-7" above the axis: the unit should be scaled instead), and an
+  annotation that runs outside its axes (into a neighbour, or clipped at the figure's edge).
+A figure of several panels needs a title above them all (suptitle); one panel, its own.
+
+:func:`check` raises :class:`FigureProblem` with all of them. :func:`gmasim.plots.save` runs
+the check before it writes anything when the environment sets ``GMASIM_FIGURE_CHECK=1``
+(the tests; a figure that fails is not written), and calls every function registered with
+:func:`gmasim.plots.add_save_hook`.
+"""
+from __future__ import annotations
+
+import re
+
+import numpy as np
+from matplotlib.legend import Legend
+from matplotlib.lines import Line2D
+from matplotlib.text import Text
+
+_UNIT = re.compile(r"\([^()]*\)|\[[^\[\]]*\]")
+
+
+class FigureProblem(AssertionError):
+    """A figure a reader cannot read alone (the sentences in ``problems``)."""
+
+    def __init__(self, name, found):
+        self.problems = list(found)
+        super().__init__(f"{name}: " + "; ".join(self.problems))
+
+
+def _is_colorbar(ax) -> bool:
+    return ax.get_label() == "<colorbar>" or hasattr(ax, "_colorbar")
+
+
+def _has_content(ax) -> bool:
+    return bool(ax.lines or ax.collections or ax.patches or ax.images or ax.texts)
+
+
+def _categorical(labels) -> bool:
+    for t in labels:
+        s = t.get_text().replace("−", "-").strip()
+        if not s or "$" in s:
+            continue
+        try:
+            float(s)
+        except ValueError:
+            return True
+    return False
+
+
+def _visible_ticklabels(axis):
+    """The tick labels matplotlib draws: ticks within the view interval, visible, non-empty."""
+    if not axis.get_visible():
+        return []
+    lo, hi = sorted(axis.get_view_interval())
+    span = hi - lo
+    out = []
+    for ticks, locs in ((axis.get_major_ticks(len(axis.get_majorticklocs())), axis.get_majorticklocs()),
+                        (axis.get_minor_ticks(len(axis.get_minorticklocs())), axis.get_minorticklocs())):
+        for tick, loc in zip(ticks, locs):
+            if not (lo - 1e-9 * span <= loc <= hi + 1e-9 * span):
+                continue
+            for lab in (tick.label1, tick.label2):
+                if lab.get_visible() and lab.get_text():
+                    out.append(lab)
+    return out
+
+
+def _label_of(ax, which):
+    get = "get_xlabel" if which == "x" else "get_ylabel"
+    own = getattr(ax, get)()
+    if own:
+        return own
+    shared = ax.get_shared_x_axes() if which == "x" else ax.get_shared_y_axes()
+    return next((getattr(o, get)() for o in shared.get_siblings(ax) if getattr(o, get)()), "")
+
+
+def _label_problems(fig) -> list[str]:
+    out = []
+    panels = [ax for ax in fig.axes if ax.get_visible() and not _is_colorbar(ax) and _has_content(ax)]
+    suptitle = fig._suptitle is not None and bool(fig._suptitle.get_text())
+    titled = any(ax.get_title(loc=loc) for ax in panels for loc in ("left", "center", "right"))
+    hosts = {ax.bbox.bounds for ax in panels}  # a twin shares its host's box
+    columns = {(round(b[0]), round(b[2])) for b in hosts}
+    top = max(panels, key=lambda ax: ax.bbox.y1) if panels else None
+    if len(columns) == 1 and top is not None and top.get_title():
+        titled, hosts = True, {top.bbox.bounds}  # one column of panels (a Bode plot): the top one's title
+    if len(hosts) > 1 and not suptitle:
+        out.append("no title (a figure of several panels needs one above them all)")
+    elif not (suptitle or titled):
+        out.append("no title")
+    for n, ax in enumerate(fig.axes):
+        if not ax.get_visible() or not ax.axison:
+            continue
+        name = ax.get_title() or f"axes {n}"
+        if _is_colorbar(ax):
+            if not (ax.get_ylabel() or ax.get_xlabel()):
+                out.append(f"colorbar of {name}: no label")
+            continue
+        if not _has_content(ax) and not ax.get_ylabel():
+            continue
+        for which, axis in (("x", ax.xaxis), ("y", ax.yaxis)):
+            ticks = _visible_ticklabels(axis)
+            if which == "x" and not any(t.get_visible() for t in ticks) and not ax.get_xlabel():
+                # an x axis without tick labels is shared with the panel below it
+                shared = ax.get_shared_x_axes().get_siblings(ax)
+                if len(shared) > 1:
+                    continue
+            label = _label_of(ax, which)
+            if which == "x" and not label and ax.get_ylabel() and len(fig.axes) > 1:
+                # a twin (twinx) carries only its y label; the x axis is its host's
+                if any(o is not ax and o.bbox.bounds == ax.bbox.bounds and o.get_xlabel() for o in fig.axes):
+                    continue
+            if not label:
+                out.append(f"{name}: no {which} label")
+            elif not _UNIT.search(label) and not _categorical(ticks):
+                out.append(f"{name}: {which} label '{label}' has no unit in parentheses")
+    return out
+
+
+def _texts(fig):
+    """Every visible, non-empty Text the figure draws, with a short name."""
+    found = []
+
+    def add(t, what):
+        if isinstance(t, Text) and t.get_visible() and t.get_text().strip() and t.get_alpha() != 0:
+            found.append((t, what))
+
+    add(fig._suptitle, "suptitle")
+    for t in fig.texts:
+        if t is not fig._suptitle and t is not getattr(fig, "_supxlabel", None) \
+                and t is not getattr(fig, "_supylabel", None):
+            add(t, "figure text")
+    add(getattr(fig, "_supxlabel", None), "x label")
+    add(getattr(fig, "_supylabel", None), "y label")
+    for leg in fig.legends:
+        for t in leg.get_texts():
+            add(t, "legend")
+        add(leg.get_title(), "legend title")
+    for ax in fig.axes:
+        if not ax.get_visible():
+            continue
+        for loc, t in (("left", ax._left_title), ("center", ax.title), ("right", ax._right_title)):
+            add(t, "title")
+        if ax.axison:
+            for axis, w in ((ax.xaxis, "x label"), (ax.yaxis, "y label")):
+                if axis.get_visible():
+                    add(axis.label, w)
+            for t in _visible_ticklabels(ax.xaxis):
+                add(t, "x tick")
+            for t in _visible_ticklabels(ax.yaxis):
+                add(t, "y tick")
+            add(ax.xaxis.get_offset_text(), "x offset")
+            add(ax.yaxis.get_offset_text(), "y offset")
+        for t in ax.texts:
+            add(t, "annotation")
+        leg = ax.get_legend()
+        if leg is not None and leg.get_visible():
+            for t in leg.get_texts():
+                add(t, "legend")
+            add(leg.get_title(), "legend title")
+    return found
+
+
+def _layout_problems(fig, renderer) -> list[str]:
+    """Offset labels ('1e-7' above an axis: scale the unit instead) and annotations that run
+    outside their axes (into a neighbour, or clipped at the figure's edge)."""
+    out = []
+    for ax in fig.axes:
+        if not ax.get_visible():
+            continue
+        for axis, which in ((ax.xaxis, "x"), (ax.yaxis, "y")):
+            off = axis.get_offset_text()
+            if axis.get_visible() and off.get_visible() and off.get_text().strip():
+                out.append(f"{ax.get_title() or 'an axes'}: {which} axis offset label "
+                           f"'{off.get_text()}' (scale the unit instead)")
+        box = ax.get_window_extent(renderer)
+        for t in ax.texts:
+            if not t.get_visible() or not t.get_text().strip():
+                continue
+            e = t.get_window_extent(renderer)
+            if e.x0 < box.x0 - 1 or e.x1 > box.x1 + 1 or e.y0 < box.y0 - 1 or e.y1 > box.y1 + 1:
+                out.append(f"annotation '{t.get_text()[:40]}' runs outside its axes "
+                           f"'{ax.get_title() or 'an axes'}'")
+    return out
+
+
+def _overlap_problems(fig, renderer, tolerance_px) -> list[str]:
+    texts = _texts(fig)
+    boxes = np.array([t.get_window_extent(renderer).extents for t, _ in texts]).reshape(-1, 4)
+    out = []
+    for i in range(len(texts)):
+        x0, y0, x1, y1 = boxes[i]
+        dx = np.minimum(x1, boxes[i + 1:, 2]) - np.maximum(x0, boxes[i + 1:, 0])
+        dy = np.minimum(y1, boxes[i + 1:, 3]) - np.maximum(y0, boxes[i + 1:, 1])
+        for j in np.nonzero((dx > tolerance_px) & (dy > tolerance_px))[0]:
+            (a, wa), (b, wb) = texts[i], texts[i + 1 + j]
+            out.append(f"{wa} '{a.get_text()[:40]}' overlaps {wb} '{b.get_text()[:40]}'")
+    return out
+
+
+def _legend_cover_problems(fig, renderer) -> list[str]:
+    out = []
+    for ax in fig.axes:
+        leg = ax.get_legend()
+        if not isinstance(leg, Legend) or not leg.get_visible():
+            continue
+        box = leg.get_window_extent(renderer)
+        for ln in ax.lines:
+            if not isinstance(ln, Line2D) or not ln.get_visible() or ln.get_label().startswith("_child"):
+                continue
+            xy = np.column_stack([np.asarray(ln.get_xdata(), float), np.asarray(ln.get_ydata(), float)])
+            xy = xy[np.all(np.isfinite(xy), axis=1)]
+            if len(xy) == 0:
+                continue
+            pts = ln.get_transform().transform(xy)
+            if ln.get_linestyle() not in ("None", "", " ") and len(pts) > 1:
+                s = np.linspace(0.0, 1.0, 16)[:, None, None]
+                pts = (pts[:-1] * (1 - s) + pts[1:] * s).reshape(-1, 2)
+            ab = ax.get_window_extent(renderer)
+            inside_ax = ((pts[:, 0] >= ab.x0) & (pts[:, 0] <= ab.x1) & (pts[:, 1] >= ab.y0) & (pts[:, 1] <= ab.y1))
+            hit = inside_ax & (pts[:, 0] > box.x0) & (pts[:, 0] < box.x1) & (pts[:, 1] > box.y0) & (pts[:, 1] < box.y1)
+            if np.any(hit):
+                label = ln.get_label() if not ln.get_label().startswith("_") else "a line"
+                out.append(f"the legend of '{ax.get_title() or 'an axes'}' covers '{label}'")
+                break
+    return out
+
+
+def problems(fig, tolerance_px: float = 1.0) -> list[str]:
+    """The defects of a figure (an empty list when it reads alone); draws it first."""
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    return (_label_problems(fig) + _overlap_problems(fig, renderer, tolerance_px)
+            + _legend_cover_problems(fig, renderer) + _layout_problems(fig, renderer))
+
+
+def check(fig, name: str = "figure") -> None:
+    """Raises FigureProblem listing the defects of ``fig``."""
+    found = problems(fig)
+    if found:
+        raise FigureProblem(name, found)

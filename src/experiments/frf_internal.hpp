@@ -1,0 +1,49 @@
+// Internal: the pieces of gmasim frf shared by frf.cpp and frf_peak.cpp (the stepped-sine
+// point, the adaptive refinement of its peak, the small-signal limit of the stimulus and the
+// choice of the markers). docs/experiments.md, "Frequency response".
+#pragma once
+
+#include <complex>
+#include <vector>
+
+#include "gmasim/experiments.hpp"
+
+namespace gmasim::detail {
+
+// One stepped-sine point at fr Hz from the settled bias state (frf.cpp).
+std::complex<double> stepped_sine_point(const Model& m, const Conditions& c, const State& bias,
+                                        const SmallSignalModel& lin, const FrfRequest& r,
+                                        double fr);
+
+// A stepped-sine curve: frequencies (ascending) and Y/I [m/A].
+struct SteppedCurve {
+  std::vector<double> f_Hz;
+  std::vector<std::complex<double>> Y;
+};
+
+// Golden-section search in ln f for the largest |Y/I| of the stepped sine between the grid
+// neighbours of its largest local maximum (r.peak_refinements evaluations); the points it
+// evaluated are merged into the curve. No local maximum in the band: the curve is unchanged.
+void refine_stepped_peak(const Model& m, const Conditions& c, const State& bias,
+                         const SmallSignalModel& lin, const FrfRequest& r, SteppedCurve& curve);
+
+// The largest local maximum of mag over f (any spacing): the vertex of the parabola in ln f
+// through it and its neighbours. {0, 0} when there is none.
+struct Peak {
+  double f_Hz = 0, mag = 0;
+};
+Peak data_peak(const std::vector<double>& f, const std::vector<double>& mag);
+
+// Largest stimulus amplitude [A] for which the field excursion of every rod stays within
+// kSmallSignalFraction of its reversible range c k / (1 - c) (eq. 9): the static field gains
+// dH_i/dI of the linearisation times the amplitude. Infinite when no rod has a finite range.
+inline constexpr double kSmallSignalFraction = 0.1;
+double small_signal_limit_A(const SmallSignalModel& lin, const Conditions& c);
+
+// Sets cv's small-signal limit, large_signal flag, markers_from and the markers (resonance,
+// bandwidth, the -3 dB reference gain) from the data the figure draws: the stepped sine when
+// the stimulus is large (or the linearisation is off), the linearisation otherwise.
+void choose_markers(FrfCurve& cv, const SmallSignalModel& lin, const Conditions& c,
+                    const FrfRequest& r);
+
+}  // namespace gmasim::detail
