@@ -177,7 +177,7 @@ TEST(Energy, EddyLossOfALinearRodMatchesTheClosedForm) {
   const double R1 = 1e7, R2 = 2e7, p1 = rod_flux(R1), p2 = rod_flux(R2);
   const double S = (R2 * p2 - R1 * p1) / (p1 - p2);  // phi = b/(R_rod + S)
   const double b = p1 * (R1 + S);                    // At per A
-  const double chi = rc.MsT_ja / (3.0 * rc.ja.a_A_per_m);
+  const double chi = rc.MsT_mag / (3.0 * rc.ja.a_A_per_m);
   const double mu = physics::kMu0 * (1.0 + chi);
   const double l = rc.length_m, A = rc.area_m2, kappa = rc.eddy_geometry_s_m_per_H;
   const double f = 200.0, w = 2.0 * physics::kPi * f, I = 1e-2;
@@ -211,7 +211,7 @@ TEST(Energy, JilesAthertonSplitClosesAndDissipatesPositively) {
   const Conditions c = make_conditions(mdma(), 20.0);
   const auto& rc = c.rods[0];
   const auto& p = rc.ja;
-  const double Ms = rc.MsT_ja;
+  const double Ms = rc.MsT_mag;
   auto phi = [&](double H, double M, double Mirr) {
     return physics::ja_stored_energy_density(
         H, M, Mirr, physics::anhysteretic_field(Mirr, Ms, p.a_A_per_m), Ms, p);

@@ -434,12 +434,12 @@ TEST(Consistent, JaStepSlopeIsTheFiniteDifferenceDerivative) {
     for (double target : cs.history)
       for (int k = 1; k <= 200; ++k) {
         const double Hn = H + (target - H) / (201 - k);
-        physics::ja_step(H, Hn, rc.MsT_ja, rc.ja, Mirr0, M0);
+        physics::ja_step(H, Hn, rc.MsT_mag, rc.ja, Mirr0, M0);
         H = Hn;
       }
     auto M_at = [&](double H1, double* slope) {
       double Mirr = Mirr0, M = M0;
-      physics::ja_step(H, H1, rc.MsT_ja, rc.ja, Mirr, M, M, slope);
+      physics::ja_step(H, H1, rc.MsT_mag, rc.ja, Mirr, M, M, slope);
       return M;
     };
     double slope = 0.0;

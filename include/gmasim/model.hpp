@@ -13,6 +13,7 @@
 #include "gmasim/parameters.hpp"
 #include "gmasim/physics/jiles_atherton.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
+#include "gmasim/physics/preisach.hpp"
 
 namespace gmasim {
 
@@ -50,6 +51,7 @@ struct Options {
   Eq11Saturation eq11_saturation = Eq11Saturation::Reference;
   bool thermal_expansion_in_output = false;
   bool geometry_thermal_expansion = true;
+  MagnetisationLaw magnetisation_law = MagnetisationLaw::JilesAtherton;
   bool operator==(const Options&) const = default;
 };
 
@@ -170,13 +172,25 @@ struct JaReference {
   double a0_A_per_m, alpha0, c0, k0_A_per_m, beta1, beta2, beta3;
 };
 
+// The Preisach law's constants at T_ref ([<rod>.preisach]; docs/model.md, "The Preisach law").
+struct PreisachReference {
+  double Hc0_A_per_m = 0;  // median coercive field of the hysterons at T_ref
+  double sigma_c = 0;      // log-normal width of the coercive fields
+  double Hu0_A_per_m = 0;  // standard deviation of the interaction fields at T_ref
+  double n_c = 0;          // coercivity law H_c^T = H_c0 (M_s^T / M_s)^n_c
+  double c0 = 0;           // reversible fraction
+  double a0_A_per_m = 0;   // reversible Langevin shape at T_ref (a^T = a0 T/T_ref)
+  double alpha0 = 0;       // mean-field coupling
+};
+
 struct RodModel {
   std::string name;
   double length_m, outer_diameter_m, inner_diameter_m, mass_kg;  // at T_ref
-  double k_f, k_j;           // eq. (7) flux-leakage and eddy-current factors
-  double joint_gap_m;        // consistent reading: equivalent air gap of the rod's joints
-  double damping_N_s_per_m;  // c_i of eq. (25)
-  JaReference ja;
+  double k_f, k_j;               // eq. (7) flux-leakage and eddy-current factors
+  double joint_gap_m;            // consistent reading: equivalent air gap of the rod's joints
+  double damping_N_s_per_m;      // c_i of eq. (25)
+  JaReference ja;                // the Jiles-Atherton law's constants (options.magnetisation_law)
+  PreisachReference preisach{};  // the Preisach law's
 };
 
 struct Material {  // Terfenol-D, shared by the rods
@@ -275,12 +289,14 @@ Model compile(const ModelSpec& spec);
 // ---------------------------------------------------------------------------------------
 struct RodConditions {
   double length_m, area_m2, r_outer_m, r_inner_m;
-  double MsT_mu, MsT_ja, MsT_E;    // M_s^T of eq. (4) as seen by eq. (3), (9)/(11), (13)
-  double Ms_strain_A_per_m;        // the M_s that normalises M in eq. (11) (Eq11Saturation)
-  double S_mu_J_per_m3;            // stress term of eq. (3)
-  physics::DeltaETerms dE;         // eq. (13) constants
-  physics::JaCoefficients ja;      // eq. (10) at T
-  double rho_ohm_m;                // eq. (8)
+  double MsT_mu, MsT_mag, MsT_E;           // M_s^T of eq. (4) as seen by eq. (3), the magnetisation
+                                           // law (eq. 9) and eq. (11), and eq. (13)
+  double Ms_strain_A_per_m;                // the M_s that normalises M in eq. (11) (Eq11Saturation)
+  double S_mu_J_per_m3;                    // stress term of eq. (3)
+  physics::DeltaETerms dE;                 // eq. (13) constants
+  physics::JaCoefficients ja;              // eq. (10) at T (the Jiles-Atherton law)
+  physics::PreisachCoefficients preisach;  // the Preisach law's at T
+  double rho_ohm_m;                        // eq. (8)
   double eddy_geometry_s_m_per_H;  // kappa of eq. (7): tau = mu kappa; H_c - H = kappa dB/dt
   double alpha_sigma;              // eq. (3) stress terms as a JA coupling S / (mu0 Ms^2) [-]
   double sigma_Pa;                 // signed prestress used in eq. (3), (6), (13)
@@ -332,8 +348,9 @@ Conditions make_conditions(const Model& m, double temperature_C, const Freeze& f
 struct RodState {
   // integrated state
   double H_A_per_m = 0;     // eddy-filtered field (eq. 7); stage 2: the lag (consistent: Newton)
-  double Mirr_A_per_m = 0;  // irreversible magnetisation (eq. 9); stage 2: ja_step
-  double x_m = 0, v_m_per_s = 0;  // stage 3: oscillator_step (eq. 15); make_state: x = F / K
+  double Mirr_A_per_m = 0;  // irreversible magnetisation (eq. 9); stage 2: the JA law's state
+  physics::PreisachHistory preisach;  // the Preisach law's state (its extrema); stage 2
+  double x_m = 0, v_m_per_s = 0;      // stage 3: oscillator_step (eq. 15); make_state: x = F / K
   // kept for the next step (hold values, warm starts)
   double Hc_A_per_m = 0;      // static field of eq. (7) at the end of the last step; stage 2
   double H_prev_A_per_m = 0;  // H one step earlier (consistent state: Newton's first guess);
@@ -391,8 +408,24 @@ struct StepInput {
   double dt_s;       // step length
 };
 
-// Advances the state by one step. Allocation-free. Throws DivergenceError.
+// Advances the state by one step. Allocation-free. Throws DivergenceError. Dispatches on
+// options.magnetisation_law at each call; a time loop dispatches once (run_loop.hpp) and calls
+// step_law<Law> (the same step, compiled for one law: gmasim/magnetisation/laws.hpp).
 void step(const Model& m, const Conditions& c, State& s, const StepInput& in);
+struct JilesAthertonLaw;
+struct PreisachLaw;
+template <class Law>
+void step_law(const Model& m, const Conditions& c, State& s, const StepInput& in);
+template <class Law>
+void quasi_static_step_law(const Model& m, const Conditions& c, State& s, double current_A);
+extern template void step_law<JilesAthertonLaw>(const Model&, const Conditions&, State&,
+                                                const StepInput&);
+extern template void step_law<PreisachLaw>(const Model&, const Conditions&, State&,
+                                           const StepInput&);
+extern template void quasi_static_step_law<JilesAthertonLaw>(const Model&, const Conditions&,
+                                                             State&, double);
+extern template void quasi_static_step_law<PreisachLaw>(const Model&, const Conditions&, State&,
+                                                        double);
 
 // Reference integrator: one plain explicit RK4 step of the same equations, with the state
 // (H, M_irr, x, v) of every rod integrated as an ODE in time and the circuit solved at each

@@ -12,6 +12,8 @@
 #include <string>
 #include <string_view>
 
+#include "gmasim/magnetisation/law_id.hpp"
+
 namespace gmasim {
 
 struct Model;
@@ -48,7 +50,8 @@ enum class Group {
   Preload,           // [preload]
   Magnet,            // [magnet] (optional, every key defaulted)
   Rod,               // [<rod>] for each rod of stack.rods
-  RodJa,             // [<rod>.ja]
+  RodJa,             // [<rod>.ja] (the Jiles-Atherton law)
+  RodPreisach,       // [<rod>.preisach] (the Preisach law)
   Element,           // [mechanics.elements.<name>]
   SensorMount,       // [mechanics.sensor_mount] (optional)
   SleeveModulus,     // [mechanics.sleeve_modulus] (optional, every key defaulted)
@@ -73,6 +76,9 @@ struct GroupDef {
   std::string_view path;  // dotted path of its table; "<rod>", "<name>" stand for instances
   TableRule table;
   std::string_view doc;
+  // A magnetisation law's group: read, required and landed only in a model that selects the
+  // law (options.magnetisation_law); absent: every model's.
+  std::optional<MagnetisationLaw> law = std::nullopt;
 };
 
 // A cross-field rule: the value must lie below / above another parameter's value. `other` is
@@ -120,6 +126,8 @@ struct OptionDef {
   int (*reads)(const Options&);
   std::string_view lands_in;  // "Options::magnetic_state"
   std::string_view doc;
+  // The word a model file may omit the option with (empty: the option is required).
+  std::string_view default_word = {};
 };
 
 std::span<const GroupDef> parameter_groups();

@@ -141,16 +141,16 @@ double current_of(D& drive, const State& st, const StepPoint& p) {
 
 // One step of the grid: the drive's current (checked), step() or quasi_static_step(), the
 // grid time, the outputs (checked), the recorder.
-template <bool kQuasiStatic, class D, class R>
+template <class Law, bool kQuasiStatic, class D, class R>
 inline void advance(const Model& m, const Conditions& c, State& st, const StepPoint& p, D& drive,
                     R& record) {
   const double current_A = current_of(drive, st, p);
   if (!std::isfinite(current_A)) [[unlikely]]
     throw_not_finite(p.t_s, "coil current [A] from the drive", current_A);
   if constexpr (kQuasiStatic) {
-    quasi_static_step(m, c, st, current_A);
+    quasi_static_step_law<Law>(m, c, st, current_A);
   } else {
-    step(m, c, st, {current_A, p.dt_s});
+    step_law<Law>(m, c, st, {current_A, p.dt_s});
     st.t_s = p.t_s;
   }
   if (!std::isfinite(st.y_m)) [[unlikely]]
@@ -160,16 +160,31 @@ inline void advance(const Model& m, const Conditions& c, State& st, const StepPo
   check_physical_validity(m, c, st, p.t_s);  // gmasim/validity.hpp (issue 19, item 3)
   record(std::as_const(st), p);
 }
+// The loop of run_loop() for one magnetisation law.
+template <class Law, class D, class R>
+void run_grid(const Model& m, const Conditions& c, State& st, const StepGrid& g, D& drive,
+              R& record);
+
 }  // namespace run_loop_detail
 
 // Runs the grid from the state st (which it advances): for each step, the drive's current,
 // step() (or quasi_static_step()), then the recorder. `c` is read at every step, so a
 // recorder that owns the Conditions object may assign new conditions between steps
 // (self-heating does). Throws DivergenceError (from step() or the checks above) with the
-// steps before it recorded; allocation-free when the drive and the recorder are.
+// steps before it recorded; allocation-free when the drive and the recorder are. The
+// magnetisation law is dispatched here, once per run (step_law<Law> inside the loop).
 template <StepDrive D, StepRecorder R>
 void run_loop(const Model& m, const Conditions& c, State& st, const StepGrid& g, D&& drive,
               R&& record) {
+  if (m.options.magnetisation_law == MagnetisationLaw::Preisach)
+    run_loop_detail::run_grid<PreisachLaw>(m, c, st, g, drive, record);
+  else
+    run_loop_detail::run_grid<JilesAthertonLaw>(m, c, st, g, drive, record);
+}
+
+template <class Law, class D, class R>
+void run_loop_detail::run_grid(const Model& m, const Conditions& c, State& st, const StepGrid& g,
+                               D& drive, R& record) {
   StepPoint p;
   switch (g.clock) {
     case StepClock::Uniform:
@@ -179,7 +194,7 @@ void run_loop(const Model& m, const Conditions& c, State& st, const StepGrid& g,
         p.k = k;
         p.sample = k - 1;
         p.t_s = g.t0_s + static_cast<double>(k) * g.dt_s;
-        run_loop_detail::advance<false>(m, c, st, p, drive, record);
+        run_loop_detail::advance<Law, false>(m, c, st, p, drive, record);
       }
       return;
     case StepClock::Spanning: {
@@ -191,7 +206,7 @@ void run_loop(const Model& m, const Conditions& c, State& st, const StepGrid& g,
         p.t_s = k == g.steps ? g.t1_s : g.t0_s + static_cast<double>(k) * g.dt_s;
         p.dt_s = p.t_s - t_prev;
         t_prev = p.t_s;
-        run_loop_detail::advance<false>(m, c, st, p, drive, record);
+        run_loop_detail::advance<Law, false>(m, c, st, p, drive, record);
       }
       return;
     }
@@ -206,7 +221,7 @@ void run_loop(const Model& m, const Conditions& c, State& st, const StepGrid& g,
           p.k = j * g.substeps + q;
           p.substep = q;
           p.t_s = t_sample + static_cast<double>(q) * g.dt_s;
-          run_loop_detail::advance<false>(m, c, st, p, drive, record);
+          run_loop_detail::advance<Law, false>(m, c, st, p, drive, record);
         }
       }
       return;
@@ -216,7 +231,7 @@ void run_loop(const Model& m, const Conditions& c, State& st, const StepGrid& g,
         p.k = k;
         p.sample = k - 1;
         p.t_s = st.t_s;
-        run_loop_detail::advance<true>(m, c, st, p, drive, record);
+        run_loop_detail::advance<Law, true>(m, c, st, p, drive, record);
       }
       return;
   }
@@ -235,7 +250,10 @@ inline void run_loop_step(const Model& m, const Conditions& c, State& st, long k
   p.dt_s = dt_s;
   HeldCurrent drive{current_A};
   NoRecorder record;
-  run_loop_detail::advance<false>(m, c, st, p, drive, record);
+  if (m.options.magnetisation_law == MagnetisationLaw::Preisach)
+    run_loop_detail::advance<PreisachLaw, false>(m, c, st, p, drive, record);
+  else
+    run_loop_detail::advance<JilesAthertonLaw, false>(m, c, st, p, drive, record);
 }
 
 // run_loop without a recorder.

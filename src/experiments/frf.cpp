@@ -14,7 +14,7 @@
 #include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
-#include "gmasim/physics/jiles_atherton.hpp"
+#include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
@@ -86,6 +86,14 @@ std::vector<double> log_grid(double f0, double f1, int n) {
 // ---------------------------------------------------------------------------------------
 namespace {
 
+// dM/dH with the irreversible state held: the magnetisation law's (the seam,
+// gmasim/magnetisation/laws.hpp).
+double reversible_susceptibility(const Model& m, const RodConditions& rc, const RodState& r) {
+  return with_magnetisation_law(m.options.magnetisation_law, [&](auto law) {
+    return decltype(law)::reversible_susceptibility(rc, r);
+  });
+}
+
 // Consistent magnetic state: the circuit seen from the rod branches. With rod reluctances R_p
 // and extra rod MMFs e, the rod fluxes solve (R_p + S) phi = b I + e (netlist.cpp), whatever
 // R_p; probe it. Then per rod the port constants, chi and tau.
@@ -124,9 +132,7 @@ void linearise_ports(const Model& m, const Conditions& c, const State& s, Circui
     L.length_m.push_back(rc.length_m);
     L.kappa_s_m_per_H.push_back(rc.eddy_geometry_s_m_per_H);
     L.area_m2.push_back(rc.area_m2);
-    const double He = r.H_A_per_m + rc.ja.alpha * r.M_A_per_m;
-    const double dMan = anhysteretic_slope(He, rc.MsT_ja, rc.ja.a_A_per_m);
-    const double chi = rc.ja.c * dMan / (1.0 - rc.ja.alpha * rc.ja.c * dMan);
+    const double chi = reversible_susceptibility(m, rc, r);
     L.chi.push_back(chi);
     L.tau_s.push_back(kMu0 * (1.0 + chi) * rc.eddy_geometry_s_m_per_H);
   }
@@ -156,9 +162,7 @@ void linearise_circuit(const Model& m, const Conditions& c, const State& s, Circ
     const auto& rc = c.rods[i];
     const auto& r = s.rods[i];
     L.tau_s.push_back(mu_at(m, i, rc, r.M_A_per_m) * rc.eddy_geometry_s_m_per_H);
-    const double He = r.H_A_per_m + rc.ja.alpha * r.M_A_per_m;
-    const double dMan = anhysteretic_slope(He, rc.MsT_ja, rc.ja.a_A_per_m);
-    L.chi.push_back(rc.ja.c * dMan / (1.0 - rc.ja.alpha * rc.ja.c * dMan));
+    L.chi.push_back(reversible_susceptibility(m, rc, r));
   }
 }
 
@@ -168,7 +172,7 @@ void linearise_forces(const Model& m, const Conditions& c, const State& s,
   const std::size_t n = s.rods.size();
   L.D_N_per_A_per_m.assign(n * n, 0.0);
   for (std::size_t j = 0; j < n; ++j) {
-    const double dM = 1e-5 * c.rods[j].MsT_ja;
+    const double dM = 1e-5 * c.rods[j].MsT_mag;
     State sp = s, sm = s;
     const auto fp = force_at(m, c.rods[j], M0[j] + dM);
     const auto fm = force_at(m, c.rods[j], M0[j] - dM);

@@ -4,8 +4,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "gmasim/errors.hpp"
 #include "gmasim/experiments.hpp"
-#include "gmasim/physics/jiles_atherton.hpp"
+#include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/run_loop.hpp"
 
 namespace gmasim {
@@ -24,6 +25,7 @@ void run_dc(const Model& m, const Conditions& c, State& s, double I, double dura
 // The printed reading: put each rod on its anhysteretic curve, M_irr = M = M_an(H + alpha M),
 // at the field it sees; the circuit then moves the field (mu depends on M), so repeat until the
 // fixed point holds, with DC steps in between that let H, the circuit and the mechanics follow.
+template <class Law>
 void anhysteretic_fixed_point(const Model& m, const Conditions& c, State& s, double bias_A) {
   double tau_max = 0.0;
   for (const auto& r : s.rods) tau_max = std::max(tau_max, r.tau_s);
@@ -32,13 +34,8 @@ void anhysteretic_fixed_point(const Model& m, const Conditions& c, State& s, dou
     for (std::size_t i = 0; i < s.rods.size(); ++i) {
       const auto& rc = c.rods[i];
       auto& r = s.rods[i];
-      JaCoefficients anh = rc.ja;
-      anh.c = 1.0;  // M = M_an(H + alpha M)
-      const double M =
-          ja_total_magnetisation(r.H_A_per_m, r.M_A_per_m, r.M_A_per_m, rc.MsT_ja, anh);
-      change = std::max(change, std::fabs(M - r.Mirr_A_per_m) / rc.MsT_ja);
-      r.Mirr_A_per_m = M;
-      r.M_A_per_m = M;
+      const double M = Law::anhysteretic_magnetisation(rc, r);
+      change = std::max(change, Law::hold_anhysteretic(r, M) / rc.MsT_mag);
       r.M_prev_A_per_m = M;
     }
     run_dc(m, c, s, bias_A, std::max(5.0 * tau_max, 1e-3));
@@ -46,9 +43,12 @@ void anhysteretic_fixed_point(const Model& m, const Conditions& c, State& s, dou
   }
 }
 
-}  // namespace
-
-State settle_at_bias(const Model& m, const Conditions& c, double bias_A, BiasState bias_state) {
+template <class Law>
+State settle_law(const Model& m, const Conditions& c, double bias_A, BiasState bias_state) {
+  if (bias_state == BiasState::Anhysteretic && !Law::kHasAnhysteretic)
+    throw InputError(
+        "the anhysteretic bias state is not available for options.magnetisation_law = "
+        "\"preisach\"; use the initial curve (frf --bias-state initial-curve)");
   State s;
   if (bias_state == BiasState::Anhysteretic &&
       m.options.magnetic_state == MagneticState::Consistent) {
@@ -58,15 +58,15 @@ State settle_at_bias(const Model& m, const Conditions& c, double bias_A, BiasSta
     // does not converge when a rod's series reluctance makes its branch nearly flux-driven).
     // Then M_irr = M_an = M, where the full law of eq. (9) holds the same state.
     Conditions anh = c;
-    for (auto& rc : anh.rods) rc.ja.c = 1.0;
+    for (auto& rc : anh.rods) Law::reduce_to_anhysteretic(rc);
     s = make_state(m, anh, bias_A);
     for (auto& r : s.rods) {
-      r.Mirr_A_per_m = r.M_A_per_m;
+      (void)Law::hold_anhysteretic(r, r.M_A_per_m);
       r.M_prev_A_per_m = r.M_A_per_m;
     }
   } else {
     s = make_state(m, c, bias_A);  // virgin curve, static equilibrium
-    if (bias_state == BiasState::Anhysteretic) anhysteretic_fixed_point(m, c, s, bias_A);
+    if (bias_state == BiasState::Anhysteretic) anhysteretic_fixed_point<Law>(m, c, s, bias_A);
   }
   double tau_max = 0.0;
   for (const auto& r : s.rods) tau_max = std::max(tau_max, r.tau_s);
@@ -74,6 +74,14 @@ State settle_at_bias(const Model& m, const Conditions& c, double bias_A, BiasSta
   run_dc(m, c, s, bias_A, std::max(20.0 * tau_max, 10e-3));
   s.t_s = 0.0;
   return s;
+}
+
+}  // namespace
+
+State settle_at_bias(const Model& m, const Conditions& c, double bias_A, BiasState bias_state) {
+  return with_magnetisation_law(m.options.magnetisation_law, [&](auto law) {
+    return settle_law<decltype(law)>(m, c, bias_A, bias_state);
+  });
 }
 
 }  // namespace gmasim

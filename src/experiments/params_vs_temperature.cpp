@@ -104,7 +104,7 @@ void add_law_rows(const Model& m, const ParamsVsTemperatureRequest& r,
       row.temperature_C = r.temperatures_C[ti];
       row.rod = m.rods[k].name;
       row.rho_ohm_m = c.rods[k].rho_ohm_m;
-      row.MsT_A_per_m = c.rods[k].MsT_ja;
+      row.MsT_A_per_m = c.rods[k].MsT_mag;
       row.E_t_GPa = c.Et_Pa * 1e-9;
       if (run.diverged) {
         row.mu_r_mean = row.M_peak_A_per_m = row.E_G_mean_GPa = nan;

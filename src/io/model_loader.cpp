@@ -310,6 +310,7 @@ void ModelLoader::read_options(const toml::table& root) {
   const long tl = node_line(*t);
   bool ok = true;
   for (const auto& o : option_table()) {
+    if (!o.default_word.empty() && !t->get(o.key)) continue;  // omitted: its default stands
     const auto* node = required(*t, o.key, "options", tl);
     ok = ok && node;
     if (!node) continue;

@@ -104,8 +104,12 @@ void ModelLoader::read_rods(const toml::table& root) {
       continue;
     }
     const auto& t = *node->as_table();
-    read_group(t, Group::Rod, rod, {"ja"});
-    read_group_table(t, Group::RodJa, node_line(t), rod);
+    // The table of the magnetisation law the options select ([<rod>.ja], [<rod>.preisach]).
+    for (const auto& g : parameter_groups()) {
+      if (!g.law || *g.law != spec_.options.magnetisation_law) continue;
+      read_group(t, Group::Rod, rod, {std::string(g.path.substr(g.path.rfind('.') + 1))});
+      read_group_table(t, g.group, node_line(t), rod);
+    }
   }
 }
 

@@ -164,6 +164,11 @@ std::string model_toml(const ModelSpec& spec, const std::string& why) {
     const std::string value(option_word(def, spec.options));
     const std::string was(option_word(def, original.options));
     if (value == was) continue;
+    if (!original.option_lines.count(name))  // an omitted option with a default
+      throw InputError(fmt::format(
+          "{}: {} is not in the model file (its default stands); changing it needs the line in "
+          "[options] (and, for magnetisation_law, the law's tables: docs/model.md)",
+          spec.source, name));
     const long line_no = spec.line_of(name);
     const std::string& line = lines.at(static_cast<std::size_t>(std::max(1L, line_no) - 1));
     const auto span = schema::value_span(line, leaf_of(name));

@@ -15,41 +15,7 @@
 #include "model/conditions_detail.hpp"
 
 namespace gmasim {
-namespace {
-
 using namespace physics;
-
-// Eq. (10) at temperature T_C for one rod, under the model's reading.
-JaCoefficients ja_at(const Model& m, const JaReference& j, double T_C) {
-  const double Tc_C = m.material.Tc_C;
-  const double T_K = T_C + kZeroCelsiusInK, Tc_K = Tc_C + kZeroCelsiusInK;
-  const double Tr_K = m.T_ref_C + kZeroCelsiusInK;
-  double t = 0.0, tr = 0.0;
-  switch (m.options.eq10_scale) {
-    case Eq10Scale::Celsius:
-      t = T_C / Tc_C;
-      tr = m.T_ref_C / Tc_C;
-      break;
-    default:
-      t = T_K / Tc_K;
-      tr = Tr_K / Tc_K;
-      break;
-  }
-  auto law = [&](double p0, double f_t, double f_tr) {
-    return m.options.eq10_scale == Eq10Scale::RoomReferenced ? p0 * f_t / f_tr : p0 * f_t;
-  };
-  JaCoefficients p{};
-  p.alpha = law(j.alpha0, eq10_alpha_factor(t, j.beta1), eq10_alpha_factor(tr, j.beta1));
-  p.k_A_per_m = law(j.k0_A_per_m, eq10_k_factor(t, j.beta2), eq10_k_factor(tr, j.beta2));
-  p.c = law(j.c0, eq10_c_factor(t, j.beta1), eq10_c_factor(tr, j.beta1));
-  if (m.options.shape_law == ShapeLaw::MeanField)
-    p.a_A_per_m = j.a0_A_per_m * mean_field_a_factor(T_K, Tr_K);
-  else
-    p.a_A_per_m = law(j.a0_A_per_m, eq10_a_factor(t, j.beta3), eq10_a_factor(tr, j.beta3));
-  return p;
-}
-
-}  // namespace
 
 Freeze parse_freeze(const std::vector<std::string>& names) {
   Freeze f;
@@ -155,10 +121,10 @@ void rod_material(const Model& m, const RodModel& rod, const Conditions& c, cons
                                     mat.x_exponent);
   };
   rc.MsT_mu = MsT(fz.permeability);
-  rc.MsT_ja = MsT(fz.magnetisation);
+  rc.MsT_mag = MsT(fz.magnetisation);
   rc.MsT_E = MsT(fz.modulus);
   rc.Ms_strain_A_per_m =
-      m.options.eq11_saturation == Eq11Saturation::Temperature ? rc.MsT_ja : mat.Ms_A_per_m;
+      m.options.eq11_saturation == Eq11Saturation::Temperature ? rc.MsT_mag : mat.Ms_A_per_m;
   const double L0 = Lambda0(rc.sigma_Pa, mat.lambda_s, mat.sigma_lambda_Pa);  // eq. (6)
   rc.S_mu_J_per_m3 =
       stress_energy_term(rc.sigma_Pa, mat.lambda_s, L0, mat.beta_per_K, d.of(fz.permeability));
@@ -174,17 +140,15 @@ void rod_material(const Model& m, const RodModel& rod, const Conditions& c, cons
                     "(1/chi = {:.4g} at M = 0); check preload.force_N, material.lambda_s, "
                     "material.sigma_lambda_Pa, options.stress_sign",
                     src, T, rod.name, inv_chi0));
-  rc.ja = ja_at(m, rod.ja, fz.magnetisation ? m.T_ref_C : T);  // eq. (10)
-  // Consistent magnetic state: eq. (3)'s stress and temperature terms act in the JA
-  // effective field (magnetic.hpp, magnetoelastic_coupling); frozen with mu_G.
+  // Consistent magnetic state: eq. (3)'s stress and temperature terms act in the magnetisation
+  // law's effective field (magnetic.hpp, magnetoelastic_coupling); frozen with mu_G.
   rc.alpha_sigma = magnetoelastic_coupling(rc.S_mu_J_per_m3, rc.MsT_mu);
-  if (m.options.magnetic_state == MagneticState::Consistent) rc.ja.alpha += rc.alpha_sigma;
-  if (!(rc.ja.a_A_per_m > 0 && rc.ja.k_A_per_m > 0 && rc.ja.c >= 0 && rc.ja.c < 1 &&
-        std::isfinite(rc.ja.alpha)))
-    throw InputError(fmt::format(
-        "{}: eq. (10) at {} degC gives unphysical JA coefficients in rod '{}' (a = {:.4g} A/m, k "
-        "= {:.4g} A/m, c = {:.4g}, alpha = {:.4g})",
-        src, T, rod.name, rc.ja.a_A_per_m, rc.ja.k_A_per_m, rc.ja.c, rc.ja.alpha));
+  // The magnetisation law's temperature laws (src/model/magnetisation/).
+  const double T_law = fz.magnetisation ? m.T_ref_C : T;
+  if (m.options.magnetisation_law == MagnetisationLaw::Preisach)
+    model_detail::preisach_conditions(m, rod, T_law, T, rc);
+  else
+    model_detail::jiles_atherton_conditions(m, rod, T_law, T, rc);
   rc.rho_ohm_m =
       resistivity(mat.rho0_ohm_m, mat.drho_dT_ohm_m_per_K, d.of(fz.resistivity));  // eq. (8)
   if (!(rc.rho_ohm_m > 0))

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/model.hpp"
-#include "gmasim/physics/jiles_atherton.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/mechanics.hpp"
 
@@ -26,6 +26,7 @@ constexpr double kGlWeight[4] = {0.5 * 0.3478548451374538, 0.5 * 0.6521451548225
                                  0.5 * 0.6521451548225463, 0.5 * 0.3478548451374538};
 
 // The magnetic terms of rod i over one step.
+template <class Law>
 void book_rod_magnetic(const Model& m, const RodConditions& rc, const StepStart& a, RodState& r,
                        double h) {
   const double V = rod_volume_m3(rc);
@@ -37,8 +38,9 @@ void book_rod_magnetic(const Model& m, const RodConditions& rc, const StepStart&
     e.eddy_J += V * rc.eddy_geometry_s_m_per_H * dB * dB / h;
   else  // printed: the lag's eddy field H_c - H against the material's dB
     e.eddy_J += V * 0.5 * ((a.Hc - a.H) + (r.Hc_A_per_m - r.H_A_per_m)) * dB;
-  // Eq. (9)'s dissipation over the step along the path H, M linear (physics::ja_step_dissipation).
-  e.hysteresis_J += V * ja_step_dissipation(a.H, a.M, r.H_A_per_m, r.M_A_per_m, rc.MsT_ja, rc.ja);
+  // The magnetisation law's dissipation over the step (Jiles-Atherton: eq. 9's along the path
+  // H, M linear, physics::ja_step_dissipation; Preisach: the switched hysterons' loss).
+  e.hysteresis_J += V * Law::step_dissipation(rc, a.H, a.M, r);
 }
 
 // The mechanical terms of rod i over one step: the oscillator's exact update (F linear, K
@@ -77,10 +79,12 @@ void book_step_energy(const Model& m, const Conditions& c, State& s, const StepS
     if (br.pm_mmf_At != 0.0) acc.magnet_J += br.pm_mmf_At * c.pm_scale * dphi;
   }
   acc.coil_emf_V = emf;
-  for (std::size_t i = 0; i < s.rods.size(); ++i) {
-    book_rod_magnetic(m, c.rods[i], start[i], s.rods[i], h_s);
+  with_magnetisation_law(m.options.magnetisation_law, [&](auto law) {
+    for (std::size_t i = 0; i < s.rods.size(); ++i)
+      book_rod_magnetic<decltype(law)>(m, c.rods[i], start[i], s.rods[i], h_s);
+  });
+  for (std::size_t i = 0; i < s.rods.size(); ++i)
     book_rod_mechanical(c.rods[i], start[i], s.rods[i], h_s);
-  }
 }
 
 namespace {
@@ -100,11 +104,10 @@ StoredEnergy stored_energy(const Model& m, const Conditions& c, const State& s) 
   for (std::size_t i = 0; i < s.rods.size(); ++i) {
     const auto& rc = c.rods[i];
     const auto& r = s.rods[i];
-    const double Han = anhysteretic_field(r.Mirr_A_per_m, rc.MsT_ja, rc.ja.a_A_per_m);
-    e.material_J +=
-        rod_volume_m3(rc) *
-        (0.5 * kMu0 * r.H_A_per_m * r.H_A_per_m +
-         ja_stored_energy_density(r.H_A_per_m, r.M_A_per_m, r.Mirr_A_per_m, Han, rc.MsT_ja, rc.ja));
+    const double phi = with_magnetisation_law(m.options.magnetisation_law, [&](auto law) {
+      return decltype(law)::stored_energy_density(rc, r);
+    });
+    e.material_J += rod_volume_m3(rc) * (0.5 * kMu0 * r.H_A_per_m * r.H_A_per_m + phi);
     e.kinetic_J += 0.5 * rc.mass_osc_kg * r.v_m_per_s * r.v_m_per_s;
     e.elastic_J += 0.5 * r.K_osc_N_per_m * r.x_m * r.x_m;
   }
@@ -150,13 +153,13 @@ EnergyBalance energy_balance(const EnergySnapshot& a, const EnergySnapshot& b) {
   // thousandth of the energy stored at the window's end. The last matters only when nothing
   // flows (a held current): there the input is round-off and |residual| / |input| would be
   // a ratio of two round-off errors.
-  const double stored_mag = std::fabs(b.stored.circuit_J) + std::fabs(b.stored.series_J) +
-                            std::fabs(b.stored.material_J);
-  const double mag_scale = std::max(
-      {std::fabs(in),
-       std::fabs(e.d_circuit_J) + std::fabs(e.d_series_J) + std::fabs(e.d_material_J) +
-           std::fabs(e.hysteresis_J) + std::fabs(e.eddy_J),
-       1e-3 * stored_mag});
+  const double stored_mag =
+      std::fabs(b.stored.circuit_J) + std::fabs(b.stored.series_J) + std::fabs(b.stored.material_J);
+  const double mag_scale =
+      std::max({std::fabs(in),
+                std::fabs(e.d_circuit_J) + std::fabs(e.d_series_J) + std::fabs(e.d_material_J) +
+                    std::fabs(e.hysteresis_J) + std::fabs(e.eddy_J),
+                1e-3 * stored_mag});
   e.magnetic_residual_rel = std::fabs(e.magnetic_residual_J) / mag_scale;
   const double mech_in = e.force_work_J + e.stiffness_work_J;
   e.mechanical_residual_J = mech_in - (e.d_kinetic_J + e.d_elastic_J + e.damping_J);

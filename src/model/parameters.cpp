@@ -8,9 +8,11 @@
 #include <algorithm>
 #include <cmath>
 #include <type_traits>
+#include <vector>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/model.hpp"
+#include "model/parameter_rows.hpp"
 
 namespace gmasim {
 namespace {
@@ -27,10 +29,6 @@ double& in_material(Model& m, std::size_t) {
 template <auto P>
 double& in_rod(Model& m, std::size_t i) {
   return m.rods[i].*P;
-}
-template <auto P>
-double& in_ja(Model& m, std::size_t i) {
-  return m.rods[i].ja.*P;
 }
 template <auto P>
 double& in_element(Model& m, std::size_t i) {
@@ -69,8 +67,7 @@ double& in_validity(Model& m, std::size_t) {
   return m.validity.*P;
 }
 
-// The land function and its text, from one spelling: LAND(in_rod, RodModel, length_m).
-#define LAND(fn, Struct, field) &fn<&Struct::field>, #Struct "::" #field
+#define LAND GMASIM_LAND
 
 using G = Group;
 using R = Rule;
@@ -83,8 +80,6 @@ constexpr GroupDef kGroups[] = {
     {G::Magnet, "magnet", TableRule::Defaulted,
      "Temperature coefficients of the permanent magnet's MMF, eq. (1)"},
     {G::Rod, "<rod>", TableRule::Required, "One Terfenol-D rod of stack.rods"},
-    {G::RodJa, "<rod>.ja", TableRule::Required,
-     "The rod's Jiles-Atherton constants at T_ref (Table 4), eq. (9)-(10)"},
     {G::Reluctance, "circuit.reluctances_per_H", TableRule::Required,
      "Named fixed reluctances; a branch's `series` sums them"},
     {G::Branch, "circuit.branches.<name>", TableRule::KeysOptional,
@@ -211,21 +206,6 @@ const ParamDef kParams[] = {
      LAND(in_rod, RodModel, joint_gap_m), 0.0, "default: no joints (one solid rod)"},
     {G::Rod, "damping_N_s_per_m", "N s/m", R::Positive, "damping c_i, eq. (25)",
      LAND(in_rod, RodModel, damping_N_s_per_m)},
-    // [<rod>.ja]
-    {G::RodJa, "a0_A_per_m", "A/m", R::Positive, "anhysteretic shape a at T_ref, eq. (9)-(10)",
-     LAND(in_ja, JaReference, a0_A_per_m)},
-    {G::RodJa, "alpha0", "-", R::Any, "inter-domain coupling alpha at T_ref, eq. (9)-(10)",
-     LAND(in_ja, JaReference, alpha0)},
-    {G::RodJa, "c0", "-", R::UnitInterval, "reversibility c at T_ref, eq. (9)-(10)",
-     LAND(in_ja, JaReference, c0)},
-    {G::RodJa, "k0_A_per_m", "A/m", R::Positive, "pinning k at T_ref, eq. (9)-(10)",
-     LAND(in_ja, JaReference, k0_A_per_m)},
-    {G::RodJa, "beta1", "-", R::Positive, "exponent beta_1 of alpha^T and c^T, eq. (10)",
-     LAND(in_ja, JaReference, beta1)},
-    {G::RodJa, "beta2", "-", R::Positive, "exponent beta_2 of k^T, eq. (10)",
-     LAND(in_ja, JaReference, beta2)},
-    {G::RodJa, "beta3", "-", R::Positive, "exponent beta_3 of the printed a^T, eq. (10)",
-     LAND(in_ja, JaReference, beta3)},
     // [circuit.reluctances_per_H]
     {G::Reluctance, "*", "1/H", R::Positive,
      "a fixed reluctance of Table 1 (any name); summed over a branch's series, eq. (23)", nullptr,
@@ -383,6 +363,13 @@ constexpr OptionChoice kMagneticState[] = {
     {"consistent", static_cast<int>(MagneticState::Consistent),
      "each rod carries the flux of its own state, B = mu0 (H + M)"},
 };
+constexpr OptionChoice kMagnetisationLaw[] = {
+    {"jiles_atherton", static_cast<int>(MagnetisationLaw::JilesAtherton),
+     "Jiles-Atherton, eq. (9)-(10): the [<rod>.ja] tables"},
+    {"preisach", static_cast<int>(MagnetisationLaw::Preisach),
+     "Preisach, log-normal coercive and Gaussian interaction fields: the [<rod>.preisach] "
+     "tables"},
+};
 constexpr OptionChoice kEq11Saturation[] = {
     {"temperature", static_cast<int>(Eq11Saturation::Temperature),
      "M normalised by M_s^T, as printed"},
@@ -404,6 +391,9 @@ const OptionDef kOptions[] = {
      "add the thermal expansion x_T of eq. (21) to the output (section 4.4.2 removes it)"},
     {"geometry_thermal_expansion", true, kBoolean, OPTION(geometry_thermal_expansion),
      "use l^T, A^T, r^T in eq. (2), (7), (17), (19)"},
+    {"magnetisation_law", false, kMagnetisationLaw, OPTION(magnetisation_law),
+     "the hysteresis law of the rods (docs/model.md, \"Magnetisation laws\"); may be omitted",
+     "jiles_atherton"},
 };
 
 #undef OPTION
@@ -489,12 +479,23 @@ std::optional<std::string> number_problem(double v) {
   return std::nullopt;
 }
 
-std::span<const GroupDef> parameter_groups() { return kGroups; }
-std::span<const ParamDef> parameter_table() { return kParams; }
+// The magnetisation laws' groups and rows (src/model/magnetisation/) follow the rod's.
+std::span<const GroupDef> parameter_groups() {
+  static const std::vector<GroupDef> groups = model_detail::with_law_entries(
+      std::span<const GroupDef>(kGroups), [](const GroupDef& g) { return g.group; },
+      [](auto law) { return law.group; });
+  return groups;
+}
+std::span<const ParamDef> parameter_table() {
+  static const std::vector<ParamDef> rows = model_detail::with_law_entries(
+      std::span<const ParamDef>(kParams), [](const ParamDef& r) { return r.group; },
+      [](auto law) { return law.rows; });
+  return rows;
+}
 std::span<const OptionDef> option_table() { return kOptions; }
 
 const GroupDef& group_def(Group g) {
-  for (const auto& d : kGroups)
+  for (const auto& d : parameter_groups())
     if (d.group == g) return d;
   throw std::logic_error("group_def: a group without a row");
 }
@@ -503,9 +504,9 @@ const ParamDef* find_param_def(const ModelSpec& spec, std::string_view dotted) {
   const auto dot = dotted.rfind('.');
   if (dot == std::string_view::npos) return nullptr;
   const std::string_view table = dotted.substr(0, dot), key = dotted.substr(dot + 1);
-  for (const auto& g : kGroups) {
+  for (const auto& g : parameter_groups()) {
     if (!path_matches(spec, g.path, table)) continue;
-    for (const auto& p : kParams)
+    for (const auto& p : parameter_table())
       if (p.group == g.group && (p.key == key || (p.key == "*" && !key.empty()))) return &p;
     return nullptr;
   }
@@ -563,28 +564,33 @@ std::string parameters_markdown() {
       "rule, meaning and where `compile()` puts it in `Model`. Besides its rule, every number "
       "must be finite and, unless 0, between " +
       fmt::format("{:g} and {:g}", kMinMagnitude, kMaxMagnitude) + " in magnitude.\n";
-  for (const auto& g : kGroups) {
+  for (const auto& g : parameter_groups()) {
     const char* presence = g.table == TableRule::Required    ? "required"
                            : g.table == TableRule::Optional  ? "optional (all keys, or none)"
                            : g.table == TableRule::Defaulted ? "optional, every key defaulted"
                                                              : "optional keys (absent: 0)";
     md += fmt::format("\n## [{}]\n\n{}; {}.\n\n", g.path, g.doc, presence);
     md += "| key | unit | rule | meaning | default | lands in |\n|---|---|---|---|---|---|\n";
-    for (const auto& p : kParams) {
+    for (const auto& p : parameter_table()) {
       if (p.group != g.group) continue;
       md += fmt::format("| `{}` | {} | {} | {} | {} | `{}` |\n", p.key, p.unit, row_rule_text(p),
                         p.doc, p.default_value ? fmt::format("{:g}", *p.default_value) : "",
                         p.lands_in);
     }
   }
-  md += "\n## [options]\n\nEvery option is required: a model file states its reading.\n\n";
+  md +=
+      "\n## [options]\n\nEvery option is required: a model file states its reading (an option "
+      "with a default may be omitted).\n\n";
   md += "| key | values | meaning | lands in |\n|---|---|---|---|\n";
   for (const auto& o : kOptions) {
     std::string values;
     for (const auto& c : o.choices)
       values += fmt::format("{}`{}`{}", values.empty() ? "" : "; ", c.word,
                             o.boolean ? "" : fmt::format(": {}", c.doc));
-    md += fmt::format("| `{}` | {} | {} | `{}` |\n", o.key, values, o.doc, o.lands_in);
+    const std::string doc = o.default_word.empty()
+                                ? std::string(o.doc)
+                                : fmt::format("{} (default: `{}`)", o.doc, o.default_word);
+    md += fmt::format("| `{}` | {} | {} | `{}` |\n", o.key, values, doc, o.lands_in);
   }
   return md;
 }

@@ -4,8 +4,8 @@
 #include <cmath>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/model.hpp"
-#include "gmasim/physics/jiles_atherton.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
@@ -16,16 +16,19 @@ namespace {
 
 using namespace physics;
 constexpr std::size_t kMax = 8;
+// The integrated state: per rod H, the magnetisation law's ODE variable q (Law::ode_*: M_irr
+// for Jiles-Atherton), x, v; and M (the law's algebraic output, kept as the warm start).
 struct Y {
-  std::array<double, kMax> H{}, Mirr{}, x{}, v{}, M{};
+  std::array<double, kMax> H{}, q{}, x{}, v{}, M{};
 };
 
-// Derivatives at (y, I). M of each rod is re-solved from (H, M_irr) (warm-started).
+// Derivatives at (y, I). M of each rod is re-solved from (H, q) (warm-started).
+template <class Law>
 void rhs(const Model& m, const Conditions& c, State& s, Y& y, double I, Y& dy) {
   const std::size_t n = s.rods.size();
   for (std::size_t i = 0; i < n; ++i) {
     const auto& rc = c.rods[i];
-    y.M[i] = ja_total_magnetisation(y.H[i], y.Mirr[i], y.M[i], rc.MsT_ja, rc.ja);
+    y.M[i] = Law::ode_magnetisation(rc, s.rods[i], y.H[i], y.q[i], y.M[i]);
     s.rod_reluctance[i] = set_rod_permeability(m, i, rc, s.rods[i], y.M[i], s.t_s);
   }
   if (!solve_circuit(m.circuit, s.rod_reluctance, I, c.pm_scale, s.circuit))
@@ -36,9 +39,7 @@ void rhs(const Model& m, const Conditions& c, State& s, Y& y, double I, Y& dy) {
     const double Hc = rod_static_field(m, i, rc, s.rods[i], s.circuit);
     const double tau = s.rods[i].mu_r * kMu0 * rc.eddy_geometry_s_m_per_H;
     dy.H[i] = (Hc - y.H[i]) / tau;
-    const double delta = dy.H[i] >= 0.0 ? 1.0 : -1.0;
-    dy.Mirr[i] =
-        ja_irreversible_slope(y.H[i], y.M[i], y.Mirr[i], delta, rc.MsT_ja, rc.ja) * dy.H[i];
+    dy.q[i] = Law::ode_rate(rc, y.H[i], y.M[i], y.q[i], dy.H[i]);
     stage[i].M_A_per_m = y.M[i];
     update_rod_mechanics(m.material, rc, stage[i]);
   }
@@ -52,10 +53,9 @@ void rhs(const Model& m, const Conditions& c, State& s, Y& y, double I, Y& dy) {
   }
 }
 
-}  // namespace
-
-void rk4_reference_step(const Model& m, const Conditions& c, State& s, double I0, double Imid,
-                        double I1, double h) {
+template <class Law>
+void rk4_step_law(const Model& m, const Conditions& c, State& s, double I0, double Imid, double I1,
+                  double h) {
   if (m.options.magnetic_state != MagneticState::Printed || m.sensor_mount.enabled)
     throw InputError(
         "rk4_reference_step: the RK4 reference integrates the printed magnetic state without a "
@@ -65,7 +65,7 @@ void rk4_reference_step(const Model& m, const Conditions& c, State& s, double I0
   for (std::size_t i = 0; i < n; ++i) {
     const auto& r = s.rods[i];
     y0.H[i] = r.H_A_per_m;
-    y0.Mirr[i] = r.Mirr_A_per_m;
+    y0.q[i] = Law::ode_variable(r);
     y0.x[i] = r.x_m;
     y0.v[i] = r.v_m_per_s;
     y0.M[i] = r.M_A_per_m;
@@ -74,27 +74,26 @@ void rk4_reference_step(const Model& m, const Conditions& c, State& s, double I0
     yt = a;
     for (std::size_t i = 0; i < n; ++i) {
       yt.H[i] += f * d.H[i];
-      yt.Mirr[i] += f * d.Mirr[i];
+      yt.q[i] += f * d.q[i];
       yt.x[i] += f * d.x[i];
       yt.v[i] += f * d.v[i];
     }
   };
-  rhs(m, c, s, y0, I0, k1);
+  rhs<Law>(m, c, s, y0, I0, k1);
   axpy(y0, 0.5 * h, k1);
-  rhs(m, c, s, yt, Imid, k2);
+  rhs<Law>(m, c, s, yt, Imid, k2);
   axpy(y0, 0.5 * h, k2);
-  rhs(m, c, s, yt, Imid, k3);
+  rhs<Law>(m, c, s, yt, Imid, k3);
   axpy(y0, h, k3);
-  rhs(m, c, s, yt, I1, k4);
+  rhs<Law>(m, c, s, yt, I1, k4);
   for (std::size_t i = 0; i < n; ++i) {
     auto& r = s.rods[i];
     r.H_A_per_m += h / 6 * (k1.H[i] + 2 * k2.H[i] + 2 * k3.H[i] + k4.H[i]);
-    r.Mirr_A_per_m += h / 6 * (k1.Mirr[i] + 2 * k2.Mirr[i] + 2 * k3.Mirr[i] + k4.Mirr[i]);
+    const double q1 = y0.q[i] + h / 6 * (k1.q[i] + 2 * k2.q[i] + 2 * k3.q[i] + k4.q[i]);
     r.x_m += h / 6 * (k1.x[i] + 2 * k2.x[i] + 2 * k3.x[i] + k4.x[i]);
     r.v_m_per_s += h / 6 * (k1.v[i] + 2 * k2.v[i] + 2 * k3.v[i] + k4.v[i]);
     r.M_prev_A_per_m = r.M_A_per_m;
-    r.M_A_per_m = ja_total_magnetisation(r.H_A_per_m, r.Mirr_A_per_m, yt.M[i], c.rods[i].MsT_ja,
-                                         c.rods[i].ja);
+    Law::ode_commit(c.rods[i], r, q1, yt.M[i]);
     update_rod_mechanics(m.material, c.rods[i], r);
     if (!std::isfinite(r.x_m) || std::fabs(r.x_m) > 1.0)
       throw DivergenceError(s.t_s + h, m.rods[i].name, "x [m] (RK4)", r.x_m,
@@ -105,6 +104,14 @@ void rk4_reference_step(const Model& m, const Conditions& c, State& s, double I0
   double y = 0.0;
   for (const auto& r : s.rods) y += r.x_m;
   s.y_m = y;
+}
+
+}  // namespace
+
+void rk4_reference_step(const Model& m, const Conditions& c, State& s, double I0, double Imid,
+                        double I1, double h) {
+  with_magnetisation_law(m.options.magnetisation_law,
+                         [&](auto law) { rk4_step_law<decltype(law)>(m, c, s, I0, Imid, I1, h); });
 }
 
 }  // namespace gmasim

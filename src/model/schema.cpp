@@ -53,8 +53,11 @@ const std::vector<std::string>& reserved_tables() {
 std::vector<std::string> group_instances(const ModelSpec& spec, Group g) {
   switch (g) {
     case Group::Rod:
-    case Group::RodJa:
       return spec.rods;
+    case Group::RodJa:
+    case Group::RodPreisach:  // a magnetisation law's: only in a model that selects it
+      return group_def(g).law == spec.options.magnetisation_law ? spec.rods
+                                                                : std::vector<std::string>{};
     case Group::Element:
       return spec.element_names;
     case Group::Sleeve:

@@ -7,8 +7,8 @@
 #include <cmath>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/model.hpp"
-#include "gmasim/physics/jiles_atherton.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
@@ -71,10 +71,11 @@ void advance_sensor_mount(const SensorMountModel& o, double q0_m, double q1_m, d
 //   line, with k_f's series reluctance R_s: physics::series_reluctance)
 //   H_c,i = H_i + kappa_i dB_i/dt  (eq. 7's eddy field, trapezoidal over the step)
 // Newton's method on the rods' fields: each rod is linearised at the iterate H* (slope
-// dM/dH of ja_step) into a branch  U = R_eff phi + U_off, the circuit is solved with
-// R_eff and the MMF -U_off, and H* moves to the field that flux implies. Quadratic; damped
-// after 8 iterations (the JA slope jumps where M_irr starts or stops moving).
+// dM/dH of the magnetisation law's move, Law::trial) into a branch  U = R_eff phi + U_off, the
+// circuit is solved with R_eff and the MMF -U_off, and H* moves to the field that flux implies.
+// Quadratic; damped after 8 iterations (the JA slope jumps where M_irr starts or stops moving).
 // quasi_static drops the eddy term (the at-rest ramp of make_state).
+template <class Law>
 void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, double current_A,
                                 double pm_scale, double h_s, bool quasi_static, double t1) {
   const std::size_t n = s.rods.size();
@@ -94,8 +95,8 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
     for (std::size_t i = 0; i < n; ++i) {
       const auto& rc = c.rods[i];
       const auto& r = s.rods[i];
-      double Mirr = r.Mirr_A_per_m, Mi = r.M_A_per_m, chi = 0.0;
-      ja_step(r.H_A_per_m, H[i], rc.MsT_ja, rc.ja, Mirr, Mi, M[i], &chi);
+      double chi = 0.0;
+      const double Mi = Law::trial(rc, r, H[i], M[i], &chi);
       M[i] = Mi;
       Bs[i] = flux_density(H[i], Mi);
       mud[i] = kMu0 * (1.0 + chi);
@@ -131,7 +132,7 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
     const auto& rc = c.rods[i];
     auto& r = s.rods[i];
     double chi = 0.0;
-    ja_step(r.H_A_per_m, H[i], rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m, M[i], &chi);
+    Law::commit(rc, r, H[i], M[i], &chi);
     const double B1 = flux_density(H[i], r.M_A_per_m);
     r.Hc_A_per_m = quasi_static
                        ? H[i]
@@ -150,11 +151,12 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
 // The magnetic state at rest (no eddy lag: eq. 7 with dB/dt = 0) moved along its
 // hysteresis loop to the MMF of current_A and the magnets at pm_scale: one increment of
 // make_state's ramp and of quasi_static_step.
+template <class Law>
 void quasi_static_magnetic_update(const Model& m, const Conditions& c, State& s, double current_A,
                                   double pm_scale, double t) {
   const std::size_t n = s.rods.size();
   if (m.options.magnetic_state == MagneticState::Consistent) {
-    consistent_magnetic_update(m, c, s, current_A, pm_scale, 1.0, true, t);
+    consistent_magnetic_update<Law>(m, c, s, current_A, pm_scale, 1.0, true, t);
     return;
   }
   for (std::size_t i = 0; i < n; ++i)
@@ -165,7 +167,7 @@ void quasi_static_magnetic_update(const Model& m, const Conditions& c, State& s,
     const auto& rc = c.rods[i];
     auto& r = s.rods[i];
     const double Hc = rod_static_field(m, i, rc, r, s.circuit);
-    ja_step(r.H_A_per_m, Hc, rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m);
+    Law::commit(rc, r, Hc, r.M_A_per_m, nullptr);
     r.H_A_per_m = Hc;
     r.Hc_A_per_m = Hc;
   }
@@ -205,7 +207,10 @@ double oscillator_stiffness(const Conditions& c, const State& s, int rod) {
   return s.rods[i].k_rod_N_per_m + load_stiffness(c.rods[i], s);  // eq. (16)
 }
 
-State make_state(const Model& m, const Conditions& c, double current_A) {
+namespace {
+
+template <class Law>
+State make_state_law(const Model& m, const Conditions& c, double current_A) {
   State s;
   const std::size_t n = m.rods.size();
   s.rods.assign(n, RodState{});
@@ -213,6 +218,7 @@ State make_state(const Model& m, const Conditions& c, double current_A) {
   s.circuit.resize(m.circuit);
   s.energy.phi_prev_Wb.assign(m.circuit.branches.size(), 0.0);
   s.current_A = current_A;
+  for (std::size_t i = 0; i < n; ++i) Law::init_state(c.rods[i], s.rods[i]);
   // Quasi-static ramp of the total MMF from zero (demagnetised rods, no field) to its
   // value at t = 0, along the initial magnetisation curve; no eddy lag (at rest).
   const int ramp_steps = 400;
@@ -220,22 +226,37 @@ State make_state(const Model& m, const Conditions& c, double current_A) {
     const double f = static_cast<double>(k) / ramp_steps;
     s.energy.enabled = k == ramp_steps;  // the last increment solves every branch (the ledger's
                                          // start values, gmasim/energy.hpp)
-    quasi_static_magnetic_update(m, c, s, f * current_A, f * c.pm_scale, 0.0);
+    quasi_static_magnetic_update<Law>(m, c, s, f * current_A, f * c.pm_scale, 0.0);
   }
   s.energy.enabled = false;
   settle_at_rest(m, c, s);
   return s;
 }
 
-void quasi_static_step(const Model& m, const Conditions& c, State& s, double current_A) {
-  quasi_static_magnetic_update(m, c, s, current_A, c.pm_scale, s.t_s);
+}  // namespace
+
+template <class Law>
+void quasi_static_step_law(const Model& m, const Conditions& c, State& s, double current_A) {
+  quasi_static_magnetic_update<Law>(m, c, s, current_A, c.pm_scale, s.t_s);
   settle_at_rest(m, c, s);
   s.current_A = current_A;
   for (std::size_t i = 0; i < s.rods.size(); ++i) {
     check(s.rods[i].H_A_per_m, s.t_s, m.rods[i].name, "H [A/m]", 1e9);
-    check(s.rods[i].M_A_per_m, s.t_s, m.rods[i].name, "M [A/m]", 1.5 * c.rods[i].MsT_ja);
+    check(s.rods[i].M_A_per_m, s.t_s, m.rods[i].name, "M [A/m]", 1.5 * c.rods[i].MsT_mag);
     check(s.rods[i].x_m, s.t_s, m.rods[i].name, "x [m]", 1.0);
   }
+}
+
+State make_state(const Model& m, const Conditions& c, double current_A) {
+  return with_magnetisation_law(m.options.magnetisation_law, [&](auto law) {
+    return make_state_law<decltype(law)>(m, c, current_A);
+  });
+}
+
+void quasi_static_step(const Model& m, const Conditions& c, State& s, double current_A) {
+  with_magnetisation_law(m.options.magnetisation_law, [&](auto law) {
+    quasi_static_step_law<decltype(law)>(m, c, s, current_A);
+  });
 }
 
 namespace {
@@ -259,6 +280,7 @@ void energy_start(State& s, std::array<StepStart, 8>& start) {
 }
 
 // The printed magnetic state's stages 1-2 (model.hpp, MagneticState::Printed).
+template <class Law>
 void printed_magnetic_update(const Model& m, const Conditions& c, State& s, const StepInput& in,
                              double t1) {
   const double h = in.dt_s;
@@ -285,7 +307,7 @@ void printed_magnetic_update(const Model& m, const Conditions& c, State& s, cons
     const double H1 = first_order_lag_step(r.H_A_per_m, r.Hc_A_per_m, Hc1, h, r.tau_s);
     const double M_guess = 2.0 * r.M_A_per_m - r.M_prev_A_per_m;  // linear extrapolation
     r.M_prev_A_per_m = r.M_A_per_m;
-    ja_step(r.H_A_per_m, H1, rc.MsT_ja, rc.ja, r.Mirr_A_per_m, r.M_A_per_m, M_guess);
+    Law::commit(rc, r, H1, M_guess, nullptr);
     r.H_A_per_m = H1;
     r.Hc_A_per_m = Hc1;
   }
@@ -294,6 +316,14 @@ void printed_magnetic_update(const Model& m, const Conditions& c, State& s, cons
 }  // namespace
 
 void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
+  if (m.options.magnetisation_law == MagnetisationLaw::Preisach)
+    step_law<PreisachLaw>(m, c, s, in);
+  else
+    step_law<JilesAthertonLaw>(m, c, s, in);
+}
+
+template <class Law>
+void step_law(const Model& m, const Conditions& c, State& s, const StepInput& in) {
   const double h = in.dt_s;
   const double t1 = s.t_s + h;
   const std::size_t n = s.rods.size();
@@ -302,12 +332,12 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
   if (s.energy.enabled) energy_start(s, start);
   // 1-2. Circuit, eddy field and JA: in the consistent state solved together by Newton.
   if (m.options.magnetic_state == MagneticState::Consistent)
-    consistent_magnetic_update(m, c, s, in.current_A, c.pm_scale, h, false, t1);
+    consistent_magnetic_update<Law>(m, c, s, in.current_A, c.pm_scale, h, false, t1);
   else
-    printed_magnetic_update(m, c, s, in, t1);
+    printed_magnetic_update<Law>(m, c, s, in, t1);
   for (std::size_t i = 0; i < n; ++i) {
     check(s.rods[i].H_A_per_m, t1, m.rods[i].name, "H [A/m]", 1e9);
-    check(s.rods[i].M_A_per_m, t1, m.rods[i].name, "M [A/m]", 1.5 * c.rods[i].MsT_ja);
+    check(s.rods[i].M_A_per_m, t1, m.rods[i].name, "M [A/m]", 1.5 * c.rods[i].MsT_mag);
   }
   // 3. Mechanics (eq. 15-18): each rod's oscillator, exact over the step with the force
   //    linear from F_n to F_{n+1} and the stiffness at the end of the step (which needs
@@ -339,5 +369,11 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
   finish_outputs(m, c, s);
   if (s.energy.enabled) book_step_energy(m, c, s, start.data(), current0_A, in.current_A, h);
 }
+
+template void step_law<JilesAthertonLaw>(const Model&, const Conditions&, State&, const StepInput&);
+template void step_law<PreisachLaw>(const Model&, const Conditions&, State&, const StepInput&);
+template void quasi_static_step_law<JilesAthertonLaw>(const Model&, const Conditions&, State&,
+                                                      double);
+template void quasi_static_step_law<PreisachLaw>(const Model&, const Conditions&, State&, double);
 
 }  // namespace gmasim

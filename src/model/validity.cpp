@@ -31,7 +31,7 @@ void check_physical_validity(const Model& m, const Conditions& c, const State& s
   for (std::size_t i = 0; i < s.rods.size(); ++i) {
     const RodState& r = s.rods[i];
     const RodConditions& rc = c.rods[i];
-    const double q = rc.MsT_ja / rc.Ms_strain_A_per_m;
+    const double q = rc.MsT_mag / rc.Ms_strain_A_per_m;
     const double strain_bound = kStrainGuardFactor * lambda_s * q * q;
     if (!(std::fabs(r.lambda) <= strain_bound)) [[unlikely]]
       beyond(t_s, m.rods[i].name, "magnetostriction lambda [-]", r.lambda, strain_bound,
@@ -40,7 +40,7 @@ void check_physical_validity(const Model& m, const Conditions& c, const State& s
       beyond(t_s, m.rods[i].name, "displacement x [m]", r.x_m, rc.length_m,
              "a rod cannot move by more than its length l^T");
     if (consistent) {
-      const double Ms = std::max(m.material.Ms_A_per_m, rc.MsT_ja);
+      const double Ms = std::max(m.material.Ms_A_per_m, rc.MsT_mag);
       const double B_bound = physics::kMu0 * (kFluxGuardMsFactor * Ms + std::fabs(r.H_A_per_m));
       if (!(std::fabs(r.B_T) <= B_bound)) [[unlikely]]
         beyond(t_s, m.rods[i].name, "flux density B [T]", r.B_T, B_bound,

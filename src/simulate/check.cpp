@@ -45,7 +45,7 @@ MagneticStateCheck check_magnetic_state(const Model& m) {
           const auto& Br = r.series.column(name + "_B_T");
           const auto& H = r.series.column(name + "_H_A_per_m");
           const auto& M = r.series.column(name + "_M_A_per_m");
-          const double scale = physics::kMu0 * c.rods[i].MsT_ja;
+          const double scale = physics::kMu0 * c.rods[i].MsT_mag;
           for (std::size_t k = 0; k < Br.size(); ++k) {
             if (std::fabs(Br[k]) > out.max_B_rod_T) {
               out.max_B_rod_T = std::fabs(Br[k]);
