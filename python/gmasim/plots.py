@@ -315,6 +315,7 @@ def bode(frf: Columns, title="Frequency response, current to displacement", clai
     am.set_ylabel("|Y/I| (dB re 1 µm/A)" if db else "|Y/I| (µm/A)")
     ap.set_ylabel("phase (°)")
     ap.set_xlabel("frequency (Hz)")
+    _log_frequency_axis(ap)
     for ax in (am, ap):
         ax.grid(alpha=0.3, which="both")
     _legend_outside(am, *(_paper_legend(am, _claims_of(claims, "first_resonance_Hz"))
@@ -322,6 +323,18 @@ def bode(frf: Columns, title="Frequency response, current to displacement", clai
     am.set_title(title)
     fig.tight_layout()
     return fig
+
+
+def _log_frequency_axis(ax):
+    """Plain-number ticks on a log frequency axis (more per decade the fewer decades it spans), minor ticks unlabelled
+    (matplotlib labels the minor ticks of an axis spanning less than a decade, and those overlap)."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+    lo, hi = ax.get_xlim()
+    decades = np.log10(hi / lo) if lo > 0 and hi > lo else 3.0
+    subs = (1.0,) if decades > 1.6 else (1.0, 2.0, 5.0) if decades > 0.7 else (1.0, 1.5, 2.0, 3.0, 5.0, 7.0)
+    ax.xaxis.set_major_locator(LogLocator(base=10, subs=subs))
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _pos: f"{v:g}"))
+    ax.xaxis.set_minor_formatter(NullFormatter())
 
 
 def tracking_error(track: Columns, title="Closed-loop tracking error against temperature", claims=None):
