@@ -71,6 +71,18 @@ Peak data_peak(const std::vector<double>& f, const std::vector<double>& mag) {
   return best;
 }
 
+// The largest local maximum of the linearisation's |Y/I| on a fine log scan of [f_lo, f_hi].
+static Peak linear_peak(const SmallSignalModel& lin, double f_lo, double f_hi) {
+  constexpr std::size_t kScan = 2000;
+  std::vector<double> f(kScan), mag(kScan);
+  const double step = std::log(f_hi / f_lo) / static_cast<double>(kScan - 1);
+  for (std::size_t k = 0; k < kScan; ++k) {
+    f[k] = f_lo * std::exp(step * static_cast<double>(k));
+    mag[k] = std::abs(lin.response(f[k]));
+  }
+  return data_peak(f, mag);
+}
+
 void refine_stepped_peak(const Model& m, const Conditions& c, const State& bias,
                          const SmallSignalModel& lin, const FrfRequest& r, SteppedCurve& curve) {
   const std::size_t n = curve.f_Hz.size();
@@ -79,10 +91,7 @@ void refine_stepped_peak(const Model& m, const Conditions& c, const State& bias,
   std::size_t kp = 0;
   for (std::size_t k = 1; k + 1 < n; ++k)
     if (mag[k] > mag[k - 1] && mag[k] >= mag[k + 1] && (kp == 0 || mag[k] > mag[kp])) kp = k;
-  if (kp == 0 || r.peak_refinements < 1) return;
-  // Golden section on [ln f(k-1), ln f(k+1)], maximising |Y/I|.
-  const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
-  double a = std::log(curve.f_Hz[kp - 1]), b = std::log(curve.f_Hz[kp + 1]);
+  if (r.peak_refinements < 1) return;
   std::vector<double> fs;
   std::vector<cd> ys;
   auto eval = [&](double u) {
@@ -90,6 +99,23 @@ void refine_stepped_peak(const Model& m, const Conditions& c, const State& bias,
     ys.push_back(stepped_sine_point(m, c, bias, lin, r, fs.back()));
     return std::abs(ys.back());
   };
+  // A grid too coarse for a sharp resonance can miss it altogether (its largest local maximum
+  // is then another, smaller peak). The linearisation's own peak, found on a fine scan, is a
+  // second candidate: one stepped point there, and its grid bracket wins if it is higher.
+  const Peak lp = linear_peak(lin, r.f_min_Hz, r.f_max_Hz);
+  double a = 0.0, b = 0.0;
+  if (kp > 0) a = std::log(curve.f_Hz[kp - 1]), b = std::log(curve.f_Hz[kp + 1]);
+  if (lp.f_Hz > curve.f_Hz.front() && lp.f_Hz < curve.f_Hz.back()) {
+    const double m_lin = eval(std::log(lp.f_Hz));
+    if (kp == 0 || m_lin > mag[kp]) {
+      const auto hi = std::upper_bound(curve.f_Hz.begin(), curve.f_Hz.end(), lp.f_Hz);
+      a = std::log(*(hi - 1)), b = std::log(*hi);
+      kp = 1;
+    }
+  }
+  if (kp == 0) return;
+  // Golden section on [a, b] (the bracket's grid neighbours), maximising |Y/I|.
+  const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
   double x1 = b - phi * (b - a), x2 = a + phi * (b - a);
   double m1 = eval(x1), m2 = r.peak_refinements > 1 ? eval(x2) : 0.0;
   for (int it = 2; it < r.peak_refinements; ++it) {
