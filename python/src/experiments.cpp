@@ -86,7 +86,7 @@ void bind_frf(py::module_& mod) {
       "frf",
       [](const Model& m, std::vector<double> temperatures_C, double f_min_Hz, double f_max_Hz,
          int points, double bias_A, double amplitude_A, bool stepped_sine, bool small_signal,
-         int threads) {
+         int peak_refinements, int threads) {
         FrfRequest r;
         r.temperatures_C = std::move(temperatures_C);
         r.f_min_Hz = f_min_Hz;
@@ -96,6 +96,7 @@ void bind_frf(py::module_& mod) {
         r.amplitude_A = amplitude_A;
         r.stepped_sine = stepped_sine;
         r.small_signal = small_signal;
+        r.peak_refinements = peak_refinements;
         r.threads = threads;
         const FrfResult res = without_gil([&] { return run_frf(m, r); });
         return report_dict(frf_report(m, r, res));
@@ -103,9 +104,11 @@ void bind_frf(py::module_& mod) {
       py::arg("model"), py::arg("temperatures_C") = FrfRequest{}.temperatures_C,
       py::arg("f_min_Hz") = 1.0, py::arg("f_max_Hz") = 5000.0, py::arg("points") = 40,
       py::arg("bias_A") = 1.0, py::arg("amplitude_A") = FrfRequest{}.amplitude_A,
-      py::arg("stepped_sine") = true, py::arg("small_signal") = true, py::arg("threads") = 0,
+      py::arg("stepped_sine") = true, py::arg("small_signal") = true,
+      py::arg("peak_refinements") = FrfRequest{}.peak_refinements, py::arg("threads") = 0,
       "Frequency response current -> displacement (Fig. 15): stepped sine and small-signal, modes "
-      "of eq. 15");
+      "of eq. 15. peak_refinements: extra stepped-sine points refining its peak (0: the grid "
+      "only).");
 }
 
 // track(): closed-loop PID tracking (Fig. 16); with feedforward="inverse" the inverse-model

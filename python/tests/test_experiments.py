@@ -37,6 +37,19 @@ def test_frf_linear_and_stepped_agree_and_modes_are_reported(mdma):
     assert 2.5 * 1270 < min(modes) < 8000 and max(modes) < 15000
 
 
+def test_frf_peak_refinements_add_points_at_the_peak(mdma):
+    """peak_refinements=0 keeps the grid; the default adds the linearisation's peak and 12 golden-section
+    points, and the stepped peak moves onto the linearisation's (observed 1270.2 Hz, < 0.01 %)."""
+    grid = gmasim.frf(mdma, temperatures_C=[20], f_min_Hz=950, f_max_Hz=1900, points=5, amplitude_A=2e-5,
+                      peak_refinements=0)
+    refined = gmasim.frf(mdma, temperatures_C=[20], f_min_Hz=950, f_max_Hz=1900, points=5, amplitude_A=2e-5)
+    assert len(grid["response"]["frequency_Hz"]) == 5
+    assert len(refined["response"]["frequency_Hz"]) == 5 + 1 + 12
+    f = np.asarray(refined["response"]["frequency_Hz"])
+    mag = np.asarray(refined["response"]["stepped_mag_um_per_A"])
+    assert abs(f[np.argmax(mag)] / 1270.2 - 1) < 2e-3
+
+
 def test_track_params_ablate_thermal(mdma):
     t = gmasim.track(mdma, temperatures_C=[20, 70], amplitudes_um=[10], frequencies_Hz=[10])
     tab = t[[k for k in t if k != "meta"][0]]
