@@ -186,7 +186,7 @@ def test_the_large_signal_frf_figure_says_so(gmasim_bin, tmp_path):
     assert summ["reference_gain_um_per_A"][0] == pytest.approx(frf["stepped_mag_um_per_A"][0], rel=1e-9)
     labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
     assert any("1270 Hz" in t for t in labels), labels
-    # the grid and, when the stepped sine has a local maximum on it, the refinement's evaluations
-    assert len(frf["frequency_Hz"]) in (5, 5 + 6)  # observed 11: a peak between 950 and 1343 Hz
+    # the grid, the stepped point at the linearisation's peak and the refinement's 6 evaluations
+    assert len(frf["frequency_Hz"]) == 5 + 1 + 6  # observed 12
     assert np.all(np.diff(frf["frequency_Hz"]) > 0)
     plt.close(fig)
