@@ -235,4 +235,8 @@ TEST(Frf, BadRequestsAreClearInputErrors) {
   EXPECT_NE(run([](FrfRequest& r) { r.temperatures_C.clear(); }).find("no temperature"),
             std::string::npos);
   EXPECT_NE(run([](FrfRequest& r) { r.amplitude_A = 0; }).find("amplitude"), std::string::npos);
+  EXPECT_NE(run([](FrfRequest& r) { r.peak_refinements = -5; }).find("--peak-refinements"),
+            std::string::npos);
+  EXPECT_NE(run([](FrfRequest& r) { r.peak_refinements = 2000000000; }).find("--peak-refinements"),
+            std::string::npos);
 }

@@ -186,7 +186,7 @@ Runner add_frf(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--peak-refinements", a->req.peak_refinements,
                   "Stepped sine: golden-section evaluations refining the largest |Y/I| peak "
-                  "between its grid neighbours [-]; 0 = off")
+                  "(and one point at the linearisation's peak) [-]; 0 = off, at most 100")
       ->capture_default_str();
   sub->add_option("--settle-periods", a->req.settle_periods,
                   "Stepped sine: minimum settling periods [-] (also >= 10 time constants)")

@@ -393,6 +393,9 @@ void check_request(const FrfRequest& r) {
   require_in(r.bias_A, -kMaxCurrent_A, kMaxCurrent_A, "bias current (--bias)", "A");
   require_int_in(r.settle_periods, 1, 1000000, "settle periods");
   require_int_in(r.measure_periods, 1, 1000000, "measure periods");
+  // Golden section shrinks its bracket by 0.618 per evaluation: 100 reach 1e-21 of it, far below
+  // what a double resolves, so more is a typing error that would run for hours.
+  require_int_in(r.peak_refinements, 0, 100, "peak refinements (--peak-refinements)");
   if (r.stepped_sine) {
     // The longest stepped-sine run (at f_min) before settling for the model's time
     // constants; the settling is checked again per frequency once those are known.
