@@ -6,7 +6,8 @@
 //   reversible_susceptibility   dM/dH with the irreversible state held (the FRF)
 //   step_dissipation, stored_energy_density   the ledgers (gmasim/energy.hpp)
 //   ode_*                 the law as an ODE for the RK4 reference
-//   kHasAnhysteretic ...  the FRF's anhysteretic bias state
+//   reduce_to_anhysteretic, anhysteretic_magnetisation, hold_anhysteretic
+//                         the FRF's anhysteretic bias state
 // Its constants land in RodModel through its parameter rows and reach RodConditions through
 // its temperature laws (src/model/magnetisation/<law>.cpp). The step is compiled once per
 // law (step_law<Law>); a run dispatches once, by with_magnetisation_law, not per step.
