@@ -308,6 +308,7 @@ void ModelLoader::read_options(const toml::table& root) {
   for (const auto& o : option_table()) keys.emplace_back(o.key);
   check_keys(*t, "[options]", keys);
   const long tl = node_line(*t);
+  spec_.option_lines["[options]"] = tl;  // model save adds an omitted option below it
   bool ok = true;
   for (const auto& o : option_table()) {
     if (!o.default_word.empty() && !t->get(o.key)) continue;  // omitted: its default stands

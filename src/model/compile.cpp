@@ -22,6 +22,7 @@ namespace {
 // The rules of every number and of the options, as the loader applies them: a spec built or
 // edited in code is held to the same rules as a file.
 void check_spec(const ModelSpec& spec) {
+  if (auto missing = schema::unset_message(spec)) fail(spec, 0, *missing);
   for (const auto& [name, pv] : spec.params)
     if (auto problem = schema::check_value(spec, name, pv.value)) fail(spec, pv.line, *problem);
   if (auto problem = check_options(spec.options))
