@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/model.hpp"
 
 using ::testing::HasSubstr;
 using ::testing::Not;

@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "gmasim/experiments.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/io/io.hpp"
 #include "gmasim/physics/preisach.hpp"
 
 using namespace gmasim;

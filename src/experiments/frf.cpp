@@ -11,12 +11,12 @@
 
 #include "experiments/frf_internal.hpp"
 #include "experiments/parallel.hpp"
-#include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/experiments.hpp"
+#include "gmasim/experiments/claims.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/model/validate.hpp"
 #include "gmasim/physics/magnetic.hpp"
-#include "gmasim/run_loop.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/simulate/run_loop.hpp"
 
 namespace gmasim {
 namespace {

@@ -1,13 +1,13 @@
 // gmasim frf's bias point (Fig. 15): the actuator settled at a DC bias current, in the
 // anhysteretic state an AC shake-down leaves or on its virgin curve (settle_at_bias,
-// gmasim/experiments.hpp). docs/experiments.md, "Frequency response".
+// gmasim/experiments/experiments.hpp). docs/experiments.md, "Frequency response".
 #include <algorithm>
 #include <cmath>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/experiments.hpp"
+#include "gmasim/experiments/experiments.hpp"
 #include "gmasim/magnetisation/laws.hpp"
-#include "gmasim/run_loop.hpp"
+#include "gmasim/simulate/run_loop.hpp"
 
 namespace gmasim {
 namespace {

@@ -1,5 +1,5 @@
 // Model files: TOML -> ModelSpec. This file holds the generic readers, the reading of the
-// numbers and options by the parameter table (gmasim/parameters.hpp) and the public entry
+// numbers and options by the parameter table (gmasim/model/parameters.hpp) and the public entry
 // points; the structure sections are in model_structure.cpp, `model show` in
 // model_describe.cpp.
 #include "io/model_loader.hpp"
@@ -13,7 +13,7 @@
 #include "common/text_io.hpp"
 #include "common/toml_io.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/io/io.hpp"
 #include "io/schema.hpp"
 
 namespace gmasim {

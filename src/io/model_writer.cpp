@@ -12,8 +12,8 @@
 
 #include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/validate.hpp"
 #include "io/schema.hpp"
 
 namespace gmasim {

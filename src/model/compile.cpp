@@ -1,6 +1,6 @@
-// ModelSpec -> Model: the numbers land where the parameter table says (gmasim/parameters.hpp),
-// then the structure (circuit, sensor, load chains) is assembled and the derived quantities
-// formed.
+// ModelSpec -> Model: the numbers land where the parameter table says
+// (gmasim/model/parameters.hpp), then the structure (circuit, sensor, load chains) is assembled and
+// the derived quantities formed.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -8,8 +8,8 @@
 #include <numbers>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/model.hpp"
-#include "gmasim/validity.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/model/validity.hpp"
 #include "model/schema.hpp"
 
 namespace gmasim {
@@ -233,7 +233,7 @@ Model compile(const ModelSpec& spec) {
   build_flux_sensor(spec, m);
   build_chains(spec, m);
   derive(spec, m);
-  check_model_validity(m);  // gmasim/validity.hpp: no rod under a crushing prestress
+  check_model_validity(m);  // gmasim/model/validity.hpp: no rod under a crushing prestress
   return m;
 }
 

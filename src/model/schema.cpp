@@ -16,7 +16,7 @@
 namespace gmasim {
 
 // =======================================================================================
-// Schema: the rows of gmasim/parameters.hpp applied to a spec
+// Schema: the rows of gmasim/model/parameters.hpp applied to a spec
 // =======================================================================================
 namespace schema {
 namespace {

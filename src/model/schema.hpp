@@ -1,4 +1,4 @@
-// Internal: the rules of the parameter table (gmasim/parameters.hpp) applied to a ModelSpec,
+// Internal: the rules of the parameter table (gmasim/model/parameters.hpp) applied to a ModelSpec,
 // shared by the loader (src/io), compile() and ModelSpec::set. Not part of the public API.
 #pragma once
 
@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 
 namespace gmasim::schema {
 

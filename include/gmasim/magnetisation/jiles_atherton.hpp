@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "gmasim/magnetisation/law_id.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 #include "gmasim/physics/jiles_atherton.hpp"
 
 namespace gmasim {
@@ -40,7 +40,7 @@ struct JilesAthertonLaw {
     return rc.ja.c * dMan / (1.0 - rc.ja.alpha * rc.ja.c * dMan);
   }
 
-  // The ledgers (gmasim/energy.hpp): the dissipation density of the step from (H0, M0) to r's
+  // The ledgers (gmasim/model/energy.hpp): the dissipation density of the step from (H0, M0) to r's
   // state, and the stored energy density of r's state [J/m^3].
   static double step_dissipation(const RodConditions& rc, double H0, double M0, const RodState& r) {
     return physics::ja_step_dissipation(H0, M0, r.H_A_per_m, r.M_A_per_m, rc.MsT_mag, rc.ja);

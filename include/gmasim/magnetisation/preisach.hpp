@@ -6,7 +6,7 @@
 #pragma once
 
 #include "gmasim/magnetisation/law_id.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 #include "gmasim/physics/preisach.hpp"
 
 namespace gmasim {

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "gmasim/mechanics/oscillator.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 
 namespace gmasim {
 

@@ -3,8 +3,9 @@
 // two step sizes, and what they say about identifiability (correlations, near-null
 // directions). docs/experiments.md, "Sensitivity".
 //
-//   S_ij = d q_i / d ln p_j        log step: p_j > 0 by its row's rule (gmasim/parameters.hpp)
-//   S_ij = d q_i / d p_j           absolute step: a parameter that may be zero or negative
+//   S_ij = d q_i / d ln p_j        log step: p_j > 0 by its row's rule
+//   (gmasim/model/parameters.hpp) S_ij = d q_i / d p_j           absolute step: a parameter that
+//   may be zero or negative
 //
 // The quantities are a list of named scalars: the claims (their `ours`, exactly as `gmasim
 // reproduce` scores them), the metric quantities (a simulate run's Metrics field at one
@@ -16,11 +17,11 @@
 #include <string>
 #include <vector>
 
-#include "gmasim/claims.hpp"
-#include "gmasim/experiments.hpp"
-#include "gmasim/model.hpp"
-#include "gmasim/reproduce.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/experiments/claims.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/experiments/reproduce.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim {
 

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "gmasim/mechanics/mechanics.hpp"
-#include "gmasim/model.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim {
 
@@ -188,8 +188,8 @@ class Pid {
   bool first_ = true;
 };
 
-// Temperature feed-forward (gmasim compensate, include/gmasim/compensate.hpp): at operating
-// temperature T the coil current is
+// Temperature feed-forward (gmasim compensate, include/gmasim/experiments/compensate.hpp): at
+// operating temperature T the coil current is
 //   i = bias + g(T) (u_PID + (r(t) - y_bias) / K_ref),   clipped to +-current_limit_A,
 // where g(T) interpolates (temperatures_C, gains) linearly (held beyond the ends) and K_ref
 // is the static gain dy/di at the bias [um/A] (0: no reference feed-forward, the schedule
@@ -201,8 +201,8 @@ struct TemperatureFeedforward {
   double gain_at(double temperature_C) const;  // 1 when off
 };
 
-// Inverse-model feed-forward (gmasim/feedforward.hpp): the current the model at the loop's
-// temperature says produces the reference, added ahead of the PID:
+// Inverse-model feed-forward (gmasim/experiments/feedforward.hpp): the current the model at the
+// loop's temperature says produces the reference, added ahead of the PID:
 //   i = clip(i_ff(t) + a u_PID, +-current_limit_A),  the PID's limits following i_ff.
 // Off unless `enabled`; not combined with the temperature feed-forward.
 struct InverseFeedforwardRequest {
@@ -356,7 +356,7 @@ ThermalExpansionResult thermal_expansion_coefficient(const Model& m);
 // ---------------------------------------------------------------------------------------
 // Reports: one table per result (CSV: one row per point, column names with units) and a
 // JSON document with the same data (src/experiments/report.cpp builds them; table_csv and
-// report_json of gmasim/io.hpp write them).
+// report_json of gmasim/io/io.hpp write them).
 // ---------------------------------------------------------------------------------------
 struct Cell {
   double number = 0.0;

@@ -6,9 +6,9 @@
 #include <utility>
 #include <vector>
 
-#include "gmasim/experiments.hpp"
-#include "gmasim/model.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim {
 
@@ -77,7 +77,7 @@ void write_files_atomic(const std::vector<std::pair<std::string, std::string>>& 
 // SIGKILL left is removed by the next write of the same file (its process is gone).
 void remove_pending_temporaries() noexcept;
 
-// Reads a user's input file whole: at most kMaxInputBytes (gmasim/validate.hpp), else an
+// Reads a user's input file whole: at most kMaxInputBytes (gmasim/model/validate.hpp), else an
 // InputError "<path>: <what> is larger than ..."; `what` names the file in messages.
 std::string read_input_file(const std::string& path, const std::string& what);
 

@@ -23,8 +23,8 @@
 #include <string>
 #include <vector>
 
-#include "gmasim/experiments.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/model/model.hpp"
 
 namespace gmasim {
 
@@ -148,7 +148,7 @@ struct FeedforwardEvaluation {
 };
 
 // Every run of the grid; the temperature schedule of pid_temperature is computed on the model
-// (gmasim/compensate.hpp, loop_temperature_feedforward). Plant steps per frequency.
+// (gmasim/experiments/compensate.hpp, loop_temperature_feedforward). Plant steps per frequency.
 FeedforwardEvaluation run_feedforward_evaluation(const Model& m,
                                                  const FeedforwardEvaluationRequest& r,
                                                  const ProgressFn& progress = {});

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 
 namespace gmasim {
 
@@ -47,7 +47,7 @@ double interpolate_held(const std::vector<double>& x, const std::vector<double>&
 // ---------------------------------------------------------------------------------------
 // Run settings and results.
 // ---------------------------------------------------------------------------------------
-// Self-heating (gmasim/self_heating.hpp): the run starts with coil, rods and housing at
+// Self-heating (gmasim/model/self_heating.hpp): the run starts with coil, rods and housing at
 // temperature_C; every thermal step the losses of that interval heat the network and the
 // Conditions are recomputed at the rods' new temperature.
 struct SelfHeatingSettings {
@@ -58,7 +58,7 @@ struct SelfHeatingSettings {
 
 struct SimulationSettings {
   double temperature_C = 20.0;  // start temperature of every node (self-heating) or the fixed one
-  // Book the energy ledgers (gmasim/energy.hpp) and the coil's terminal quantities over the
+  // Book the energy ledgers (gmasim/model/energy.hpp) and the coil's terminal quantities over the
   // metrics window (Result::energy, Result::coil). `gmasim simulate`, Python's simulate() and
   // `model check` turn it on; self-heating books them whatever this says (its losses come from
   // the ledger). Off by default for the experiments that run many simulations: it solves every
@@ -156,7 +156,7 @@ struct Result {
   double energy_in_J = 0, energy_stored_J = 0, energy_out_J = 0;
 };
 
-// The validation layer (gmasim/validate.hpp): throws InputError naming the field, its value
+// The validation layer (gmasim/model/validate.hpp): throws InputError naming the field, its value
 // and the rule for a non-finite or out-of-range number (currents |I| <= kMaxCurrent_A,
 // frequencies in (0, kMaxFrequency_Hz], a table that starts before t = 0 or later than 0,
 // run lengths whose step count exceeds kMaxSteps or whose record exceeds kMaxRecordedRows).
@@ -218,7 +218,7 @@ struct MagneticStateCheck {
   double max_inconsistency_T = 0;                // max |phi_i / A_i - mu0 (H_i + M_i)|
   double max_inconsistency_rel = 0;              // the same over mu0 (|H| + M_s^T) of that rod
   std::string where_B_rod, where_inconsistency;  // "rod2, 150 degC, 12 A, 10 Hz, t = ... s"
-  // The energy ledgers (gmasim/energy.hpp) over the last period of each run: the worse
+  // The energy ledgers (gmasim/model/energy.hpp) over the last period of each run: the worse
   // relative residual of the two, where, and the largest coupling fraction (the mechanical
   // input the one-way coupling does not draw from the coil, over the magnetic input).
   double energy_residual_rel = 0;

@@ -57,7 +57,7 @@ enum gmasim_status {
  * the step no longer holds the state at constant current (docs/model.md, "Time step"). */
 #define GMASIM_MIN_DT_S 1e-12
 #define GMASIM_MAX_DT_S 1e-3
-/* Largest coil current magnitude [A] (kMaxCurrent_A of gmasim/simulate.hpp). */
+/* Largest coil current magnitude [A] (kMaxCurrent_A of gmasim/simulate/simulate.hpp). */
 #define GMASIM_MAX_CURRENT_A 1000.0
 
 typedef struct gmasim_model gmasim_model; /* a compiled, immutable model */

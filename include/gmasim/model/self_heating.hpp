@@ -5,7 +5,7 @@
 // thermal step and recomputes the Conditions at the new rod temperature.
 #pragma once
 
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 
 namespace gmasim {
 

@@ -8,9 +8,9 @@
 #include <utility>
 #include <vector>
 
-#include "gmasim/circuit.hpp"
-#include "gmasim/energy.hpp"
-#include "gmasim/parameters.hpp"
+#include "gmasim/model/circuit.hpp"
+#include "gmasim/model/energy.hpp"
+#include "gmasim/model/parameters.hpp"
 #include "gmasim/physics/jiles_atherton.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/preisach.hpp"
@@ -40,7 +40,7 @@ enum class MagneticState { Printed, Consistent };
 enum class Eq11Saturation { Temperature, Reference };
 
 // Parsed once, by the loader or ModelSpec::set_options, from the words of the option table
-// (gmasim/parameters.hpp). The defaults are the built-in model's readings (a test holds them
+// (gmasim/model/parameters.hpp). The defaults are the built-in model's readings (a test holds them
 // to models/mdma.toml): a ModelSpec built in code has them unless it sets others; a model file
 // must state every option.
 struct Options {
@@ -78,7 +78,7 @@ struct ModelSpec {
   std::string text;    // the TOML text it was parsed from (model_toml() edits it)
   // Every numeric parameter by its dotted TOML name ("rod1.ja.k0_A_per_m").
   std::map<std::string, ParamValue> params;
-  Options options;  // [options], parsed (gmasim/parameters.hpp, option_table())
+  Options options;  // [options], parsed (gmasim/model/parameters.hpp, option_table())
   std::map<std::string, std::string> meta;  // [meta] texts by dotted name ("meta.name")
   // Source lines of the options, the meta texts, structure keys and optional tables'
   // headers, by dotted name ("options.magnetic_state", "stack.rods", "[thermal_network]").
@@ -101,7 +101,7 @@ struct ModelSpec {
   // involve it; throws InputError (and leaves the spec unchanged) if unknown or refused.
   void set(const std::string& dotted, double value);
   // Sets options ("options.magnetic_state" or "magnetic_state") from their words, all at
-  // once: the rules between options (gmasim/parameters.hpp, check_options) apply to the
+  // once: the rules between options (gmasim/model/parameters.hpp, check_options) apply to the
   // result, whatever the order. Throws InputError naming the allowed words or the rule broken,
   // and leaves the options unchanged.
   void set_options(const std::vector<std::pair<std::string, std::string>>& name_word);
@@ -245,7 +245,7 @@ struct ThermalExpansionModel {
 };
 
 // Where the model was validated ([validity], every key defaulted; issue 19, item 8). Outside
-// it a run is allowed but warned about (gmasim/validity.hpp, temperature_warning).
+// it a run is allowed but warned about (gmasim/model/validity.hpp, temperature_warning).
 struct ValidityModel {
   double validated_min_C = 20.0, validated_max_C = 150.0;
 };
@@ -341,7 +341,7 @@ Conditions make_conditions(const Model& m, double temperature_C, const Freeze& f
 // rk4_reference_step() writes the same fields by its own integration; quasi_static_step()
 // writes every field but t_s as one increment of make_state's ramp does (stages 1-2 without
 // eddy lag, then the force and the static equilibrium x = F / K). Nothing else writes a State,
-// except run_loop() and run_loop_step() (gmasim/run_loop.hpp, the latter for the Stepper),
+// except run_loop() and run_loop_step() (gmasim/simulate/run_loop.hpp, the latter for the Stepper),
 // which set t_s to the grid's time after each step (t0 + k dt: no drift from repeated
 // addition), and settle_at_bias (src/experiments/frf.cpp): its anhysteretic start
 // (M_irr = M = M_an) and t_s = 0 once the bias point has settled.
@@ -370,7 +370,7 @@ struct RodState {
   double B_T = 0;  // the flux density the circuit assigns to the rod, phi / A; end of step()
   double K_osc_N_per_m = 0;  // the oscillator's stiffness over the last step (eq. 16 at mid-step);
                              // stage 3 (make_state: at rest)
-  RodEnergy energy;          // the ledgers' running sums (gmasim/energy.hpp); end of step()
+  RodEnergy energy;          // the ledgers' running sums (gmasim/model/energy.hpp); end of step()
 };
 
 struct State {
@@ -387,7 +387,8 @@ struct State {
   CircuitWorkspace circuit;  // stage 1: the rod branches' fluxes phi (eq. 23), the consistent
                              // state's linearised rod MMFs (rod_extra_mmf)
   std::vector<double> rod_reluctance;  // per rod, eq. (2) (consistent: linearised); stage 1
-  EnergyAccumulators energy;  // the ledgers (gmasim/energy.hpp): booked by step() when enabled
+  EnergyAccumulators
+      energy;  // the ledgers (gmasim/model/energy.hpp): booked by step() when enabled
 };
 
 // Sizes every buffer, and places the actuator at rest in its quasi-static equilibrium

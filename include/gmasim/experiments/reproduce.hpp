@@ -1,6 +1,6 @@
 // `gmasim reproduce`: the whole study of the paper on one model, and the claims table
 // (READING-NOTES' list of the paper's numbers, each beside ours with a stated tolerance).
-// The claims themselves are data (data/claims.toml, gmasim/claims.hpp); score_claims
+// The claims themselves are data (data/claims.toml, gmasim/experiments/claims.hpp); score_claims
 // computes ours for each with the extractor its kind names.
 #pragma once
 
@@ -8,9 +8,9 @@
 #include <utility>
 #include <vector>
 
-#include "gmasim/claims.hpp"
-#include "gmasim/experiments.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/experiments/claims.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/model/model.hpp"
 
 namespace gmasim {
 

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
@@ -42,8 +42,9 @@ inline double rod_static_field(const Model& m, std::size_t i, const RodCondition
 // Magnetostriction, Delta-E modulus and force of a rod at its present M (eq. 11-14, 17).
 inline void update_rod_mechanics(const Material& mat, const RodConditions& rc, RodState& r) {
   r.E_Pa = physics::delta_e_modulus(r.M_A_per_m / rc.MsT_E, rc.dE);  // eq. (13)
-  r.lambda = physics::magnetostriction(r.M_A_per_m / rc.Ms_strain_A_per_m, mat.lambda_s, rc.sigma_p_Pa,
-                                       r.E_Pa);                                 // eq. (11)-(12)
+  r.lambda =
+      physics::magnetostriction(r.M_A_per_m / rc.Ms_strain_A_per_m, mat.lambda_s, rc.sigma_p_Pa,
+                                r.E_Pa);                                        // eq. (11)-(12)
   r.F_N = physics::rod_force(r.lambda, r.E_Pa, rc.area_m2);                     // eq. (14)
   r.k_rod_N_per_m = physics::axial_stiffness(r.E_Pa, rc.area_m2, rc.length_m);  // eq. (17)
 }

@@ -18,8 +18,8 @@
 #include <string_view>
 #include <vector>
 
-#include "gmasim/model.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim {
 
@@ -74,8 +74,8 @@ struct MeasurementCondition {
   std::string rod;     // rod of the field_A_per_m / strain_ppm columns; "": the first rod
   long precycles = 0;  // passes of the record's own drive before the compared pass
   InitialState initial_state = InitialState::Demagnetised;  // before the pre-cycles
-  OffsetMode offset = OffsetMode::Absolute;       // of displacement_um / strain_ppm
-  OffsetMode flux_offset = OffsetMode::Absolute;  // of flux_T
+  OffsetMode offset = OffsetMode::Absolute;                 // of displacement_um / strain_ppm
+  OffsetMode flux_offset = OffsetMode::Absolute;            // of flux_T
   // The prestress the record was measured at [MPa]: the stress in the first rod of
   // stack.rods; the record is simulated with the preload that gives it (its force replaces
   // the model's preload). NaN: the model's own preload.
@@ -180,8 +180,8 @@ std::vector<std::string> fitted_claims(const FitSpec& spec);
 // A TOML file ([[parameter]] and [[target]] tables), or inline
 // "name:lower:upper[:log][,name:lower:upper...]". Throws InputError.
 // A [[target]] with `claim = "<id>"` takes its kind, value and condition from that claim
-// (gmasim/claims.hpp): of the spec's top-level `claims = "file"` (relative to the spec) if
-// it names one, else of `claims` if given, else of the built-in data/claims.toml.
+// (gmasim/experiments/claims.hpp): of the spec's top-level `claims = "file"` (relative to the spec)
+// if it names one, else of `claims` if given, else of the built-in data/claims.toml.
 struct ClaimsData;
 FitSpec load_fit_spec(const std::string& file_or_inline);
 FitSpec parse_fit_spec(const std::string& toml_text, const std::string& source_name,

@@ -6,7 +6,7 @@
 // record's root solve tries single steps from a copy of the state; that is no time loop.)
 //
 //   StepGrid   where the steps lie in time, built by one of its factories, which apply the
-//              step-count limit (kMaxSteps, gmasim/validate.hpp) in one place;
+//              step-count limit (kMaxSteps, gmasim/model/validate.hpp) in one place;
 //   drive      the coil current of each step: a function of the step's end time,
 //              `double(double t_s)`, or of the state and the step,
 //              `double(const State&, const StepPoint&)` (a field-driven record solves for the
@@ -30,8 +30,8 @@
 #include <type_traits>
 #include <utility>
 
-#include "gmasim/model.hpp"
-#include "gmasim/validity.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/model/validity.hpp"
 
 namespace gmasim {
 
@@ -157,7 +157,7 @@ inline void advance(const Model& m, const Conditions& c, State& st, const StepPo
     throw_not_finite(p.t_s, "output y [m]", st.y_m);
   if (!std::isfinite(st.B_T)) [[unlikely]]
     throw_not_finite(p.t_s, "flux density B [T] of the induction coil", st.B_T);
-  check_physical_validity(m, c, st, p.t_s);  // gmasim/validity.hpp (issue 19, item 3)
+  check_physical_validity(m, c, st, p.t_s);  // gmasim/model/validity.hpp (issue 19, item 3)
   record(std::as_const(st), p);
 }
 // The loop of run_loop() for one magnetisation law.
@@ -239,8 +239,8 @@ void run_loop_detail::run_grid(const Model& m, const Conditions& c, State& st, c
 
 // Step k (1, 2, ...) of a Uniform grid from t = 0 with the current held over the step: the
 // loop's one step, with its checks and its time rule (State::t_s = k dt), for callers that
-// are handed one current at a time: the sample-by-sample Stepper (gmasim/stepper.hpp, the C
-// API, Python), which therefore judges divergence exactly as simulate() does.
+// are handed one current at a time: the sample-by-sample Stepper (gmasim/simulate/stepper.hpp, the
+// C API, Python), which therefore judges divergence exactly as simulate() does.
 inline void run_loop_step(const Model& m, const Conditions& c, State& st, long k, double dt_s,
                           double current_A) {
   StepPoint p;

@@ -1,21 +1,22 @@
 // Stepper: one actuator simulated sample by sample, for real-time loops and co-simulation
 // (a controller that computes the next coil current from the last output). The session that
-// the C API (gmasim/gmasim_c.h) and the Python gmasim.Stepper wrap: a model, the conditions at
+// the C API (gmasim/capi/gmasim_c.h) and the Python gmasim.Stepper wrap: a model, the conditions at
 // one temperature, the state, a fixed time step, and a divergence latch (docs/c_api.md).
 #pragma once
 
 #include <memory>
 #include <string>
 
-#include "gmasim/model.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/model/validate.hpp"
 
 namespace gmasim {
 
-// Time steps a Stepper accepts [s]: kMinStepDt_s <= dt_s <= kMaxStepperDt_s (gmasim/validate.hpp).
-// step() is exact for the eddy-current and mechanical updates, but a step longer than a
-// millisecond resolves neither the eddy time constants nor the 7-20 kHz mechanical modes, and one
-// shorter than 1e-12 s no longer holds the state (docs/model.md, "Time step").
+// Time steps a Stepper accepts [s]: kMinStepDt_s <= dt_s <= kMaxStepperDt_s
+// (gmasim/model/validate.hpp). step() is exact for the eddy-current and mechanical updates, but a
+// step longer than a millisecond resolves neither the eddy time constants nor the 7-20 kHz
+// mechanical modes, and one shorter than 1e-12 s no longer holds the state (docs/model.md, "Time
+// step").
 inline constexpr double kMaxStepperDt_s = kMaxStepDt_s;
 
 class Stepper {

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 
 namespace gmasim {
 
@@ -35,7 +35,7 @@ inline constexpr double kFluxGuardMsFactor = 1.05;
 
 // Throws DivergenceError(t_s, rod, quantity, value, "beyond the physical bound ...") for the
 // first rod whose state breaks a bound. Allocation-free unless it throws; called by the run loop
-// after every step (gmasim/run_loop.hpp) and by the Stepper through it.
+// after every step (gmasim/simulate/run_loop.hpp) and by the Stepper through it.
 void check_physical_validity(const Model& m, const Conditions& c, const State& s, double t_s);
 
 // Terfenol-D's compressive strength is 305-880 MPa (manufacturer data); no rod survives a
