@@ -1,0 +1,6 @@
+// Forwarding header: gmasim/compensate.hpp moved to gmasim/experiments/compensate.hpp (issue 21;
+// docs/layers.md, "The public headers"). Kept so that existing users still compile; include the new
+// path.
+#pragma once
+
+#include "gmasim/experiments/compensate.hpp"

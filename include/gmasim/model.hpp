@@ -1,0 +1,5 @@
+// Forwarding header: gmasim/model.hpp moved to gmasim/model/model.hpp (issue 21; docs/layers.md,
+// "The public headers"). Kept so that existing users still compile; include the new path.
+#pragma once
+
+#include "gmasim/model/model.hpp"

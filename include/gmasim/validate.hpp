@@ -1,0 +1,6 @@
+// Forwarding header: gmasim/validate.hpp moved to gmasim/model/validate.hpp (issue 21;
+// docs/layers.md, "The public headers"). Kept so that existing users still compile; include the new
+// path.
+#pragma once
+
+#include "gmasim/model/validate.hpp"
