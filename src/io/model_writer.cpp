@@ -122,6 +122,30 @@ void comment_out_law_tables(std::vector<std::string>& lines, const ModelSpec& or
       if (!io_detail::trim(lines[k]).empty()) lines[k] = "# " + lines[k];
   }
 }
+// The changed options: on their lines, or (an omitted option) into `added` for [options].
+void write_options(std::vector<std::string>& lines,
+                   std::map<std::string, std::vector<std::string>>& added, const ModelSpec& spec,
+                   const ModelSpec& original, const std::string& why) {
+  auto leaf_of = [](const std::string& dotted) { return dotted.substr(dotted.rfind('.') + 1); };
+  for (const auto& def : option_table()) {
+    const std::string name = "options." + std::string(def.key);
+    const std::string value(option_word(def, spec.options));
+    const std::string was(option_word(def, original.options));
+    if (value == was) continue;
+    if (!original.option_lines.count(name)) {  // an omitted option: added to [options]
+      const std::string text = def.boolean ? value : "\"" + value + "\"";
+      added["options"].push_back(
+          fmt::format("{} = {}  # set: {}; was its default {}", def.key, text, why, was));
+      continue;
+    }
+    const long line_no = spec.line_of(name);
+    const std::string& line = lines.at(static_cast<std::size_t>(std::max(1L, line_no) - 1));
+    const auto span = schema::value_span(line, leaf_of(name));
+    const bool quoted = span && span->begin < line.size() && line[span->begin] == '"';
+    replace_value(lines, line_no, leaf_of(name), quoted ? "\"" + value + "\"" : value,
+                  fmt::format("set: {}; was {}", why, was), spec.source);
+  }
+}
 }  // namespace
 
 ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assignments,
@@ -206,24 +230,7 @@ std::string model_toml(const ModelSpec& spec, const std::string& why) {
     replace_value(lines, was.line, leaf_of(name), schema::toml_float(pv.value), comment,
                   spec.source);
   }
-  for (const auto& def : option_table()) {
-    const std::string name = "options." + std::string(def.key);
-    const std::string value(option_word(def, spec.options));
-    const std::string was(option_word(def, original.options));
-    if (value == was) continue;
-    if (!original.option_lines.count(name)) {  // an omitted option: added to [options]
-      const std::string text = def.boolean ? value : "\"" + value + "\"";
-      added["options"].push_back(
-          fmt::format("{} = {}  # set: {}; was its default {}", def.key, text, why, was));
-      continue;
-    }
-    const long line_no = spec.line_of(name);
-    const std::string& line = lines.at(static_cast<std::size_t>(std::max(1L, line_no) - 1));
-    const auto span = schema::value_span(line, leaf_of(name));
-    const bool quoted = span && span->begin < line.size() && line[span->begin] == '"';
-    replace_value(lines, line_no, leaf_of(name), quoted ? "\"" + value + "\"" : value,
-                  fmt::format("set: {}; was {}", why, was), spec.source);
-  }
+  write_options(lines, added, spec, original, why);
   if (law_changed)
     comment_out_law_tables(
         lines, original,
