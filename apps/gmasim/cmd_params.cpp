@@ -7,8 +7,10 @@
 #include "experiment_cli.hpp"
 #include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiment_fields.hpp"
 #include "gmasim/experiments.hpp"
 #include "gmasim/io.hpp"
+#include "request_options.hpp"
 
 namespace gmasim::cli {
 namespace {
@@ -16,8 +18,9 @@ namespace {
 struct ParamsArgs {
   bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
   ModelArgs model;
-  std::string out = "out/params", temperatures = "20,40,60,80,100,120,150", retention = "6,8,10,12";
+  std::string out = "out/params";
   ParamsVsTemperatureRequest req;
+  RequestOptions<ParamsVsTemperatureRequest> options;  // gmasim/experiment_fields.hpp
 };
 
 void print_thermal(const ThermalExpansionResult& t) {
@@ -31,9 +34,8 @@ void print_thermal(const ThermalExpansionResult& t) {
 
 int run_params_cmd(ParamsArgs& a) {
   const Model model = load_model_args(a.model);
-  a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
+  a.options.apply();
   warn_temperatures(model, a.req.temperatures_C, "--temperatures");
-  a.req.retention_currents_pp_A = parse_list(a.retention, "--retention-currents", "A");
   prepare_output_dir(a.out, {"params", "thermal"}, model_inputs(a.model));
   const auto res = run_params_vs_temperature(model, a.req);
   auto files = write_report(a.out, "params", params_report(model, a.req, res));
@@ -84,22 +86,7 @@ Runner add_params(CLI::App& app) {
       "and the thermal expansion coefficient (eq. 21). Writes params*.csv, params.json, "
       "thermal.csv, thermal.json");
   add_model_options(sub, a->model);
-  sub->add_option("--temperatures", a->temperatures, "Temperatures [degC]; list or range")
-      ->capture_default_str();
-  sub->add_option("--current-pp", a->req.current_pp_A,
-                  "Current peak-to-peak of the Fig. 19 operating point [A]")
-      ->capture_default_str();
-  sub->add_option("--frequency", a->req.frequency_Hz, "Excitation frequency [Hz]")
-      ->capture_default_str();
-  sub->add_option("--retention-currents", a->retention,
-                  "Current peak-to-peak values of the retention table [A]; list or range")
-      ->capture_default_str();
-  sub->add_option("--current-min", a->req.current_min_A, "Minimum of the biased sine [A]")
-      ->capture_default_str();
-  sub->add_option("--periods", a->req.periods, "Periods per run [-]; statistics over the last")
-      ->capture_default_str();
-  sub->add_option("--threads", a->req.threads, "Worker threads [-]; 0 = all cores")
-      ->capture_default_str();
+  a->options.add(sub, a->req);
   sub->add_flag("--plot", a->plot, "Also draw <out>/params.png and .svg (matplotlib)");
   sub->add_option("--out", a->out, "Output directory")->capture_default_str();
   return [a, sub]() -> int { return sub->parsed() ? run_params_cmd(*a) : -1; };

@@ -13,6 +13,7 @@
 #include "experiments/parallel.hpp"
 #include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiment_fields.hpp"
 #include "gmasim/experiments.hpp"
 #include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/physics/magnetic.hpp"
@@ -526,6 +527,7 @@ void fill_curve(FrfCurve& cv, const SmallSignalModel& lin, const cd* stepped,
 
 FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progress) {
   check_request(r);
+  fields::check_request_fields(r);  // the table's rules (gmasim/experiment_fields.hpp)
   std::vector<Conditions> conds;
   for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
 
