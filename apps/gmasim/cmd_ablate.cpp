@@ -14,13 +14,7 @@
 namespace gmasim::cli {
 namespace {
 
-struct AblateArgs {
-  bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
-  ModelArgs model;
-  std::string out = "out/ablate";
-  AblateRequest req;
-  RequestOptions<AblateRequest> options;  // the request's table (gmasim/experiment_fields.hpp)
-};
+using AblateArgs = ExperimentArgs<AblateRequest>;
 
 int run_ablate_cmd(AblateArgs& a) {
   const Model model = load_model_args(a.model);
@@ -60,17 +54,15 @@ int run_ablate_cmd(AblateArgs& a) {
 }  // namespace
 
 Runner add_ablate(CLI::App& app) {
-  auto a = std::make_shared<AblateArgs>();
-  auto* sub = app.add_subcommand(
-      "ablate", fmt::format("Freeze the temperature dependence of each law ({}) at 20 degC one "
-                            "at a time, then all; deviation from the full model (Fig. 20). "
-                            "Writes ablate.csv, ablate.json",
-                            freeze_name_list()));
-  add_model_options(sub, a->model);
-  a->options.add(sub, a->req);
-  sub->add_flag("--plot", a->plot, "Also draw <out>/ablate.png and .svg (matplotlib)");
-  sub->add_option("--out", a->out, "Output directory")->capture_default_str();
-  return [a, sub]() -> int { return sub->parsed() ? run_ablate_cmd(*a) : -1; };
+  return add_experiment<AblateArgs>(
+      app,
+      {"ablate",
+       fmt::format("Freeze the temperature dependence of each law ({}) at 20 degC one at a time, "
+                   "then all; deviation from the full model (Fig. 20). Writes ablate.csv, "
+                   "ablate.json",
+                   freeze_name_list()),
+       "out/ablate", "Also draw <out>/ablate.png and .svg (matplotlib)", false},
+      [](CLI::App*, AblateArgs&) {}, run_ablate_cmd);
 }
 
 }  // namespace gmasim::cli

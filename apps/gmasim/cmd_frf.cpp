@@ -20,13 +20,8 @@ namespace {
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 constexpr double kMismatchWarnPct = 5.0;  // stepped sine vs linearisation: warn above
 
-struct FrfArgs {
-  bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
-  ModelArgs model;
-  std::string out = "out/frf", method = "both", bias_state = "anhysteretic";
-  FrfRequest req;
-  RequestOptions<FrfRequest> options;  // the request's table (gmasim/experiment_fields.hpp)
-  bool progress = false;
+struct FrfArgs : ExperimentArgs<FrfRequest> {
+  std::string method = "both", bias_state = "anhysteretic";
 };
 
 // The resonance's shift and the change of its amplitude across the temperatures (Fig. 15:
@@ -160,26 +155,24 @@ int run_frf_cmd(FrfArgs& a) {
 }  // namespace
 
 Runner add_frf(CLI::App& app) {
-  auto a = std::make_shared<FrfArgs>();
-  auto* sub = app.add_subcommand(
-      "frf",
-      "Frequency response current -> displacement (Fig. 15): stepped sine and/or small-signal "
-      "linearisation about a DC bias, first resonance, -3 dB bandwidth, eq. (15) modes. Writes "
-      "frf.csv, frf_summary.csv, frf_modes.csv, frf_eddy.csv and frf.json");
-  add_model_options(sub, a->model);
-  a->options.add(sub, a->req);
-  sub->add_option("--method", a->method, "stepped, linear or both")
-      ->check(CLI::IsMember({"stepped", "linear", "both"}))
-      ->capture_default_str();
-  sub->add_option("--bias-state", a->bias_state,
-                  "Magnetic state at the bias: anhysteretic (after AC shake-down) or "
-                  "initial-curve (virgin curve; the JA minor loop then creeps)")
-      ->check(CLI::IsMember({"anhysteretic", "initial-curve"}))
-      ->capture_default_str();
-  sub->add_flag("--progress", a->progress, "Progress on stderr even when it is not a terminal");
-  sub->add_flag("--plot", a->plot, "Also draw <out>/frf.png and .svg (matplotlib)");
-  sub->add_option("--out", a->out, "Output directory")->capture_default_str();
-  return [a, sub]() -> int { return sub->parsed() ? run_frf_cmd(*a) : -1; };
+  auto own = [](CLI::App* sub, FrfArgs& a) {
+    sub->add_option("--method", a.method, "stepped, linear or both")
+        ->check(CLI::IsMember({"stepped", "linear", "both"}))
+        ->capture_default_str();
+    sub->add_option("--bias-state", a.bias_state,
+                    "Magnetic state at the bias: anhysteretic (after AC shake-down) or "
+                    "initial-curve (virgin curve; the JA minor loop then creeps)")
+        ->check(CLI::IsMember({"anhysteretic", "initial-curve"}))
+        ->capture_default_str();
+  };
+  return add_experiment<FrfArgs>(
+      app,
+      {"frf",
+       "Frequency response current -> displacement (Fig. 15): stepped sine and/or small-signal "
+       "linearisation about a DC bias, first resonance, -3 dB bandwidth, eq. (15) modes. Writes "
+       "frf.csv, frf_summary.csv, frf_modes.csv, frf_eddy.csv and frf.json",
+       "out/frf", "Also draw <out>/frf.png and .svg (matplotlib)"},
+      own, run_frf_cmd);
 }
 
 }  // namespace gmasim::cli

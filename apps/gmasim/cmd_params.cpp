@@ -15,13 +15,7 @@
 namespace gmasim::cli {
 namespace {
 
-struct ParamsArgs {
-  bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
-  ModelArgs model;
-  std::string out = "out/params";
-  ParamsVsTemperatureRequest req;
-  RequestOptions<ParamsVsTemperatureRequest> options;  // gmasim/experiment_fields.hpp
-};
+using ParamsArgs = ExperimentArgs<ParamsVsTemperatureRequest>;
 
 void print_thermal(const ThermalExpansionResult& t) {
   fmt::print(
@@ -79,17 +73,14 @@ int run_params_cmd(ParamsArgs& a) {
 }  // namespace
 
 Runner add_params(CLI::App& app) {
-  auto a = std::make_shared<ParamsArgs>();
-  auto* sub = app.add_subcommand(
-      "params-vs-temperature",
-      "mu_G, rho_G, M_G, E_G and E_t against temperature (Fig. 19), stroke retention (Fig. 18) "
-      "and the thermal expansion coefficient (eq. 21). Writes params*.csv, params.json, "
-      "thermal.csv, thermal.json");
-  add_model_options(sub, a->model);
-  a->options.add(sub, a->req);
-  sub->add_flag("--plot", a->plot, "Also draw <out>/params.png and .svg (matplotlib)");
-  sub->add_option("--out", a->out, "Output directory")->capture_default_str();
-  return [a, sub]() -> int { return sub->parsed() ? run_params_cmd(*a) : -1; };
+  return add_experiment<ParamsArgs>(
+      app,
+      {"params-vs-temperature",
+       "mu_G, rho_G, M_G, E_G and E_t against temperature (Fig. 19), stroke retention (Fig. 18) "
+       "and the thermal expansion coefficient (eq. 21). Writes params*.csv, params.json, "
+       "thermal.csv, thermal.json",
+       "out/params", "Also draw <out>/params.png and .svg (matplotlib)", false},
+      [](CLI::App*, ParamsArgs&) {}, run_params_cmd);
 }
 
 Runner add_thermal(CLI::App& app) {

@@ -15,14 +15,7 @@
 namespace gmasim::cli {
 namespace {
 
-struct SweepArgs {
-  bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
-  ModelArgs model;
-  std::string out = "out/sweep";
-  SweepRequest req;
-  RequestOptions<SweepRequest> options;  // the request's table (gmasim/experiment_fields.hpp)
-  bool progress = false;
-};
+using SweepArgs = ExperimentArgs<SweepRequest>;
 
 int run_sweep_cmd(SweepArgs& a) {
   const Model model = load_model_args(a.model);
@@ -73,18 +66,14 @@ int run_sweep_cmd(SweepArgs& a) {
 }  // namespace
 
 Runner add_sweep(CLI::App& app) {
-  auto a = std::make_shared<SweepArgs>();
-  auto* sub = app.add_subcommand(
-      "sweep",
-      "Grid over temperature x current peak-to-peak x frequency (Fig. 12-14): stroke, "
-      "hysteresis, B peak-to-peak and their change vs a reference temperature; points run in "
-      "parallel. Writes sweep.csv and sweep.json");
-  add_model_options(sub, a->model);
-  a->options.add(sub, a->req);
-  sub->add_flag("--progress", a->progress, "Progress on stderr even when it is not a terminal");
-  sub->add_flag("--plot", a->plot, "Also draw <out>/sweep.png and .svg (matplotlib)");
-  sub->add_option("--out", a->out, "Output directory")->capture_default_str();
-  return [a, sub]() -> int { return sub->parsed() ? run_sweep_cmd(*a) : -1; };
+  return add_experiment<SweepArgs>(
+      app,
+      {"sweep",
+       "Grid over temperature x current peak-to-peak x frequency (Fig. 12-14): stroke, "
+       "hysteresis, B peak-to-peak and their change vs a reference temperature; points run in "
+       "parallel. Writes sweep.csv and sweep.json",
+       "out/sweep", "Also draw <out>/sweep.png and .svg (matplotlib)"},
+      [](CLI::App*, SweepArgs&) {}, run_sweep_cmd);
 }
 
 }  // namespace gmasim::cli

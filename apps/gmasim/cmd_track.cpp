@@ -17,13 +17,7 @@
 namespace gmasim::cli {
 namespace {
 
-struct TrackArgs {
-  bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
-  ModelArgs model;
-  std::string out = "out/track";
-  TrackRequest req;
-  RequestOptions<TrackRequest> options;  // the request's table (gmasim/experiment_fields.hpp)
-  bool progress = false;
+struct TrackArgs : ExperimentArgs<TrackRequest> {
   // --feedforward inverse: the evaluation against mismatched plants (gmasim/feedforward.hpp)
   std::string feedforward = "none", mismatch = "all",
               controllers = "pid,pid_temperature,pid_inverse";
@@ -143,35 +137,33 @@ int run_track_cmd(TrackArgs& a) {
 }  // namespace
 
 Runner add_track(CLI::App& app) {
-  auto a = std::make_shared<TrackArgs>();
-  auto* sub = app.add_subcommand(
-      "track",
-      "Closed-loop displacement tracking with the paper's discrete PID (Fig. 16): RMS and peak "
-      "tracking error against temperature. Writes track.csv, track.json, track_example.csv");
-  add_model_options(sub, a->model);
-  a->options.add(sub, a->req);
-  sub->add_option("--feedforward", a->feedforward,
-                  "none: the PID alone (track.csv per point); inverse: the inverse-model "
-                  "feed-forward evaluated against plants that differ from the model (track.csv "
-                  "per run: temperature_C, frequency_Hz, amplitude_um, mismatch, controller, "
-                  "rms_error_um; track_ratios.csv); inverse_static: the same with the "
-                  "quasi-static inverse alone. docs/experiments.md")
-      ->check(CLI::IsMember({"none", "inverse", "inverse_static"}))
-      ->capture_default_str();
-  a->feedforward_only.push_back(
-      sub->add_option("--mismatch", a->mismatch,
-                      "With --feedforward: the plants: all (M_s, k, lambda_s x (1 +- 0.1), "
-                      "temperature +-10 degC: 16), none (the model itself), both (17)")
-          ->capture_default_str());
-  a->feedforward_only.push_back(
-      sub->add_option("--controllers", a->controllers,
-                      "With --feedforward: pid, pid_temperature, pid_inverse (comma-separated)")
-          ->capture_default_str());
-  a->feedforward_only.push_back(a->options.option("--feedforward-band"));
-  sub->add_flag("--progress", a->progress, "Progress on stderr even when it is not a terminal");
-  sub->add_flag("--plot", a->plot, "Also draw <out>/track.png and .svg (matplotlib)");
-  sub->add_option("--out", a->out, "Output directory")->capture_default_str();
-  return [a, sub]() -> int { return sub->parsed() ? run_track_cmd(*a) : -1; };
+  auto own = [](CLI::App* sub, TrackArgs& a) {
+    sub->add_option("--feedforward", a.feedforward,
+                    "none: the PID alone (track.csv per point); inverse: the inverse-model "
+                    "feed-forward evaluated against plants that differ from the model (track.csv "
+                    "per run: temperature_C, frequency_Hz, amplitude_um, mismatch, controller, "
+                    "rms_error_um; track_ratios.csv); inverse_static: the same with the "
+                    "quasi-static inverse alone. docs/experiments.md")
+        ->check(CLI::IsMember({"none", "inverse", "inverse_static"}))
+        ->capture_default_str();
+    a.feedforward_only.push_back(
+        sub->add_option("--mismatch", a.mismatch,
+                        "With --feedforward: the plants: all (M_s, k, lambda_s x (1 +- 0.1), "
+                        "temperature +-10 degC: 16), none (the model itself), both (17)")
+            ->capture_default_str());
+    a.feedforward_only.push_back(
+        sub->add_option("--controllers", a.controllers,
+                        "With --feedforward: pid, pid_temperature, pid_inverse (comma-separated)")
+            ->capture_default_str());
+    a.feedforward_only.push_back(a.options.option("--feedforward-band"));
+  };
+  return add_experiment<TrackArgs>(
+      app,
+      {"track",
+       "Closed-loop displacement tracking with the paper's discrete PID (Fig. 16): RMS and peak "
+       "tracking error against temperature. Writes track.csv, track.json, track_example.csv",
+       "out/track", "Also draw <out>/track.png and .svg (matplotlib)"},
+      own, run_track_cmd);
 }
 
 }  // namespace gmasim::cli

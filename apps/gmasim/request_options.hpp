@@ -8,11 +8,14 @@
 
 #include <CLI/CLI.hpp>
 #include <deque>
+#include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
 
+#include "commands.hpp"
 #include "experiment_cli.hpp"
 #include "gmasim/request_table.hpp"
 
@@ -63,5 +66,41 @@ class RequestOptions {
   std::deque<ListOption> lists_;  // stable addresses: CLI11 binds to `text`
   std::vector<std::pair<std::string_view, CLI::Option*>> options_;
 };
+
+// The arguments every experiment subcommand holds: the model, the request with its table's
+// options, --progress, --plot and --out.
+template <class R>
+struct ExperimentArgs {
+  ModelArgs model;
+  R req;
+  RequestOptions<R> options;  // the request's table (gmasim/experiment_fields.hpp)
+  std::string out;
+  bool plot = false, progress = false;
+};
+
+struct ExperimentCommand {
+  const char* name;         // the subcommand
+  std::string description;  // its help
+  const char* out;          // the default output directory
+  const char* plot_help;    // --plot's help
+  bool progress = true;     // offers --progress
+};
+
+// Registers an experiment subcommand: the model options, the request table's options, then
+// extra(sub, args) for the command's own, then --progress, --plot, --out. run(args) runs it.
+template <class Args, class Extra, class Run>
+Runner add_experiment(CLI::App& app, const ExperimentCommand& c, Extra extra, Run run) {
+  auto a = std::make_shared<Args>();
+  a->out = c.out;
+  auto* sub = app.add_subcommand(c.name, c.description);
+  add_model_options(sub, a->model);
+  a->options.add(sub, a->req);
+  extra(sub, *a);
+  if (c.progress)
+    sub->add_flag("--progress", a->progress, "Progress on stderr even when it is not a terminal");
+  sub->add_flag("--plot", a->plot, c.plot_help);
+  sub->add_option("--out", a->out, "Output directory")->capture_default_str();
+  return [a, sub, run]() -> int { return sub->parsed() ? run(*a) : -1; };
+}
 
 }  // namespace gmasim::cli

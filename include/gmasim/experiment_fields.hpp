@@ -5,6 +5,7 @@
 
 #include <tuple>
 
+#include "gmasim/compensate.hpp"
 #include "gmasim/experiments.hpp"
 #include "gmasim/request_table.hpp"
 #include "gmasim/validate.hpp"
@@ -17,14 +18,29 @@ inline constexpr Rule kThreads = in(0, kMaxThreads);
 inline constexpr Rule kCurrent = in(-kMaxCurrent_A, kMaxCurrent_A);
 inline constexpr Rule kPeriods = in(1.0, kMaxPeriods);
 
+// Rows that several requests share, spelled once.
+template <class R>
+constexpr auto threads_row(unsigned where) {
+  return field<R>("threads", "-", kThreads, "--threads", "Worker threads [-]; 0 = all cores", where,
+                  GMASIM_REF(R, threads));
+}
+template <class R>
+constexpr auto temperatures_row(std::string_view help = "Temperatures [degC]; list or range") {
+  return field<R>("temperatures_C", "degC", finite(), "--temperatures", help, kCliPy,
+                  GMASIM_REF(R, temperatures_C));
+}
+template <class R>
+constexpr auto current_min_row(std::string_view help = "Minimum of the biased sine [A]") {
+  return field<R>("current_min_A", "A", finite(), "--current-min", help, kCliMeta,
+                  GMASIM_REF(R, current_min_A));
+}
+
 template <>
 struct RequestFields<SweepRequest> {
   using R = SweepRequest;
   static constexpr std::string_view experiment = "sweep";
   static constexpr auto rows = std::tuple{
-      field<R>("temperatures_C", "degC", finite(), "--temperatures",
-               "Temperatures [degC]: list '20,30,40' or range start:step:stop", kCliPy,
-               GMASIM_REF(R, temperatures_C)),
+      temperatures_row<R>("Temperatures [degC]: list '20,30,40' or range start:step:stop"),
       field<R>("currents_pp_A", "A", nonnegative(), "--currents",
                "Current peak-to-peak values [A] of the biased sine (Fig. 11); list or range",
                kCliPy, GMASIM_REF(R, currents_pp_A)),
@@ -34,16 +50,13 @@ struct RequestFields<SweepRequest> {
                "Relative changes are against this temperature [degC] (run even if not in the "
                "grid)",
                All, GMASIM_REF(R, reference_temperature_C)),
-      field<R>("current_min_A", "A", finite(), "--current-min",
-               "Minimum of the biased sine [A] (paper: -3 A)", kCliMeta,
-               GMASIM_REF(R, current_min_A)),
+      current_min_row<R>("Minimum of the biased sine [A] (paper: -3 A)"),
       field<R>("periods", "-", kPeriods, "--periods",
                "Periods per point [-]; metrics over the last one", All, GMASIM_REF(R, periods)),
       field<R>("dt_s", "s", nonnegative(), "--dt",
                "Time step [s]; 0 = automatic rule (T/2000, at most 10 us)", All,
                GMASIM_REF(R, dt_s)),
-      field<R>("threads", "-", kThreads, "--threads", "Worker threads [-]; 0 = all cores", kCliPy,
-               GMASIM_REF(R, threads)),
+      threads_row<R>(kCliPy),
   };
 };
 
@@ -52,8 +65,7 @@ struct RequestFields<FrfRequest> {
   using R = FrfRequest;
   static constexpr std::string_view experiment = "frf";
   static constexpr auto rows = std::tuple{
-      field<R>("temperatures_C", "degC", finite(), "--temperatures",
-               "Temperatures [degC]; list or range", kCliPy, GMASIM_REF(R, temperatures_C)),
+      temperatures_row<R>(),
       field<R>("f_min_Hz", "Hz", positive(), "--f-min", "Lowest frequency [Hz]", kCliPy,
                GMASIM_REF(R, f_min_Hz)),
       field<R>("f_max_Hz", "Hz", in(0.0, kMaxFrequency_Hz), "--f-max", "Highest frequency [Hz]",
@@ -81,8 +93,7 @@ struct RequestFields<FrfRequest> {
       field<R>("measure_periods", "-", in(1, 1e6), "--measure-periods",
                "Stepped sine: periods in the first-harmonic measurement [-]", kCliMeta,
                GMASIM_REF(R, measure_periods)),
-      field<R>("threads", "-", kThreads, "--threads", "Worker threads [-]; 0 = all cores", kCliPy,
-               GMASIM_REF(R, threads)),
+      threads_row<R>(kCliPy),
   };
 };
 
@@ -91,8 +102,7 @@ struct RequestFields<TrackRequest> {
   using R = TrackRequest;
   static constexpr std::string_view experiment = "track";
   static constexpr auto rows = std::tuple{
-      field<R>("temperatures_C", "degC", finite(), "--temperatures",
-               "Temperatures [degC]; list or range", kCliPy, GMASIM_REF(R, temperatures_C)),
+      temperatures_row<R>(),
       field<R>("amplitudes_um", "um", in(0.0, kMaxTrackAmplitude_um), "--amplitudes",
                "Reference amplitudes [um] (sine about y_bias)", kCliPy,
                GMASIM_REF(R, amplitudes_um)),
@@ -132,8 +142,7 @@ struct RequestFields<TrackRequest> {
       field<R>("dt_s", "s", nonnegative(), "--dt",
                "Plant time step [s]; 0 = automatic (<= 10 us, <= T/2000, divides 1/fs)", Cli,
                GMASIM_REF(R, dt_s)),
-      field<R>("threads", "-", kThreads, "--threads", "Worker threads [-]; 0 = all cores", kCliPy,
-               GMASIM_REF(R, threads)),
+      threads_row<R>(kCliPy),
       field<R>("feedforward_band_Hz", "Hz", in(0.0, 1e5), "--feedforward-band",
                "Fit band of the linear part's inverse [Hz]", kCliPy,
                GMASIM_REF(R, inverse.band_Hz)),
@@ -151,12 +160,10 @@ struct RequestFields<AblateRequest> {
                "Excitation frequencies [Hz]; list or range", kCliPy, GMASIM_REF(R, frequencies_Hz)),
       field<R>("current_pp_A", "A", nonnegative(), "--current-pp", "Current peak-to-peak [A]", All,
                GMASIM_REF(R, current_pp_A)),
-      field<R>("current_min_A", "A", finite(), "--current-min", "Minimum of the biased sine [A]",
-               kCliMeta, GMASIM_REF(R, current_min_A)),
+      current_min_row<R>(),
       field<R>("periods", "-", kPeriods, "--periods", "Periods per run [-]; errors over the last",
                kCliMeta, GMASIM_REF(R, periods)),
-      field<R>("threads", "-", kThreads, "--threads", "Worker threads [-]; 0 = all cores", Cli,
-               GMASIM_REF(R, threads)),
+      threads_row<R>(Cli),
   };
 };
 
@@ -165,8 +172,7 @@ struct RequestFields<ParamsVsTemperatureRequest> {
   using R = ParamsVsTemperatureRequest;
   static constexpr std::string_view experiment = "params-vs-temperature";
   static constexpr auto rows = std::tuple{
-      field<R>("temperatures_C", "degC", finite(), "--temperatures",
-               "Temperatures [degC]; list or range", kCliPy, GMASIM_REF(R, temperatures_C)),
+      temperatures_row<R>(),
       field<R>("current_pp_A", "A", nonnegative(), "--current-pp",
                "Current peak-to-peak of the Fig. 19 operating point [A]", All,
                GMASIM_REF(R, current_pp_A)),
@@ -175,12 +181,45 @@ struct RequestFields<ParamsVsTemperatureRequest> {
       field<R>("retention_currents_pp_A", "A", nonnegative(), "--retention-currents",
                "Current peak-to-peak values of the retention table [A]; list or range", Cli,
                GMASIM_REF(R, retention_currents_pp_A)),
-      field<R>("current_min_A", "A", finite(), "--current-min", "Minimum of the biased sine [A]",
-               kCliMeta, GMASIM_REF(R, current_min_A)),
+      current_min_row<R>(),
       field<R>("periods", "-", kPeriods, "--periods",
                "Periods per run [-]; statistics over the last", kCliMeta, GMASIM_REF(R, periods)),
-      field<R>("threads", "-", kThreads, "--threads", "Worker threads [-]; 0 = all cores", Cli,
-               GMASIM_REF(R, threads)),
+      threads_row<R>(Cli),
+  };
+};
+
+// --adjust is the CLI's own option (a choice) and an extra argument of Python's compensate();
+// the report records it first. The target stroke it records is the result's (the solved one).
+template <>
+struct RequestFields<CompensateRequest> {
+  using R = CompensateRequest;
+  static constexpr std::string_view experiment = "compensate";
+  static constexpr auto rows = std::tuple{
+      field<R>("adjust", "-", any(), "", "", Meta, GMASIM_REF(R, adjust)),
+      field<R>("reference_temperature_C", "degC", finite(), "--reference-temperature",
+               "Temperature whose stroke is the target [degC]", All,
+               GMASIM_REF(R, reference_temperature_C)),
+      field<R>("reference_current_pp_A", "A", in(0.0, 2.0 * kMaxCurrent_A),
+               "--reference-current-pp", "Reference drive: biased-sine current peak-to-peak [A]",
+               All, GMASIM_REF(R, reference_current_pp_A)),
+      field<R>("current_min_A", "A", kCurrent, "--current-min",
+               "Reference drive: current minimum [A]", All, GMASIM_REF(R, current_min_A),
+               "reference_current_min_A"),
+      field<R>("target_stroke_um", "um", in(0.0, kMaxTrackAmplitude_um), "--target-stroke",
+               "Target stroke [um]; 0 = the reference drive's stroke at the reference temperature",
+               kCliPy, GMASIM_REF(R, target_stroke_um)),
+      temperatures_row<R>("Temperatures of the schedule [degC]: list or start:step:stop"),
+      field<R>("frequency_Hz", "Hz", in(0.0, kMaxFrequency_Hz), "--frequency",
+               "Drive frequency [Hz]", All, GMASIM_REF(R, frequency_Hz)),
+      field<R>("periods", "-", kPeriods, "--periods",
+               "Periods per run; the stroke is over the last [-]", Cli, GMASIM_REF(R, periods)),
+      field<R>("max_current_A", "A", in(0.0, kMaxCurrent_A), "--max-current",
+               "Largest |current| any drive may reach [A]", All, GMASIM_REF(R, max_current_A)),
+      field<R>("tolerance_um", "um", in(1e-9, 1e3), "--tolerance",
+               "Stroke tolerance of the solved drive [um]", All, GMASIM_REF(R, tolerance_um)),
+      field<R>("dt_s", "s", nonnegative(), "--dt", "Time step [s]; 0 = automatic rule", Cli,
+               GMASIM_REF(R, dt_s)),
+      threads_row<R>(kCliPy),
   };
 };
 

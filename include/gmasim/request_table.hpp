@@ -51,10 +51,10 @@ struct Field {
     R r{};
     return ref(r);
   }
-  std::string_view meta_name() const { return meta_key.empty() ? name : meta_key; }
-  bool in_cli() const { return (where & Cli) != 0u; }
-  bool in_python() const { return (where & Python) != 0u; }
-  bool in_meta() const { return (where & Meta) != 0u; }
+  constexpr std::string_view meta_name() const { return meta_key.empty() ? name : meta_key; }
+  constexpr bool in_cli() const { return (where & Cli) != 0u; }
+  constexpr bool in_python() const { return (where & Python) != 0u; }
+  constexpr bool in_meta() const { return (where & Meta) != 0u; }
 };
 
 // A row: field<R>(name, unit, rule, cli, help, where, GMASIM_REF(R, path) [, meta_key]).
@@ -71,6 +71,9 @@ constexpr auto field(std::string_view name, std::string_view unit, Rule rule, st
 // and `static constexpr std::string_view experiment = "sweep";`.
 template <class R>
 struct RequestFields;
+
+template <class R>
+using Rows = std::remove_cvref_t<decltype(RequestFields<R>::rows)>;
 
 template <class R, class F>
 void for_each_field(F&& f) {

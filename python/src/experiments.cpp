@@ -123,48 +123,32 @@ void bind_track(py::module_& mod) {
 
 // compensate(): the drive schedule that restores the stroke, and its tracking.
 void bind_compensate(py::module_& mod) {
-  mod.def(
-      "compensate",
-      [](const Model& m, std::vector<double> temperatures_C, double reference_temperature_C,
-         double reference_current_pp_A, double current_min_A, double target_stroke_um,
-         double frequency_Hz, const std::string& adjust, double max_current_A, double tolerance_um,
-         bool track, std::vector<double> track_amplitudes_um,
-         std::vector<double> track_frequencies_Hz, double bias_A, int threads) {
-        CompensateRequest r;
-        r.temperatures_C = std::move(temperatures_C);
-        r.reference_temperature_C = reference_temperature_C;
-        r.reference_current_pp_A = reference_current_pp_A;
-        r.current_min_A = current_min_A;
-        r.target_stroke_um = target_stroke_um;
-        r.frequency_Hz = frequency_Hz;
+  def_request<CompensateRequest>(
+      mod, "compensate",
+      "Temperature compensation: the drive restoring the target stroke at each temperature "
+      "(table 'schedule'), and with track=True PID tracking plain vs with temperature "
+      "feed-forward (table 'track'). docs/experiments.md",
+      [](const Model& m, CompensateRequest& r, const std::string& adjust, bool track,
+         std::vector<double> track_amplitudes_um, std::vector<double> track_frequencies_Hz,
+         double bias_A) {
         r.adjust = parse_compensation_adjust(adjust);
-        r.max_current_A = max_current_A;
-        r.tolerance_um = tolerance_um;
-        r.threads = threads;
         return report_dict(without_gil([&] {
           const CompensateResult res = run_compensate(m, r);
           if (!track) return compensate_report(m, r, res);
           TrackRequest t;
           t.temperatures_C = r.temperatures_C;
-          t.amplitudes_um = track_amplitudes_um;
-          t.frequencies_Hz = track_frequencies_Hz;
+          t.amplitudes_um = std::move(track_amplitudes_um);
+          t.frequencies_Hz = std::move(track_frequencies_Hz);
           t.bias_A = bias_A;
-          t.threads = threads;
+          t.threads = r.threads;
           const CompensatedTrack ct = run_compensated_track(m, r, t);
           return compensate_report(m, r, res, &ct);
         }));
       },
-      py::arg("model"), py::arg("temperatures_C") = CompensateRequest{}.temperatures_C,
-      py::arg("reference_temperature_C") = 20.0, py::arg("reference_current_pp_A") = 8.0,
-      py::arg("current_min_A") = -3.0, py::arg("target_stroke_um") = 0.0,
-      py::arg("frequency_Hz") = 10.0, py::arg("adjust") = "amplitude",
-      py::arg("max_current_A") = 30.0, py::arg("tolerance_um") = 1e-3, py::arg("track") = false,
-      py::arg("track_amplitudes_um") = std::vector<double>{10.0},
-      py::arg("track_frequencies_Hz") = std::vector<double>{10.0}, py::arg("bias_A") = 1.0,
-      py::arg("threads") = 0,
-      "Temperature compensation: the drive restoring the target stroke at each temperature "
-      "(table 'schedule'), and with track=True PID tracking plain vs with temperature "
-      "feed-forward (table 'track'). docs/experiments.md");
+      Extra<std::string>{"adjust", compensation_adjust_name(CompensateRequest{}.adjust)},
+      Extra<bool>{"track", false}, Extra<std::vector<double>>{"track_amplitudes_um", {10.0}},
+      Extra<std::vector<double>>{"track_frequencies_Hz", {10.0}},
+      Extra<double>{"bias_A", TrackRequest{}.bias_A});
 }
 
 // The temperature laws: ablate() (Fig. 20), params_vs_temperature() (Fig. 18-19) and

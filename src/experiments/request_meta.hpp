@@ -6,6 +6,7 @@
 #include <string>
 #include <string_view>
 
+#include "gmasim/compensate.hpp"
 #include "gmasim/experiments.hpp"
 #include "gmasim/request_table.hpp"
 
@@ -18,6 +19,8 @@ inline Cell meta_cell(std::uint64_t v) { return Cell(static_cast<double>(v)); }
 inline Cell meta_cell(BiasState v) {
   return Cell(v == BiasState::Anhysteretic ? "anhysteretic" : "initial_curve");
 }
+
+inline Cell meta_cell(CompensationAdjust v) { return Cell(compensation_adjust_name(v)); }
 
 template <class R>
 void add_request_meta(Report& report, const R& r) {
