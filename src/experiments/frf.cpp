@@ -13,7 +13,9 @@
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/claims.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/experiments.hpp"
+#include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/model/validate.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/simulate/run_loop.hpp"
@@ -256,6 +258,7 @@ void fill_curve(FrfCurve& cv, const SmallSignalModel& lin, const cd* stepped,
 
 FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progress) {
   check_request(r);
+  fields::check_request_fields(r);  // the table's rules (gmasim/experiment_fields.hpp)
   std::vector<Conditions> conds;
   for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
 
