@@ -1,7 +1,7 @@
-// The request tables (gmasim/experiment_fields.hpp, issue 21 item 3) and the Metrics table:
-// every default satisfies its own row's rule, a value beyond a rule is refused with a message
-// naming the option, the report metadata holds each Meta row's value, and every Metrics field
-// has a row.
+// The request tables (gmasim/experiments/experiment_fields.hpp, issue 21 item 3) and the Metrics
+// table: every default satisfies its own row's rule, a value beyond a rule is refused with a
+// message naming the option, the report metadata holds each Meta row's value, and every Metrics
+// field has a row.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,8 +11,8 @@
 
 #include "experiments_fixtures.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/experiment_fields.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim {
 namespace {

@@ -18,7 +18,8 @@ namespace gmasim::cli {
 namespace {
 
 struct TrackArgs : ExperimentArgs<TrackRequest> {
-  // --feedforward inverse: the evaluation against mismatched plants (gmasim/experiments/feedforward.hpp)
+  // --feedforward inverse: the evaluation against mismatched plants
+  // (gmasim/experiments/feedforward.hpp)
   std::string feedforward = "none", mismatch = "all",
               controllers = "pid,pid_temperature,pid_inverse";
   std::vector<CLI::Option*> feedforward_only;  // refused without --feedforward inverse*

@@ -1,6 +1,6 @@
-// The CLI options of a request, generated from its table (gmasim/request_table.hpp): one option
-// per row marked Cli, with the row's flag and help, the default shown from the struct's own
-// initialiser. A list row (std::vector<double>) takes a list or range ("20,30" or "20:10:70",
+// The CLI options of a request, generated from its table (gmasim/experiments/request_table.hpp):
+// one option per row marked Cli, with the row's flag and help, the default shown from the struct's
+// own initialiser. A list row (std::vector<double>) takes a list or range ("20,30" or "20:10:70",
 // parse_list) and replaces the default only when given.
 #pragma once
 
@@ -17,7 +17,7 @@
 
 #include "commands.hpp"
 #include "experiment_cli.hpp"
-#include "gmasim/request_table.hpp"
+#include "gmasim/experiments/request_table.hpp"
 
 namespace gmasim::cli {
 
@@ -73,7 +73,7 @@ template <class R>
 struct ExperimentArgs {
   ModelArgs model;
   R req;
-  RequestOptions<R> options;  // the request's table (gmasim/experiment_fields.hpp)
+  RequestOptions<R> options;  // the request's table (gmasim/experiments/experiment_fields.hpp)
   std::string out;
   bool plot = false, progress = false;
 };

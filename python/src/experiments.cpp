@@ -55,7 +55,8 @@ auto without_gil(F&& f) {
 }
 
 // sweep(): temperature x current x frequency (Fig. 12-14). The keyword arguments of the
-// experiments are the Python rows of their request tables (gmasim/experiment_fields.hpp).
+// experiments are the Python rows of their request tables
+// (gmasim/experiments/experiment_fields.hpp).
 void bind_sweep(py::module_& mod) {
   def_request<SweepRequest>(
       mod, "sweep",

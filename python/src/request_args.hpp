@@ -1,8 +1,8 @@
 // Python functions over a request, their keyword arguments generated from its table
-// (gmasim/request_table.hpp): one argument per row marked Python, in the table's order, with the
-// row's name and the struct's own default, then the function's extra arguments (not fields of the
-// request). pybind11 sees an ordinary typed signature, so the docstring's first line names every
-// argument with its type and default as before.
+// (gmasim/experiments/request_table.hpp): one argument per row marked Python, in the table's order,
+// with the row's name and the struct's own default, then the function's extra arguments (not fields
+// of the request). pybind11 sees an ordinary typed signature, so the docstring's first line names
+// every argument with its type and default as before.
 #pragma once
 
 #include <pybind11/pybind11.h>
@@ -13,8 +13,8 @@
 #include <tuple>
 #include <utility>
 
-#include "gmasim/model.hpp"
-#include "gmasim/request_table.hpp"
+#include "gmasim/experiments/request_table.hpp"
+#include "gmasim/model/model.hpp"
 
 namespace gmasim::py_bind {
 

@@ -110,7 +110,7 @@ void validate_request(const Model& m, const CompensateRequest& r) {
   s.periods = r.periods;
   s.dt_s = r.dt_s;
   validate(s);
-  fields::check_request_fields(r);  // the table's rules (gmasim/experiment_fields.hpp)
+  fields::check_request_fields(r);  // the table's rules (gmasim/experiments/experiment_fields.hpp)
 }
 
 // The drive x in (0, x_hi] whose stroke at temperature T is the target (a root of
@@ -297,7 +297,8 @@ Report compensate_report(const Model& m, const CompensateRequest& req, const Com
   Report r;
   r.experiment = "compensate";
   r.meta.emplace_back("model", m.spec.source);
-  fields::add_request_meta(r, req);  // the request's table (gmasim/experiment_fields.hpp)
+  fields::add_request_meta(r,
+                           req);  // the request's table (gmasim/experiments/experiment_fields.hpp)
   fields::insert_meta_after(r, "frequency_Hz", "target_stroke_um", res.target_stroke_um);
   fields::insert_meta_after(r, "target_stroke_um", "reference_stroke_um", res.reference.stroke_um);
   r.meta.emplace_back("wall_time_s", res.wall_time_s);

@@ -258,7 +258,7 @@ void fill_curve(FrfCurve& cv, const SmallSignalModel& lin, const cd* stepped,
 
 FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progress) {
   check_request(r);
-  fields::check_request_fields(r);  // the table's rules (gmasim/experiment_fields.hpp)
+  fields::check_request_fields(r);  // the table's rules (gmasim/experiments/experiment_fields.hpp)
   std::vector<Conditions> conds;
   for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
 

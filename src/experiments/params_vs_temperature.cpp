@@ -134,7 +134,7 @@ void add_law_rows(const Model& m, const ParamsVsTemperatureRequest& r,
 ParamsVsTemperatureResult run_params_vs_temperature(const Model& m,
                                                     const ParamsVsTemperatureRequest& r) {
   check_request(r);
-  fields::check_request_fields(r);  // the table's rules (gmasim/experiment_fields.hpp)
+  fields::check_request_fields(r);  // the table's rules (gmasim/experiments/experiment_fields.hpp)
   std::vector<Conditions> conds;
   for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
 

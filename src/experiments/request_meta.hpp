@@ -1,14 +1,14 @@
-// The report metadata of a request, from its table (gmasim/request_table.hpp): every row marked
-// Meta, in the table's order, under its metadata key.
+// The report metadata of a request, from its table (gmasim/experiments/request_table.hpp): every
+// row marked Meta, in the table's order, under its metadata key.
 #pragma once
 
 #include <cstdint>
 #include <string>
 #include <string_view>
 
-#include "gmasim/compensate.hpp"
-#include "gmasim/experiments.hpp"
-#include "gmasim/request_table.hpp"
+#include "gmasim/experiments/compensate.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/experiments/request_table.hpp"
 
 namespace gmasim::fields {
 

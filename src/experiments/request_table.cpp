@@ -1,5 +1,5 @@
-// The rule check of the request tables (gmasim/request_table.hpp).
-#include "gmasim/request_table.hpp"
+// The rule check of the request tables (gmasim/experiments/request_table.hpp).
+#include "gmasim/experiments/request_table.hpp"
 
 #include <fmt/format.h>
 

@@ -100,7 +100,7 @@ void add_changes(const SweepRequest& r, bool ref_in_grid, std::size_t grid,
 
 SweepResult run_sweep(const Model& m, const SweepRequest& r, const ProgressFn& progress) {
   check_request(m, r);
-  fields::check_request_fields(r);  // the table's rules (gmasim/experiment_fields.hpp)
+  fields::check_request_fields(r);  // the table's rules (gmasim/experiments/experiment_fields.hpp)
   // The work list: the grid, then the reference temperature if it is not in the grid.
   std::vector<Job> jobs;
   for (double T : r.temperatures_C)

@@ -1,14 +1,15 @@
 // The request tables of the experiments of gmasim/experiments.hpp (issue 21, item 3): one row
-// per field (gmasim/request_table.hpp). The order of the rows is the order of the report's
-// metadata and of the Python keyword arguments; the defaults are the structs' initialisers.
+// per field (gmasim/experiments/request_table.hpp). The order of the rows is the order of the
+// report's metadata and of the Python keyword arguments; the defaults are the structs'
+// initialisers.
 #pragma once
 
 #include <tuple>
 
-#include "gmasim/compensate.hpp"
-#include "gmasim/experiments.hpp"
-#include "gmasim/request_table.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/experiments/compensate.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/experiments/request_table.hpp"
+#include "gmasim/model/validate.hpp"
 
 namespace gmasim::fields {
 

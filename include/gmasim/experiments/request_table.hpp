@@ -6,7 +6,8 @@
 //   - the Python keyword arguments and their defaults (python/src/request_args.hpp),
 //   - the report metadata (add_request_meta below; src/experiments/report.cpp),
 //   - a check of every row's rule (check_request_fields), after the experiment's own checks.
-// The tables themselves: gmasim/experiment_fields.hpp (and the other requests' headers).
+// The tables themselves: gmasim/experiments/experiment_fields.hpp (and the other requests'
+// headers).
 #pragma once
 
 #include <cstdint>
