@@ -74,8 +74,8 @@ struct MeasurementCondition {
   std::string rod;     // rod of the field_A_per_m / strain_ppm columns; "": the first rod
   long precycles = 0;  // passes of the record's own drive before the compared pass
   InitialState initial_state = InitialState::Demagnetised;  // before the pre-cycles
-  OffsetMode offset = OffsetMode::Absolute;       // of displacement_um / strain_ppm
-  OffsetMode flux_offset = OffsetMode::Absolute;  // of flux_T
+  OffsetMode offset = OffsetMode::Absolute;                 // of displacement_um / strain_ppm
+  OffsetMode flux_offset = OffsetMode::Absolute;            // of flux_T
   // The prestress the record was measured at [MPa]: the stress in the first rod of
   // stack.rods; the record is simulated with the preload that gives it (its force replaces
   // the model's preload). NaN: the model's own preload.
@@ -430,6 +430,12 @@ struct StageEvaluations {
   long covariance = 0;  // the Jacobians of the linearised intervals
   long profile = 0;     // the profile likelihood
   long profile_budget = -1;  // the profile's allowance (-1: no limit)
+  // Wall time [s] of each stage (rank 0's clock; the search's includes the start model's
+  // evaluation and, on a resumed run, only this run's part).
+  double search_s = 0, refine_s = 0, covariance_s = 0, profile_s = 0;
+  // Results copied instead of simulated again: a point equal to one just evaluated (not in
+  // the counts above).
+  long reused = 0;
 };
 
 struct IdentifyResult {

@@ -170,10 +170,13 @@ void write_history(JsonWriter& w, const HistoryEntry& h) {
 }  // namespace
 
 std::string stage_text(const StageEvaluations& se) {
-  return fmt::format("search {}, refinement {}, covariance {}, profile {} of {}", se.search,
-                     se.refine, se.covariance, se.profile,
-                     se.profile_budget < 0 ? std::string("no limit")
-                                           : fmt::format("{} allowed", se.profile_budget));
+  return fmt::format(
+      "search {} in {:.1f} s, refinement {} in {:.1f} s, covariance {} in {:.1f} s, profile {} of "
+      "{} in {:.1f} s{}",
+      se.search, se.search_s, se.refine, se.refine_s, se.covariance, se.covariance_s, se.profile,
+      se.profile_budget < 0 ? std::string("no limit")
+                            : fmt::format("{} allowed", se.profile_budget),
+      se.profile_s, se.reused > 0 ? fmt::format("; {} repeated points reused", se.reused) : "");
 }
 
 namespace {
@@ -413,6 +416,13 @@ std::string fit_report_json(const IdentifyResult& r, const FitProvenance& p) {
   } else {
     w.null();  // no limit
   }
+  w.key("reused").integer(se.reused);
+  w.end_object();
+  w.key("wall_s_by_stage").begin_object(JsonLayout::Inline);
+  w.numbers({{"search", se.search_s},
+             {"refine", se.refine_s},
+             {"covariance", se.covariance_s},
+             {"profile", se.profile_s}});
   w.end_object();
   w.key("best_found_by").string(r.best_found_by);
   w.key("wall_s").number(r.wall_s);
