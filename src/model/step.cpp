@@ -67,6 +67,26 @@ void advance_sensor_mount(const SensorMountModel& o, double q0_m, double q1_m, d
   s.q_m = q1_m;
 }
 
+// The consistent state's end of step for one rod: the law's last Newton trial at H1 (its flux
+// density B1), the eddy field of eq. (7) (trapezoid; at rest H_c = H), the histories of the
+// first guess and the slope mu_r = 1 + dM/dH.
+template <class Law>
+void commit_rod(const RodConditions& rc, RodState& r, const typename Law::Trial& trial, double H1,
+                double B0, double B1, bool quasi_static, double h_s) {
+  r.M_prev2_A_per_m = r.M_prev_A_per_m;
+  r.M_prev_A_per_m = r.M_A_per_m;
+  Law::commit_trial(rc, r, trial);
+  r.Hc_A_per_m = quasi_static ? H1
+                              : eddy_static_field_trapezoid(r.H_A_per_m, H1, r.Hc_A_per_m, B0, B1,
+                                                            rc.eddy_geometry_s_m_per_H, h_s);
+  r.H_prev2_A_per_m = r.H_prev_A_per_m;
+  r.H_prev_A_per_m = r.H_A_per_m;
+  r.H_A_per_m = H1;
+  r.mu_r = 1.0 + trial.dM_dH;
+  r.tau_s = kMu0 * r.mu_r * rc.eddy_geometry_s_m_per_H;
+  r.phi_Wb = B1 * rc.area_m2;
+}
+
 // Consistent magnetic state (docs/model.md, "Magnetic state"). At the end of the step every
 // rod i satisfies, with its own JA state (eq. 9) and the circuit (eq. 23):
 //   phi_i = A_i B_i,  B_i = mu0 (H_i + M_i(H_i)),  U_i = l_i H_c,i + R_s,i phi_i  (eq. 7, first
@@ -148,22 +168,8 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
     }
   }
   for (std::size_t i = 0; i < n; ++i) {  // commit the end-of-step state: the last iterate
-    const auto& rc = c.rods[i];
-    auto& r = s.rods[i];
-    r.M_prev2_A_per_m = r.M_prev_A_per_m;
-    r.M_prev_A_per_m = r.M_A_per_m;
-    Law::commit_trial(rc, r, trial[i]);
-    r.Hc_A_per_m = quasi_static
-                       ? H[i]
-                       : eddy_static_field_trapezoid(r.H_A_per_m, H[i], r.Hc_A_per_m, B0[i], Bs[i],
-                                                     rc.eddy_geometry_s_m_per_H, h_s);
-    r.H_prev2_A_per_m = r.H_prev_A_per_m;
-    r.H_prev_A_per_m = r.H_A_per_m;
-    r.H_A_per_m = H[i];
-    r.mu_r = 1.0 + trial[i].dM_dH;
-    r.tau_s = kMu0 * r.mu_r * rc.eddy_geometry_s_m_per_H;
-    r.phi_Wb = Bs[i] * rc.area_m2;
-    s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])] = r.phi_Wb;
+    commit_rod<Law>(c.rods[i], s.rods[i], trial[i], H[i], B0[i], Bs[i], quasi_static, h_s);
+    s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])] = s.rods[i].phi_Wb;
   }
 }
 
