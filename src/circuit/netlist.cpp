@@ -234,8 +234,7 @@ template <int K>
 bool rod_solve(const CircuitMatrices& L, const double* R, const double* mmf, double current_A,
                double pm_scale, int k_any, NodalBuffers& ws) {
   const int k = K > 0 ? K : k_any;
-  std::array<double, 64> A{};
-  std::array<double, 8> DF{}, Btu{}, x{}, piv{};
+  double A[64], DF[8], Btu[8], x[8], piv[8];  // written before read (no zero fill: hot path)
   const double* S = L.S8.data();
   for (int r = 0; r < k; ++r) {
     DF[r] = mmf[r] / R[r];

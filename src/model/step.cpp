@@ -1,5 +1,6 @@
 // The coupled step: circuit (eq. 2-3, 23) -> eddy lag (eq. 7) -> JA (eq. 9) -> Delta-E,
-// strain and force (eq. 11-14) -> mechanics (eq. 15-18). See docs/model.md, "The step".
+// strain and force (eq. 11-14) -> mechanics (eq. 15-18), as the named stages of
+// gmasim/step_stages.hpp. See docs/model.md, "The step".
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
 #include "gmasim/rod_laws.hpp"
+#include "gmasim/step_stages.hpp"
 
 namespace gmasim {
 namespace {
@@ -63,6 +65,26 @@ void advance_sensor_mount(const SensorMountModel& o, double q0_m, double q1_m, d
   oscillator_step(o.mass_kg, c, k, c * qdot + k * q0_m, c * qdot + k * q1_m, h_s, s.z_m,
                   s.z_v_m_per_s);
   s.q_m = q1_m;
+}
+
+// The consistent state's end of step for one rod: the law's last Newton trial at H1 (its flux
+// density B1), the eddy field of eq. (7) (trapezoid; at rest H_c = H), the histories of the
+// first guess and the slope mu_r = 1 + dM/dH.
+template <class Law>
+void commit_rod(const RodConditions& rc, RodState& r, const typename Law::Trial& trial, double H1,
+                double B0, double B1, bool quasi_static, double h_s) {
+  r.M_prev2_A_per_m = r.M_prev_A_per_m;
+  r.M_prev_A_per_m = r.M_A_per_m;
+  Law::commit_trial(rc, r, trial);
+  r.Hc_A_per_m = quasi_static ? H1
+                              : eddy_static_field_trapezoid(r.H_A_per_m, H1, r.Hc_A_per_m, B0, B1,
+                                                            rc.eddy_geometry_s_m_per_H, h_s);
+  r.H_prev2_A_per_m = r.H_prev_A_per_m;
+  r.H_prev_A_per_m = r.H_A_per_m;
+  r.H_A_per_m = H1;
+  r.mu_r = 1.0 + trial.dM_dH;
+  r.tau_s = kMu0 * r.mu_r * rc.eddy_geometry_s_m_per_H;
+  r.phi_Wb = B1 * rc.area_m2;
 }
 
 // Consistent magnetic state (docs/model.md, "Magnetic state"). At the end of the step every
@@ -146,22 +168,8 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
     }
   }
   for (std::size_t i = 0; i < n; ++i) {  // commit the end-of-step state: the last iterate
-    const auto& rc = c.rods[i];
-    auto& r = s.rods[i];
-    r.M_prev2_A_per_m = r.M_prev_A_per_m;
-    r.M_prev_A_per_m = r.M_A_per_m;
-    Law::commit_trial(rc, r, trial[i]);
-    r.Hc_A_per_m = quasi_static
-                       ? H[i]
-                       : eddy_static_field_trapezoid(r.H_A_per_m, H[i], r.Hc_A_per_m, B0[i], Bs[i],
-                                                     rc.eddy_geometry_s_m_per_H, h_s);
-    r.H_prev2_A_per_m = r.H_prev_A_per_m;
-    r.H_prev_A_per_m = r.H_A_per_m;
-    r.H_A_per_m = H[i];
-    r.mu_r = 1.0 + trial[i].dM_dH;
-    r.tau_s = kMu0 * r.mu_r * rc.eddy_geometry_s_m_per_H;
-    r.phi_Wb = Bs[i] * rc.area_m2;
-    s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])] = r.phi_Wb;
+    commit_rod<Law>(c.rods[i], s.rods[i], trial[i], H[i], B0[i], Bs[i], quasi_static, h_s);
+    s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])] = s.rods[i].phi_Wb;
   }
 }
 
@@ -278,32 +286,14 @@ void quasi_static_step(const Model& m, const Conditions& c, State& s, double cur
 
 namespace {
 
-// The ledgers' start values (gmasim/energy.hpp): every branch's flux and each rod's state
-// before the step.
-void energy_start(State& s, std::array<StepStart, 8>& start) {
-  std::copy(s.circuit.phi.begin(), s.circuit.phi.end(), s.energy.phi_prev_Wb.begin());
-  for (std::size_t i = 0; i < s.rods.size(); ++i) {
-    const auto& r = s.rods[i];
-    start[i] = {r.H_A_per_m,
-                r.Hc_A_per_m,
-                r.M_A_per_m,
-                r.Mirr_A_per_m,
-                flux_density(r.H_A_per_m, r.M_A_per_m),
-                r.x_m,
-                r.v_m_per_s,
-                r.F_N,
-                r.K_osc_N_per_m};
-  }
-}
-
-// The printed magnetic state's stages 1-2 (model.hpp, MagneticState::Printed).
+// The printed magnetic state (model.hpp, MagneticState::Printed): explicit, in sequence.
 template <class Law>
 void printed_magnetic_update(const Model& m, const Conditions& c, State& s, const StepInput& in,
                              double t1) {
   const double h = in.dt_s;
   const std::size_t n = s.rods.size();
-  // 1. Rod reluctances (eq. 2-3) at the magnetisation extrapolated to the end of the step
-  //    (M* = 2 M_n - M_{n-1}, second order), then the nodal solve (eq. 23).
+  // Rod reluctances (eq. 2-3) at the magnetisation extrapolated to the end of the step
+  // (M* = 2 M_n - M_{n-1}, second order), then the nodal solve (eq. 23).
   for (std::size_t i = 0; i < n; ++i) {
     const auto& rc = c.rods[i];
     auto& r = s.rods[i];
@@ -315,7 +305,7 @@ void printed_magnetic_update(const Model& m, const Conditions& c, State& s, cons
   if (!solve_circuit(m.circuit, s.rod_reluctance, in.current_A, c.pm_scale, s.circuit,
                      s.energy.enabled))
     throw DivergenceError(t1, "", "nodal matrix of the circuit", 0.0, "not positive definite");
-  // 2. Per rod: static field (eq. 7), eddy lag (eq. 7), JA (eq. 9).
+  // Per rod: static field (eq. 7), eddy lag (eq. 7), the law (eq. 9).
   for (std::size_t i = 0; i < n; ++i) {
     const auto& rc = c.rods[i];
     auto& r = s.rods[i];
@@ -332,6 +322,89 @@ void printed_magnetic_update(const Model& m, const Conditions& c, State& s, cons
 
 }  // namespace
 
+// Stage 0: the step's end time and start current; the ledgers' start values (every branch's
+// flux and each rod's state before the step, gmasim/energy.hpp) when they are enabled.
+void stage_begin(State& s, const StepInput& in, StepScratch& w) {
+  w.t1_s = s.t_s + in.dt_s;
+  w.current0_A = s.current_A;
+  if (!s.energy.enabled) return;
+  std::copy(s.circuit.phi.begin(), s.circuit.phi.end(), s.energy.phi_prev_Wb.begin());
+  for (std::size_t i = 0; i < s.rods.size(); ++i) {
+    const auto& r = s.rods[i];
+    w.start[i] = {r.H_A_per_m,
+                  r.Hc_A_per_m,
+                  r.M_A_per_m,
+                  r.Mirr_A_per_m,
+                  flux_density(r.H_A_per_m, r.M_A_per_m),
+                  r.x_m,
+                  r.v_m_per_s,
+                  r.F_N,
+                  r.K_osc_N_per_m};
+  }
+}
+
+// Stage 1: the magnetic state at the end of the step. Circuit (eq. 2-3, 23), eddy field
+// (eq. 7) and the magnetisation law (eq. 9): solved together by Newton's method in the
+// consistent state (consistent_magnetic_update), in sequence in the printed reading
+// (printed_magnetic_update). Guards: |H| <= 1e9 A/m, |M| <= 1.5 M_s^T.
+template <class Law>
+void stage_magnetic(const Model& m, const Conditions& c, State& s, const StepInput& in,
+                    const StepScratch& w) {
+  if (m.options.magnetic_state == MagneticState::Consistent)
+    consistent_magnetic_update<Law>(m, c, s, in.current_A, c.pm_scale, in.dt_s, false, w.t1_s);
+  else
+    printed_magnetic_update<Law>(m, c, s, in, w.t1_s);
+  for (std::size_t i = 0; i < s.rods.size(); ++i) {
+    check(s.rods[i].H_A_per_m, w.t1_s, m.rods[i].name, "H [A/m]", 1e9);
+    check(s.rods[i].M_A_per_m, w.t1_s, m.rods[i].name, "M [A/m]", 1.5 * c.rods[i].MsT_mag);
+  }
+}
+
+// Stage 2: each rod's Delta-E modulus (eq. 13), magnetostriction (eq. 11-12), force (eq. 14)
+// and axial stiffness (eq. 17) at its new magnetisation; keeps the start's force and
+// stiffness (eq. 16) for stage 3.
+void stage_strain(const Model& m, const Conditions& c, State& s, StepScratch& w) {
+  for (std::size_t i = 0; i < s.rods.size(); ++i) {
+    w.F0_N[i] = s.rods[i].F_N;
+    w.K0_N_per_m[i] = s.rods[i].k_rod_N_per_m + s.rods[i].k_load_N_per_m;
+    update_rod_mechanics(m.material, c.rods[i], s.rods[i]);
+  }
+}
+
+// Stage 3: mechanics (eq. 15-18). Each rod's oscillator, exact over the step with the force
+// linear from F_n to F_{n+1} and the stiffness of eq. (16) at mid-step: the mean of its
+// values at the ends, where the end value's load stiffness (eq. 18) needs every rod's new
+// modulus (stage 2): the Delta-E effect varies K over the step, its mean keeps the update second
+// order in h (docs/model.md, "Time step"). Then the sensor mount (model.hpp, SensorMountModel).
+// Guard: |x| <= 1 m.
+void stage_mechanics(const Model& m, const Conditions& c, State& s, const StepInput& in,
+                     const StepScratch& w) {
+  for (std::size_t i = 0; i < s.rods.size(); ++i) {
+    const auto& rc = c.rods[i];
+    auto& r = s.rods[i];
+    r.k_load_N_per_m = load_stiffness(rc, s);
+    const double K = 0.5 * (w.K0_N_per_m[i] + r.k_rod_N_per_m + r.k_load_N_per_m);
+    r.K_osc_N_per_m = K;
+    oscillator_step(rc.mass_osc_kg, rc.damping_osc_N_s_per_m, K, w.F0_N[i], r.F_N, in.dt_s, r.x_m,
+                    r.v_m_per_s);
+    check(r.x_m, w.t1_s, m.rods[i].name, "x [m]", 1.0);
+  }
+  if (m.sensor_mount.enabled) {
+    advance_sensor_mount(m.sensor_mount, s.q_m, recoil_m(m, c, s), in.dt_s, s);
+    check(s.z_m, w.t1_s, "sensor mount", "z [m]", 1.0);
+  }
+}
+
+// Stage 4: the outputs (finish_outputs: eq. 20-21 and the flux densities).
+void stage_outputs(const Model& m, const Conditions& c, State& s) { finish_outputs(m, c, s); }
+
+// Stage 5: the step's energy ledgers (gmasim/energy.hpp), when enabled.
+void stage_ledger(const Model& m, const Conditions& c, State& s, const StepInput& in,
+                  const StepScratch& w) {
+  if (s.energy.enabled)
+    book_step_energy(m, c, s, w.start.data(), w.current0_A, in.current_A, in.dt_s);
+}
+
 void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
   if (m.options.magnetisation_law == MagnetisationLaw::Preisach)
     step_law<PreisachLaw>(m, c, s, in);
@@ -339,54 +412,24 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
     step_law<JilesAthertonLaw>(m, c, s, in);
 }
 
+// The step: the stages in order (gmasim/step_stages.hpp).
 template <class Law>
 void step_law(const Model& m, const Conditions& c, State& s, const StepInput& in) {
-  const double h = in.dt_s;
-  const double t1 = s.t_s + h;
-  const std::size_t n = s.rods.size();
-  std::array<StepStart, 8> start{};
-  const double current0_A = s.current_A;
-  if (s.energy.enabled) energy_start(s, start);
-  // 1-2. Circuit, eddy field and JA: in the consistent state solved together by Newton.
-  if (m.options.magnetic_state == MagneticState::Consistent)
-    consistent_magnetic_update<Law>(m, c, s, in.current_A, c.pm_scale, h, false, t1);
-  else
-    printed_magnetic_update<Law>(m, c, s, in, t1);
-  for (std::size_t i = 0; i < n; ++i) {
-    check(s.rods[i].H_A_per_m, t1, m.rods[i].name, "H [A/m]", 1e9);
-    check(s.rods[i].M_A_per_m, t1, m.rods[i].name, "M [A/m]", 1.5 * c.rods[i].MsT_mag);
-  }
-  // 3. Mechanics (eq. 15-18): each rod's oscillator, exact over the step with the force
-  //    linear from F_n to F_{n+1} and the stiffness at the end of the step (which needs
-  //    every rod's new modulus first: eq. 18 couples them).
-  std::array<double, 8> F0{}, K0{};
-  for (std::size_t i = 0; i < n; ++i) {
-    F0[i] = s.rods[i].F_N;
-    K0[i] = s.rods[i].k_rod_N_per_m + s.rods[i].k_load_N_per_m;
-    update_rod_mechanics(m.material, c.rods[i], s.rods[i]);
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto& rc = c.rods[i];
-    auto& r = s.rods[i];
-    r.k_load_N_per_m = load_stiffness(rc, s);
-    // Eq. (16) at mid-step: the stiffness varies with M over the step (the Delta-E effect);
-    // its mean keeps the update second order in h (docs/model.md, "Time step").
-    const double K = 0.5 * (K0[i] + r.k_rod_N_per_m + r.k_load_N_per_m);
-    r.K_osc_N_per_m = K;
-    oscillator_step(rc.mass_osc_kg, rc.damping_osc_N_s_per_m, K, F0[i], r.F_N, h, r.x_m,
-                    r.v_m_per_s);
-    check(r.x_m, t1, m.rods[i].name, "x [m]", 1.0);
-  }
-  if (m.sensor_mount.enabled) {
-    advance_sensor_mount(m.sensor_mount, s.q_m, recoil_m(m, c, s), h, s);
-    check(s.z_m, t1, "sensor mount", "z [m]", 1.0);
-  }
-  s.t_s = t1;
+  StepScratch w;
+  stage_begin(s, in, w);
+  stage_magnetic<Law>(m, c, s, in, w);
+  stage_strain(m, c, s, w);
+  stage_mechanics(m, c, s, in, w);
+  s.t_s = w.t1_s;
   s.current_A = in.current_A;
-  finish_outputs(m, c, s);
-  if (s.energy.enabled) book_step_energy(m, c, s, start.data(), current0_A, in.current_A, h);
+  stage_outputs(m, c, s);
+  stage_ledger(m, c, s, in, w);
 }
 
+template void stage_magnetic<JilesAthertonLaw>(const Model&, const Conditions&, State&,
+                                               const StepInput&, const StepScratch&);
+template void stage_magnetic<PreisachLaw>(const Model&, const Conditions&, State&, const StepInput&,
+                                          const StepScratch&);
 template void step_law<JilesAthertonLaw>(const Model&, const Conditions&, State&, const StepInput&);
 template void step_law<PreisachLaw>(const Model&, const Conditions&, State&, const StepInput&);
 template void quasi_static_step_law<JilesAthertonLaw>(const Model&, const Conditions&, State&,

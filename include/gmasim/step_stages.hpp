@@ -1,0 +1,48 @@
+// step() in named stages (issue 21; in the manner of MuJoCo's mj_fwdPosition / mj_fwdVelocity):
+// each stage is a free function over the state, run in this order by step_law<Law>
+// (src/model/step.cpp), and callable on its own by tests and other integrators.
+//   stage_ledger_start   the ledgers' start values (gmasim/energy.hpp), when enabled
+//   stage_magnetic<Law>  circuit (eq. 2-3, 23), eddy field (eq. 7) and the magnetisation law
+//                        (eq. 9 for Jiles-Atherton): the consistent state's Newton solve, or the
+//                        printed reading's explicit sequence
+//   stage_strain         Delta-E modulus, magnetostriction, force and stiffness (eq. 11-14, 17)
+//   stage_mechanics      each rod's oscillator over the step (eq. 15-16, 18) and the sensor mount
+//   stage_outputs        the stack's output y (eq. 20-21) and the flux densities
+//   stage_ledger         the step's energy ledgers (gmasim/energy.hpp), when enabled
+// A stage's inputs are the state and what earlier stages left in StepScratch.
+#pragma once
+
+#include <array>
+
+#include "gmasim/energy.hpp"
+#include "gmasim/model.hpp"
+
+namespace gmasim {
+
+// What a step carries from its start to its later stages.
+struct StepScratch {
+  double t1_s = 0.0;                   // the end of the step
+  double current0_A = 0.0;             // the coil current at its start
+  std::array<StepStart, 8> start{};    // the ledgers' start values (stage_ledger_start)
+  std::array<double, 8> F0_N{};        // each rod's force at the start (stage_strain)
+  std::array<double, 8> K0_N_per_m{};  // each rod's stiffness k_rod + k_load at the start
+};
+
+// Sets t1_s and current0_A (and, with the ledgers enabled, their start values).
+void stage_begin(State& s, const StepInput& in, StepScratch& w);
+template <class Law>
+void stage_magnetic(const Model& m, const Conditions& c, State& s, const StepInput& in,
+                    const StepScratch& w);
+void stage_strain(const Model& m, const Conditions& c, State& s, StepScratch& w);
+void stage_mechanics(const Model& m, const Conditions& c, State& s, const StepInput& in,
+                     const StepScratch& w);
+void stage_outputs(const Model& m, const Conditions& c, State& s);
+void stage_ledger(const Model& m, const Conditions& c, State& s, const StepInput& in,
+                  const StepScratch& w);
+
+extern template void stage_magnetic<JilesAthertonLaw>(const Model&, const Conditions&, State&,
+                                                      const StepInput&, const StepScratch&);
+extern template void stage_magnetic<PreisachLaw>(const Model&, const Conditions&, State&,
+                                                 const StepInput&, const StepScratch&);
+
+}  // namespace gmasim
