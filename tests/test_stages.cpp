@@ -1,4 +1,4 @@
-// step() in named stages (gmasim/step_stages.hpp, issue 21): the stages called one by one
+// step() in named stages (gmasim/model/step_stages.hpp, issue 21): the stages called one by one
 // advance a state exactly as step() does, for both readings of the magnetic state, with the
 // energy ledgers booked, and with each magnetisation law.
 #include <gtest/gtest.h>
@@ -9,7 +9,7 @@
 #include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/model.hpp"
 #include "gmasim/simulate.hpp"
-#include "gmasim/step_stages.hpp"
+#include "gmasim/model/step_stages.hpp"
 
 using namespace gmasim;
 

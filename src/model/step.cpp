@@ -1,6 +1,6 @@
 // The coupled step: circuit (eq. 2-3, 23) -> eddy lag (eq. 7) -> JA (eq. 9) -> Delta-E,
 // strain and force (eq. 11-14) -> mechanics (eq. 15-18), as the named stages of
-// gmasim/step_stages.hpp. See docs/model.md, "The step".
+// gmasim/model/step_stages.hpp. See docs/model.md, "The step".
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -9,12 +9,12 @@
 
 #include "gmasim/errors.hpp"
 #include "gmasim/magnetisation/laws.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/model/rod_laws.hpp"
+#include "gmasim/model/step_stages.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
-#include "gmasim/rod_laws.hpp"
-#include "gmasim/step_stages.hpp"
 
 namespace gmasim {
 namespace {
@@ -412,7 +412,7 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
     step_law<JilesAthertonLaw>(m, c, s, in);
 }
 
-// The step: the stages in order (gmasim/step_stages.hpp).
+// The step: the stages in order (gmasim/model/step_stages.hpp).
 template <class Law>
 void step_law(const Model& m, const Conditions& c, State& s, const StepInput& in) {
   StepScratch w;

@@ -14,8 +14,8 @@
 
 #include <array>
 
-#include "gmasim/energy.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/model/energy.hpp"
+#include "gmasim/model/model.hpp"
 
 namespace gmasim {
 
