@@ -29,9 +29,10 @@ const Objective& objective(int steps_per_period) {
     r.objective.steps_per_period = steps_per_period;
     const MeasurementSet data = synthesize_measurements(truth, r);
     const FitSpec fit = load_fit_spec(
-        "rod1.ja.k0:1500:6000:log,rod1.ja.a0:3000:12000:log,rod1.ja.c0:0.01:0.3:log,"
-        "rod1.ja.alpha0:-0.08:-0.005,rod1.k_j:0.3:3:log,material.beta:-4e-5:-2e-6:log,"
-        "material.chi_m:8:50:log,rod1.damping:50:1500:log");
+        "rod1.ja.k0_A_per_m:1500:6000:log,rod1.ja.a0_A_per_m:3000:12000:log,rod1.ja.c0:0.01:0.3:"
+        "log,"
+        "rod1.ja.alpha0:-0.08:-0.005,rod1.k_j:0.3:3:log,material.beta_per_K:-4e-5:-2e-6:log,"
+        "material.chi_m:8:50:log,rod1.damping_N_s_per_m:50:1500:log");
     ObjectiveSettings s;
     s.steps_per_period = steps_per_period;
     slot = std::make_unique<Objective>(builtin_model_spec(), data, fit, s);

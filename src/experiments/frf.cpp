@@ -13,7 +13,9 @@
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/claims.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/experiments.hpp"
+#include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/model/validate.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/simulate/run_loop.hpp"
@@ -235,13 +237,11 @@ void fill_curve(FrfCurve& cv, const SmallSignalModel& lin, const cd* stepped,
   }
   if (!r.small_signal) return;  // markers from the stepped sine (detail::choose_markers)
   // Resonance and bandwidth of the linear model on a dense grid (cheap to evaluate).
-  const std::vector<double> fd = log_grid(r.f_min_Hz, r.f_max_Hz, 4000);
-  std::vector<double> md(fd.size());
-  for (std::size_t k = 0; k < fd.size(); ++k) md[k] = std::abs(lin.response(fd[k]));
-  cv.first_resonance_Hz = find_resonance_Hz(fd, md);
+  const LinearFrfMarkers lm = linear_frf_markers(lin, r.f_min_Hz, r.f_max_Hz);
+  cv.first_resonance_Hz = lm.first_resonance_Hz;
   if (cv.first_resonance_Hz > 0)
     cv.first_resonance_mag_um_per_A = std::abs(lin.response(cv.first_resonance_Hz)) * 1e6;
-  cv.bandwidth_3dB_Hz = find_bandwidth_3dB_Hz(fd, md);
+  cv.bandwidth_3dB_Hz = lm.bandwidth_3dB_Hz;
   // The same search beyond the band, up to twice the highest mode.
   double f_top = r.f_max_Hz;
   for (double fm : cv.mode_frequencies_Hz) f_top = std::max(f_top, 2.0 * fm);
@@ -254,8 +254,23 @@ void fill_curve(FrfCurve& cv, const SmallSignalModel& lin, const cd* stepped,
 
 }  // namespace
 
+LinearFrfMarkers linear_frf_markers(const SmallSignalModel& lin, double f_min_Hz, double f_max_Hz) {
+  const std::vector<double> fd = log_grid(f_min_Hz, f_max_Hz, 4000);
+  std::vector<double> md(fd.size());
+  for (std::size_t k = 0; k < fd.size(); ++k) md[k] = std::abs(lin.response(fd[k]));
+  return {find_resonance_Hz(fd, md), find_bandwidth_3dB_Hz(fd, md)};
+}
+
+LinearFrfMarkers linear_frf_markers(const Model& m, double T_C, double bias_A) {
+  const FrfRequest r;
+  const Conditions c = make_conditions(m, T_C);
+  const State bias = settle_at_bias(m, c, bias_A, r.bias_state);
+  return linear_frf_markers(linearise(m, c, bias), r.f_min_Hz, r.f_max_Hz);
+}
+
 FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progress) {
   check_request(r);
+  fields::check_request_fields(r);  // the table's rules (gmasim/experiments/experiment_fields.hpp)
   std::vector<Conditions> conds;
   for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
 

@@ -36,7 +36,7 @@ void anhysteretic_fixed_point(const Model& m, const Conditions& c, State& s, dou
       auto& r = s.rods[i];
       const double M = Law::anhysteretic_magnetisation(rc, r);
       change = std::max(change, Law::hold_anhysteretic(rc, r, M) / rc.MsT_mag);
-      r.M_prev_A_per_m = r.M_A_per_m;
+      r.M_prev_A_per_m = r.M_prev2_A_per_m = r.M_A_per_m;
     }
     run_dc(m, c, s, bias_A, std::max(5.0 * tau_max, 1e-3));
     if (change < 1e-10) break;

@@ -430,6 +430,12 @@ struct StageEvaluations {
   long covariance = 0;  // the Jacobians of the linearised intervals
   long profile = 0;     // the profile likelihood
   long profile_budget = -1;  // the profile's allowance (-1: no limit)
+  // Wall time [s] of each stage (rank 0's clock; the search's includes the start model's
+  // evaluation and, on a resumed run, only this run's part).
+  double search_s = 0, refine_s = 0, covariance_s = 0, profile_s = 0;
+  // Results copied instead of simulated again: a point equal to one just evaluated (not in
+  // the counts above).
+  long reused = 0;
 };
 
 struct IdentifyResult {

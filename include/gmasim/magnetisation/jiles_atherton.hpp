@@ -27,6 +27,31 @@ struct JilesAthertonLaw {
     physics::ja_step(r.H_A_per_m, H1, rc.MsT_mag, rc.ja, Mirr, M, M_guess, dM_dH);
     return M;
   }
+  // The consistent state's Newton solve tries several end fields H1 of one move: begin_move
+  // fixes what depends on the move's start only (H_e0 and M_an(H_e0)), trial_from returns M, the
+  // slope dM/dH and the state the move would leave at H1, and commit_trial commits that trial
+  // as it is (the last Newton iterate; no second evaluation of the law).
+  using MoveStart = physics::JaMoveStart;
+  struct Trial {
+    double M, dM_dH, Mirr;
+  };
+  static MoveStart begin_move(const RodConditions& rc, const RodState& r) {
+    return physics::ja_move_start(r.H_A_per_m, r.M_A_per_m, rc.MsT_mag, rc.ja);
+  }
+  static Trial trial_from(const RodConditions& rc, const RodState& r, const MoveStart& st,
+                          double H1, double M_guess) {
+    Trial t{};
+    double chi_e = 0.0;
+    physics::ja_step_from(r.H_A_per_m, st, H1, rc.MsT_mag, rc.ja, r.Mirr_A_per_m, r.M_A_per_m,
+                          M_guess, t.Mirr, t.M, chi_e);
+    t.dM_dH = physics::ja_slope(chi_e, rc.ja);
+    return t;
+  }
+  static void commit_trial(const RodConditions&, RodState& r, const Trial& t) {
+    r.Mirr_A_per_m = t.Mirr;
+    r.M_A_per_m = t.M;
+  }
+
   // The same move, committed: r's M_irr and M at H1 (r.H_A_per_m is the caller's to set).
   static void commit(const RodConditions& rc, RodState& r, double H1, double M_guess,
                      double* dM_dH) {

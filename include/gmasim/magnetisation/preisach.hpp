@@ -30,6 +30,36 @@ struct PreisachLaw {
     return physics::preisach_magnetisation(H1, rc.MsT_mag, rc.preisach, r.preisach, M_guess, dM_dH,
                                            nullptr);
   }
+  // The consistent state's Newton iterates (as JilesAthertonLaw's): the trial keeps the reduced
+  // input x1 it reached, and commit_trial pushes it onto the history without evaluating the
+  // distribution again.
+  struct MoveStart {};
+  struct Trial {
+    double M, dM_dH, x1;
+    bool moved;
+  };
+  static MoveStart begin_move(const RodConditions&, const RodState&) { return {}; }
+  static Trial trial_from(const RodConditions& rc, const RodState& r, const MoveStart&, double H1,
+                          double M_guess) {
+    Trial t{r.M_A_per_m, 0.0, 0.0, H1 != r.H_A_per_m};
+    if (!t.moved) {
+      t.dM_dH = reversible_susceptibility(rc, r);
+      return t;
+    }
+    t.M = physics::preisach_magnetisation(H1, rc.MsT_mag, rc.preisach, r.preisach, M_guess,
+                                          &t.dM_dH, &t.x1);
+    return t;
+  }
+  static void commit_trial(const RodConditions& rc, RodState& r, const Trial& t) {
+    if (!t.moved) {
+      r.preisach.last_dmc = 0.0;
+      return;
+    }
+    r.M_A_per_m = t.M;
+    physics::preisach_commit(rc.preisach.dist, r.preisach, t.x1);
+    r.Mirr_A_per_m = rc.MsT_mag * (1.0 - rc.preisach.c) * (2.0 * r.preisach.mu_now - 1.0);
+  }
+
   static void commit(const RodConditions& rc, RodState& r, double H1, double M_guess,
                      double* dM_dH) {
     if (H1 == r.H_A_per_m) {

@@ -352,12 +352,16 @@ struct RodState {
   physics::PreisachHistory preisach;  // the Preisach law's state (its extrema); stage 2
   double x_m = 0, v_m_per_s = 0;      // stage 3: oscillator_step (eq. 15); make_state: x = F / K
   // kept for the next step (hold values, warm starts)
-  double Hc_A_per_m = 0;      // static field of eq. (7) at the end of the last step; stage 2
-  double H_prev_A_per_m = 0;  // H one step earlier (consistent state: Newton's first guess);
-                              // stage 2, consistent state only
-  double M_A_per_m = 0;       // total magnetisation consistent with (H, M_irr); stage 2: ja_step
-  double M_prev_A_per_m = 0;  // M one step earlier (stage 1's extrapolation); stage 2
-  double F_N = 0;             // force at the end of the last step (eq. 14); stage 3
+  double Hc_A_per_m = 0;       // static field of eq. (7) at the end of the last step; stage 2
+  double H_prev_A_per_m = 0;   // H one step earlier (consistent state: Newton's first guess);
+                               // stage 2, consistent state only
+  double H_prev2_A_per_m = 0;  // H two steps earlier (the same guess, quadratic); stage 2,
+                               // consistent state only
+  double M_A_per_m = 0;        // total magnetisation consistent with (H, M_irr); stage 2: ja_step
+  double M_prev_A_per_m = 0;   // M one step earlier (stage 1's extrapolation; consistent state:
+                               // the law's first guess); stage 2
+  double M_prev2_A_per_m = 0;  // M two steps earlier (consistent state: the law's first guess)
+  double F_N = 0;              // force at the end of the last step (eq. 14); stage 3
   // reported
   double mu_r = 1;    // eq. (3) at the extrapolated M, stage 1 (printed); the JA differential
                       // permeability 1 + dM/dH, stage 2 (consistent)
@@ -389,6 +393,9 @@ struct State {
   std::vector<double> rod_reluctance;  // per rod, eq. (2) (consistent: linearised); stage 1
   EnergyAccumulators
       energy;  // the ledgers (gmasim/model/energy.hpp): booked by step() when enabled
+  // Statistics: circuit solves of the consistent magnetic state's Newton method (one per
+  // iteration), summed over the steps since make_state (quasi-static moves included).
+  long newton_solves = 0;
 };
 
 // Sizes every buffer, and places the actuator at rest in its quasi-static equilibrium
