@@ -320,7 +320,7 @@ FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progres
                          {});
   for (std::size_t ti = 0; ti < nT; ++ti) {
     fill_curve(res.curves[ti], lin[ti], sc[ti].Y.data(), sc[ti].f_Hz, r);
-    detail::choose_markers(res.curves[ti], lin[ti], conds[ti], r);
+    detail::choose_markers(res.curves[ti], m, lin[ti], conds[ti], r);
   }
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

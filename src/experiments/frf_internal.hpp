@@ -35,15 +35,16 @@ struct Peak {
 Peak data_peak(const std::vector<double>& f, const std::vector<double>& mag);
 
 // Largest stimulus amplitude [A] for which the field excursion of every rod stays within
-// kSmallSignalFraction of its reversible range c k / (1 - c) (eq. 9): the static field gains
+// kSmallSignalFraction of its reversible range (the law's reversible_field_range: JA's
+// c k / (1 - c) of eq. 9, Preisach's smallest switching excursion): the static field gains
 // dH_i/dI of the linearisation times the amplitude. Infinite when no rod has a finite range.
 inline constexpr double kSmallSignalFraction = 0.1;
-double small_signal_limit_A(const SmallSignalModel& lin, const Conditions& c);
+double small_signal_limit_A(const Model& m, const SmallSignalModel& lin, const Conditions& c);
 
 // Sets cv's small-signal limit, large_signal flag, markers_from and the markers (resonance,
 // bandwidth, the -3 dB reference gain) from the data the figure draws: the stepped sine when
 // the stimulus is large (or the linearisation is off), the linearisation otherwise.
-void choose_markers(FrfCurve& cv, const SmallSignalModel& lin, const Conditions& c,
+void choose_markers(FrfCurve& cv, const Model& m, const SmallSignalModel& lin, const Conditions& c,
                     const FrfRequest& r);
 
 }  // namespace gmasim::detail

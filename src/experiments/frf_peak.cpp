@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "experiments/frf_internal.hpp"
+#include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/physics/magnetic.hpp"
 
 namespace gmasim::detail {
@@ -146,22 +147,23 @@ void refine_stepped_peak(const Model& m, const Conditions& c, const State& bias,
   curve = std::move(sorted);
 }
 
-double small_signal_limit_A(const SmallSignalModel& lin, const Conditions& c) {
+double small_signal_limit_A(const Model& m, const SmallSignalModel& lin, const Conditions& c) {
   const Eigen::VectorXd g = static_field_gains(lin);
   double limit = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < c.rods.size() && i < static_cast<std::size_t>(g.size()); ++i) {
-    const auto& ja = c.rods[i].ja;
     const double dHdI = std::fabs(g(static_cast<Eigen::Index>(i)));
-    if (!(ja.c < 1.0) || !(dHdI > 0.0)) continue;
-    const double reversible_A_per_m = ja.c * ja.k_A_per_m / (1.0 - ja.c);
+    const double reversible_A_per_m = with_magnetisation_law(
+        m.options.magnetisation_law,
+        [&](auto law) { return decltype(law)::reversible_field_range(c.rods[i]); });
+    if (!std::isfinite(reversible_A_per_m) || !(dHdI > 0.0)) continue;
     limit = std::min(limit, kSmallSignalFraction * reversible_A_per_m / dHdI);
   }
   return limit;
 }
 
-void choose_markers(FrfCurve& cv, const SmallSignalModel& lin, const Conditions& c,
+void choose_markers(FrfCurve& cv, const Model& m, const SmallSignalModel& lin, const Conditions& c,
                     const FrfRequest& r) {
-  cv.small_signal_limit_A = small_signal_limit_A(lin, c);
+  cv.small_signal_limit_A = small_signal_limit_A(m, lin, c);
   cv.large_signal = r.stepped_sine && r.amplitude_A > cv.small_signal_limit_A;
   if (r.stepped_sine && (cv.large_signal || !r.small_signal)) {
     const Peak p = data_peak(cv.f_Hz, cv.stepped_mag_um_per_A);

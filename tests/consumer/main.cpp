@@ -35,8 +35,8 @@ int main() {
     gmasim::State s2 = gmasim::make_state(m, c, 0.0);
     gmasim::run_loop(m, c, s2, gmasim::StepGrid::uniform(0.0, 1e-5, 100, "consumer ramp"),
                      [](double t) { return 0.05 * (t / 1e-5); });
-    std::printf("C++ run_loop: y_m %.17g, %zu parameter rows\n", s2.y_m,
-                gmasim::parameter_table().size());
+    std::printf("C++ run_loop (headers by their new paths): stroke %.17g m, %zu parameter rows\n",
+                s2.y_m, gmasim::parameter_table().size());
     const bool same = std::fabs(s2.y_m - s.y_m) <= 1e-9 * std::fabs(s.y_m);
     return s.y_m > 0.0 && same && printed.rod_count() == 3 ? 0 : 1;
   } catch (const std::exception& e) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 
 #include "gmasim/magnetisation/law_id.hpp"
 #include "gmasim/model/model.hpp"
@@ -91,6 +92,14 @@ struct JilesAthertonLaw {
     r.Mirr_A_per_m = q1;
     r.M_A_per_m =
         physics::ja_total_magnetisation(r.H_A_per_m, r.Mirr_A_per_m, M_guess, rc.MsT_mag, rc.ja);
+  }
+
+  // The field excursion about a reversal that stays (nearly) reversible [A/m]: the FRF's
+  // small-signal limit is 10 % of it. JA: c k / (1 - c) (eq. 9: the reversible range of M_irr
+  // pinned); infinite when c >= 1.
+  static double reversible_field_range(const RodConditions& rc) {
+    if (!(rc.ja.c < 1.0)) return std::numeric_limits<double>::infinity();
+    return rc.ja.c * rc.ja.k_A_per_m / (1.0 - rc.ja.c);
   }
 
   // The FRF's anhysteretic bias (settle_at_bias): the law reduced to its anhysteretic curve

@@ -102,6 +102,13 @@ struct PreisachLaw {
     physics::preisach_commit(rc.preisach.dist, r.preisach, x1);
   }
 
+  // The field excursion about a reversal that switches no hysteron [A/m]: a move of dx from a
+  // reversal switches those with 2 h_c <= dx, none below the smallest coercive field of the
+  // histogram, so 2 edge_0 H_c^T (effective field; the FRF's small-signal limit is 10 % of it).
+  static double reversible_field_range(const RodConditions& rc) {
+    return 2.0 * rc.preisach.dist.edge[0] * rc.preisach.Hc_A_per_m;
+  }
+
   // The FRF's anhysteretic bias (settle_at_bias; docs/model.md, "The Preisach law"): the state
   // an AC demagnetisation about the bias leaves. reduce_to_anhysteretic shrinks every coercive
   // field 1000-fold (the interaction fields stay): the hysterons then switch where their
