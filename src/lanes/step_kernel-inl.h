@@ -141,8 +141,10 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, RodStates<D>& s, V<D> I, V<D> p
     V<D> R[kMaxRods], mmf[kMaxRods], phi[kMaxRods];
     for (int i = 0; i < n; ++i) {
       V<D> chi;
-      M[i] =
-          Law::trial(d, ja_constants(c, i), s.f[kH][i], s.f[kMirr][i], s.f[kM][i], H[i], M[i], chi);
+      // a lane that has converged keeps the iterate it converged at
+      M[i] = hn::IfThenElse(done, M[i],
+                            Law::trial(d, ja_constants(c, i), s.f[kH][i], s.f[kMirr][i], s.f[kM][i],
+                                       H[i], M[i], chi));
       Bs[i] = hn::Mul(C(d, kMu0), hn::Add(H[i], M[i]));
       mud[i] = hn::Mul(C(d, kMu0), hn::Add(C(d, 1.0), chi));
       const V<D> l = c.rod(kLength, i);
