@@ -74,8 +74,8 @@ struct MeasurementCondition {
   std::string rod;     // rod of the field_A_per_m / strain_ppm columns; "": the first rod
   long precycles = 0;  // passes of the record's own drive before the compared pass
   InitialState initial_state = InitialState::Demagnetised;  // before the pre-cycles
-  OffsetMode offset = OffsetMode::Absolute;       // of displacement_um / strain_ppm
-  OffsetMode flux_offset = OffsetMode::Absolute;  // of flux_T
+  OffsetMode offset = OffsetMode::Absolute;                 // of displacement_um / strain_ppm
+  OffsetMode flux_offset = OffsetMode::Absolute;            // of flux_T
   // The prestress the record was measured at [MPa]: the stress in the first rod of
   // stack.rods; the record is simulated with the preload that gives it (its force replaces
   // the model's preload). NaN: the model's own preload.
@@ -201,6 +201,9 @@ struct ObjectiveSettings {
   // order in the increment: 500 is within 1e-6 of the p-p of a 48 um loop
   // (tests/test_identify_records.cpp).
   double quasi_static_increments = 500.0;
+  // The records advance together in SIMD lanes (gmasim/lanes.hpp) where the model and the
+  // records allow (timed, current-driven, from rest); false: one scalar run per record.
+  bool lanes = true;
 };
 // The rules of ObjectiveSettings (steps per period in [8, 1e6], dt >= 0, target periods in
 // [1, 1e4], flux weight in [0, 1e6], quasi-static increments in [10, 1e6]): one check for

@@ -56,6 +56,8 @@ class LaneBatch {
   // The lane's state as step() leaves it, into s (sized by make_state for the lane's model:
   // no allocation).
   void unpack(std::size_t lane, State& s) const;
+  // Sets the lane's State::t_s (a grid that starts again, as run_loop() does at its t0).
+  void set_time(std::size_t lane, double t_s);
 
  private:
   std::unique_ptr<lanes::LaneData> d_;

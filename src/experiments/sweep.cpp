@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 #include <span>
 
 #include "experiments/parallel.hpp"
@@ -143,6 +144,8 @@ SweepResult run_sweep(const Model& m, const SweepRequest& r, const ProgressFn& p
     // depend on the other lanes, so neither on the blocks nor on the thread count).
     const std::size_t blocks = static_cast<std::size_t>(res.threads);
     const std::size_t per = (jobs.size() + blocks - 1) / blocks;
+    std::mutex mu;  // the progress callback, once per point, serialised
+    std::size_t done = 0;
     detail::parallel_for(
         blocks, res.threads,
         [&](std::size_t b) {
@@ -151,8 +154,11 @@ SweepResult run_sweep(const Model& m, const SweepRequest& r, const ProgressFn& p
           const std::vector<Result> runs =
               simulate_lanes(m, std::span<const SimulationSettings>(settings.data() + i0, i1 - i0));
           for (std::size_t i = i0; i < i1; ++i) store(i, runs[i - i0]);
+          if (!progress) return;
+          const std::lock_guard<std::mutex> lock(mu);
+          for (std::size_t i = i0; i < i1; ++i) progress(++done, jobs.size());
         },
-        progress);
+        nullptr);
   } else {
     detail::parallel_for(
         jobs.size(), res.threads, [&](std::size_t i) { store(i, simulate(m, settings[i])); },

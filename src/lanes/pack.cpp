@@ -257,6 +257,8 @@ void LaneBatch::unpack(std::size_t j, State& s) const {
   for (int f = 0; f < kGlobalStateCount; ++f) *globals[f] = L.glob(f)[j];
 }
 
+void LaneBatch::set_time(std::size_t lane, double t_s) { d_->glob(lanes::kT)[lane] = t_s; }
+
 std::string LaneBatch::error(std::size_t j) const {
   using namespace lanes;
   LaneData& L = *d_;
