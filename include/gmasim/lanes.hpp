@@ -56,6 +56,11 @@ class LaneBatch {
   // The lane's state as step() leaves it, into s (sized by make_state for the lane's model:
   // no allocation).
   void unpack(std::size_t lane, State& s) const;
+  // The lane's outputs without unpacking: y and B of the coil (State::y_m, B_T), and one
+  // rod's displacement x.
+  double y_m(std::size_t lane) const;
+  double B_T(std::size_t lane) const;
+  double x_m(std::size_t lane, int rod) const;
   // Sets the lane's State::t_s (a grid that starts again, as run_loop() does at its t0).
   void set_time(std::size_t lane, double t_s);
 
@@ -68,7 +73,10 @@ class LaneBatch {
 // simulate() for many settings of one model: the settings the lanes can run (no
 // self-heating, no energy ledger, a model lanes_supported) advance together in lanes,
 // grouped by their step count; the others run simulate(). Results in the order of the
-// settings; the same validation and errors as simulate().
-std::vector<Result> simulate_lanes(const Model& m, std::span<const SimulationSettings> settings);
+// settings; the same validation and errors as simulate(). metrics_only: a lane's series holds
+// only the rows of its metrics window (the last period) and the one before it, enough for the
+// metrics, which are those of the full record (what a sweep keeps).
+std::vector<Result> simulate_lanes(const Model& m, std::span<const SimulationSettings> settings,
+                                   bool metrics_only = false);
 
 }  // namespace gmasim

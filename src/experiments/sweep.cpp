@@ -151,8 +151,8 @@ SweepResult run_sweep(const Model& m, const SweepRequest& r, const ProgressFn& p
         [&](std::size_t b) {
           const std::size_t i0 = std::min(jobs.size(), b * per),
                             i1 = std::min(jobs.size(), i0 + per);
-          const std::vector<Result> runs =
-              simulate_lanes(m, std::span<const SimulationSettings>(settings.data() + i0, i1 - i0));
+          const std::vector<Result> runs = simulate_lanes(
+              m, std::span<const SimulationSettings>(settings.data() + i0, i1 - i0), true);
           for (std::size_t i = i0; i < i1; ++i) store(i, runs[i - i0]);
           if (!progress) return;
           const std::lock_guard<std::mutex> lock(mu);

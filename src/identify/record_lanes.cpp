@@ -37,6 +37,9 @@ struct LaneRecord {
   std::vector<double>* B = nullptr;
 
   double si(const State& x) const { return strain ? x.rods[rod].x_m / length_m : x.y_m; }
+  double si(const LaneBatch& b, std::size_t lane) const {
+    return strain ? b.x_m(lane, static_cast<int>(rod)) / length_m : b.y_m(lane);
+  }
   // The record's drive at t (record_run.cpp, TableDrive: forward-moving linear interpolation).
   double current_at(double t) {
     if (sine) return w.current_at(t);
@@ -65,17 +68,17 @@ struct LaneRecord {
     t_prev = ts.front();
   }
   // After a step ending at t: the samples up to t, interpolated linearly.
-  void after_step(double t, bool last) {
+  void after_step(const LaneBatch& b, std::size_t lane, double t, bool last) {
     const auto& ts = meas->t_s;
-    const double r_now = si(st);
+    const double r_now = si(b, lane), B_now = b.B_T(lane);
     while (last && j < ts.size() && ts[j] <= t) {
       const double f = (ts[j] - t_prev) / (t - t_prev);
       (*response)[j] = (r_prev + f * (r_now - r_prev)) * 1e6;
-      if (B) (*B)[j] = B_prev + f * (st.B_T - B_prev);
+      if (B) (*B)[j] = B_prev + f * (B_now - B_prev);
       ++j;
     }
     r_prev = r_now;
-    B_prev = st.B_T;
+    B_prev = B_now;
     t_prev = t;
   }
   void end_pass(bool last) {
@@ -170,9 +173,9 @@ void run_records_lanes(const Model& m, StartCache& starts,
       if (batch.diverged(k)) throw DivergenceError(batch.error(k));
       const long pass = (q - 1) / lr.grid.steps;
       const bool last = pass + 1 == lr.passes;
-      batch.unpack(k, lr.st);
-      lr.after_step(t1[k], last);
-      if (q % lr.grid.steps == 0) {  // the pass ends
+      lr.after_step(batch, k, t1[k], last);
+      if (q % lr.grid.steps == 0) {  // the pass ends: its state for the samples after t1
+        batch.unpack(k, lr.st);
         lr.end_pass(last);
         if (!last) lr.begin_pass(pass + 2 == lr.passes);
       }

@@ -65,24 +65,28 @@ HWY_INLINE void oscillator_step(D d, V<D> m, V<D> c, V<D> k, V<D> F0, V<D> F1, V
       decay,
       hn::Sub(hn::Mul(ed0, cs),
               hn::Mul(hn::Div(hn::Add(hn::Mul(hn::Mul(wn, wn), e0), hn::Mul(zwn, ed0)), wd), sn)));
-  // over-damped
-  const V<D> s = hn::Mul(wn, hn::Sqrt(hn::Sub(hn::Mul(zeta, zeta), C(d, 1.0))));
-  const V<D> nzwn = hn::Mul(hn::Neg(zeta), wn);
-  const V<D> r1 = hn::Add(nzwn, s), r2 = hn::Sub(nzwn, s);
-  const V<D> A1 = hn::Div(hn::Sub(ed0, hn::Mul(r2, e0)), hn::Sub(r1, r2));
-  const V<D> A2 = hn::Div(hn::Sub(hn::Mul(r1, e0), ed0), hn::Sub(r1, r2));
-  const V<D> E1 = hn::Exp(d, hn::Mul(r1, h)), E2 = hn::Exp(d, hn::Mul(r2, h));
-  const V<D> e1o = hn::Add(hn::Mul(A1, E1), hn::Mul(A2, E2));
-  const V<D> ed1o = hn::Add(hn::Mul(hn::Mul(A1, r1), E1), hn::Mul(hn::Mul(A2, r2), E2));
-  // critically damped
-  const V<D> Ec = hn::Exp(d, hn::Mul(hn::Neg(wn), h));
-  const V<D> Bc = hn::Add(ed0, hn::Mul(wn, e0));
-  const V<D> eBh = hn::Add(e0, hn::Mul(Bc, h));
-  const V<D> e1c = hn::Mul(eBh, Ec);
-  const V<D> ed1c = hn::Mul(hn::Sub(Bc, hn::Mul(wn, eBh)), Ec);
-  const Mk<D> under = hn::Lt(zeta, C(d, 1.0 - 1e-9)), over = hn::Gt(zeta, C(d, 1.0 + 1e-9));
-  const V<D> e1 = hn::IfThenElse(under, e1u, hn::IfThenElse(over, e1o, e1c));
-  const V<D> ed1 = hn::IfThenElse(under, ed1u, hn::IfThenElse(over, ed1o, ed1c));
+  const Mk<D> under = hn::Lt(zeta, C(d, 1.0 - 1e-9));
+  V<D> e1 = e1u, ed1 = ed1u;
+  if (!hn::AllTrue(d, under)) {  // the other regimes only where a lane needs them
+    // over-damped
+    const V<D> s = hn::Mul(wn, hn::Sqrt(hn::Sub(hn::Mul(zeta, zeta), C(d, 1.0))));
+    const V<D> nzwn = hn::Mul(hn::Neg(zeta), wn);
+    const V<D> r1 = hn::Add(nzwn, s), r2 = hn::Sub(nzwn, s);
+    const V<D> A1 = hn::Div(hn::Sub(ed0, hn::Mul(r2, e0)), hn::Sub(r1, r2));
+    const V<D> A2 = hn::Div(hn::Sub(hn::Mul(r1, e0), ed0), hn::Sub(r1, r2));
+    const V<D> E1 = hn::Exp(d, hn::Mul(r1, h)), E2 = hn::Exp(d, hn::Mul(r2, h));
+    const V<D> e1o = hn::Add(hn::Mul(A1, E1), hn::Mul(A2, E2));
+    const V<D> ed1o = hn::Add(hn::Mul(hn::Mul(A1, r1), E1), hn::Mul(hn::Mul(A2, r2), E2));
+    // critically damped
+    const V<D> Ec = hn::Exp(d, hn::Mul(hn::Neg(wn), h));
+    const V<D> Bc = hn::Add(ed0, hn::Mul(wn, e0));
+    const V<D> eBh = hn::Add(e0, hn::Mul(Bc, h));
+    const V<D> e1c = hn::Mul(eBh, Ec);
+    const V<D> ed1c = hn::Mul(hn::Sub(Bc, hn::Mul(wn, eBh)), Ec);
+    const Mk<D> over = hn::Gt(zeta, C(d, 1.0 + 1e-9));
+    e1 = hn::IfThenElse(under, e1u, hn::IfThenElse(over, e1o, e1c));
+    ed1 = hn::IfThenElse(under, ed1u, hn::IfThenElse(over, ed1o, ed1c));
+  }
   const V<D> xp1 = hn::Div(hn::Sub(F1, gck), k);
   x = hn::Add(xp1, e1);
   v = hn::Add(vp, ed1);

@@ -257,6 +257,10 @@ void LaneBatch::unpack(std::size_t j, State& s) const {
   for (int f = 0; f < kGlobalStateCount; ++f) *globals[f] = L.glob(f)[j];
 }
 
+double LaneBatch::y_m(std::size_t lane) const { return d_->glob(lanes::kY)[lane]; }
+double LaneBatch::B_T(std::size_t lane) const { return d_->glob(lanes::kBSensor)[lane]; }
+double LaneBatch::x_m(std::size_t lane, int rod) const { return d_->rod(lanes::kX, rod)[lane]; }
+
 void LaneBatch::set_time(std::size_t lane, double t_s) { d_->glob(lanes::kT)[lane] = t_s; }
 
 std::string LaneBatch::error(std::size_t j) const {

@@ -41,6 +41,7 @@ struct LaneRun {
   Conditions c;
   State st;
   bool live = false;
+  long first_recorded = 0;  // metrics_only: the step before the last period's window
 };
 
 void finish(const SimulationSettings& s, const Plan& p, Result& r) {
@@ -53,7 +54,8 @@ void finish(const SimulationSettings& s, const Plan& p, Result& r) {
 
 // The rest states (make_state), then the steps of the group in lanes.
 void run_group(const Model& m, std::span<const SimulationSettings> settings,
-               const std::vector<std::size_t>& idx, const Plan& p, std::vector<Result>& out) {
+               const std::vector<std::size_t>& idx, const Plan& p, bool metrics_only,
+               std::vector<Result>& out) {
   const auto wall0 = std::chrono::steady_clock::now();
   std::vector<LaneRun> runs(idx.size());
   std::vector<const Model*> models;
@@ -73,7 +75,9 @@ void run_group(const Model& m, std::span<const SimulationSettings> settings,
       lr.st = make_state(m, lr.c, s.waveform.current_at(0.0));
       lr.st.energy.enabled = false;
       check_physical_validity(m, lr.c, lr.st, 0.0);
-      record(lr.c, lr.st, r.series);
+      if (metrics_only)
+        lr.first_recorded = p.steps - std::lround(s.waveform.period_s() / p.dt_s) - 1;
+      if (lr.first_recorded <= 0) record(lr.c, lr.st, r.series);
       lr.live = true;
       models.push_back(&m);
       conds.push_back(&lr.c);
@@ -89,6 +93,7 @@ void run_group(const Model& m, std::span<const SimulationSettings> settings,
     const std::size_t n = lane_of.size();
     std::vector<double> current(n), dt(n, p.dt_s), t1(n);
     std::size_t live = n;
+
     for (long k = 1; k <= p.steps && live > 0; ++k) {
       const double t = 0.0 + static_cast<double>(k) * p.dt_s;  // the Uniform clock
       for (std::size_t l = 0; l < n; ++l) {
@@ -108,7 +113,8 @@ void run_group(const Model& m, std::span<const SimulationSettings> settings,
           continue;
         }
         r.steps = k;
-        if (k % settings[lr.setting].record_every == 0 || k == p.steps) {
+        if (k >= lr.first_recorded &&
+            (k % settings[lr.setting].record_every == 0 || k == p.steps)) {
           batch.unpack(l, lr.st);
           record(lr.c, lr.st, r.series);
         }
@@ -126,7 +132,8 @@ void run_group(const Model& m, std::span<const SimulationSettings> settings,
 
 }  // namespace
 
-std::vector<Result> simulate_lanes(const Model& m, std::span<const SimulationSettings> settings) {
+std::vector<Result> simulate_lanes(const Model& m, std::span<const SimulationSettings> settings,
+                                   bool metrics_only) {
   std::vector<Result> out(settings.size());
   const bool model_ok = lanes_supported(m);
   std::map<long, std::vector<std::size_t>> groups;  // step count -> settings
@@ -149,7 +156,7 @@ std::vector<Result> simulate_lanes(const Model& m, std::span<const SimulationSet
     plans[key] = p;
     groups[key].push_back(i);
   }
-  for (const auto& [key, idx] : groups) run_group(m, settings, idx, plans[key], out);
+  for (const auto& [key, idx] : groups) run_group(m, settings, idx, plans[key], metrics_only, out);
   return out;
 }
 
