@@ -10,9 +10,9 @@
 #include <memory>
 #include <mutex>
 
-#include "gmasim/identify.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/lanes.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/simulate/lanes.hpp"
 
 namespace {
 
@@ -30,7 +30,8 @@ const Objective& objective(int steps_per_period, bool lanes = true) {
     r.objective.steps_per_period = steps_per_period;
     const MeasurementSet data = synthesize_measurements(truth, r);
     const FitSpec fit = load_fit_spec(
-        "rod1.ja.k0_A_per_m:1500:6000:log,rod1.ja.a0_A_per_m:3000:12000:log,rod1.ja.c0:0.01:0.3:log,"
+        "rod1.ja.k0_A_per_m:1500:6000:log,rod1.ja.a0_A_per_m:3000:12000:log,rod1.ja.c0:0.01:0.3:"
+        "log,"
         "rod1.ja.alpha0:-0.08:-0.005,rod1.k_j:0.3:3:log,material.beta_per_K:-4e-5:-2e-6:log,"
         "material.chi_m:8:50:log,rod1.damping_N_s_per_m:50:1500:log");
     ObjectiveSettings s;

@@ -5,9 +5,9 @@
 #include <benchmark/benchmark.h>
 
 #include "common.hpp"
-#include "gmasim/experiments.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/lanes.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/simulate/lanes.hpp"
 
 namespace {
 

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/identify.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/io/io.hpp"
 #include "test_util.hpp"
 
 using ::testing::HasSubstr;
@@ -267,7 +267,8 @@ TEST(RealLoop, ProfileCostsNoMoreThanTheSearchAndTheStagesAddUp) {
   o.profile_evaluations = 0;  // no limit
   const IdentifyResult u = identify(single_rod(), noisy_loop(), three_constants(), o);
   std::printf("[ stages ] no limit: %s\n", stage_text(u.stage_evaluations).c_str());
-  EXPECT_GT(u.stage_evaluations.profile, s.search);  // observed 60
+  EXPECT_GT(u.stage_evaluations.profile,
+            s.search);  // observed 55 (60 before repeated points were reused)
   EXPECT_EQ(u.stage_evaluations.profile_budget, -1);
   EXPECT_EQ(stage_sum(u.stage_evaluations), u.evaluations);
 }

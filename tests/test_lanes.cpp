@@ -13,12 +13,12 @@
 
 #include "alloc_counter.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/experiments.hpp"
-#include "gmasim/identify.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/lanes.hpp"
-#include "gmasim/model.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/simulate/lanes.hpp"
+#include "gmasim/simulate/simulate.hpp"
 #include "hwy/targets.h"
 
 namespace {

@@ -10,9 +10,9 @@
 
 #include "bindings.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/simulate.hpp"
-#include "gmasim/validity.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/validity.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace py = pybind11;
 using namespace gmasim;
@@ -34,16 +34,11 @@ py::dict series_dict(const TimeSeries& ts) {
 
 py::dict metrics_dict(const Metrics& m) {
   py::dict d;
-  d["stroke_um"] = m.stroke_um;
-  d["hysteresis_um"] = m.hysteresis_um;
-  d["B_pp_T"] = m.B_pp_T;
-  d["y_mean_um"] = m.y_mean_um;
-  d["window_start_s"] = m.window_start_s;
-  d["window_end_s"] = m.window_end_s;
+  for (const MetricRow& row : kMetricRows) d[py::str(row.name.data())] = m.*row.member;
   return d;
 }
 
-// The energy ledgers over the metrics window as mean powers [W] (gmasim/energy.hpp).
+// The energy ledgers over the metrics window as mean powers [W] (gmasim/model/energy.hpp).
 py::dict energy_dict(const Model& m, const Result& r) {
   const auto& e = r.energy;
   const double T = e.duration_s;

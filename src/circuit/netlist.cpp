@@ -3,16 +3,17 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <array>
+#include <cmath>
 #include <utility>
 #include <vector>
 
-#include "gmasim/circuit.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/model/circuit.hpp"
 
 namespace gmasim {
 
 // The fixed part of the nodal matrix and the precomputed pieces of the low-rank (Woodbury)
-// solve (gmasim/circuit.hpp).
+// solve (gmasim/model/circuit.hpp).
 struct CircuitMatrices {
   Eigen::MatrixXd fixed_laplacian;  // contribution of the fixed-reluctance branches
   // Low-rank pieces, when Circuit::lowrank.enabled:
@@ -22,6 +23,10 @@ struct CircuitMatrices {
   Eigen::VectorXd psi_pm;       // G0^-1 b per unit PM scale (fixed branches)
   Eigen::VectorXd Bt_psi_coil;  // B^T psi_coil (k)
   Eigen::VectorXd Bt_psi_pm;    // B^T psi_pm (k)
+  // The same k x k pieces in plain fixed storage for the step's hot path (rod_solve): S row-major
+  // with stride 8, and B^T psi_coil, B^T psi_pm.
+  std::array<double, 64> S8{};
+  std::array<double, 8> bt_coil8{}, bt_pm8{};
 };
 
 using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 8, 1>;
@@ -146,6 +151,11 @@ void set_lowrank_pieces(const Circuit& c, const Eigen::LLT<Eigen::MatrixXd>& llt
   L.psi_pm = llt0.solve(b_pm);
   L.Bt_psi_coil = B.transpose() * L.psi_coil;
   L.Bt_psi_pm = B.transpose() * L.psi_pm;
+  for (int r = 0; r < k; ++r) {
+    for (int q = 0; q < k; ++q) L.S8[static_cast<std::size_t>(8 * r + q)] = L.S(r, q);
+    L.bt_coil8[static_cast<std::size_t>(r)] = L.Bt_psi_coil(r);
+    L.bt_pm8[static_cast<std::size_t>(r)] = L.Bt_psi_pm(r);
+  }
 }
 
 }  // namespace
@@ -216,27 +226,55 @@ double potential_drop(const CircuitBranch& br, const Eigen::VectorXd& psi) {
 // The k x k part of the low-rank solve, with D = diag(1/R_rod), F the rods' own MMFs and
 // u = I psi_coil + pm psi_pm:
 //   v = B^T u - S D F,  (D^-1 + S) z' = v,  z = z' + D F,  B^T psi = B^T u - S z.
-// Leaves z in ws.z and the rod potential drops B^T psi in ws.v. Fixed-size Eigen types for
-// small k (the hot path of the step); capacity-8 storage otherwise. Allocation-free.
+// Leaves z in ws.z and the rod potential drops B^T psi in ws.v. The matrix D^-1 + S has the
+// same (dense, k x k) structure every step; it is factorised as L D L^T without square roots
+// in fixed storage, unrolled for K = 1..4 rods (the hot path of the consistent state's Newton
+// solve), K = 0 for any k <= 8. Allocation-free. False if a pivot is not positive.
 template <int K>
-bool rod_solve(const CircuitMatrices& L, std::span<const double> R, const double* mmf,
-               double current_A, double pm_scale, NodalBuffers& ws) {
-  constexpr int kMax = K == Eigen::Dynamic ? 8 : K;
-  using Vec = Eigen::Matrix<double, K, 1, 0, kMax, 1>;
-  using Mat = Eigen::Matrix<double, K, K, 0, kMax, kMax>;
-  const int k = static_cast<int>(R.size());
-  const Mat S = L.S;
-  Vec DF(k);
-  for (int r = 0; r < k; ++r) DF(r) = mmf[r] / R[static_cast<std::size_t>(r)];
-  const Vec Btu = current_A * L.Bt_psi_coil + pm_scale * L.Bt_psi_pm;
-  Mat A = S;
-  for (int r = 0; r < k; ++r) A(r, r) += R[static_cast<std::size_t>(r)];
-  const Eigen::LLT<Mat> llt(A);
-  if (llt.info() != Eigen::Success) return false;
-  const Vec z = llt.solve(Vec(Btu - S * DF)) + DF;
-  if (!z.allFinite()) return false;
-  ws.z.head(k) = z;
-  ws.v.head(k) = Btu - S * z;
+bool rod_solve(const CircuitMatrices& L, const double* R, const double* mmf, double current_A,
+               double pm_scale, int k_any, NodalBuffers& ws) {
+  const int k = K > 0 ? K : k_any;
+  std::array<double, 64> A{};
+  std::array<double, 8> DF{}, Btu{}, x{}, piv{};
+  const double* S = L.S8.data();
+  for (int r = 0; r < k; ++r) {
+    DF[r] = mmf[r] / R[r];
+    Btu[r] = current_A * L.bt_coil8[r] + pm_scale * L.bt_pm8[r];
+  }
+  for (int r = 0; r < k; ++r) {
+    double SDF = 0.0;
+    for (int q = 0; q < k; ++q) SDF += S[8 * r + q] * DF[q];
+    x[r] = Btu[r] - SDF;
+  }
+  for (int j = 0; j < k; ++j) {  // L D L^T of S + diag(R), unit L below the diagonal of A
+    double d = S[9 * j] + R[j];
+    for (int p = 0; p < j; ++p) d -= A[8 * j + p] * A[8 * j + p] * piv[p];
+    if (!(d > 0.0)) return false;
+    piv[j] = d;
+    for (int i = j + 1; i < k; ++i) {
+      double a = S[8 * i + j];
+      for (int p = 0; p < j; ++p) a -= A[8 * i + p] * A[8 * j + p] * piv[p];
+      A[8 * i + j] = a / d;
+    }
+  }
+  for (int i = 0; i < k; ++i)
+    for (int p = 0; p < i; ++p) x[i] -= A[8 * i + p] * x[p];
+  for (int i = k - 1; i >= 0; --i) {
+    x[i] /= piv[i];
+    for (int p = i + 1; p < k; ++p) x[i] -= A[8 * p + i] * x[p];
+  }
+  bool finite = true;
+  for (int r = 0; r < k; ++r) {
+    x[r] += DF[r];
+    finite = finite && std::isfinite(x[r]);
+  }
+  if (!finite) return false;
+  for (int r = 0; r < k; ++r) {
+    double Sz = 0.0;
+    for (int q = 0; q < k; ++q) Sz += S[8 * r + q] * x[q];
+    ws.z(r) = x[r];
+    ws.v(r) = Btu[r] - Sz;
+  }
   return true;
 }
 
@@ -254,22 +292,23 @@ bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_
     mmf[static_cast<std::size_t>(r)] =
         branch_mmf(c.branches[static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)])],
                    current_A, pm_scale, ws);
+  const double* R = rod_reluctance_per_H.data();
   bool ok = false;
   switch (k) {
     case 1:
-      ok = rod_solve<1>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, nb);
+      ok = rod_solve<1>(L, R, mmf.data(), current_A, pm_scale, k, nb);
       break;
     case 2:
-      ok = rod_solve<2>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, nb);
+      ok = rod_solve<2>(L, R, mmf.data(), current_A, pm_scale, k, nb);
       break;
     case 3:
-      ok = rod_solve<3>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, nb);
+      ok = rod_solve<3>(L, R, mmf.data(), current_A, pm_scale, k, nb);
       break;
     case 4:
-      ok = rod_solve<4>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, nb);
+      ok = rod_solve<4>(L, R, mmf.data(), current_A, pm_scale, k, nb);
       break;
     default:
-      ok = rod_solve<Eigen::Dynamic>(L, rod_reluctance_per_H, mmf.data(), current_A, pm_scale, nb);
+      ok = rod_solve<0>(L, R, mmf.data(), current_A, pm_scale, k, nb);
   }
   if (!ok) return false;
   // The rod fluxes from the k x k solve, phi_r = (drop_r + F_r) / R_r (the same numbers

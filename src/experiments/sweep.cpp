@@ -10,9 +10,10 @@
 
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/experiments.hpp"
-#include "gmasim/lanes.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/model/validate.hpp"
+#include "gmasim/simulate/lanes.hpp"
 
 namespace gmasim {
 namespace {
@@ -103,6 +104,7 @@ void add_changes(const SweepRequest& r, bool ref_in_grid, std::size_t grid,
 
 SweepResult run_sweep(const Model& m, const SweepRequest& r, const ProgressFn& progress) {
   check_request(m, r);
+  fields::check_request_fields(r);  // the table's rules (gmasim/experiments/experiment_fields.hpp)
   // The work list: the grid, then the reference temperature if it is not in the grid.
   std::vector<Job> jobs;
   for (double T : r.temperatures_C)

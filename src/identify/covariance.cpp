@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -253,6 +254,7 @@ void set_profile_intervals(const Objective& obj, BatchEvaluator& ev, const std::
   const double chi_opt = f * f;
   const double thr = 3.841458820694124 * chi_opt / dof;  // chi^2_1(95 %) s^2
   const long ev0 = ev.evaluations();
+  const auto t0 = std::chrono::steady_clock::now();
   Profiler profiler(obj, ev, u, chi_opt, thr, o, comm, prof);
   std::vector<std::size_t> todo;
   for (std::size_t j = 0; j < out.parameters.size(); ++j) {
@@ -282,6 +284,7 @@ void set_profile_intervals(const Objective& obj, BatchEvaluator& ev, const std::
     if (cut) cut_names += (cut_names.empty() ? "" : ", ") + fp.name;
   }
   prof.evaluations = ev.evaluations() - ev0;
+  prof.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   prof.budget_hit = !cut_names.empty();
   if (!names.empty()) {
     out.covariance_note += fmt::format(

@@ -7,9 +7,59 @@
 
 namespace gmasim::identify_detail {
 
+const BatchEvaluator::Memo* BatchEvaluator::recall(const std::vector<double>& u) const {
+  for (const Memo& e : memo_)
+    if (e.u == u) return &e;
+  return nullptr;
+}
+
 std::vector<char> BatchEvaluator::run(const std::vector<std::vector<double>>& points,
                                       std::vector<std::vector<double>>& res) {
   const std::size_t P = points.size();
+  // source[i]: the index in `fresh` of point i's evaluation, or -1 - (memo index).
+  std::vector<std::vector<double>> fresh;
+  std::vector<long> source(P);
+  for (std::size_t i = 0; i < P; ++i) {
+    if (const Memo* e = recall(points[i])) {
+      source[i] = -1 - (e - memo_.data());
+      continue;
+    }
+    const auto it = std::find(fresh.begin(), fresh.end(), points[i]);
+    source[i] = it - fresh.begin();
+    if (it == fresh.end()) fresh.push_back(points[i]);
+  }
+  std::vector<std::vector<double>> fresh_res;
+  const std::vector<char> fresh_ok = evaluate(fresh, fresh_res);
+  res.assign(P, {});
+  std::vector<char> ok(P, 0);
+  for (std::size_t i = 0; i < P; ++i) {
+    if (source[i] < 0) {
+      const Memo& e = memo_[static_cast<std::size_t>(-1 - source[i])];
+      res[i] = e.r;
+      ok[i] = e.ok;
+    } else {
+      res[i] = fresh_res[static_cast<std::size_t>(source[i])];
+      ok[i] = fresh_ok[static_cast<std::size_t>(source[i])];
+    }
+  }
+  reused_ += static_cast<long>(P - fresh.size());
+  for (std::size_t k = 0; k < fresh.size(); ++k) {  // remembered after the copies above
+    Memo e{std::move(fresh[k]), std::move(fresh_res[k]), fresh_ok[k]};
+    if (memo_.size() < kMemo) {
+      memo_.push_back(std::move(e));
+    } else {
+      memo_[memo_next_] = std::move(e);
+      memo_next_ = (memo_next_ + 1) % kMemo;
+    }
+  }
+  return ok;
+}
+
+std::vector<char> BatchEvaluator::evaluate(const std::vector<std::vector<double>>& points,
+                                           std::vector<std::vector<double>>& res) {
+  const std::size_t P = points.size();
+  res.clear();
+  if (P == 0) return {};  // every rank alike: nothing to share
   const std::size_t m = obj_.residual_count();
   const int R = comm_.size(), me = comm_.rank();
   res.assign(P, std::vector<double>(m, 0.0));

@@ -7,7 +7,7 @@
 #include <thread>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/model/validate.hpp"
 #include "internal.hpp"
 
 namespace gmasim {
@@ -17,6 +17,10 @@ using namespace identify_detail;
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
 
 // The options no other part checks before the search needs them.
 void check_options(const IdentifyOptions& o) {
@@ -138,9 +142,13 @@ void set_parameters(const Objective& obj, BatchEvaluator& ev, const std::vector<
           "(raise --profile-evaluations for profiles)");
     }
     const long before = ev.evaluations();
+    const auto t0 = Clock::now();
     fill_covariance(obj, ev, u, f, oc, comm, res, prof);
-    res.stage_evaluations.profile += prof.evaluations;
-    res.stage_evaluations.covariance += ev.evaluations() - before - prof.evaluations;
+    auto& se = res.stage_evaluations;
+    se.profile += prof.evaluations;
+    se.covariance += ev.evaluations() - before - prof.evaluations;
+    se.profile_s += prof.wall_s;
+    se.covariance_s += seconds_since(t0) - prof.wall_s;
     return;
   }
   const auto p = obj.to_params(u);
@@ -179,8 +187,10 @@ void settle_optimum(const Objective& obj, BatchEvaluator& ev, const IdentifyOpti
     f = prof.lowest_f;
     res.best_found_by = "profile";
     const long before = ev.evaluations();
+    const auto t0 = Clock::now();
     const RefineOutcome ro = refine_lm(obj, ev, u, o, comm, {});
     se.refine += ev.evaluations() - before;
+    se.refine_s += seconds_since(t0);
     res.interrupted = ro.interrupted;
     if (ro.f < f) {
       u = ro.u;
@@ -233,8 +243,11 @@ IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, cons
   std::vector<double> u = ga.best_u;
   double f = ga.best_f;
   res.stage_evaluations.search = ga.evaluations + 1;  // with the start model's evaluation
+  res.stage_evaluations.search_s = seconds_since(t0);
+  const auto t_refine = Clock::now();
   refine_champion(obj, ev, ga, o, comm, t0, u, f, res);
   res.stage_evaluations.refine = ev.evaluations();
+  res.stage_evaluations.refine_s = seconds_since(t_refine);
 
   // ---- intervals (and the best point any stage found) --------------------------------------
   settle_optimum(obj, ev, o, comm, u, f, res);
@@ -251,6 +264,7 @@ IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, cons
     res.targets = obj.target_fits(u);
   }
   res.evaluations = ga.evaluations + ev.evaluations() + 1;
+  res.stage_evaluations.reused = ev.reused();
   res.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
   return res;
 }

@@ -7,13 +7,17 @@
 #include <string>
 #include <vector>
 
-#include "gmasim/identify.hpp"
+#include "gmasim/identify/identify.hpp"
 #include "identify/communicator.hpp"
 
 namespace gmasim::identify_detail {
 
 // Evaluates residual vectors at a batch of points: point i on rank i % R, and on each rank
 // over `threads` worker threads. Every rank gets every result, bit-identical.
+// An evaluation is a pure function of the point, so a point equal (bit for bit) to another of
+// the batch or to one of the last kMemo points evaluated is not simulated again: its result is
+// copied (a Jacobian's one-sided columns at a bound repeat the centre; the covariance's
+// Jacobian at the optimum repeats the refinement's last). The memo is the same on every rank.
 class BatchEvaluator {
  public:
   BatchEvaluator(const Objective& obj, int threads, Collective& comm)
@@ -21,13 +25,27 @@ class BatchEvaluator {
   // ok[i] = residuals(points[i]) succeeded; res[i] has residual_count() values.
   std::vector<char> run(const std::vector<std::vector<double>>& points,
                         std::vector<std::vector<double>>& res);
+  // Model evaluations run (all ranks); a result copied from the memo or the batch is not one.
   long evaluations() const { return evaluations_; }
+  long reused() const { return reused_; }
 
  private:
+  struct Memo {
+    std::vector<double> u, r;
+    char ok = 0;
+  };
+  static constexpr std::size_t kMemo = 64;
+  // The distinct points not in the memo, evaluated over ranks and threads.
+  std::vector<char> evaluate(const std::vector<std::vector<double>>& points,
+                             std::vector<std::vector<double>>& res);
+  const Memo* recall(const std::vector<double>& u) const;
+
   const Objective& obj_;
   int threads_;
   Collective& comm_;
-  long evaluations_ = 0;
+  long evaluations_ = 0, reused_ = 0;
+  std::vector<Memo> memo_;  // a ring of the last kMemo evaluations
+  std::size_t memo_next_ = 0;
 };
 
 // Reduces (f, u) to the best over ranks (lowest f, then lowest rank); every rank gets it.
@@ -120,6 +138,7 @@ FittedParameter fitted_parameter(const Objective& obj, std::size_t j, double val
 struct ProfileOutcome {
   long budget = -1;         // evaluations it may spend (-1: no limit)
   long evaluations = 0;     // evaluations it spent
+  double wall_s = 0.0;      // and its wall time
   bool budget_hit = false;  // a profile was cut short by the budget
   double lowest_f = 0.0;    // the lowest RMS [%] of any point it evaluated, and where
   std::vector<double> lowest_u;

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <limits>
 
-#include "gmasim/experiments.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/model/validate.hpp"
 #include "gmasim/physics/magnetic.hpp"
-#include "gmasim/validate.hpp"
 #include "identify/record_run.hpp"
 
 namespace gmasim {
@@ -79,14 +79,9 @@ double lowest_resonance_Hz(const Model& m, const ResonanceRun& run) {
     return E / static_cast<double>(st.rods.size()) * 1e-9;
   }
   if (run.kind != TargetKind::ResonanceHz) {  // the small-signal frequency response (Fig. 15)
-    FrfRequest r;
-    r.temperatures_C = {run.T};
-    r.bias_A = run.bias;
-    r.stepped_sine = false;
-    r.threads = 1;
-    const FrfResult frf = run_frf(m, r);  // kept alive: cv refers into it
-    const FrfCurve& cv = frf.curves.at(0);
-    return run.kind == TargetKind::FrfPeakHz ? cv.first_resonance_Hz : cv.bandwidth_3dB_Hz;
+    // run_frf's linearised markers without the rest of its curve (the same numbers).
+    const LinearFrfMarkers lm = linear_frf_markers(m, run.T, run.bias);
+    return run.kind == TargetKind::FrfPeakHz ? lm.first_resonance_Hz : lm.bandwidth_3dB_Hz;
   }
   const Conditions c = make_conditions(m, run.T);
   const State st = make_state(m, c, run.bias);

@@ -5,9 +5,9 @@
 #include <deque>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/lanes.hpp"
-#include "gmasim/run_loop.hpp"
-#include "gmasim/validity.hpp"
+#include "gmasim/model/validity.hpp"
+#include "gmasim/simulate/lanes.hpp"
+#include "gmasim/simulate/run_loop.hpp"
 #include "identify/record_run.hpp"
 
 namespace gmasim::identify_detail {

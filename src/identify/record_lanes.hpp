@@ -7,7 +7,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "gmasim/identify.hpp"
+#include "gmasim/identify/identify.hpp"
 #include "identify/objective_runs.hpp"
 
 namespace gmasim::identify_detail {

@@ -9,8 +9,8 @@
 
 #include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/identify.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/io/io.hpp"
 #include "io/json.hpp"
 #include "io/schema.hpp"
 
@@ -170,10 +170,13 @@ void write_history(JsonWriter& w, const HistoryEntry& h) {
 }  // namespace
 
 std::string stage_text(const StageEvaluations& se) {
-  return fmt::format("search {}, refinement {}, covariance {}, profile {} of {}", se.search,
-                     se.refine, se.covariance, se.profile,
-                     se.profile_budget < 0 ? std::string("no limit")
-                                           : fmt::format("{} allowed", se.profile_budget));
+  return fmt::format(
+      "search {} in {:.1f} s, refinement {} in {:.1f} s, covariance {} in {:.1f} s, profile {} of "
+      "{} in {:.1f} s{}",
+      se.search, se.search_s, se.refine, se.refine_s, se.covariance, se.covariance_s, se.profile,
+      se.profile_budget < 0 ? std::string("no limit")
+                            : fmt::format("{} allowed", se.profile_budget),
+      se.profile_s, se.reused > 0 ? fmt::format("; {} repeated points reused", se.reused) : "");
 }
 
 namespace {
@@ -380,6 +383,29 @@ std::string fitted_model_toml(const std::string& start_text, const ModelSpec& st
   return text;
 }
 
+// What each stage spent: evaluations (and the profile's budget, the reused points), wall time.
+static void write_stages(JsonWriter& w, const StageEvaluations& se) {
+  w.key("evaluations_by_stage").begin_object(JsonLayout::Inline);
+  w.key("search").integer(se.search);
+  w.key("refine").integer(se.refine);
+  w.key("covariance").integer(se.covariance);
+  w.key("profile").integer(se.profile);
+  w.key("profile_budget");
+  if (se.profile_budget >= 0) {
+    w.integer(se.profile_budget);
+  } else {
+    w.null();  // no limit
+  }
+  w.key("reused").integer(se.reused);
+  w.end_object();
+  w.key("wall_s_by_stage").begin_object(JsonLayout::Inline);
+  w.numbers({{"search", se.search_s},
+             {"refine", se.refine_s},
+             {"covariance", se.covariance_s},
+             {"profile", se.profile_s}});
+  w.end_object();
+}
+
 std::string fit_report_json(const IdentifyResult& r, const FitProvenance& p) {
   JsonWriter w;
   w.begin_object();
@@ -401,19 +427,7 @@ std::string fit_report_json(const IdentifyResult& r, const FitProvenance& p) {
   w.key("refine").string(r.refine_summary);
   w.end_object();
   w.key("evaluations").integer(r.evaluations);
-  const StageEvaluations& se = r.stage_evaluations;
-  w.key("evaluations_by_stage").begin_object(JsonLayout::Inline);
-  w.key("search").integer(se.search);
-  w.key("refine").integer(se.refine);
-  w.key("covariance").integer(se.covariance);
-  w.key("profile").integer(se.profile);
-  w.key("profile_budget");
-  if (se.profile_budget >= 0) {
-    w.integer(se.profile_budget);
-  } else {
-    w.null();  // no limit
-  }
-  w.end_object();
+  write_stages(w, r.stage_evaluations);
   w.key("best_found_by").string(r.best_found_by);
   w.key("wall_s").number(r.wall_s);
   w.key("ga_evals_per_s").number(r.ga_evals_per_s);

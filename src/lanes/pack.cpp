@@ -8,8 +8,8 @@
 #include <map>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/lanes.hpp"
-#include "gmasim/validity.hpp"
+#include "gmasim/model/validity.hpp"
+#include "gmasim/simulate/lanes.hpp"
 #include "lanes/lane_data.hpp"
 
 namespace gmasim {

@@ -6,9 +6,9 @@
 #include <map>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/lanes.hpp"
-#include "gmasim/run_loop.hpp"
-#include "gmasim/validity.hpp"
+#include "gmasim/model/validity.hpp"
+#include "gmasim/simulate/lanes.hpp"
+#include "gmasim/simulate/run_loop.hpp"
 #include "simulate/record.hpp"
 
 namespace gmasim {

@@ -10,8 +10,8 @@
 #define GMASIM_LANES_STEP_KERNEL_INL_H_
 #endif
 
+#include "gmasim/model/validity.hpp"
 #include "gmasim/physics/magnetic.hpp"
-#include "gmasim/validity.hpp"
 #include "hwy/highway.h"
 #include "lanes/ja_lanes-inl.h"
 #include "lanes/lane_data.hpp"

@@ -71,79 +71,96 @@ void advance_sensor_mount(const SensorMountModel& o, double q0_m, double q1_m, d
 //   line, with k_f's series reluctance R_s: physics::series_reluctance)
 //   H_c,i = H_i + kappa_i dB_i/dt  (eq. 7's eddy field, trapezoidal over the step)
 // Newton's method on the rods' fields: each rod is linearised at the iterate H* (slope
-// dM/dH of the magnetisation law's move, Law::trial) into a branch  U = R_eff phi + U_off, the
-// circuit is solved with R_eff and the MMF -U_off, and H* moves to the field that flux implies.
-// Quadratic; damped after 8 iterations (the JA slope jumps where M_irr starts or stops moving).
-// quasi_static drops the eddy term (the at-rest ramp of make_state).
+// dM/dH of the magnetisation law's move, Law::trial_from) into a branch  U = R_eff phi + U_off,
+// the circuit is solved with R_eff and the MMF -U_off, and H* moves to the field that flux
+// implies. Quadratic; damped after 8 iterations (the JA slope jumps where M_irr starts or stops
+// moving). Converged when every correction is below 1e-7 A/m + 1e-11 |H|; the last iterate,
+// whose law evaluation the solve used, is committed as it is (Law::commit_trial). First guess:
+// H and M extrapolated quadratically from the last three steps (H = 3 H_n - 3 H_n-1 + H_n-2),
+// so that one correction usually converges (two solves a step); the law's inner solve starts
+// each later iterate on its tangent, M + dM/dH dH.
+// quasi_static drops the eddy term (the at-rest ramp of make_state) and starts at H_n.
 template <class Law>
 void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, double current_A,
                                 double pm_scale, double h_s, bool quasi_static, double t1) {
   const std::size_t n = s.rods.size();
-  std::array<double, 8> H{}, M{}, Bs{}, mud{}, B0{}, e0{}, g{};
+  std::array<double, 8> H{}, Mg{}, inv_mud{}, B0{}, e0{}, g{}, Bs{}, l_A{}, inv_A{};
+  std::array<typename Law::MoveStart, 8> start{};
+  std::array<typename Law::Trial, 8> trial{};
   for (std::size_t i = 0; i < n; ++i) {
     const auto& r = s.rods[i];
+    const auto& rc = c.rods[i];
+    start[i] = Law::begin_move(rc, r);
     B0[i] = flux_density(r.H_A_per_m, r.M_A_per_m);
-    e0[i] = quasi_static ? 0.0 : r.Hc_A_per_m - r.H_A_per_m;
-    g[i] = quasi_static ? 0.0 : 2.0 * c.rods[i].eddy_geometry_s_m_per_H / h_s;
-    H[i] = quasi_static ? r.H_A_per_m : 2.0 * r.H_A_per_m - r.H_prev_A_per_m;
-    M[i] = r.M_A_per_m + (r.mu_r - 1.0) * (H[i] - r.H_A_per_m);
+    l_A[i] = rc.length_m / rc.area_m2;
+    inv_A[i] = 1.0 / rc.area_m2;
+    if (quasi_static) {
+      H[i] = r.H_A_per_m;
+      Mg[i] = r.M_A_per_m;
+    } else {
+      e0[i] = r.Hc_A_per_m - r.H_A_per_m;
+      g[i] = 2.0 * rc.eddy_geometry_s_m_per_H / h_s;
+      H[i] = 3.0 * (r.H_A_per_m - r.H_prev_A_per_m) + r.H_prev2_A_per_m;
+      Mg[i] = 3.0 * (r.M_A_per_m - r.M_prev_A_per_m) + r.M_prev2_A_per_m;
+    }
   }
   constexpr int kMaxIterations = 60;
-  double worst = 0.0;
-  int worst_rod = 0;
   for (int it = 0;; ++it) {
     for (std::size_t i = 0; i < n; ++i) {
       const auto& rc = c.rods[i];
-      const auto& r = s.rods[i];
-      double chi = 0.0;
-      const double Mi = Law::trial(rc, r, H[i], M[i], &chi);
-      M[i] = Mi;
-      Bs[i] = flux_density(H[i], Mi);
-      mud[i] = kMu0 * (1.0 + chi);
-      const double l = rc.length_m;
-      s.rod_reluctance[i] = l / rc.area_m2 * (1.0 / mud[i] + g[i]) + rc.series_reluctance_per_H;
-      s.circuit.rod_extra_mmf[i] = -l * (H[i] - Bs[i] / mud[i] - g[i] * B0[i] - e0[i]);
+      trial[i] = Law::trial_from(rc, s.rods[i], start[i], H[i], Mg[i]);
+      Bs[i] = flux_density(H[i], trial[i].M);
+      inv_mud[i] = 1.0 / (kMu0 * (1.0 + trial[i].dM_dH));
+      s.rod_reluctance[i] = l_A[i] * (inv_mud[i] + g[i]) + rc.series_reluctance_per_H;
+      s.circuit.rod_extra_mmf[i] =
+          -rc.length_m * (H[i] - Bs[i] * inv_mud[i] - g[i] * B0[i] - e0[i]);
     }
+    ++s.newton_solves;
     if (!solve_circuit(m.circuit, s.rod_reluctance, current_A, pm_scale, s.circuit,
                        s.energy.enabled))
       throw DivergenceError(t1, "", "nodal matrix of the circuit", 0.0, "not positive definite");
-    worst = 0.0;
+    double worst = 0.0;
+    int worst_rod = 0;
     bool converged = true;
-    const double damping = it < 8 ? 1.0 : 0.5;
+    std::array<double, 8> dH{};
     for (std::size_t i = 0; i < n; ++i) {
       const double phi = s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
-      const double dH = (phi / c.rods[i].area_m2 - Bs[i]) / mud[i];
-      if (std::fabs(dH) > worst) {
-        worst = std::fabs(dH);
+      dH[i] = (phi * inv_A[i] - Bs[i]) * inv_mud[i];
+      if (std::fabs(dH[i]) > worst) {
+        worst = std::fabs(dH[i]);
         worst_rod = static_cast<int>(i);
       }
-      if (!(std::fabs(dH) <= 1e-7 + 1e-11 * std::fabs(H[i]))) converged = false;
-      H[i] += damping * dH;
+      if (!(std::fabs(dH[i]) <= 1e-7 + 1e-11 * std::fabs(H[i]))) converged = false;
     }
-    if (converged) break;
+    if (converged) break;  // the last iterate: its correction is below the tolerance
     if (it == kMaxIterations || !std::isfinite(worst)) {
       if (worst <= 1e-3) break;  // 1 mA/m: far below anything the outputs resolve
       throw DivergenceError(t1, m.rods[static_cast<std::size_t>(worst_rod)].name,
                             "field H [A/m] of the consistent magnetic state", worst,
                             "Newton's method did not converge");
     }
+    const double damping = it < 8 ? 1.0 : 0.5;
+    for (std::size_t i = 0; i < n; ++i) {
+      H[i] += damping * dH[i];
+      Mg[i] = trial[i].M + trial[i].dM_dH * damping * dH[i];  // on the law's tangent
+    }
   }
-  for (std::size_t i = 0; i < n; ++i) {  // commit the end-of-step state
+  for (std::size_t i = 0; i < n; ++i) {  // commit the end-of-step state: the last iterate
     const auto& rc = c.rods[i];
     auto& r = s.rods[i];
-    double chi = 0.0;
-    Law::commit(rc, r, H[i], M[i], &chi);
-    const double B1 = flux_density(H[i], r.M_A_per_m);
+    r.M_prev2_A_per_m = r.M_prev_A_per_m;
+    r.M_prev_A_per_m = r.M_A_per_m;
+    Law::commit_trial(rc, r, trial[i]);
     r.Hc_A_per_m = quasi_static
                        ? H[i]
-                       : eddy_static_field_trapezoid(r.H_A_per_m, H[i], r.Hc_A_per_m, B0[i], B1,
+                       : eddy_static_field_trapezoid(r.H_A_per_m, H[i], r.Hc_A_per_m, B0[i], Bs[i],
                                                      rc.eddy_geometry_s_m_per_H, h_s);
+    r.H_prev2_A_per_m = r.H_prev_A_per_m;
     r.H_prev_A_per_m = r.H_A_per_m;
     r.H_A_per_m = H[i];
-    r.M_prev_A_per_m = r.M_A_per_m;
-    r.mu_r = 1.0 + chi;
+    r.mu_r = 1.0 + trial[i].dM_dH;
     r.tau_s = kMu0 * r.mu_r * rc.eddy_geometry_s_m_per_H;
-    r.phi_Wb = B1 * rc.area_m2;
+    r.phi_Wb = Bs[i] * rc.area_m2;
     s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])] = r.phi_Wb;
   }
 }
@@ -181,8 +198,8 @@ void settle_at_rest(const Model& m, const Conditions& c, State& s) {
   const std::size_t n = s.rods.size();
   for (std::size_t i = 0; i < n; ++i) {
     auto& r = s.rods[i];
-    r.M_prev_A_per_m = r.M_A_per_m;
-    r.H_prev_A_per_m = r.H_A_per_m;
+    r.M_prev2_A_per_m = r.M_prev_A_per_m = r.M_A_per_m;
+    r.H_prev2_A_per_m = r.H_prev_A_per_m = r.H_A_per_m;
     if (!consistent) r.tau_s = r.mu_r * kMu0 * c.rods[i].eddy_geometry_s_m_per_H;
     update_rod_mechanics(m.material, c.rods[i], r);
   }

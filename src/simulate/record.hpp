@@ -4,8 +4,8 @@
 
 #include <cstddef>
 
-#include "gmasim/model.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim {
 

@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "gmasim/magnetisation/law_id.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 #include "gmasim/physics/jiles_atherton.hpp"
 
 namespace gmasim {
@@ -26,6 +26,31 @@ struct JilesAthertonLaw {
     physics::ja_step(r.H_A_per_m, H1, rc.MsT_mag, rc.ja, Mirr, M, M_guess, dM_dH);
     return M;
   }
+  // The consistent state's Newton solve tries several end fields H1 of one move: begin_move
+  // fixes what depends on the move's start only (H_e0 and M_an(H_e0)), trial_from returns M, the
+  // slope dM/dH and the state the move would leave at H1, and commit_trial commits that trial
+  // as it is (the last Newton iterate; no second evaluation of the law).
+  using MoveStart = physics::JaMoveStart;
+  struct Trial {
+    double M, dM_dH, Mirr;
+  };
+  static MoveStart begin_move(const RodConditions& rc, const RodState& r) {
+    return physics::ja_move_start(r.H_A_per_m, r.M_A_per_m, rc.MsT_mag, rc.ja);
+  }
+  static Trial trial_from(const RodConditions& rc, const RodState& r, const MoveStart& st,
+                          double H1, double M_guess) {
+    Trial t{};
+    double chi_e = 0.0;
+    physics::ja_step_from(r.H_A_per_m, st, H1, rc.MsT_mag, rc.ja, r.Mirr_A_per_m, r.M_A_per_m,
+                          M_guess, t.Mirr, t.M, chi_e);
+    t.dM_dH = physics::ja_slope(chi_e, rc.ja);
+    return t;
+  }
+  static void commit_trial(const RodConditions&, RodState& r, const Trial& t) {
+    r.Mirr_A_per_m = t.Mirr;
+    r.M_A_per_m = t.M;
+  }
+
   // The same move, committed: r's M_irr and M at H1 (r.H_A_per_m is the caller's to set).
   static void commit(const RodConditions& rc, RodState& r, double H1, double M_guess,
                      double* dM_dH) {
@@ -40,7 +65,7 @@ struct JilesAthertonLaw {
     return rc.ja.c * dMan / (1.0 - rc.ja.alpha * rc.ja.c * dMan);
   }
 
-  // The ledgers (gmasim/energy.hpp): the dissipation density of the step from (H0, M0) to r's
+  // The ledgers (gmasim/model/energy.hpp): the dissipation density of the step from (H0, M0) to r's
   // state, and the stored energy density of r's state [J/m^3].
   static double step_dissipation(const RodConditions& rc, double H0, double M0, const RodState& r) {
     return physics::ja_step_dissipation(H0, M0, r.H_A_per_m, r.M_A_per_m, rc.MsT_mag, rc.ja);
@@ -70,7 +95,6 @@ struct JilesAthertonLaw {
 
   // The FRF's anhysteretic bias (settle_at_bias): the law reduced to its anhysteretic curve
   // (c = 1: M = M_an(H + alpha M)), its magnetisation there, and the state that holds it.
-  static constexpr bool kHasAnhysteretic = true;
   static void reduce_to_anhysteretic(RodConditions& rc) { rc.ja.c = 1.0; }
   static double anhysteretic_magnetisation(const RodConditions& rc, const RodState& r) {
     physics::JaCoefficients anh = rc.ja;
@@ -78,7 +102,7 @@ struct JilesAthertonLaw {
     return physics::ja_total_magnetisation(r.H_A_per_m, r.M_A_per_m, r.M_A_per_m, rc.MsT_mag, anh);
   }
   // Returns how far the law's state moved (|change of M_irr|) [A/m].
-  static double hold_anhysteretic(RodState& r, double M) {
+  static double hold_anhysteretic(const RodConditions&, RodState& r, double M) {
     const double moved = std::fabs(M - r.Mirr_A_per_m);
     r.Mirr_A_per_m = M;
     r.M_A_per_m = M;

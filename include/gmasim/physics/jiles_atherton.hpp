@@ -142,26 +142,31 @@ inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, dou
 // the scalar equation  g(M1) = M1 - (1-c) M_irr1(M1) - c M_an(H1 + alpha M1) = 0  by
 // Newton's method with its exact derivative (H_e depends on M through alpha), M_irr1 from
 // ja_irreversible_update. M_guess is the starting point (e.g. linear extrapolation).
-// On entry M must be consistent with (H0, Mirr); on exit Mirr and M hold the values at H1.
-// If dM_dH is given it receives the differential susceptibility along the step at H1,
-//   dM1/dH1 = chi_e / (1 - alpha chi_e),  chi_e = (1-c) dM_irr1/dH_e + c dM_an/dH_e
-// (the implicit-function derivative of g; the consistent magnetic state's Newton solve
-// uses it). At H1 == H0 it is the reversible slope (M_irr pinned).
-inline void ja_step(double H0, double H1, double MsT_A_per_m, const JaCoefficients& p, double& Mirr,
-                    double& M, double M_guess, double* dM_dH = nullptr) {
+// The step's start enters through He0 = H0 + alpha M0 and Man0 = M_an(He0) (ja_move_start:
+// fixed while a caller tries several end fields H1 from the same start). Returns M1 and M_irr1
+// in M1_out and Mirr1_out; chi_e_out receives
+//   chi_e = (1-c) dM_irr1/dH_e + c dM_an/dH_e  at H1,
+// from which dM1/dH1 = chi_e / (1 - alpha chi_e) (the implicit-function derivative of g).
+// At H1 == H0 nothing moves: M_irr1 = M_irr0, M1 = M0 and chi_e is the reversible c dM_an/dH_e.
+struct JaMoveStart {
+  double He0, Man0;
+};
+inline JaMoveStart ja_move_start(double H0, double M0, double MsT_A_per_m,
+                                 const JaCoefficients& p) {
+  const double He0 = H0 + p.alpha * M0;
+  return {He0, MsT_A_per_m * langevin(He0 * (1.0 / p.a_A_per_m))};
+}
+inline void ja_step_from(double H0, const JaMoveStart& st, double H1, double MsT_A_per_m,
+                         const JaCoefficients& p, double Mirr0, double M0, double M_guess,
+                         double& Mirr1_out, double& M1_out, double& chi_e_out) {
   const double inv_a = 1.0 / p.a_A_per_m;
-  auto slope = [&](double chi_e) {
-    if (dM_dH) *dM_dH = chi_e / (1.0 - p.alpha * chi_e);
-  };
   if (H1 == H0) {
-    if (dM_dH) {
-      const LangevinValue lv = langevin_pair((H0 + p.alpha * M) * inv_a);
-      slope(p.c * MsT_A_per_m * inv_a * lv.dL);
-    }
+    const LangevinValue lv = langevin_pair((H0 + p.alpha * M0) * inv_a);
+    Mirr1_out = Mirr0;
+    M1_out = M0;
+    chi_e_out = p.c * MsT_A_per_m * inv_a * lv.dL;
     return;
   }
-  const double He0 = H0 + p.alpha * M;
-  const double Man0 = MsT_A_per_m * langevin(He0 * inv_a);
   const double tol = 1e-12 * MsT_A_per_m;
   double M1 = M_guess;
   for (int it = 0; it < 60; ++it) {
@@ -171,20 +176,44 @@ inline void ja_step(double H0, double H1, double MsT_A_per_m, const JaCoefficien
     const double dMan = MsT_A_per_m * inv_a * lv.dL;
     double dMirr = 0.0;
     const double Mirr1 =
-        ja_irreversible_update(Mirr, Man0, Man1, dMan, He1 - He0, p.k_A_per_m, dMirr);
+        ja_irreversible_update(Mirr0, st.Man0, Man1, dMan, He1 - st.He0, p.k_A_per_m, dMirr);
     const double Mnew = (1.0 - p.c) * Mirr1 + p.c * Man1;
     const double g = M1 - Mnew;
     const double chi_e = (1.0 - p.c) * dMirr + p.c * dMan;
     if (std::fabs(g) <= tol || it == 59) {
-      Mirr = Mirr1;
-      M = Mnew;
-      slope(chi_e);
+      Mirr1_out = Mirr1;
+      M1_out = Mnew;
+      chi_e_out = chi_e;
       return;
     }
     double dg = 1.0 - p.alpha * chi_e;
     if (dg < 0.2) dg = 0.2;  // alpha > 0 (positive feedback): damp the Newton step
     M1 -= g / dg;
   }
+}
+// The slope dM/dH = chi_e / (1 - alpha chi_e) along a step (ja_step_from's chi_e).
+inline double ja_slope(double chi_e, const JaCoefficients& p) {
+  return chi_e / (1.0 - p.alpha * chi_e);
+}
+
+// One step of eq. (9) from H0 to H1 (ja_step_from from the start (H0, Mirr, M)).
+// On entry M must be consistent with (H0, Mirr); on exit Mirr and M hold the values at H1.
+// If dM_dH is given it receives the differential susceptibility along the step at H1
+// (ja_slope; at H1 == H0 the reversible slope, M_irr pinned).
+inline void ja_step(double H0, double H1, double MsT_A_per_m, const JaCoefficients& p, double& Mirr,
+                    double& M, double M_guess, double* dM_dH = nullptr) {
+  if (H1 == H0) {
+    if (dM_dH) {
+      double Mirr1 = 0.0, M1 = 0.0, chi_e = 0.0;
+      ja_step_from(H0, {}, H1, MsT_A_per_m, p, Mirr, M, M_guess, Mirr1, M1, chi_e);
+      *dM_dH = ja_slope(chi_e, p);
+    }
+    return;
+  }
+  double chi_e = 0.0;
+  ja_step_from(H0, ja_move_start(H0, M, MsT_A_per_m, p), H1, MsT_A_per_m, p, Mirr, M, M_guess, Mirr,
+               M, chi_e);
+  if (dM_dH) *dM_dH = ja_slope(chi_e, p);
 }
 inline void ja_step(double H0, double H1, double MsT_A_per_m, const JaCoefficients& p, double& Mirr,
                     double& M) {
