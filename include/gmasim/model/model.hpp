@@ -391,15 +391,11 @@ struct State {
   CircuitWorkspace circuit;  // stage 1: the rod branches' fluxes phi (eq. 23), the consistent
                              // state's linearised rod MMFs (rod_extra_mmf)
   std::vector<double> rod_reluctance;  // per rod, eq. (2) (consistent: linearised); stage 1
-<<<<<<< ours
   EnergyAccumulators
       energy;  // the ledgers (gmasim/model/energy.hpp): booked by step() when enabled
-=======
-  EnergyAccumulators energy;  // the ledgers (gmasim/energy.hpp): booked by step() when enabled
   // Statistics: circuit solves of the consistent magnetic state's Newton method (one per
   // iteration), summed over the steps since make_state (quasi-static moves included).
   long newton_solves = 0;
->>>>>>> theirs
 };
 
 // Sizes every buffer, and places the actuator at rest in its quasi-static equilibrium
