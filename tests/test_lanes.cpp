@@ -155,10 +155,11 @@ TEST(Lanes, FallbackTargetsAgree) {
   EXPECT_EQ(lanes_width(), best_width);
 }
 
-// The lanes against the scalar step(): they differ only in Highway's exp/cos/sin/tanh
-// (a few ulp) against libm's, and in the circuit's summation order. Observed relative
-// difference after 3000 steps (0.3 periods) of y, B and every rod's H and M: 1.1e-12;
-// tolerance 1e-11.
+// The lanes against the scalar step(): they differ in Highway's exp/cos/sin/tanh (a few ulp)
+// against libm's, and since the stepfast merge in the Newton path (the scalar step commits
+// its last iterate from another predictor; docs/lanes.md): both within the Newton tolerance.
+// Observed relative difference after 3000 steps of y, B and every rod's H and M: 4.2e-9
+// (1.1e-12 before the merge); tolerance 4e-8.
 TEST(Lanes, FollowTheScalarStep) {
   const Runs runs(9);
   LaneBatch b = runs.batch();
@@ -182,7 +183,7 @@ TEST(Lanes, FollowTheScalarStep) {
       auto rel = [&](double x, double ref, double scale) {
         const double e = std::fabs(x - ref) / scale;
         worst = std::max(worst, e);
-        EXPECT_LE(e, 1e-11) << "lane " << i << " step " << k;
+        EXPECT_LE(e, 4e-8) << "lane " << i << " step " << k;
       };
       rel(s.y_m, scalar[i].y_m, 1e-6);  // [m]: relative to 1 um
       rel(s.B_T, scalar[i].B_T, 1.0);
