@@ -12,16 +12,17 @@
 
 #include "gmasim/identify/identify.hpp"
 #include "gmasim/io/io.hpp"
+#include "gmasim/simulate/lanes.hpp"
 
 namespace {
 
 using namespace gmasim;
 
-const Objective& objective(int steps_per_period) {
+const Objective& objective(int steps_per_period, bool lanes = true) {
   static std::mutex mu;
-  static std::map<int, std::unique_ptr<Objective>> cache;
+  static std::map<std::pair<int, bool>, std::unique_ptr<Objective>> cache;
   const std::lock_guard<std::mutex> lock(mu);
-  auto& slot = cache[steps_per_period];
+  auto& slot = cache[{steps_per_period, lanes}];
   if (!slot) {
     const Model truth = load_model("");
     SyntheticRequest r;  // the 12 conditions
@@ -35,6 +36,7 @@ const Objective& objective(int steps_per_period) {
         "material.chi_m:8:50:log,rod1.damping_N_s_per_m:50:1500:log");
     ObjectiveSettings s;
     s.steps_per_period = steps_per_period;
+    s.lanes = lanes;
     slot = std::make_unique<Objective>(builtin_model_spec(), data, fit, s);
   }
   return *slot;
@@ -51,6 +53,24 @@ void BM_Objective12Conditions(benchmark::State& bs) {
   bs.counters["steps_per_period"] =
       benchmark::Counter(static_cast<double>(bs.range(0)), benchmark::Counter::kAvgThreads);
 }
+// The same evaluation with its 12 records in SIMD lanes (batched) and one scalar run per
+// record (scalar), side by side in one run: the items/s ratio is the lanes' speed-up.
+void objective_evals(benchmark::State& bs, bool lanes) {
+  const Objective& obj = objective(static_cast<int>(bs.range(0)), lanes);
+  std::vector<double> u = obj.start_unit();
+  u[0] = 0.4;
+  for (auto _ : bs) benchmark::DoNotOptimize(obj.rms_pct(u));
+  bs.SetItemsProcessed(bs.iterations());
+  bs.counters["evals_per_s"] =
+      benchmark::Counter(static_cast<double>(bs.iterations()), benchmark::Counter::kIsRate);
+  bs.counters["simd_lanes"] = lanes ? lanes_width() : 1;
+  bs.SetLabel(lanes ? "lanes on " + lanes_target() : "scalar step()");
+}
+void BM_Objective12Conditions_scalar(benchmark::State& bs) { objective_evals(bs, false); }
+void BM_Objective12Conditions_batched(benchmark::State& bs) { objective_evals(bs, true); }
+BENCHMARK(BM_Objective12Conditions_scalar)->Arg(200)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Objective12Conditions_batched)->Arg(200)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 BENCHMARK(BM_Objective12Conditions)
     ->Arg(200)
     ->Arg(500)

@@ -7,6 +7,7 @@
 #include "common.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/io/io.hpp"
+#include "gmasim/simulate/lanes.hpp"
 
 namespace {
 
@@ -14,26 +15,43 @@ using namespace gmasim;
 
 using bench::mdma;
 
-void BM_SweepDefaultGrid(benchmark::State& bs) {
+void sweep_grid(benchmark::State& bs, bool lanes, int threads) {
   const Model& m = mdma();
   SweepRequest r;  // the default grid
-  r.threads = static_cast<int>(bs.range(0));
+  r.threads = threads;
+  r.lanes = lanes;
   std::size_t points = 0;
-  long steps = 0;
   for (auto _ : bs) {
     const SweepResult res = run_sweep(m, r);
     points += res.points.size();
     benchmark::DoNotOptimize(res.points.back().metrics.stroke_um);
   }
   // 10 Hz at the automatic dt (10 us): 3 periods = 30000 steps per point.
-  steps = static_cast<long>(3 * 0.1 / 10e-6);
+  const long steps = static_cast<long>(3 * 0.1 / 10e-6);
   bs.counters["points_per_s"] =
       benchmark::Counter(static_cast<double>(points), benchmark::Counter::kIsRate);
   bs.counters["points"] = static_cast<double>(points) / static_cast<double>(bs.iterations());
   bs.counters["steps_per_point"] = static_cast<double>(steps);
   bs.counters["threads"] = static_cast<double>(r.threads);
+  bs.counters["simd_lanes"] = lanes ? lanes_width() : 1;
+  bs.SetLabel(lanes ? "lanes on " + lanes_target() : "scalar step()");
 }
-BENCHMARK(BM_SweepDefaultGrid)
+
+// The default grid, scalar (one simulate() per point) and batched (SIMD lanes), on 1 and 2
+// threads; the ratio batched/scalar of points_per_s at equal threads is the lanes' speed-up.
+void BM_SweepDefaultGrid_scalar(benchmark::State& bs) {
+  sweep_grid(bs, false, static_cast<int>(bs.range(0)));
+}
+void BM_SweepDefaultGrid_batched(benchmark::State& bs) {
+  sweep_grid(bs, true, static_cast<int>(bs.range(0)));
+}
+BENCHMARK(BM_SweepDefaultGrid_scalar)
+    ->Arg(1)
+    ->Arg(2)
+    ->Iterations(3)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SweepDefaultGrid_batched)
     ->Arg(1)
     ->Arg(2)
     ->Iterations(3)

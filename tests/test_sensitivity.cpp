@@ -198,6 +198,9 @@ TEST(Sensitivity, SmoothQuantitiesAgreeAndThreadCountDoesNotMatter) {
   sw.temperatures_C = {20};
   sw.currents_pp_A = {8};
   sw.frequencies_Hz = {10};
+  // A metric quantity is a scalar simulate() with the energy ledgers (which the SIMD lanes do
+  // not book): the scalar sweep's point, bit for bit.
+  sw.lanes = false;
   EXPECT_EQ(a.quantities[1].value, run_sweep(mdma(), sw).points[0].metrics.stroke_um);
   EXPECT_EQ(a.quantities[1].kind, QuantityKind::Metric);
 }

@@ -2,14 +2,18 @@
 // per point, points in parallel. docs/experiments.md, "Sweep".
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <mutex>
+#include <span>
 
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/model/validate.hpp"
+#include "gmasim/simulate/lanes.hpp"
 
 namespace gmasim {
 namespace {
@@ -117,27 +121,51 @@ SweepResult run_sweep(const Model& m, const SweepRequest& r, const ProgressFn& p
   res.threads = resolve_thread_count(r.threads, jobs.size());
   res.simulations = static_cast<long>(jobs.size());
   std::vector<SweepPoint> slots(jobs.size());
+  std::vector<SimulationSettings> settings(jobs.size());
+  for (std::size_t i = 0; i < jobs.size(); ++i) {
+    const Job& j = jobs[i];
+    SimulationSettings& s = settings[i];
+    s.temperature_C = j.T;
+    s.waveform = biased_sine(j.pp, j.f, r.current_min_A);
+    s.periods = r.periods;
+    s.dt_s = r.dt_s;
+    s.freeze = r.freeze;
+  }
+  auto store = [&](std::size_t i, const Result& run) {
+    SweepPoint& p = slots[i];
+    p.temperature_C = jobs[i].T;
+    p.current_pp_A = jobs[i].pp;
+    p.frequency_Hz = jobs[i].f;
+    p.diverged = run.diverged;
+    p.error = run.error;
+    if (run.has_metrics) p.metrics = run.metrics;
+  };
   const auto wall0 = std::chrono::steady_clock::now();
-  detail::parallel_for(
-      jobs.size(), res.threads,
-      [&](std::size_t i) {
-        const Job& j = jobs[i];
-        SimulationSettings s;
-        s.temperature_C = j.T;
-        s.waveform = biased_sine(j.pp, j.f, r.current_min_A);
-        s.periods = r.periods;
-        s.dt_s = r.dt_s;
-        s.freeze = r.freeze;
-        const Result run = simulate(m, s);
-        SweepPoint& p = slots[i];
-        p.temperature_C = j.T;
-        p.current_pp_A = j.pp;
-        p.frequency_Hz = j.f;
-        p.diverged = run.diverged;
-        p.error = run.error;
-        if (run.has_metrics) p.metrics = run.metrics;
-      },
-      progress);
+  if (r.lanes && lanes_supported(m)) {
+    // One block of points per thread, each advancing in SIMD lanes (a lane's numbers do not
+    // depend on the other lanes, so neither on the blocks nor on the thread count).
+    const std::size_t blocks = static_cast<std::size_t>(res.threads);
+    const std::size_t per = (jobs.size() + blocks - 1) / blocks;
+    std::mutex mu;  // the progress callback, once per point, serialised
+    std::size_t done = 0;
+    detail::parallel_for(
+        blocks, res.threads,
+        [&](std::size_t b) {
+          const std::size_t i0 = std::min(jobs.size(), b * per),
+                            i1 = std::min(jobs.size(), i0 + per);
+          const std::vector<Result> runs = simulate_lanes(
+              m, std::span<const SimulationSettings>(settings.data() + i0, i1 - i0), true);
+          for (std::size_t i = i0; i < i1; ++i) store(i, runs[i - i0]);
+          if (!progress) return;
+          const std::lock_guard<std::mutex> lock(mu);
+          for (std::size_t i = i0; i < i1; ++i) progress(++done, jobs.size());
+        },
+        nullptr);
+  } else {
+    detail::parallel_for(
+        jobs.size(), res.threads, [&](std::size_t i) { store(i, simulate(m, settings[i])); },
+        progress);
+  }
   res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
   add_changes(r, ref_in_grid, grid, slots);

@@ -14,6 +14,7 @@
 #include "gmasim/errors.hpp"
 #include "gmasim/identify/identify.hpp"
 #include "identify/objective_runs.hpp"
+#include "identify/record_lanes.hpp"
 #include "identify/record_run.hpp"
 
 namespace gmasim {
@@ -90,10 +91,27 @@ struct Objective::Impl {
   // The records' residuals. Throws InputError / DivergenceError.
   void record_residuals(const Model& model, StartCache& starts, double* r) const {
     std::vector<double> y, B;
-    for (const auto& cd : conds) {
+    std::vector<std::vector<double>> ys, Bs;
+    const bool lanes = settings.lanes && conds.size() > 1 && all_records_in_lanes(model);
+    if (lanes) {  // every record in its own SIMD lane (identify/record_lanes.hpp)
+      std::vector<const Measurement*> recs;
+      std::vector<bool> flux;
+      for (const auto& cd : conds) {
+        recs.push_back(&data.items[cd.index]);
+        flux.push_back(cd.flux);
+      }
+      identify_detail::run_records_lanes(model, starts, recs, flux, settings, ys, Bs);
+    }
+    for (std::size_t k = 0; k < conds.size(); ++k) {
+      const CondData& cd = conds[k];
       const Measurement& meas = data.items[cd.index];
-      identify_detail::run_record_from_start(model, starts, meas, settings, y,
-                                             cd.flux ? &B : nullptr);
+      if (lanes) {
+        y.swap(ys[k]);
+        B.swap(Bs[k]);
+      } else {
+        identify_detail::run_record_from_start(model, starts, meas, settings, y,
+                                               cd.flux ? &B : nullptr);
+      }
       identify_detail::apply_offset(meas.condition.offset, meas.response, cd.compare_begin, y);
       if (cd.flux)
         identify_detail::apply_offset(meas.condition.flux_offset, meas.flux_T, cd.compare_begin, B);
@@ -103,6 +121,12 @@ struct Objective::Impl {
         if (cd.flux) r[cd.rB_offset + i - cd.compare_begin] = cd.B_scale * (B[i] - meas.flux_T[i]);
       }
     }
+  }
+
+  bool all_records_in_lanes(const Model& model) const {
+    for (const auto& cd : conds)
+      if (!identify_detail::record_in_lanes(model, data.items[cd.index])) return false;
+    return true;
   }
 
   // The simulations of the scalar targets. Throws InputError / DivergenceError.

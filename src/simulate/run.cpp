@@ -10,9 +10,9 @@
 #include "gmasim/model/validity.hpp"
 #include "gmasim/simulate/run_loop.hpp"
 #include "gmasim/simulate/simulate.hpp"
+#include "simulate/record.hpp"
 
 namespace gmasim {
-namespace {
 
 // Column layout of the recorded series: global columns, then per rod.
 constexpr int kGlobal = 6;  // t_s, current_A, y_um, B_T, xT_um, y_stack_um
@@ -51,6 +51,8 @@ void record(const Conditions& c, const State& s, TimeSeries& ts) {
     col[b + 8].push_back(r.B_T);
   }
 }
+
+namespace {
 
 // The run's grid (docs/model.md, "Time step"), after validate(): a uniform grid from t = 0.
 struct RunLength {

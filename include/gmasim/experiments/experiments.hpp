@@ -35,6 +35,9 @@ struct SweepRequest {
   double dt_s = 0.0;  // 0: auto_dt
   int threads = 0;    // 0: all hardware threads
   Freeze freeze;
+  // Grid points advance together in SIMD lanes (gmasim/simulate/lanes.hpp) where the model
+  // allows; false: one scalar simulate() per point (the reference the benchmarks compare with).
+  bool lanes = true;
 };
 
 struct SweepPoint {

@@ -201,6 +201,9 @@ struct ObjectiveSettings {
   // order in the increment: 500 is within 1e-6 of the p-p of a 48 um loop
   // (tests/test_identify_records.cpp).
   double quasi_static_increments = 500.0;
+  // The records advance together in SIMD lanes (gmasim/simulate/lanes.hpp) where the model and
+  // the records allow (timed, current-driven, from rest); false: one scalar run per record.
+  bool lanes = true;
 };
 // The rules of ObjectiveSettings (steps per period in [8, 1e6], dt >= 0, target periods in
 // [1, 1e4], flux weight in [0, 1e6], quasi-static increments in [10, 1e6]): one check for

@@ -1,0 +1,82 @@
+// Batched SIMD lanes (issue 22, docs/lanes.md): one step advances W independent simulations
+// at once -- different temperatures, currents, frequencies or parameter vectors of models
+// with the same structure -- with the instruction set chosen at run time for the CPU
+// (Highway's dynamic dispatch: AVX-512, AVX2, SSE4 or the portable fallback). Each lane
+// does what step() followed by run_loop()'s checks does (model/step.cpp), with its own
+// Newton convergence (masked), and records its own divergence instead of throwing.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "gmasim/model/model.hpp"
+#include "gmasim/simulate/simulate.hpp"
+
+namespace gmasim {
+
+namespace lanes {
+struct LaneData;
+}
+
+// Whether lanes can advance model m: the Jiles-Atherton law, the consistent magnetic state, a
+// circuit on the low-rank path (gmasim/circuit.hpp) with the flux sensor on rod branches, at
+// most 8 rods. `why` receives the reason when not.
+bool lanes_supported(const Model& m, std::string* why = nullptr);
+
+// The SIMD target the dispatcher chose on this CPU ("AVX3", "AVX2", ...) and its width in
+// doubles (the lanes one vector instruction advances).
+std::string lanes_target();
+int lanes_width();
+
+class LaneBatch {
+ public:
+  // One lane per (model, conditions, state); the models share the structure of models[0]
+  // (rods, circuit topology, load chains, sensor mount, options; InputError otherwise).
+  // The states are where each lane starts (make_state, or a state step() advanced); the
+  // pointers need not outlive the constructor. Buffers are sized here, once.
+  LaneBatch(std::span<const Model* const> models, std::span<const Conditions* const> conditions,
+            std::span<const State* const> states);
+  ~LaneBatch();
+  LaneBatch(LaneBatch&&) noexcept;
+  LaneBatch& operator=(LaneBatch&&) noexcept;
+
+  std::size_t size() const;
+  // One step of every live lane: current at the step's end, step length and the grid's time
+  // at its end (run_loop's t_k), size() values each. width_one runs the width-1 instance of
+  // the same kernel (the reference a lane is compared with). Allocation-free.
+  void step(std::span<const double> current_A, std::span<const double> dt_s,
+            std::span<const double> t1_s, bool width_one = false);
+  // Whether the lane stopped, and why: the DivergenceError text step() or run_loop() would
+  // have thrown (time, rod, quantity, value). A stopped lane keeps its last good state.
+  bool diverged(std::size_t lane) const;
+  std::string error(std::size_t lane) const;
+  // The lane's state as step() leaves it, into s (sized by make_state for the lane's model:
+  // no allocation).
+  void unpack(std::size_t lane, State& s) const;
+  // The lane's outputs without unpacking: y and B of the coil (State::y_m, B_T), and one
+  // rod's displacement x.
+  double y_m(std::size_t lane) const;
+  double B_T(std::size_t lane) const;
+  double x_m(std::size_t lane, int rod) const;
+  // Sets the lane's State::t_s (a grid that starts again, as run_loop() does at its t0).
+  void set_time(std::size_t lane, double t_s);
+
+ private:
+  std::unique_ptr<lanes::LaneData> d_;
+  std::vector<std::string> rod_names_;
+  std::vector<double> in_current_, in_dt_, in_t1_;  // padded inputs
+};
+
+// simulate() for many settings of one model: the settings the lanes can run (no
+// self-heating, no energy ledger, a model lanes_supported) advance together in lanes,
+// grouped by their step count; the others run simulate(). Results in the order of the
+// settings; the same validation and errors as simulate(). metrics_only: a lane's series holds
+// only the rows of its metrics window (the last period) and the one before it, enough for the
+// metrics, which are those of the full record (what a sweep keeps).
+std::vector<Result> simulate_lanes(const Model& m, std::span<const SimulationSettings> settings,
+                                   bool metrics_only = false);
+
+}  // namespace gmasim

@@ -1,0 +1,186 @@
+// The objective's records in SIMD lanes (record_lanes.hpp).
+#include "identify/record_lanes.hpp"
+
+#include <algorithm>
+#include <deque>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/model/validity.hpp"
+#include "gmasim/simulate/lanes.hpp"
+#include "gmasim/simulate/run_loop.hpp"
+#include "identify/record_run.hpp"
+
+namespace gmasim::identify_detail {
+
+bool record_in_lanes(const Model& m, const Measurement& meas) {
+  const auto& c = meas.condition;
+  return lanes_supported(m) && meas.drive_kind == DriveInput::Current && !c.quasi_static &&
+         c.initial_state == InitialState::Demagnetised;
+}
+
+namespace {
+
+// One record's run (record_run.cpp, RecordRun::run_timed): its grid, drive and sampling.
+struct LaneRecord {
+  const Measurement* meas = nullptr;
+  const Model* model = nullptr;
+  Conditions c;
+  State st;
+  StepGrid grid;
+  Waveform w;
+  bool sine = false;
+  long passes = 1, total = 0;
+  std::size_t rod = 0, j = 0, table_j = 1;
+  bool strain = false;
+  double length_m = 1, r_prev = 0, B_prev = 0, t_prev = 0;
+  std::vector<double>* response = nullptr;
+  std::vector<double>* B = nullptr;
+
+  double si(const State& x) const { return strain ? x.rods[rod].x_m / length_m : x.y_m; }
+  double si(const LaneBatch& b, std::size_t lane) const {
+    return strain ? b.x_m(lane, static_cast<int>(rod)) / length_m : b.y_m(lane);
+  }
+  // The record's drive at t (record_run.cpp, TableDrive: forward-moving linear interpolation).
+  double current_at(double t) {
+    if (sine) return w.current_at(t);
+    const auto& ts = meas->t_s;
+    const auto& v = meas->drive;
+    if (t <= ts.front()) return v.front();
+    if (t >= ts.back()) return v.back();
+    while (table_j + 1 < ts.size() && ts[table_j] < t) ++table_j;
+    while (table_j > 1 && ts[table_j - 1] > t) --table_j;
+    const double f = (t - ts[table_j - 1]) / (ts[table_j] - ts[table_j - 1]);
+    return v[table_j - 1] + f * (v[table_j] - v[table_j - 1]);
+  }
+  void store(std::size_t i, const State& x) {
+    (*response)[i] = si(x) * 1e6;
+    if (B) (*B)[i] = x.B_T;
+  }
+  // The start of a pass: the samples at or before t0 from the state, the interpolation's start.
+  void begin_pass(bool last) {
+    const auto& ts = meas->t_s;
+    j = 0;
+    table_j = 1;
+    for (; j < ts.size() && ts[j] <= ts.front(); ++j)
+      if (last) store(j, st);
+    r_prev = si(st);
+    B_prev = st.B_T;
+    t_prev = ts.front();
+  }
+  // After a step ending at t: the samples up to t, interpolated linearly.
+  void after_step(const LaneBatch& b, std::size_t lane, double t, bool last) {
+    const auto& ts = meas->t_s;
+    const double r_now = si(b, lane), B_now = b.B_T(lane);
+    while (last && j < ts.size() && ts[j] <= t) {
+      const double f = (ts[j] - t_prev) / (t - t_prev);
+      (*response)[j] = (r_prev + f * (r_now - r_prev)) * 1e6;
+      if (B) (*B)[j] = B_prev + f * (B_now - B_prev);
+      ++j;
+    }
+    r_prev = r_now;
+    B_prev = B_now;
+    t_prev = t;
+  }
+  void end_pass(bool last) {
+    for (; last && j < meas->t_s.size(); ++j) store(j, st);
+  }
+};
+
+void set_up(LaneRecord& lr, const Model& m, StartCache& starts, std::deque<Model>& preloaded,
+            const ObjectiveSettings& s) {
+  const Measurement& meas = *lr.meas;
+  const auto& cond = meas.condition;
+  const double T = cond.temperature_C, I0 = record_initial_current(meas);
+  if (std::isnan(cond.prestress_MPa)) {
+    lr.model = &m;
+    const auto& [c, st] = starts.get(T, I0);
+    lr.c = c;
+    lr.st = st;
+  } else {
+    preloaded.push_back(with_record_preload(m, cond));
+    lr.model = &preloaded.back();
+    lr.c = make_conditions(*lr.model, T);
+    lr.st = make_state(*lr.model, lr.c, I0);
+  }
+  lr.rod = record_rod(*lr.model, meas);
+  lr.strain = meas.response_kind == ResponseOutput::Strain;
+  lr.length_m = lr.c.rods[lr.rod].length_m;
+  lr.sine = cond.current_source == "sine";
+  if (lr.sine) lr.w = biased_sine(cond.current_pp_A, cond.frequency_Hz, cond.current_min_A);
+  const double t0 = meas.t_s.front(), t1 = meas.t_s.back();
+  const double dt_target = objective_step(s, meas.periodic() ? 1.0 / cond.frequency_Hz : 0.0);
+  const std::string what = meas.path + ": steps over the record";
+  lr.grid = StepGrid::spanning(t0, t1, steps_to_resolve((t1 - t0) / dt_target, 1, what), what);
+  lr.passes = 1 + cond.precycles;
+  lr.total = lr.passes * lr.grid.steps;
+  lr.response->resize(meas.t_s.size());
+  if (lr.B) lr.B->resize(meas.t_s.size());
+  lr.st.t_s = t0;
+  lr.begin_pass(lr.passes == 1);
+}
+
+}  // namespace
+
+void run_records_lanes(const Model& m, StartCache& starts,
+                       const std::vector<const Measurement*>& records,
+                       const std::vector<bool>& flux, const ObjectiveSettings& s,
+                       std::vector<std::vector<double>>& response,
+                       std::vector<std::vector<double>>& B_T) {
+  const std::size_t n = records.size();
+  response.resize(n);
+  B_T.resize(n);
+  std::vector<LaneRecord> runs(n);
+  std::deque<Model> preloaded;  // stable addresses
+  std::vector<const Model*> models(n);
+  std::vector<const Conditions*> conds(n);
+  std::vector<const State*> states(n);
+  long longest = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    LaneRecord& lr = runs[k];
+    lr.meas = records[k];
+    lr.response = &response[k];
+    lr.B = flux[k] ? &B_T[k] : nullptr;
+    set_up(lr, m, starts, preloaded, s);
+    models[k] = lr.model;
+    conds[k] = &lr.c;
+    states[k] = &lr.st;
+    longest = std::max(longest, lr.total);
+  }
+  LaneBatch batch(models, conds, states);
+  std::vector<double> current(n), dt(n), t1(n);
+  std::vector<double> t_prev(n);
+  for (std::size_t k = 0; k < n; ++k) t_prev[k] = runs[k].grid.t0_s;
+  for (long q = 1; q <= longest; ++q) {
+    for (std::size_t k = 0; k < n; ++k) {  // StepClock::Spanning within the lane's pass
+      LaneRecord& lr = runs[k];
+      const long steps = lr.grid.steps;
+      const long kk = q > lr.total ? steps : (q - 1) % steps + 1;  // a finished lane idles
+      if (kk == 1 && q <= lr.total) {
+        t_prev[k] = lr.grid.t0_s;
+        batch.set_time(k, lr.grid.t0_s);
+      }
+      const double t =
+          kk == steps ? lr.grid.t1_s : lr.grid.t0_s + static_cast<double>(kk) * lr.grid.dt_s;
+      dt[k] = q > lr.total ? lr.grid.dt_s : t - t_prev[k];
+      t_prev[k] = t;
+      t1[k] = t;
+      current[k] = lr.current_at(t);
+    }
+    batch.step(current, dt, t1);
+    for (std::size_t k = 0; k < n; ++k) {
+      LaneRecord& lr = runs[k];
+      if (q > lr.total) continue;
+      if (batch.diverged(k)) throw DivergenceError(batch.error(k));
+      const long pass = (q - 1) / lr.grid.steps;
+      const bool last = pass + 1 == lr.passes;
+      lr.after_step(batch, k, t1[k], last);
+      if (q % lr.grid.steps == 0) {  // the pass ends: its state for the samples after t1
+        batch.unpack(k, lr.st);
+        lr.end_pass(last);
+        if (!last) lr.begin_pass(pass + 2 == lr.passes);
+      }
+    }
+  }
+}
+
+}  // namespace gmasim::identify_detail

@@ -1,0 +1,28 @@
+// The objective's records in SIMD lanes (gmasim/lanes.hpp, docs/lanes.md): the timed,
+// current-driven records that start at rest advance together, one lane each, with what
+// run_record (record_run.cpp, RecordRun::run_timed) does for one of them -- the same grid
+// (StepClock::Spanning), drive, pre-cycles and interpolated samples.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "gmasim/identify/identify.hpp"
+#include "identify/objective_runs.hpp"
+
+namespace gmasim::identify_detail {
+
+// Whether run_records_lanes can run the record: current-driven (sine or table), timed, from
+// the rest state (initial_state = demagnetised), on a model lanes_supported.
+bool record_in_lanes(const Model& m, const Measurement& meas);
+
+// Runs the records (each record_in_lanes) in lanes: response[k] (and B_T[k] if flux[k]) as
+// run_record_from_start gives them. Throws the DivergenceError of the first record (in the
+// given order) that diverges, as the scalar loop would.
+void run_records_lanes(const Model& m, StartCache& starts,
+                       const std::vector<const Measurement*>& records,
+                       const std::vector<bool>& flux, const ObjectiveSettings& s,
+                       std::vector<std::vector<double>>& response,
+                       std::vector<std::vector<double>>& B_T);
+
+}  // namespace gmasim::identify_detail

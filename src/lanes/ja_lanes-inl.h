@@ -1,0 +1,196 @@
+// The Jiles-Atherton law (eq. 9) over SIMD lanes: the magnetisation-law seam's lane entry
+// (docs/lanes.md, "Laws"). One function per law of gmasim/physics/jiles_atherton.hpp and
+// magnetic.hpp, operation for operation the scalar code, branches replaced by per-lane
+// selects; D is any Highway tag (width 1 is the reference instance). Included once per target
+// by src/lanes/step_lanes.cpp (hwy/foreach_target.h).
+#if defined(GMASIM_LANES_JA_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef GMASIM_LANES_JA_INL_H_
+#undef GMASIM_LANES_JA_INL_H_
+#else
+#define GMASIM_LANES_JA_INL_H_
+#endif
+
+#include "hwy/contrib/math/math-inl.h"
+#include "hwy/highway.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace gmasim::lanes::HWY_NAMESPACE {
+
+namespace hn = hwy::HWY_NAMESPACE;
+
+template <class D>
+using V = hn::Vec<D>;
+template <class D>
+using Mk = hn::Mask<D>;
+
+template <class D>
+HWY_INLINE V<D> C(D d, double x) {
+  return hn::Set(d, x);
+}
+
+// Langevin function and slope (jiles_atherton.hpp, langevin_pair): L = coth x - 1/x,
+// L' = 1/x^2 - 1/sinh^2 x from one exponential, Taylor series for |x| < 0.1.
+template <class D>
+HWY_INLINE void langevin_pair(D d, V<D> x, V<D>& L, V<D>& dL) {
+  const V<D> ax = hn::Abs(x);
+  const V<D> x2 = hn::Mul(x, x);
+  const V<D> Lt = hn::Mul(
+      x,
+      hn::Sub(
+          C(d, 1.0 / 3.0),
+          hn::Mul(
+              x2,
+              hn::Sub(
+                  C(d, 1.0 / 45.0),
+                  hn::Mul(x2, hn::Sub(C(d, 2.0 / 945.0),
+                                      hn::Mul(x2, hn::Sub(C(d, 1.0 / 4725.0),
+                                                          hn::Mul(x2, C(d, 2.0 / 93555.0))))))))));
+  const V<D> dLt = hn::Sub(
+      C(d, 1.0 / 3.0),
+      hn::Mul(
+          x2,
+          hn::Sub(C(d, 1.0 / 15.0),
+                  hn::Mul(x2, hn::Sub(C(d, 2.0 / 189.0),
+                                      hn::Mul(x2, hn::Sub(C(d, 1.0 / 675.0),
+                                                          hn::Mul(x2, C(d, 2.0 / 10395.0)))))))));
+  const V<D> inv_x = hn::Div(C(d, 1.0), x);
+  const Mk<D> pos = hn::Gt(x, hn::Zero(d));
+  const V<D> Lb = hn::Sub(hn::IfThenElse(pos, C(d, 1.0), C(d, -1.0)), inv_x);
+  const V<D> inv_x2 = hn::Mul(inv_x, inv_x);
+  const V<D> e = hn::Exp(d, hn::Mul(C(d, -2.0), ax));
+  const V<D> ome = hn::Sub(C(d, 1.0), e);
+  const V<D> coth_abs = hn::Div(hn::Add(C(d, 1.0), e), ome);
+  const V<D> inv_sinh2 = hn::Div(hn::Mul(C(d, 4.0), e), hn::Mul(ome, ome));
+  const V<D> Lm = hn::Sub(hn::IfThenElse(pos, coth_abs, hn::Neg(coth_abs)), inv_x);
+  const V<D> dLm = hn::Sub(inv_x2, inv_sinh2);
+  const Mk<D> small = hn::Lt(ax, C(d, 0.1)), big = hn::Gt(ax, C(d, 40.0));
+  L = hn::IfThenElse(small, Lt, hn::IfThenElse(big, Lb, Lm));
+  dL = hn::IfThenElse(small, dLt, hn::IfThenElse(big, inv_x2, dLm));
+}
+
+// exp(-r) and q(r) = (1 - exp(-r))/r (magnetic.hpp, lag_weights), Taylor series for r < 1e-2.
+template <class D>
+HWY_INLINE void lag_weights(D d, V<D> r, V<D>& E, V<D>& q) {
+  E = hn::Exp(d, hn::Neg(r));
+  const V<D> qt = hn::Sub(
+      C(d, 1.0),
+      hn::Mul(
+          r,
+          hn::Sub(
+              C(d, 1.0 / 2),
+              hn::Mul(
+                  r, hn::Sub(
+                         C(d, 1.0 / 6),
+                         hn::Mul(r, hn::Sub(C(d, 1.0 / 24),
+                                            hn::Mul(r, hn::Sub(C(d, 1.0 / 120),
+                                                               hn::Mul(r, C(d, 1.0 / 720)))))))))));
+  q = hn::IfThenElse(hn::Lt(r, C(d, 1e-2)), qt, hn::Div(hn::Sub(C(d, 1.0), E), r));
+}
+
+// Eq. (9), second line, integrated over one step (jiles_atherton.hpp,
+// ja_irreversible_update): M_irr relaxes towards M_an along the path length with "time
+// constant" k, pinned while (M_an - M_irr) delta <= 0. Returns M_irr1; dMirr = dM_irr1/dH_e1.
+template <class D>
+HWY_INLINE V<D> ja_irreversible_update(D d, V<D> Mirr0, V<D> Man0, V<D> Man1, V<D> dMan1, V<D> dHe,
+                                       V<D> k, V<D>& dMirr) {
+  const V<D> zero = hn::Zero(d);
+  const V<D> delta = hn::IfThenElse(hn::Gt(dHe, zero), C(d, 1.0), C(d, -1.0));
+  const V<D> d0 = hn::Mul(hn::Sub(Man0, Mirr0), delta);
+  const V<D> d1 = hn::Mul(hn::Sub(Man1, Mirr0), delta);
+  const Mk<D> still = hn::Or(hn::Eq(dHe, zero), hn::And(hn::Le(d0, zero), hn::Le(d1, zero)));
+  const Mk<D> cross = hn::Le(d0, zero);  // M_an crosses M_irr inside the step
+  V<D> s = hn::Abs(dHe);
+  const V<D> frac = hn::Div(d1, hn::Sub(d1, d0));
+  const V<D> d10 = hn::Sub(d1, d0);
+  const V<D> ds_cross =
+      hn::Sub(hn::Mul(delta, frac),
+              hn::Div(hn::Mul(hn::Mul(hn::Mul(s, d0), delta), dMan1), hn::Mul(d10, d10)));
+  const V<D> ds = hn::IfThenElse(cross, ds_cross, delta);
+  s = hn::IfThenElse(cross, hn::Mul(s, frac), s);
+  const V<D> u0 = hn::IfThenElse(cross, Mirr0, Man0);
+  const V<D> r = hn::Div(s, k);
+  V<D> E, q;
+  lag_weights(d, r, E, q);
+  const V<D> dq_dr = hn::IfThenElse(hn::Gt(r, C(d, 1e-12)), hn::Div(hn::Sub(E, q), r), C(d, -0.5));
+  const V<D> a0 = hn::Sub(Mirr0, u0), a1 = hn::Sub(Man1, u0);
+  const V<D> dm =
+      hn::Add(hn::Mul(hn::Sub(C(d, 1.0), q), dMan1),
+              hn::Mul(hn::Div(ds, k), hn::Sub(hn::Mul(hn::Neg(a0), E), hn::Mul(a1, dq_dr))));
+  dMirr = hn::IfThenElse(still, zero, dm);
+  const V<D> m1 = hn::Sub(hn::Add(Man1, hn::Mul(a0, E)), hn::Mul(a1, q));
+  return hn::IfThenElse(still, Mirr0, m1);
+}
+
+// The JA constants of one rod over the lanes (RodConditions::ja, MsT_mag).
+template <class D>
+struct JaLaneConstants {
+  V<D> MsT, a, alpha, c, k;
+};
+
+// One step of eq. (9) from H0 to H1 (jiles_atherton.hpp, ja_step): Newton's method on
+// g(M1) = M1 - (1-c) M_irr1(M1) - c M_an(H1 + alpha M1), per lane and masked: a lane whose
+// |g| <= tol keeps the values of that iterate while the others iterate (at most 60). Mirr and
+// M are read (the state at H0) and receive the values at H1; chi receives dM1/dH1's chi_e.
+template <class D>
+HWY_INLINE void ja_step(D d, V<D> H0, V<D> H1, const JaLaneConstants<D>& p, V<D>& Mirr, V<D>& M,
+                        V<D> M_guess, V<D>& chi_e_out) {
+  const V<D> inv_a = hn::Div(C(d, 1.0), p.a);
+  const Mk<D> same = hn::Eq(H1, H0);
+  const V<D> He0 = hn::Add(H0, hn::Mul(p.alpha, M));
+  V<D> L0, dL0;
+  langevin_pair(d, hn::Mul(He0, inv_a), L0, dL0);
+  // H1 == H0: M_irr pinned, the reversible slope.
+  V<D> chi = hn::Mul(hn::Mul(hn::Mul(p.c, p.MsT), inv_a), dL0);
+  const V<D> Man0 = hn::Mul(p.MsT, L0);
+  const V<D> tol = hn::Mul(C(d, 1e-12), p.MsT);
+  V<D> M1 = M_guess, Mirr_out = Mirr, M_out = M;
+  Mk<D> done = same;
+  for (int it = 0; it < 60 && !hn::AllTrue(d, done); ++it) {
+    const V<D> He1 = hn::Add(H1, hn::Mul(p.alpha, M1));
+    V<D> L1, dL1;
+    langevin_pair(d, hn::Mul(He1, inv_a), L1, dL1);
+    const V<D> Man1 = hn::Mul(p.MsT, L1);
+    const V<D> dMan = hn::Mul(hn::Mul(p.MsT, inv_a), dL1);
+    V<D> dMirr;
+    const V<D> Mirr1 =
+        ja_irreversible_update(d, Mirr, Man0, Man1, dMan, hn::Sub(He1, He0), p.k, dMirr);
+    const V<D> Mnew = hn::Add(hn::Mul(hn::Sub(C(d, 1.0), p.c), Mirr1), hn::Mul(p.c, Man1));
+    const V<D> g = hn::Sub(M1, Mnew);
+    const V<D> chi_e = hn::Add(hn::Mul(hn::Sub(C(d, 1.0), p.c), dMirr), hn::Mul(p.c, dMan));
+    const Mk<D> fin = hn::AndNot(
+        done,
+        hn::Or(hn::Le(hn::Abs(g), tol), it == 59 ? hn::FirstN(d, hn::Lanes(d)) : hn::FirstN(d, 0)));
+    Mirr_out = hn::IfThenElse(fin, Mirr1, Mirr_out);
+    M_out = hn::IfThenElse(fin, Mnew, M_out);
+    chi = hn::IfThenElse(fin, chi_e, chi);
+    done = hn::Or(done, fin);
+    V<D> dg = hn::Sub(C(d, 1.0), hn::Mul(p.alpha, chi_e));
+    dg = hn::IfThenElse(hn::Lt(dg, C(d, 0.2)), C(d, 0.2), dg);  // alpha > 0: damped step
+    M1 = hn::IfThenElse(done, M1, hn::Sub(M1, hn::Div(g, dg)));
+  }
+  Mirr = Mirr_out;
+  M = M_out;
+  chi_e_out = hn::Div(chi, hn::Sub(C(d, 1.0), hn::Mul(p.alpha, chi)));  // dM1/dH1
+}
+
+// The law's lane entry (gmasim/magnetisation/jiles_atherton.hpp, JilesAthertonLaw): trial
+// and commit of a move H0 -> H1 over the lanes; its state per rod is M_irr (kMirr).
+struct JilesAthertonLanes {
+  template <class D>
+  static V<D> trial(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> Mirr0, V<D> M0, V<D> H1,
+                    V<D> M_guess, V<D>& dM_dH) {
+    V<D> Mirr = Mirr0, M = M0;
+    ja_step(d, H0, H1, p, Mirr, M, M_guess, dM_dH);
+    return M;
+  }
+  template <class D>
+  static void commit(D d, const JaLaneConstants<D>& p, V<D> H0, V<D>& Mirr, V<D>& M, V<D> H1,
+                     V<D> M_guess, V<D>& dM_dH) {
+    ja_step(d, H0, H1, p, Mirr, M, M_guess, dM_dH);
+  }
+};
+
+}  // namespace gmasim::lanes::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#endif  // GMASIM_LANES_JA_INL_H_

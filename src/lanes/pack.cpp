@@ -1,0 +1,322 @@
+// LaneBatch (gmasim/lanes.hpp): packing models, conditions and states into the lanes'
+// structure of arrays (lanes/lane_data.hpp), unpacking, and each lane's diagnosis.
+#include <fmt/format.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/model/validity.hpp"
+#include "gmasim/simulate/lanes.hpp"
+#include "lanes/lane_data.hpp"
+
+namespace gmasim {
+
+using lanes::LaneData;
+
+bool lanes_supported(const Model& m, std::string* why) {
+  auto no = [&](const char* reason) {
+    if (why) *why = reason;
+    return false;
+  };
+  if (m.options.magnetisation_law != MagnetisationLaw::JilesAtherton)
+    return no("the lanes have the Jiles-Atherton law only (no Preisach lanes yet)");
+  if (m.options.magnetic_state != MagneticState::Consistent)
+    return no("the lanes run the consistent magnetic state only");
+  if (!m.circuit.lowrank.enabled) return no("the circuit is not on the low-rank path");
+  if (m.rods.empty() || m.rods.size() > static_cast<std::size_t>(lanes::kMaxRods))
+    return no("the lanes take 1 to 8 rods");
+  for (int b : m.flux_sensor_branches)
+    if (m.circuit.branches[static_cast<std::size_t>(b)].rod < 0)
+      return no("the flux sensor reads a branch that is not a rod's");
+  return true;
+}
+
+std::string lanes_target() { return lanes::dispatch_target_name(); }
+int lanes_width() { return lanes::dispatch_lanes(); }
+
+namespace {
+
+// The low-rank pieces of the circuit (circuit/netlist.cpp, set_lowrank_pieces): with G0 the
+// fixed branches' Laplacian and B the rod branches' incidence, S = B^T G0^-1 B and
+// B^T G0^-1 b for the coil (per ampere) and the magnets (per unit scale).
+struct LowRank {
+  Eigen::MatrixXd S;
+  Eigen::VectorXd bt_coil, bt_pm;
+};
+LowRank lowrank_pieces(const Circuit& c) {
+  const auto n = static_cast<Eigen::Index>(c.node_count());
+  const auto k = static_cast<Eigen::Index>(c.rod_branch.size());
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n), B = Eigen::MatrixXd::Zero(n, k);
+  Eigen::VectorXd b_coil = Eigen::VectorXd::Zero(n), b_pm = Eigen::VectorXd::Zero(n);
+  for (Eigen::Index r = 0; r < k; ++r) {
+    const auto& br =
+        c.branches[static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)])];
+    if (br.from >= 0) B(br.from, r) += 1.0;
+    if (br.to >= 0) B(br.to, r) -= 1.0;
+  }
+  for (const auto& br : c.branches) {
+    if (br.rod >= 0) continue;
+    const double g = 1.0 / br.fixed_reluctance_per_H;
+    if (br.from >= 0) {
+      G(br.from, br.from) += g;
+      b_coil(br.from) -= br.coil_turns * g;
+      b_pm(br.from) -= br.pm_mmf_At * g;
+    }
+    if (br.to >= 0) {
+      G(br.to, br.to) += g;
+      b_coil(br.to) += br.coil_turns * g;
+      b_pm(br.to) += br.pm_mmf_At * g;
+    }
+    if (br.from >= 0 && br.to >= 0) {
+      G(br.from, br.to) -= g;
+      G(br.to, br.from) -= g;
+    }
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(G);
+  LowRank L;
+  L.S = B.transpose() * llt.solve(B);
+  L.bt_coil = B.transpose() * llt.solve(b_coil);
+  L.bt_pm = B.transpose() * llt.solve(b_pm);
+  return L;
+}
+
+lanes::Structure structure_of(const Model& m, const Conditions& c) {
+  lanes::Structure st;
+  st.rods = m.rod_count();
+  st.mount = m.sensor_mount.enabled;
+  st.xT_in_output = m.options.thermal_expansion_in_output;
+  for (int b : m.flux_sensor_branches)
+    st.sensor_rods[static_cast<std::size_t>(st.sensor_count++)] =
+        m.circuit.branches[static_cast<std::size_t>(b)].rod;
+  for (std::size_t i = 0; i < c.rods.size(); ++i) {
+    st.chain_count[i] = c.rods[i].chain_rod_count;
+    for (int k = 0; k < c.rods[i].chain_rod_count; ++k)
+      st.chain[i][static_cast<std::size_t>(k)] = c.rods[i].chain_rods[static_cast<std::size_t>(k)];
+  }
+  return st;
+}
+
+bool same_structure(const lanes::Structure& a, const lanes::Structure& b) {
+  return a.rods == b.rods && a.mount == b.mount && a.xT_in_output == b.xT_in_output &&
+         a.sensor_count == b.sensor_count && a.sensor_rods == b.sensor_rods && a.chain == b.chain &&
+         a.chain_count == b.chain_count;
+}
+
+// Lane j's numbers from its model, conditions and state.
+void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, const State& s,
+               const LowRank& lr) {
+  using namespace lanes;
+  auto rod = [&](int f, int i) -> double& { return L.rod(f, i)[j]; };
+  auto glob = [&](int f) -> double& { return L.glob(f)[j]; };
+  const int n = m.rod_count();
+  double sensor_area = 0.0;
+  for (int b : m.flux_sensor_branches)
+    sensor_area +=
+        c.rods[static_cast<std::size_t>(m.circuit.branches[static_cast<std::size_t>(b)].rod)]
+            .area_m2;
+  for (int i = 0; i < n; ++i) {
+    const RodState& r = s.rods[static_cast<std::size_t>(i)];
+    const RodConditions& rc = c.rods[static_cast<std::size_t>(i)];
+    const double state[kRodStateCount] = {
+        r.H_A_per_m,      r.Mirr_A_per_m,  r.M_A_per_m, r.Hc_A_per_m, r.H_prev_A_per_m,
+        r.M_prev_A_per_m, r.x_m,           r.v_m_per_s, r.F_N,        r.mu_r,
+        r.E_Pa,           r.lambda,        r.tau_s,     r.phi_Wb,     r.k_rod_N_per_m,
+        r.k_load_N_per_m, r.K_osc_N_per_m, r.B_T};
+    for (int f = 0; f < kRodStateCount; ++f) rod(f, i) = state[f];
+    const auto& br =
+        m.circuit
+            .branches[static_cast<std::size_t>(m.circuit.rod_branch[static_cast<std::size_t>(i)])];
+    const double q = rc.MsT_mag / rc.Ms_strain_A_per_m;
+    const double constants[kRodFieldCount - kRodStateCount] = {
+        rc.length_m,
+        rc.area_m2,
+        rc.MsT_mag,
+        rc.MsT_E,
+        rc.Ms_strain_A_per_m,
+        rc.dE.inverse_Es_per_Pa,
+        rc.dE.rotation_compliance_per_Pa,
+        rc.dE.coupling,
+        rc.dE.mu0_Ms2_over_chi_m_J_per_m3,
+        rc.dE.S_J_per_m3,
+        rc.ja.a_A_per_m,
+        rc.ja.alpha,
+        rc.ja.c,
+        rc.ja.k_A_per_m,
+        rc.eddy_geometry_s_m_per_H,
+        rc.series_reluctance_per_H,
+        rc.mass_osc_kg,
+        rc.momentum_mass_kg,
+        rc.damping_osc_N_s_per_m,
+        rc.fixed_compliance_m_per_N,
+        rc.sigma_p_Pa,
+        br.coil_turns,
+        br.pm_mmf_At,
+        kStrainGuardFactor * m.material.lambda_s * q * q,
+        std::max(m.material.Ms_A_per_m, rc.MsT_mag)};
+    for (int f = kRodStateCount; f < kRodFieldCount; ++f) rod(f, i) = constants[f - kRodStateCount];
+    for (int b = 0; b < n; ++b) L.S(i, b)[j] = lr.S(i, b);
+    L.bt_coil(i)[j] = lr.bt_coil(i);
+    L.bt_pm(i)[j] = lr.bt_pm(i);
+  }
+  const double globals[] = {s.t_s,
+                            s.current_A,
+                            s.y_m,
+                            s.y_stack_m,
+                            s.q_m,
+                            s.z_m,
+                            s.z_v_m_per_s,
+                            s.B_T,
+                            c.pm_scale,
+                            c.thermal_expansion_m,
+                            m.sensor_mount.mass_kg,
+                            m.sensor_mount.stiffness_N_per_m,
+                            m.sensor_mount.damping_N_s_per_m,
+                            m.sensor_mount.actuator_mass_kg,
+                            m.material.lambda_s,
+                            sensor_area};
+  for (int f = 0; f <= kSensorArea; ++f) glob(f) = globals[f];
+  for (int f = kFail; f < kGlobalFieldCount; ++f) glob(f) = 0.0;
+}
+
+}  // namespace
+
+LaneBatch::LaneBatch(std::span<const Model* const> models,
+                     std::span<const Conditions* const> conditions,
+                     std::span<const State* const> states)
+    : d_(std::make_unique<LaneData>()) {
+  const std::size_t n = models.size();
+  if (n == 0 || conditions.size() != n || states.size() != n)
+    throw InputError(fmt::format("lanes: {} models, {} conditions, {} states: need as many of each",
+                                 n, conditions.size(), states.size()));
+  std::string why;
+  for (const Model* m : models)
+    if (!lanes_supported(*m, &why)) throw InputError("lanes: " + why);
+  d_->resize(n);
+  d_->st = structure_of(*models[0], *conditions[0]);
+  std::map<const Model*, LowRank> lowrank;
+  for (std::size_t j = 0; j < d_->npad; ++j) {
+    const std::size_t src = j < n ? j : 0;  // padding repeats lane 0
+    const Model& m = *models[src];
+    if (j < n && !same_structure(d_->st, structure_of(m, *conditions[src])))
+      throw InputError(
+          fmt::format("lanes: simulation {} has another structure than simulation 0 "
+                      "(rods, load chains, sensor, mount)",
+                      j));
+    auto it = lowrank.find(&m);
+    if (it == lowrank.end()) it = lowrank.emplace(&m, lowrank_pieces(m.circuit)).first;
+    pack_lane(*d_, j, m, *conditions[src], *states[src], it->second);
+  }
+  for (const auto& r : models[0]->rods) rod_names_.push_back(r.name);
+  in_current_.assign(d_->npad, 0.0);
+  in_dt_.assign(d_->npad, 1.0);
+  in_t1_.assign(d_->npad, 0.0);
+}
+
+LaneBatch::~LaneBatch() = default;
+LaneBatch::LaneBatch(LaneBatch&&) noexcept = default;
+LaneBatch& LaneBatch::operator=(LaneBatch&&) noexcept = default;
+
+std::size_t LaneBatch::size() const { return d_->n; }
+
+void LaneBatch::step(std::span<const double> current_A, std::span<const double> dt_s,
+                     std::span<const double> t1_s, bool width_one) {
+  const std::size_t n = d_->n;
+  if (current_A.size() != n || dt_s.size() != n || t1_s.size() != n)
+    throw InputError(fmt::format("lanes: step with {} currents, {} steps, {} times for {} lanes",
+                                 current_A.size(), dt_s.size(), t1_s.size(), n));
+  std::copy(current_A.begin(), current_A.end(), in_current_.begin());
+  std::copy(dt_s.begin(), dt_s.end(), in_dt_.begin());
+  std::copy(t1_s.begin(), t1_s.end(), in_t1_.begin());
+  for (std::size_t j = n; j < d_->npad; ++j) {  // padding: lane 0's inputs
+    in_current_[j] = current_A[0];
+    in_dt_[j] = dt_s[0];
+    in_t1_[j] = t1_s[0];
+  }
+  lanes::step_dispatch(*d_, {in_current_.data(), in_dt_.data(), in_t1_.data()}, width_one);
+}
+
+bool LaneBatch::diverged(std::size_t lane) const { return d_->glob(lanes::kFail)[lane] != 0.0; }
+
+void LaneBatch::unpack(std::size_t j, State& s) const {
+  using namespace lanes;
+  LaneData& L = *d_;
+  for (int i = 0; i < L.st.rods; ++i) {
+    RodState& r = s.rods[static_cast<std::size_t>(i)];
+    double* const fields[kRodStateCount] = {
+        &r.H_A_per_m,      &r.Mirr_A_per_m,  &r.M_A_per_m, &r.Hc_A_per_m, &r.H_prev_A_per_m,
+        &r.M_prev_A_per_m, &r.x_m,           &r.v_m_per_s, &r.F_N,        &r.mu_r,
+        &r.E_Pa,           &r.lambda,        &r.tau_s,     &r.phi_Wb,     &r.k_rod_N_per_m,
+        &r.k_load_N_per_m, &r.K_osc_N_per_m, &r.B_T};
+    for (int f = 0; f < kRodStateCount; ++f) *fields[f] = L.rod(f, i)[j];
+  }
+  double* const globals[kGlobalStateCount] = {&s.t_s, &s.current_A, &s.y_m,         &s.y_stack_m,
+                                              &s.q_m, &s.z_m,       &s.z_v_m_per_s, &s.B_T};
+  for (int f = 0; f < kGlobalStateCount; ++f) *globals[f] = L.glob(f)[j];
+}
+
+double LaneBatch::y_m(std::size_t lane) const { return d_->glob(lanes::kY)[lane]; }
+double LaneBatch::B_T(std::size_t lane) const { return d_->glob(lanes::kBSensor)[lane]; }
+double LaneBatch::x_m(std::size_t lane, int rod) const { return d_->rod(lanes::kX, rod)[lane]; }
+
+void LaneBatch::set_time(std::size_t lane, double t_s) { d_->glob(lanes::kT)[lane] = t_s; }
+
+std::string LaneBatch::error(std::size_t j) const {
+  using namespace lanes;
+  LaneData& L = *d_;
+  const auto code = static_cast<int>(L.glob(kFail)[j]);
+  if (code == kOk) return "";
+  const double t = L.glob(kFailT)[j], v = L.glob(kFailValue)[j], bound = L.glob(kFailBound)[j];
+  const int rod_index = static_cast<int>(L.glob(kFailRod)[j]);
+  const std::string rod =
+      rod_index >= 0 ? rod_names_[static_cast<std::size_t>(rod_index)] : std::string();
+  // step()'s check(): |value| <= limit
+  auto check = [&](const std::string& where, const char* quantity) {
+    return DivergenceError(t, where, quantity, v,
+                           std::isfinite(v) ? fmt::format("|value| exceeds {:g}", bound)
+                                            : std::string("not finite"))
+        .what();
+  };
+  // check_physical_validity's beyond()
+  auto beyond = [&](const char* quantity, const char* rule) {
+    return DivergenceError(t, rod, quantity, v,
+                           fmt::format("beyond the physical bound {:.4g}: {}; the model is "
+                                       "outside its range (check the values `gmasim model "
+                                       "check` warns about)",
+                                       bound, rule))
+        .what();
+  };
+  switch (code) {
+    case kFailNewton:
+      return DivergenceError(t, rod, "field H [A/m] of the consistent magnetic state", v,
+                             "Newton's method did not converge")
+          .what();
+    case kFailCircuit:
+      return DivergenceError(t, "", "nodal matrix of the circuit", 0.0, "not positive definite")
+          .what();
+    case kFailH:
+      return check(rod, "H [A/m]");
+    case kFailM:
+      return check(rod, "M [A/m]");
+    case kFailX:
+      return check(rod, "x [m]");
+    case kFailZ:
+      return check("sensor mount", "z [m]");
+    case kFailY:
+      return DivergenceError(t, "", "output y [m]", v, "not finite").what();
+    case kFailBSensor:
+      return DivergenceError(t, "", "flux density B [T] of the induction coil", v, "not finite")
+          .what();
+    case kFailStrain:
+      return beyond("magnetostriction lambda [-]",
+                    "eq. (11) gives at most 1.5 lambda_s (M/M_s)^2 with |M| <= 1.5 M_s^T");
+    case kFailDisplacement:
+      return beyond("displacement x [m]", "a rod cannot move by more than its length l^T");
+    default:
+      return beyond("flux density B [T]", "B = mu0 (H + M) with |M| <= M_s");
+  }
+}
+
+}  // namespace gmasim

@@ -1,0 +1,163 @@
+// simulate_lanes (gmasim/lanes.hpp): simulate() for many settings at once, the runs that
+// share a step count advancing together in a LaneBatch. Each lane's run is simulate()'s: the
+// same grid, rest state, records, checks, metrics and error texts (src/simulate/run.cpp).
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/model/validity.hpp"
+#include "gmasim/simulate/lanes.hpp"
+#include "gmasim/simulate/run_loop.hpp"
+#include "simulate/record.hpp"
+
+namespace gmasim {
+namespace {
+
+struct Plan {
+  double dt_s = 0, duration_s = 0;
+  long steps = 0;
+};
+
+// simulate()'s grid of a periodic run (run.cpp, run_length): whole steps per period.
+Plan periodic_plan(const SimulationSettings& s) {
+  const auto& w = s.waveform;
+  Plan p;
+  const double dt0 = s.dt_s > 0.0 ? s.dt_s : auto_dt(w);
+  const double per = w.period_s();
+  const long n = steps_to_resolve(per / dt0, 0, "steps per period");
+  p.dt_s = per / static_cast<double>(n);
+  p.duration_s = s.periods * per;
+  const StepGrid g =
+      StepGrid::covering(0.0, p.duration_s, p.dt_s, "simulation (--dt, --duration or --periods)");
+  p.dt_s = g.dt_s;
+  p.steps = g.steps;
+  return p;
+}
+
+// One lane's run: its conditions, its state (kept for unpacking) and its result.
+struct LaneRun {
+  std::size_t setting = 0;
+  Conditions c;
+  State st;
+  bool live = false;
+  long first_recorded = 0;  // metrics_only: the step before the last period's window
+};
+
+void finish(const SimulationSettings& s, const Plan& p, Result& r) {
+  if (r.series.rows() > 0) r.thermal_expansion_um = r.series.column("xT_um").back();
+  if (!r.diverged) {
+    r.metrics = compute_metrics(r.series, p.duration_s - s.waveform.period_s(), p.duration_s);
+    r.has_metrics = true;
+  }
+}
+
+// The rest states (make_state), then the steps of the group in lanes.
+void run_group(const Model& m, std::span<const SimulationSettings> settings,
+               const std::vector<std::size_t>& idx, const Plan& p, bool metrics_only,
+               std::vector<Result>& out) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  std::vector<LaneRun> runs(idx.size());
+  std::vector<const Model*> models;
+  std::vector<const Conditions*> conds;
+  std::vector<const State*> states;
+  std::vector<std::size_t> lane_of;  // lane -> run
+  for (std::size_t q = 0; q < idx.size(); ++q) {
+    LaneRun& lr = runs[q];
+    const SimulationSettings& s = settings[idx[q]];
+    Result& r = out[idx[q]];
+    lr.setting = idx[q];
+    lr.c = make_conditions(m, s.temperature_C, s.freeze);
+    r.dt_s = p.dt_s;
+    r.thermal_expansion_start_um = r.thermal_expansion_um = lr.c.thermal_expansion_m * 1e6;
+    make_columns(m, r.series, static_cast<std::size_t>(p.steps / s.record_every + 2));
+    try {
+      lr.st = make_state(m, lr.c, s.waveform.current_at(0.0));
+      lr.st.energy.enabled = false;
+      check_physical_validity(m, lr.c, lr.st, 0.0);
+      if (metrics_only)
+        lr.first_recorded = p.steps - std::lround(s.waveform.period_s() / p.dt_s) - 1;
+      if (lr.first_recorded <= 0) record(lr.c, lr.st, r.series);
+      lr.live = true;
+      models.push_back(&m);
+      conds.push_back(&lr.c);
+      states.push_back(&lr.st);
+      lane_of.push_back(q);
+    } catch (const DivergenceError& e) {
+      r.diverged = true;
+      r.error = e.what();
+    }
+  }
+  if (!lane_of.empty()) {
+    LaneBatch batch(models, conds, states);
+    const std::size_t n = lane_of.size();
+    std::vector<double> current(n), dt(n, p.dt_s), t1(n);
+    std::size_t live = n;
+
+    for (long k = 1; k <= p.steps && live > 0; ++k) {
+      const double t = 0.0 + static_cast<double>(k) * p.dt_s;  // the Uniform clock
+      for (std::size_t l = 0; l < n; ++l) {
+        current[l] = settings[runs[lane_of[l]].setting].waveform.current_at(t);
+        t1[l] = t;
+      }
+      batch.step(current, dt, t1);
+      for (std::size_t l = 0; l < n; ++l) {
+        LaneRun& lr = runs[lane_of[l]];
+        if (!lr.live) continue;
+        Result& r = out[lr.setting];
+        if (batch.diverged(l)) {
+          r.diverged = true;
+          r.error = batch.error(l);
+          lr.live = false;
+          --live;
+          continue;
+        }
+        r.steps = k;
+        if (k >= lr.first_recorded &&
+            (k % settings[lr.setting].record_every == 0 || k == p.steps)) {
+          batch.unpack(l, lr.st);
+          record(lr.c, lr.st, r.series);
+        }
+      }
+    }
+  }
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  for (const LaneRun& lr : runs) {
+    Result& r = out[lr.setting];
+    r.wall_time_s = wall / static_cast<double>(runs.size());
+    finish(settings[lr.setting], p, r);
+  }
+}
+
+}  // namespace
+
+std::vector<Result> simulate_lanes(const Model& m, std::span<const SimulationSettings> settings,
+                                   bool metrics_only) {
+  std::vector<Result> out(settings.size());
+  const bool model_ok = lanes_supported(m);
+  std::map<long, std::vector<std::size_t>> groups;  // step count -> settings
+  std::map<long, Plan> plans;
+  for (std::size_t i = 0; i < settings.size(); ++i) {
+    const SimulationSettings& s = settings[i];
+    validate(s);
+    if (!model_ok || s.self_heating.enabled || s.energy_ledger || !s.waveform.periodic() ||
+        s.progress) {
+      out[i] = simulate(m, s);
+      continue;
+    }
+    const Plan p = periodic_plan(s);
+    // A group shares the step count and the step (the lanes' time grid).
+    const long key = p.steps;
+    if (plans.count(key) && plans[key].dt_s != p.dt_s) {
+      out[i] = simulate(m, s);
+      continue;
+    }
+    plans[key] = p;
+    groups[key].push_back(i);
+  }
+  for (const auto& [key, idx] : groups) run_group(m, settings, idx, plans[key], metrics_only, out);
+  return out;
+}
+
+}  // namespace gmasim

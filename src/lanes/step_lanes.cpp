@@ -1,0 +1,185 @@
+// The batched step's stages after the magnetic state, its chunk loop and its run-time
+// dispatch (docs/lanes.md). Compiled once per SIMD target by hwy/foreach_target.h; the CPU's
+// best target is chosen at run time (HWY_DYNAMIC_DISPATCH). Built with -ffp-contract=off
+// (CMakeLists.txt): each lane equals the width-1 instance bit for bit.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "lanes/step_lanes.cpp"
+#include "hwy/foreach_target.h"  // IWYU pragma: keep
+#include "hwy/highway.h"
+#include "lanes/step_kernel-inl.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace gmasim::lanes::HWY_NAMESPACE {
+
+// Stage 3 (model/step.cpp, step_law): each rod's Delta-E modulus, strain, force and stiffness
+// (eq. 11-14, 17), its load stiffness (eq. 18) and its oscillator over the step (eq. 15-16,
+// stiffness at mid-step); then the sensor mount's probe (model.hpp, SensorMountModel).
+template <class D>
+HWY_INLINE void mechanics(const Chunk<D>& c, RodStates<D>& s, V<D> h, V<D> t1, Fails<D>& fails) {
+  const D d = c.d;
+  const int n = c.n;
+  const Structure& st = c.L.st;
+  V<D> F0[kMaxRods], K0[kMaxRods];
+  const V<D> lambda_s = c.glob(kLambdaS);
+  for (int i = 0; i < n; ++i) {
+    F0[i] = s.f[kF][i];
+    K0[i] = hn::Add(s.f[kKRod][i], s.f[kKLoad][i]);
+    const V<D> M = s.f[kM][i], A = c.rod(kArea, i);
+    const V<D> E = delta_e_modulus(d, hn::Div(M, c.rod(kMsTE, i)), c.rod(kInvEs, i), c.rod(kRot, i),
+                                   c.rod(kCoupling, i), c.rod(kMu0Ms2, i), c.rod(kSdE, i));
+    s.f[kE][i] = E;
+    s.f[kLambda][i] =
+        magnetostriction(d, hn::Div(M, c.rod(kMsStrain, i)), lambda_s, c.rod(kSigmaP, i), E);
+    s.f[kF][i] = hn::Mul(hn::Mul(s.f[kLambda][i], E), A);
+    s.f[kKRod][i] = hn::Div(hn::Mul(E, A), c.rod(kLength, i));
+  }
+  for (int i = 0; i < n; ++i) {
+    V<D> inv_k = c.rod(kFixedCompl, i);
+    for (int k = 0; k < st.chain_count[static_cast<std::size_t>(i)]; ++k)
+      inv_k = hn::Add(
+          inv_k,
+          hn::Div(C(d, 1.0),
+                  s.f[kKRod][st.chain[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)]]));
+    s.f[kKLoad][i] = hn::Div(C(d, 1.0), inv_k);
+    const V<D> K = hn::Mul(C(d, 0.5), hn::Add(hn::Add(K0[i], s.f[kKRod][i]), s.f[kKLoad][i]));
+    s.f[kKOsc][i] = K;
+    oscillator_step(d, c.rod(kMassOsc, i), c.rod(kDampOsc, i), K, F0[i], s.f[kF][i], h, s.f[kX][i],
+                    s.f[kV][i]);
+    fails.check(d, s.f[kX][i], C(d, 1.0), kFailX, i, t1);
+  }
+}
+
+// The probe on its bracket (model/step.cpp, advance_sensor_mount) and the outputs
+// (finish_outputs): y = sum x (eq. 20) + the probe's deflection (+ x_T), B of the coil.
+template <class D>
+HWY_INLINE void mount_and_outputs(const Chunk<D>& c, RodStates<D>& s, V<D>* g, V<D> h, V<D> t1,
+                                  Fails<D>& fails) {
+  const D d = c.d;
+  const Structure& st = c.L.st;
+  if (st.mount) {
+    V<D> p = hn::Zero(d);
+    for (int i = 0; i < c.n; ++i) p = hn::Add(p, hn::Mul(c.rod(kMomMass, i), s.f[kX][i]));
+    const V<D> q1 = hn::Div(p, c.glob(kActMass));
+    const V<D> q0 = g[kQ];
+    const V<D> qdot = hn::Div(hn::Sub(q1, q0), h);
+    const V<D> cm = c.glob(kMountC), km = c.glob(kMountK);
+    oscillator_step(d, c.glob(kMountMass), cm, km, hn::Add(hn::Mul(cm, qdot), hn::Mul(km, q0)),
+                    hn::Add(hn::Mul(cm, qdot), hn::Mul(km, q1)), h, g[kZ], g[kZv]);
+    g[kQ] = q1;
+    fails.check(d, g[kZ], C(d, 1.0), kFailZ, -1, t1);
+  }
+  V<D> y = hn::Zero(d);
+  for (int i = 0; i < c.n; ++i) y = hn::Add(y, s.f[kX][i]);
+  g[kYStack] = y;
+  if (st.mount) y = hn::Add(y, hn::Sub(g[kZ], g[kQ]));
+  if (st.xT_in_output) y = hn::Add(y, c.glob(kXT));
+  g[kY] = y;
+  V<D> phi = hn::Zero(d);
+  for (int k = 0; k < st.sensor_count; ++k)
+    phi = hn::Add(phi, s.f[kPhi][st.sensor_rods[static_cast<std::size_t>(k)]]);
+  g[kBSensor] = hn::Div(phi, c.glob(kSensorArea));
+  for (int i = 0; i < c.n; ++i) s.f[kB][i] = hn::Div(s.f[kPhi][i], c.rod(kArea, i));
+}
+
+// run_loop's checks after the step (gmasim/run_loop.hpp, advance): y and B finite, every
+// rod's strain, displacement and flux density possible (check_physical_validity).
+template <class D>
+HWY_INLINE void run_loop_checks(const Chunk<D>& c, const RodStates<D>& s, const V<D>* g, V<D> t,
+                                Fails<D>& fails) {
+  const D d = c.d;
+  const V<D> zero = hn::Zero(d);
+  fails.mark(d, hn::Not(hn::IsFinite(g[kY])), kFailY, g[kY], -1, t, zero);
+  fails.mark(d, hn::Not(hn::IsFinite(g[kBSensor])), kFailBSensor, g[kBSensor], -1, t, zero);
+  for (int i = 0; i < c.n; ++i) {
+    const V<D> strain_bound = c.rod(kStrainBound, i), length = c.rod(kLength, i);
+    fails.mark(d, hn::Not(hn::Le(hn::Abs(s.f[kLambda][i]), strain_bound)), kFailStrain,
+               s.f[kLambda][i], i, t, strain_bound);
+    fails.mark(d, hn::Not(hn::Lt(hn::Abs(s.f[kX][i]), length)), kFailDisplacement, s.f[kX][i], i, t,
+               length);
+    const V<D> bound =
+        hn::Mul(C(d, physics::kMu0),
+                hn::Add(hn::Mul(C(d, kFluxGuardMsFactor), c.rod(kFluxMs, i)), hn::Abs(s.f[kH][i])));
+    fails.mark(d, hn::Not(hn::Le(hn::Abs(s.f[kB][i]), bound)), kFailFlux, s.f[kB][i], i, t, bound);
+  }
+}
+
+// One step of lanes [j, j + Lanes(d)): load, the stages, store where the lane is still alive
+// (a lane that fails keeps its state before the step, as simulate() records it).
+template <class D>
+HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in) {
+  const Chunk<D> c{d, L, j, L.st.rods};
+  RodStates<D> s;
+  for (int f = 0; f < kRodStateCount; ++f)
+    for (int i = 0; i < c.n; ++i) s.f[f][i] = c.rod(f, i);
+  V<D> g[kGlobalStateCount];
+  for (int f = 0; f < kGlobalStateCount; ++f) g[f] = c.glob(f);
+  Fails<D> fails{hn::Ne(c.glob(kFail), hn::Zero(d)),
+                 c.glob(kFail),
+                 c.glob(kFailValue),
+                 c.glob(kFailRod),
+                 c.glob(kFailT),
+                 c.glob(kFailBound)};
+  const Mk<D> alive = hn::Not(fails.failed);
+  const V<D> I = hn::LoadU(d, in.current_A + j), h = hn::LoadU(d, in.dt_s + j);
+  const V<D> t1 = hn::Add(g[kT], h);  // step()'s t1 = s.t_s + h
+  V<D> H[kMaxRods], M[kMaxRods], B0[kMaxRods];
+  newton_fields<JilesAthertonLanes>(c, s, I, c.glob(kPmScale), h, t1, H, M, B0, fails);
+  commit_fields<JilesAthertonLanes>(c, s, h, H, M, B0);
+  for (int i = 0; i < c.n; ++i) {
+    fails.check(d, s.f[kH][i], C(d, 1e9), kFailH, i, t1);
+    fails.check(d, s.f[kM][i], hn::Mul(C(d, 1.5), c.rod(kMsTMag, i)), kFailM, i, t1);
+  }
+  mechanics(c, s, h, t1, fails);
+  mount_and_outputs(c, s, g, h, t1, fails);
+  g[kT] = hn::LoadU(d, in.t1_s + j);
+  g[kCurrent] = I;
+  run_loop_checks(c, s, g, g[kT], fails);
+  const Mk<D> keep = hn::AndNot(fails.failed, alive);  // alive and not failed now
+  for (int f = 0; f < kRodStateCount; ++f)
+    for (int i = 0; i < c.n; ++i) hn::BlendedStore(s.f[f][i], keep, d, L.rod(f, i) + j);
+  for (int f = 0; f < kGlobalStateCount; ++f) hn::BlendedStore(g[f], keep, d, L.glob(f) + j);
+  hn::StoreU(fails.code, d, L.glob(kFail) + j);
+  hn::StoreU(fails.value, d, L.glob(kFailValue) + j);
+  hn::StoreU(fails.rod, d, L.glob(kFailRod) + j);
+  hn::StoreU(fails.t, d, L.glob(kFailT) + j);
+  hn::StoreU(fails.bound, d, L.glob(kFailBound) + j);
+}
+
+// All lanes, in chunks of the target's width (or of 1: the reference instance).
+void StepAll(LaneData& L, const StepInputs& in, bool width_one) {
+  if (width_one) {
+    const hn::CappedTag<double, 1> d1;
+    for (std::size_t j = 0; j < L.npad; ++j) step_chunk(d1, L, j, in);
+    return;
+  }
+  const hn::ScalableTag<double> d;
+  const std::size_t w = hn::Lanes(d);
+  for (std::size_t j = 0; j < L.npad; j += w) step_chunk(d, L, j, in);
+}
+
+int WidthOf() { return static_cast<int>(hn::Lanes(hn::ScalableTag<double>())); }
+
+}  // namespace gmasim::lanes::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace gmasim::lanes {
+
+HWY_EXPORT(StepAll);
+HWY_EXPORT(WidthOf);
+
+void step_dispatch(LaneData& d, const StepInputs& in, bool width_one) {
+  HWY_DYNAMIC_DISPATCH(StepAll)(d, in, width_one);
+}
+
+int dispatch_lanes() { return HWY_DYNAMIC_DISPATCH(WidthOf)(); }
+
+const char* dispatch_target_name() {
+  // The best target this CPU supports among those compiled in (what HWY_DYNAMIC_DISPATCH
+  // calls): SupportedAndGeneratedTargets() lists them best first.
+  const auto targets = hwy::SupportedAndGeneratedTargets();
+  return targets.empty() ? "none" : hwy::TargetName(targets.front());
+}
+
+}  // namespace gmasim::lanes
+#endif  // HWY_ONCE

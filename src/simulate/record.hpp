@@ -1,0 +1,18 @@
+// simulate()'s recorded series (src/simulate/run.cpp), shared with the lanes' simulate_lanes
+// (src/lanes/simulate_lanes.cpp) so that both record the same columns the same way.
+#pragma once
+
+#include <cstddef>
+
+#include "gmasim/model/model.hpp"
+#include "gmasim/simulate/simulate.hpp"
+
+namespace gmasim {
+
+// The columns of Result::series (t_s, current_A, y_um, ..., then per rod), each reserving
+// `reserve` rows.
+void make_columns(const Model& m, TimeSeries& ts, std::size_t reserve);
+// One row of the series from the state at the end of a step.
+void record(const Conditions& c, const State& s, TimeSeries& ts);
+
+}  // namespace gmasim

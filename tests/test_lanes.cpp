@@ -1,0 +1,318 @@
+// Batched SIMD lanes (gmasim/lanes.hpp, docs/lanes.md): each lane equals the width-1
+// instance of the same kernel bit for bit, on the dispatched target and on the fallback
+// targets; the lanes follow the scalar step() to the tolerance of their different exp/cos;
+// a lane's divergence is its own; the step allocates nothing; simulate_lanes reproduces
+// simulate()'s metrics.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <vector>
+
+#include "alloc_counter.hpp"
+#include "gmasim/errors.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/simulate/lanes.hpp"
+#include "gmasim/simulate/simulate.hpp"
+#include "hwy/targets.h"
+
+namespace {
+
+using namespace gmasim;
+
+const Model& builtin() {
+  static const Model m = load_model("");
+  return m;
+}
+
+// n simulations at rest: temperatures 20..75 degC, 10 Hz biased sines of 4..10 A.
+struct Runs {
+  std::vector<Conditions> c;
+  std::vector<State> s;
+  std::vector<double> pp;
+  explicit Runs(std::size_t n) {
+    for (std::size_t i = 0; i < n; ++i) {
+      c.push_back(make_conditions(builtin(), 20.0 + 5.0 * static_cast<double>(i)));
+      pp.push_back(4.0 + 0.5 * static_cast<double>(i % 13));
+      s.push_back(make_state(builtin(), c.back(), 0.0));
+    }
+  }
+  double current(std::size_t i, double t) const {
+    return 0.5 * pp[i] * (1.0 - std::cos(2.0 * 3.141592653589793 * 10.0 * t));
+  }
+  LaneBatch batch() const {
+    std::vector<const Model*> m(c.size(), &builtin());
+    std::vector<const Conditions*> cp;
+    std::vector<const State*> sp;
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      cp.push_back(&c[i]);
+      sp.push_back(&s[i]);
+    }
+    return LaneBatch(m, cp, sp);
+  }
+};
+
+constexpr double kDt = 10e-6;
+
+// The numbers of a State that step() sets, in one list.
+std::vector<double> numbers(const State& s) {
+  std::vector<double> v = {s.t_s, s.current_A, s.y_m,         s.y_stack_m,
+                           s.q_m, s.z_m,       s.z_v_m_per_s, s.B_T};
+  for (const auto& r : s.rods)
+    for (double x : {r.H_A_per_m, r.Mirr_A_per_m, r.M_A_per_m, r.Hc_A_per_m, r.H_prev_A_per_m,
+                     r.M_prev_A_per_m, r.x_m, r.v_m_per_s, r.F_N, r.mu_r, r.E_Pa, r.lambda, r.tau_s,
+                     r.phi_Wb, r.k_rod_N_per_m, r.k_load_N_per_m, r.K_osc_N_per_m, r.B_T})
+      v.push_back(x);
+  return v;
+}
+
+// Steps every lane of a and b (b: the width-1 instance) and checks bitwise equality.
+void expect_lanes_equal_width_one(const Runs& runs, long steps) {
+  LaneBatch a = runs.batch(), b = runs.batch();
+  const std::size_t n = runs.c.size();
+  std::vector<double> cur(n), dt(n, kDt), t1(n);
+  State sa = runs.s[0], sb = runs.s[0];
+  for (long k = 1; k <= steps; ++k) {
+    const double t = static_cast<double>(k) * kDt;
+    for (std::size_t i = 0; i < n; ++i) {
+      cur[i] = runs.current(i, t);
+      t1[i] = t;
+    }
+    a.step(cur, dt, t1);
+    b.step(cur, dt, t1, true);
+    if (k % 50 != 0 && k != steps) continue;
+    for (std::size_t i = 0; i < n; ++i) {
+      a.unpack(i, sa);
+      b.unpack(i, sb);
+      const auto va = numbers(sa), vb = numbers(sb);
+      ASSERT_EQ(0, std::memcmp(va.data(), vb.data(), va.size() * sizeof(double)))
+          << "lane " << i << " step " << k << " target " << lanes_target();
+      ASSERT_FALSE(a.diverged(i)) << a.error(i);
+    }
+  }
+}
+
+TEST(Lanes, EachLaneEqualsTheWidthOneInstance) {
+  // 11 lanes: one full AVX-512 vector and a partial one (padding).
+  expect_lanes_equal_width_one(Runs(11), 1500);
+  std::printf("lanes: target %s, %d doubles per vector\n", lanes_target().c_str(), lanes_width());
+}
+
+// The fallback targets (SSE4: 2 lanes, and the portable EMU128 the baseline build compiles)
+// give each lane the width-1 numbers too, and the same run as the best target to the
+// rounding of FMA-based vs separate multiply-add in Highway's exp/cos (observed 8.7e-12,
+// tolerance 1e-10).
+TEST(Lanes, FallbackTargetsAgree) {
+  const Runs runs(5);
+  auto run = [&](LaneBatch& b, std::vector<double>& last) {
+    std::vector<double> cur(5), dt(5, kDt), t1(5);
+    for (long k = 1; k <= 1000; ++k) {
+      for (std::size_t i = 0; i < 5; ++i) {
+        cur[i] = runs.current(i, static_cast<double>(k) * kDt);
+        t1[i] = static_cast<double>(k) * kDt;
+      }
+      b.step(cur, dt, t1);
+    }
+    State s = runs.s[0];
+    last.clear();
+    for (std::size_t i = 0; i < 5; ++i) {
+      b.unpack(i, s);
+      for (double x : numbers(s)) last.push_back(x);
+    }
+  };
+  LaneBatch best = runs.batch();
+  std::vector<double> ref, got;
+  run(best, ref);
+  const int best_width = lanes_width();
+  int tried = 0;
+  for (int64_t target : {int64_t{HWY_SSE4}, int64_t{HWY_EMU128}, int64_t{HWY_SCALAR}}) {
+    if ((hwy::SupportedAndGeneratedTargets().size() == 0)) break;
+    hwy::SetSupportedTargetsForTest(target);
+    const auto targets = hwy::SupportedAndGeneratedTargets();
+    if (targets.empty() || targets.front() != target) continue;  // not compiled in
+    ++tried;
+    std::printf("fallback %s: %d doubles per vector\n", hwy::TargetName(target), lanes_width());
+    EXPECT_LE(lanes_width(), best_width);
+    expect_lanes_equal_width_one(runs, 400);
+    LaneBatch b = runs.batch();
+    run(b, got);
+    double worst = 0.0;
+    for (std::size_t q = 0; q < ref.size(); ++q) {
+      const double e = std::fabs(got[q] - ref[q]) / std::max(std::fabs(ref[q]), 1e-300);
+      worst = std::max(worst, e);
+      EXPECT_LE(e, 1e-10) << "value " << q << " on " << hwy::TargetName(target);
+    }
+    std::printf("fallback %s vs best: largest relative difference %.3g\n", hwy::TargetName(target),
+                worst);
+  }
+  hwy::SetSupportedTargetsForTest(0);
+  EXPECT_GE(tried, 1);
+  EXPECT_EQ(lanes_width(), best_width);
+}
+
+// The lanes against the scalar step(): they differ in Highway's exp/cos/sin/tanh (a few ulp)
+// against libm's, and since the stepfast merge in the Newton path (the scalar step commits
+// its last iterate from another predictor; docs/lanes.md): both within the Newton tolerance.
+// Observed relative difference after 3000 steps of y, B and every rod's H and M: 4.2e-9
+// (1.1e-12 before the merge); tolerance 4e-8.
+TEST(Lanes, FollowTheScalarStep) {
+  const Runs runs(9);
+  LaneBatch b = runs.batch();
+  std::vector<State> scalar = runs.s;
+  const std::size_t n = 9;
+  std::vector<double> cur(n), dt(n, kDt), t1(n);
+  State s = runs.s[0];
+  double worst = 0.0;
+  for (long k = 1; k <= 3000; ++k) {
+    const double t = static_cast<double>(k) * kDt;
+    for (std::size_t i = 0; i < n; ++i) {
+      cur[i] = runs.current(i, t);
+      t1[i] = t;
+      step(builtin(), runs.c[i], scalar[i], {cur[i], kDt});
+      scalar[i].t_s = t;
+    }
+    b.step(cur, dt, t1);
+    if (k % 100 != 0) continue;
+    for (std::size_t i = 0; i < n; ++i) {
+      b.unpack(i, s);
+      auto rel = [&](double x, double ref, double scale) {
+        const double e = std::fabs(x - ref) / scale;
+        worst = std::max(worst, e);
+        EXPECT_LE(e, 4e-8) << "lane " << i << " step " << k;
+      };
+      rel(s.y_m, scalar[i].y_m, 1e-6);  // [m]: relative to 1 um
+      rel(s.B_T, scalar[i].B_T, 1.0);
+      for (std::size_t r = 0; r < s.rods.size(); ++r) {
+        rel(s.rods[r].H_A_per_m, scalar[i].rods[r].H_A_per_m, 1e4);
+        rel(s.rods[r].M_A_per_m, scalar[i].rods[r].M_A_per_m, 8e5);
+      }
+    }
+  }
+  std::printf("lanes vs scalar step(): largest relative difference %.3g\n", worst);
+}
+
+// A lane that diverges stops there with its own diagnosis (time, rod, quantity); the others
+// go on exactly as without it.
+TEST(Lanes, DivergenceIsPerLane) {
+  Runs runs(4), alone(4);
+  runs.pp[2] = 1e12;  // an absurd current in lane 2 only
+  LaneBatch b = runs.batch(), ref = alone.batch();
+  std::vector<double> cur(4), cur_ref(4), dt(4, kDt), t1(4);
+  for (long k = 1; k <= 200; ++k) {
+    const double t = static_cast<double>(k) * kDt;
+    for (std::size_t i = 0; i < 4; ++i) {
+      cur[i] = runs.current(i, t);
+      cur_ref[i] = alone.current(i, t);
+      t1[i] = t;
+    }
+    b.step(cur, dt, t1);
+    ref.step(cur_ref, dt, t1);
+  }
+  EXPECT_TRUE(b.diverged(2));
+  const std::string e = b.error(2);
+  EXPECT_NE(e.find("t = "), std::string::npos) << e;
+  EXPECT_NE(e.find("rod"), std::string::npos) << e;
+  State sa = runs.s[0], sb = runs.s[0];
+  for (std::size_t i : {0, 1, 3}) {
+    EXPECT_FALSE(b.diverged(i));
+    b.unpack(i, sa);
+    ref.unpack(i, sb);
+    EXPECT_EQ(numbers(sa), numbers(sb)) << "lane " << i;
+  }
+  // A scalar run with that current throws; the lane's text names the same quantity.
+  State s = runs.s[2];
+  std::string scalar_error;
+  try {
+    for (long k = 1; k <= 200; ++k) {
+      const double t = static_cast<double>(k) * kDt;
+      step(builtin(), runs.c[2], s, {runs.current(2, t), kDt});
+      s.t_s = t;
+    }
+  } catch (const DivergenceError& err) {
+    scalar_error = err.quantity;
+  }
+  ASSERT_FALSE(scalar_error.empty());
+  EXPECT_NE(e.find(scalar_error), std::string::npos) << e << " vs " << scalar_error;
+}
+
+// The batched step allocates nothing (buffers sized once, in the constructor).
+TEST(Lanes, StepAllocatesNothing) {
+  const Runs runs(10);
+  LaneBatch b = runs.batch();
+  std::vector<double> cur(10, 3.0), dt(10, kDt), t1(10, kDt);
+  b.step(cur, dt, t1);
+  gmasim_test::g_allocations = 0;
+  gmasim_test::g_counting = true;
+  for (int k = 2; k < 50; ++k) {
+    for (double& t : t1) t = k * kDt;
+    b.step(cur, dt, t1);
+    b.step(cur, dt, t1, true);
+  }
+  gmasim_test::g_counting = false;
+  EXPECT_EQ(gmasim_test::g_allocations.load(), 0);
+}
+
+// simulate_lanes: each setting's metrics as simulate() gives them, to the lanes' tolerance.
+TEST(Lanes, SimulateLanesMatchesSimulate) {
+  std::vector<SimulationSettings> set;
+  for (double T : {20.0, 60.0, 110.0})
+    for (double pp : {4.0, 8.0}) {
+      SimulationSettings s;
+      s.temperature_C = T;
+      s.waveform = biased_sine(pp, 50.0);
+      s.periods = 1;
+      set.push_back(s);
+    }
+  const std::vector<Result> got = simulate_lanes(builtin(), set);
+  ASSERT_EQ(got.size(), set.size());
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    const Result ref = simulate(builtin(), set[i]);
+    ASSERT_FALSE(got[i].diverged) << got[i].error;
+    ASSERT_TRUE(got[i].has_metrics);
+    EXPECT_EQ(got[i].series.rows(), ref.series.rows());
+    EXPECT_NEAR(got[i].metrics.stroke_um, ref.metrics.stroke_um, 1e-9 * ref.metrics.stroke_um);
+    EXPECT_NEAR(got[i].metrics.hysteresis_um, ref.metrics.hysteresis_um,
+                1e-9 * ref.metrics.stroke_um);
+    EXPECT_NEAR(got[i].metrics.B_pp_T, ref.metrics.B_pp_T, 1e-9 * ref.metrics.B_pp_T);
+  }
+}
+
+// The identify objective with its records in lanes (identify/record_lanes.cpp) against one
+// scalar run per record: every residual (12 records of y and B, 2 periods, 100 samples per
+// period, with one pre-cycle-free sine each) to the lanes' rounding. Residuals are in % of
+// each record's p-p; observed difference ~1e-10 %, tolerance 1e-8 %.
+TEST(Lanes, ObjectiveResidualsMatchTheScalarRuns) {
+  SyntheticRequest req;
+  req.samples_per_period = 100;
+  req.noise_pct = 0.0;
+  req.flux_noise_pct = 0.0;
+  req.objective.steps_per_period = 100;
+  const MeasurementSet data = synthesize_measurements(builtin(), req);
+  const FitSpec fit = load_fit_spec("rod1.ja.k0_A_per_m:1500:6000:log,material.chi_m:8:50:log");
+  ObjectiveSettings s;
+  s.steps_per_period = 100;
+  s.flux_weight = 1.0;
+  const Objective batched(builtin_model_spec(), data, fit, s);
+  s.lanes = false;
+  const Objective scalar(builtin_model_spec(), data, fit, s);
+  std::vector<double> u = batched.start_unit();
+  u[0] = 0.37;
+  std::vector<double> ra(batched.residual_count()), rb(scalar.residual_count());
+  ASSERT_TRUE(batched.residuals(u.data(), ra.data()));
+  ASSERT_TRUE(scalar.residuals(u.data(), rb.data()));
+  double worst = 0.0;
+  for (std::size_t i = 0; i < ra.size(); ++i) {
+    worst = std::max(worst, std::fabs(ra[i] - rb[i]));
+    EXPECT_NEAR(ra[i], rb[i], 1e-8) << "residual " << i;
+  }
+  std::printf("objective lanes vs scalar: %zu residuals, largest difference %.3g %%\n", ra.size(),
+              worst);
+  EXPECT_GT(std::fabs(ra[0]) + std::fabs(ra[ra.size() / 2]), 0.0);  // not the truth
+}
+
+}  // namespace
