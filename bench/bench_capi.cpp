@@ -5,8 +5,8 @@
 //   --benchmark_filter=CApi
 #include <benchmark/benchmark.h>
 
-#include "gmasim/gmasim_c.h"
-#include "gmasim/simulate.hpp"
+#include "gmasim/capi/gmasim_c.h"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace {
 

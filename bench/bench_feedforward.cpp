@@ -1,5 +1,5 @@
-// Real-time cost of the inverse-model feed-forward (gmasim/feedforward.hpp, issue 20): one
-// controller sample (the polynomial preview filter and the quasi-static inverse on the shadow
+// Real-time cost of the inverse-model feed-forward (gmasim/experiments/feedforward.hpp, issue 20):
+// one controller sample (the polynomial preview filter and the quasi-static inverse on the shadow
 // state) while tracking a 20 um, 100 Hz sine at 10 kHz, 20 and 70 degC, on the built-in model.
 // The budget of a 10 kHz controller is 100 us per sample. The counters report the quasi-static
 // steps per sample. Run: build/ci/bin/gmasim_bench --benchmark_filter=Feedforward
@@ -9,8 +9,8 @@
 #include <cmath>
 
 #include "common.hpp"
-#include "gmasim/feedforward.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/experiments/feedforward.hpp"
+#include "gmasim/model/model.hpp"
 
 namespace {
 

@@ -10,8 +10,8 @@
 #include <memory>
 #include <mutex>
 
-#include "gmasim/identify.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/io/io.hpp"
 
 namespace {
 

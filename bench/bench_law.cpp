@@ -8,10 +8,10 @@
 #include <string>
 
 #include "common.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/io/io.hpp"
 #include "gmasim/magnetisation/laws.hpp"
-#include "gmasim/model.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace {
 

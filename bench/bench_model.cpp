@@ -5,8 +5,8 @@
 #include <benchmark/benchmark.h>
 
 #include "common.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/model.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// Overhead of the run loop (gmasim/run_loop.hpp, issue 10) over a hand-written step loop:
+// Overhead of the run loop (gmasim/simulate/run_loop.hpp, issue 10) over a hand-written step loop:
 // one period of the 400 Hz biased sine (2000 steps, 70 degC) on the built-in model, with the
 // same drive; the loop adds the finiteness checks of the current and the outputs and the call
 // of a (no-op, or recording) recorder. Run: build/ci/bin/gmasim_bench --benchmark_filter=Loop
@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "common.hpp"
-#include "gmasim/model.hpp"
-#include "gmasim/run_loop.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/simulate/run_loop.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace {
 

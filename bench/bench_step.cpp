@@ -6,9 +6,9 @@
 #include <cmath>
 
 #include "common.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/model.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace {
 
@@ -33,7 +33,7 @@ void BM_FullModelStep(benchmark::State& bs) {
 }
 BENCHMARK(BM_FullModelStep)->Arg(0)->Arg(1);
 
-// The same step of the built-in model with the energy ledgers booked (gmasim/energy.hpp:
+// The same step of the built-in model with the energy ledgers booked (gmasim/model/energy.hpp:
 // every branch of the circuit solved, each rod's dissipation along the step's path and its
 // oscillator's power by Gauss-Legendre), against BM_FullModelStep/0 (issue 18).
 void BM_FullModelStepWithLedger(benchmark::State& bs) {

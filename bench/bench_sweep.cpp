@@ -4,9 +4,9 @@
 // Run: build/ci/bin/gmasim_bench --benchmark_filter=Sweep
 #include <benchmark/benchmark.h>
 
-#include "gmasim/experiments.hpp"
 #include "common.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/io/io.hpp"
 
 namespace {
 

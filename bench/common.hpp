@@ -3,8 +3,8 @@
 
 #include <string>
 
-#include "gmasim/io.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/model.hpp"
 
 namespace gmasim::bench {
 

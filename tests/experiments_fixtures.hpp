@@ -5,8 +5,8 @@
 #include <string>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/model.hpp"
 #include "gmasim/physics/magnetic.hpp"
 
 namespace gmasim_experiments_test {

@@ -10,8 +10,8 @@
 #include <sstream>
 #include <string>
 
-#include "gmasim/identify.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/io/io.hpp"
 
 namespace gmasim_test {
 

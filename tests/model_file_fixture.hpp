@@ -9,7 +9,7 @@
 #include <sstream>
 #include <string>
 
-#include "gmasim/io.hpp"
+#include "gmasim/io/io.hpp"
 #include "test_util.hpp"
 
 namespace gmasim_test {

@@ -1,4 +1,4 @@
-// The C API (gmasim/gmasim_c.h) and the Stepper under it: stepping allocates nothing, is
+// The C API (gmasim/capi/gmasim_c.h) and the Stepper under it: stepping allocates nothing, is
 // bit-identical to driving gmasim::step directly, and every error path returns its status
 // code with a message naming the value and the rule.
 #include <gmock/gmock.h>
@@ -14,11 +14,11 @@
 #include <vector>
 
 #include "alloc_counter.hpp"
+#include "gmasim/capi/gmasim_c.h"
 #include "gmasim/errors.hpp"
-#include "gmasim/gmasim_c.h"
-#include "gmasim/io.hpp"
-#include "gmasim/simulate.hpp"
-#include "gmasim/stepper.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/simulate/simulate.hpp"
+#include "gmasim/simulate/stepper.hpp"
 #include "gmasim/version.h"
 
 using ::testing::HasSubstr;

@@ -1,4 +1,4 @@
-// The energy ledgers (gmasim/energy.hpp, docs/model.md "Energy ledgers"): both close per
+// The energy ledgers (gmasim/model/energy.hpp, docs/model.md "Energy ledgers"): both close per
 // cycle, each term comes from its own law (perturbing one breaks the balance), a closed-form
 // eddy-current loss, the JA energy split and its positive dissipation, the printed reading's
 // violation, and the time step's observed order.
@@ -14,12 +14,12 @@
 #include <map>
 #include <string>
 
-#include "gmasim/energy.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/energy.hpp"
+#include "gmasim/model/model.hpp"
 #include "gmasim/physics/jiles_atherton.hpp"
-#include "gmasim/run_loop.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/simulate/run_loop.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 using namespace gmasim;
 

@@ -12,9 +12,9 @@
 #include "alloc_counter.hpp"
 #include "experiments_fixtures.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/experiments.hpp"
-#include "gmasim/feedforward.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/experiments/feedforward.hpp"
+#include "gmasim/model/model.hpp"
 
 using namespace gmasim;
 using namespace gmasim_experiments_test;

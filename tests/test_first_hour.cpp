@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/identify.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/simulate/simulate.hpp"
 #include "model_file_fixture.hpp"
 #include "test_util.hpp"
 

@@ -18,14 +18,14 @@
 #include <vector>
 
 #include "experiments_fixtures.hpp"
-#include "gmasim/compensate.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/experiments.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/experiments/compensate.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/experiments/reproduce.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/model.hpp"
 #include "gmasim/physics/magnetic.hpp"
-#include "gmasim/reproduce.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 using namespace gmasim;
 using namespace gmasim_experiments_test;

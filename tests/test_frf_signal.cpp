@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "experiments_fixtures.hpp"
-#include "gmasim/experiments.hpp"
+#include "gmasim/experiments/experiments.hpp"
 
 using namespace gmasim;
 using namespace gmasim_experiments_test;

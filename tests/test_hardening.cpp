@@ -15,14 +15,14 @@
 #include <vector>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/experiments.hpp"
-#include "gmasim/identify.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/run_loop.hpp"
-#include "gmasim/simulate.hpp"
-#include "gmasim/stepper.hpp"
-#include "gmasim/validate.hpp"
-#include "gmasim/validity.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/validate.hpp"
+#include "gmasim/model/validity.hpp"
+#include "gmasim/simulate/run_loop.hpp"
+#include "gmasim/simulate/simulate.hpp"
+#include "gmasim/simulate/stepper.hpp"
 #include "test_util.hpp"
 
 using gmasim_test::input_error;

@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "gmasim/experiments.hpp"
-#include "gmasim/identify.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/io/io.hpp"
 #include "identify_fixture.hpp"
 #include "test_util.hpp"
 

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "gmasim/identify.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/io/io.hpp"
 #include "identify_fixture.hpp"
 #include "test_util.hpp"
 

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/identify.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/io/io.hpp"
 #include "test_util.hpp"
 
 using ::testing::HasSubstr;

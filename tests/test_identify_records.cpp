@@ -11,8 +11,8 @@
 
 #include "alloc_counter.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/identify.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/io/io.hpp"
 #include "test_util.hpp"
 
 using ::testing::HasSubstr;

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/validate.hpp"
 #include "model_file_fixture.hpp"
 #include "test_util.hpp"
 
@@ -216,7 +216,7 @@ TEST(Errors, DivergenceMessage) {
 }
 
 // ---------------------------------------------------------------------------------------
-// The validation layer (gmasim/validate.hpp, issue 8)
+// The validation layer (gmasim/model/validate.hpp, issue 8)
 // ---------------------------------------------------------------------------------------
 TEST(Validate, CountsAreCheckedBeforeConversion) {
   using gmasim::checked_count;

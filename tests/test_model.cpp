@@ -11,11 +11,11 @@
 
 #include "alloc_counter.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/model.hpp"
 #include "gmasim/physics/jiles_atherton.hpp"
 #include "gmasim/physics/magnetic.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 using gmasim_test::g_allocations;
 using gmasim_test::g_counting;
@@ -328,7 +328,7 @@ TEST(Numerics, StepAllocatesNothing) {
   for (int k = 2; k < 20000; ++k) step(m, c, s, {w.current_at(k * 1e-6), 1e-6});
   g_counting = false;
   EXPECT_EQ(g_allocations.load(), 0);
-  // With the energy ledgers booked (gmasim/energy.hpp) too.
+  // With the energy ledgers booked (gmasim/model/energy.hpp) too.
   s.energy.enabled = true;
   g_counting = true;
   for (int k = 20000; k < 24000; ++k) step(m, c, s, {w.current_at(k * 1e-6), 1e-6});

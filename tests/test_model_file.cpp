@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/validate.hpp"
 #include "model_file_fixture.hpp"
 #include "test_util.hpp"
 

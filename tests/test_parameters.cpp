@@ -1,4 +1,4 @@
-// The parameter table (gmasim/parameters.hpp): every number of the shipped model files has
+// The parameter table (gmasim/model/parameters.hpp): every number of the shipped model files has
 // its row, every row lands in its own Model field and nowhere else, units agree with key
 // suffixes, options parse once and round-trip, and docs/parameters.md is the table.
 #include <fmt/format.h>
@@ -13,8 +13,8 @@
 #include <string>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/parameters.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/parameters.hpp"
 
 using ::testing::HasSubstr;
 

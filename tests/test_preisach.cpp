@@ -13,13 +13,13 @@
 #include <vector>
 
 #include "alloc_counter.hpp"
-#include "gmasim/energy.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/io/io.hpp"
 #include "gmasim/magnetisation/laws.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/model/energy.hpp"
+#include "gmasim/model/model.hpp"
 #include "gmasim/physics/preisach.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 using namespace gmasim;
 using namespace gmasim::physics;

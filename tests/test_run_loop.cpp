@@ -1,7 +1,7 @@
-// The run loop (gmasim/run_loop.hpp, issue 10): each clock of StepGrid against a hand-written
-// loop with the same floating-point recipe (bit for bit: EXPECT_EQ on doubles), the loop's own
-// checks (finite drive current and outputs) and the step limits of the grid factories, and
-// that the loop with a no-op recorder allocates nothing.
+// The run loop (gmasim/simulate/run_loop.hpp, issue 10): each clock of StepGrid against a
+// hand-written loop with the same floating-point recipe (bit for bit: EXPECT_EQ on doubles), the
+// loop's own checks (finite drive current and outputs) and the step limits of the grid factories,
+// and that the loop with a no-op recorder allocates nothing.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -12,10 +12,10 @@
 
 #include "alloc_counter.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/model.hpp"
-#include "gmasim/run_loop.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/simulate/run_loop.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 using namespace gmasim;
 using gmasim_test::g_allocations;

@@ -6,9 +6,9 @@
 #include <string>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/self_heating.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/self_heating.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace {
 

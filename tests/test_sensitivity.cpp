@@ -1,5 +1,5 @@
-// gmasim sensitivity (gmasim/sensitivity.hpp): the claims from only the experiments they
-// need (the same numbers as the whole study), central differences against analytic
+// gmasim sensitivity (gmasim/experiments/sensitivity.hpp): the claims from only the experiments
+// they need (the same numbers as the whole study), central differences against analytic
 // derivatives, the two step sizes, the flags, thread-count independence, identifiability.
 #include <gtest/gtest.h>
 
@@ -10,9 +10,9 @@
 
 #include "experiments_fixtures.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/reproduce.hpp"
-#include "gmasim/sensitivity.hpp"
+#include "gmasim/experiments/reproduce.hpp"
+#include "gmasim/experiments/sensitivity.hpp"
+#include "gmasim/io/io.hpp"
 
 namespace {
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/model/validate.hpp"
 
 namespace gmasim::cli {
 namespace {

@@ -7,9 +7,9 @@
 
 #include "commands.hpp"
 #include "experiment_cli.hpp"
-#include "gmasim/compensate.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/experiments/compensate.hpp"
+#include "gmasim/io/io.hpp"
 
 namespace gmasim::cli {
 namespace {

@@ -9,8 +9,8 @@
 #include "commands.hpp"
 #include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/experiments.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/io/io.hpp"
 
 namespace gmasim::cli {
 namespace {

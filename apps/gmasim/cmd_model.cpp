@@ -5,10 +5,10 @@
 
 #include "commands.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/parameters.hpp"
-#include "gmasim/simulate.hpp"
-#include "gmasim/validity.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/parameters.hpp"
+#include "gmasim/model/validity.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim::cli {
 namespace {
@@ -38,7 +38,7 @@ int run_show(const ModelArgs& a, bool doc) {
   return 0;
 }
 
-// The parameter table itself (gmasim/parameters.hpp), as text or as docs/parameters.md.
+// The parameter table itself (gmasim/model/parameters.hpp), as text or as docs/parameters.md.
 int run_params(bool markdown) {
   if (markdown) {
     fmt::print("{}", parameters_markdown());

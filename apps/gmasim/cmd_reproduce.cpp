@@ -14,8 +14,8 @@
 #include "commands.hpp"
 #include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/reproduce.hpp"
+#include "gmasim/experiments/reproduce.hpp"
+#include "gmasim/io/io.hpp"
 
 namespace gmasim::cli {
 namespace {

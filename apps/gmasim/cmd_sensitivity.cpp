@@ -12,9 +12,9 @@
 #include "commands.hpp"
 #include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/identify.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/sensitivity.hpp"
+#include "gmasim/experiments/sensitivity.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/io/io.hpp"
 
 namespace gmasim::cli {
 namespace {

@@ -13,9 +13,9 @@
 #include "commands.hpp"
 #include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/simulate.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/validate.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim::cli {
 namespace {

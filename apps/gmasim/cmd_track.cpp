@@ -7,10 +7,10 @@
 #include "commands.hpp"
 #include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/experiments.hpp"
-#include "gmasim/feedforward.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/experiments/feedforward.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/validate.hpp"
 
 namespace gmasim::cli {
 namespace {
@@ -22,7 +22,8 @@ struct TrackArgs {
               frequencies = "10,100";
   TrackRequest req;
   bool progress = false;
-  // --feedforward inverse: the evaluation against mismatched plants (gmasim/feedforward.hpp)
+  // --feedforward inverse: the evaluation against mismatched plants
+  // (gmasim/experiments/feedforward.hpp)
   std::string feedforward = "none", mismatch = "all",
               controllers = "pid,pid_temperature,pid_inverse";
   std::vector<CLI::Option*> feedforward_only;  // refused without --feedforward inverse*

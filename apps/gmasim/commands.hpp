@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/model.hpp"
 
 namespace gmasim::cli {
 
@@ -74,7 +74,7 @@ void print_warning(const std::string& what);  // "gmasim: warning: ..." on stder
 // The handler that removes the temporaries of a write in progress and lets `sig` end the
 // process (main installs it for SIGINT, SIGTERM, SIGHUP; identify's second signal gets it).
 void install_fatal_signal_handler(int sig);
-// The model's values far outside Terfenol-D's known range (gmasim/validity.hpp), as warnings.
+// The model's values far outside Terfenol-D's known range (gmasim/model/validity.hpp), as warnings.
 void print_model_warnings(const Model& m);
 // One warning naming `flag` and the temperatures outside the model's validated range.
 void warn_temperatures(const Model& m, const std::vector<double>& temperatures_C,

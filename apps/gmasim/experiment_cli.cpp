@@ -12,8 +12,8 @@
 #include <mutex>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/validate.hpp"
 
 namespace gmasim::cli {
 namespace {

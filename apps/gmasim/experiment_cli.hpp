@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "gmasim/experiments.hpp"
+#include "gmasim/experiments/experiments.hpp"
 
 namespace gmasim::cli {
 

@@ -18,8 +18,8 @@
 
 #include "commands.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/validity.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/validity.hpp"
 #include "gmasim/version.h"
 
 namespace gmasim::cli {

@@ -4,7 +4,7 @@ wing (strain rising with the field, from each branch's strain minimum): the loop
 between the rising and the falling branch at equal strain) at fractions of the wing's strain
 span, the knee (the field where the rising branch reaches 80 % of the span) and the field of
 steepest rise. Reads gmasim measurement CSV files (field_A_per_m, strain_ppm; one period,
-starting at the field minimum). Usage: loop_shape.py FILE [FILE ...]"""
+starting at the field minimum; a loop at negative fields is mirrored). Usage: loop_shape.py FILE [FILE ...]"""
 import csv
 import sys
 
@@ -37,6 +37,10 @@ def wing(H, S):
 
 def shape(path):
     H, S = read(path)
+    if max(H) < -0.5 * min(H):  # a loop at negative fields (-6..0 A): its mirror image, from its
+        H = [-h for h in H]  # field minimum, so the wing rises with the field like the others
+        j = min(range(len(H)), key=lambda i: H[i])
+        H, S = H[j:] + H[:j], S[j:] + S[:j]
     k = max(range(len(H)), key=lambda i: H[i])
     up_H, up_S = wing(H[: k + 1], S[: k + 1])
     dn_H, dn_S = wing(H[k:][::-1], S[k:][::-1])

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "gmasim/model.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim::py_bind {
 pybind11::array_t<double> to_numpy(const std::vector<double>& v);

@@ -1,14 +1,14 @@
 // Bindings of the experiments: each returns the experiment's report (the same tables the
 // CLI writes as CSV) as {"meta": {...}, "<table>": {column: ndarray or list of str}}.
-#include "gmasim/experiments.hpp"
+#include "gmasim/experiments/experiments.hpp"
 
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
-#include "gmasim/compensate.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/feedforward.hpp"
-#include "gmasim/reproduce.hpp"
+#include "gmasim/experiments/compensate.hpp"
+#include "gmasim/experiments/feedforward.hpp"
+#include "gmasim/experiments/reproduce.hpp"
 
 namespace py = pybind11;
 
@@ -112,7 +112,7 @@ void bind_frf(py::module_& mod) {
 }
 
 // track(): closed-loop PID tracking (Fig. 16); with feedforward="inverse" the inverse-model
-// feed-forward evaluated against mismatched plants (gmasim/feedforward.hpp).
+// feed-forward evaluated against mismatched plants (gmasim/experiments/feedforward.hpp).
 py::dict track_feedforward(const Model& m, const TrackRequest& r, const std::string& feedforward,
                            const std::string& mismatch,
                            const std::vector<std::string>& controllers) {

@@ -10,9 +10,9 @@
 
 #include "bindings.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/simulate.hpp"
-#include "gmasim/validity.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/validity.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace py = pybind11;
 using namespace gmasim;
@@ -43,7 +43,7 @@ py::dict metrics_dict(const Metrics& m) {
   return d;
 }
 
-// The energy ledgers over the metrics window as mean powers [W] (gmasim/energy.hpp).
+// The energy ledgers over the metrics window as mean powers [W] (gmasim/model/energy.hpp).
 py::dict energy_dict(const Model& m, const Result& r) {
   const auto& e = r.energy;
   const double T = e.duration_s;

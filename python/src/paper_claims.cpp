@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "bindings.hpp"
-#include "gmasim/claims.hpp"
+#include "gmasim/experiments/claims.hpp"
 
 namespace py = pybind11;
 

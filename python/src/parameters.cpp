@@ -1,5 +1,5 @@
-// gmasim.parameter_table(): the C++ parameter table (gmasim/parameters.hpp) as Python data.
-#include "gmasim/parameters.hpp"
+// gmasim.parameter_table(): the C++ parameter table (gmasim/model/parameters.hpp) as Python data.
+#include "gmasim/model/parameters.hpp"
 
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>

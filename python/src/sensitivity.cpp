@@ -1,12 +1,12 @@
-// Binding of run_sensitivity (gmasim/sensitivity.hpp); the Python entry point with its
+// Binding of run_sensitivity (gmasim/experiments/sensitivity.hpp); the Python entry point with its
 // docstring is gmasim.sensitivity (python/gmasim/_sensitivity.py), which shapes the arrays.
-#include "gmasim/sensitivity.hpp"
+#include "gmasim/experiments/sensitivity.hpp"
 
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
-#include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments/claims.hpp"
 
 namespace py = pybind11;
 

@@ -1,7 +1,7 @@
 // gmasim.Stepper: the actuator stepped sample by sample from Python (gmasim::Stepper, the
 // session under the C API too). Also the module's __version__ (bind_stepper is the module's
 // one hook for this file).
-#include "gmasim/stepper.hpp"
+#include "gmasim/simulate/stepper.hpp"
 
 #include <fmt/format.h>
 #include <pybind11/numpy.h>
@@ -15,7 +15,7 @@
 
 #include "bindings.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/simulate/simulate.hpp"
 #include "gmasim/version.h"
 
 namespace py = pybind11;

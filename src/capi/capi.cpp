@@ -1,6 +1,7 @@
-// The C API (gmasim/gmasim_c.h) over gmasim::Stepper: status codes instead of exceptions, error
-// messages in fixed buffers (setting one allocates nothing), no exception crosses the boundary,
-// and generation-counted handles (capi/handles.hpp): a freed or unknown handle is an error code.
+// The C API (gmasim/capi/gmasim_c.h) over gmasim::Stepper: status codes instead of exceptions,
+// error messages in fixed buffers (setting one allocates nothing), no exception crosses the
+// boundary, and generation-counted handles (capi/handles.hpp): a freed or unknown handle is an
+// error code.
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -9,11 +10,11 @@
 #include <new>
 #include <string>
 
+#include "gmasim/capi/gmasim_c.h"
 #include "gmasim/errors.hpp"
-#include "gmasim/gmasim_c.h"
-#include "gmasim/io.hpp"
-#include "gmasim/simulate.hpp"
-#include "gmasim/stepper.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/simulate/simulate.hpp"
+#include "gmasim/simulate/stepper.hpp"
 #include "gmasim/version.h"
 #include "handles.hpp"  // src/capi/, beside this file
 

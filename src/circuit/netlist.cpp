@@ -6,13 +6,13 @@
 #include <utility>
 #include <vector>
 
-#include "gmasim/circuit.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/model/circuit.hpp"
 
 namespace gmasim {
 
 // The fixed part of the nodal matrix and the precomputed pieces of the low-rank (Woodbury)
-// solve (gmasim/circuit.hpp).
+// solve (gmasim/model/circuit.hpp).
 struct CircuitMatrices {
   Eigen::MatrixXd fixed_laplacian;  // contribution of the fixed-reluctance branches
   // Low-rank pieces, when Circuit::lowrank.enabled:

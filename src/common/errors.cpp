@@ -5,7 +5,7 @@
 
 #include <utility>
 
-#include "gmasim/validate.hpp"
+#include "gmasim/model/validate.hpp"
 
 namespace gmasim {
 

@@ -9,7 +9,7 @@
 #include <cstring>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/model/validate.hpp"
 
 namespace gmasim::io_detail {
 

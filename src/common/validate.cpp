@@ -1,5 +1,5 @@
-// The validation layer (include/gmasim/validate.hpp, issue 8).
-#include "gmasim/validate.hpp"
+// The validation layer (include/gmasim/model/validate.hpp, issue 8).
+#include "gmasim/model/validate.hpp"
 
 #include <fmt/format.h>
 #include <sys/resource.h>

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "gmasim/experiments.hpp"
-#include "gmasim/reproduce.hpp"
-#include "gmasim/sensitivity.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/experiments/reproduce.hpp"
+#include "gmasim/experiments/sensitivity.hpp"
 
 namespace gmasim::detail {
 

@@ -2,7 +2,7 @@
 // that computes our value from a `gmasim reproduce` study, and the scoring of a claim by its
 // tolerance rule. The claims themselves (numbers, tolerances, conditions) are data; the
 // loader is src/experiments/claims_loader.cpp.
-#include "gmasim/claims.hpp"
+#include "gmasim/experiments/claims.hpp"
 
 #include <fmt/format.h>
 
@@ -12,7 +12,7 @@
 #include <string_view>
 #include <utility>
 
-#include "gmasim/reproduce.hpp"
+#include "gmasim/experiments/reproduce.hpp"
 
 namespace gmasim {
 namespace {

@@ -13,8 +13,8 @@
 
 #include "common/text_io.hpp"
 #include "common/toml_io.hpp"
-#include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments/claims.hpp"
 
 namespace gmasim {
 

@@ -2,7 +2,7 @@
 // stroke(drive) - target, bracketed and solved with Boost.Math's TOMS 748), the gain
 // schedule those drives define, and tracking with the schedule as temperature feed-forward.
 // docs/experiments.md, "Temperature compensation".
-#include "gmasim/compensate.hpp"
+#include "gmasim/experiments/compensate.hpp"
 
 #include <fmt/format.h>
 
@@ -15,8 +15,8 @@
 
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/simulate.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/model/validate.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim {
 namespace {

@@ -1,7 +1,7 @@
 // Inverse-model feed-forward (issue 20): the stable polynomial inverse of the model's linear
-// part and the quasi-static inverse of the model with its hysteresis. gmasim/feedforward.hpp;
-// docs/experiments.md, "Inverse-model feed-forward".
-#include "gmasim/feedforward.hpp"
+// part and the quasi-static inverse of the model with its hysteresis.
+// gmasim/experiments/feedforward.hpp; docs/experiments.md, "Inverse-model feed-forward".
+#include "gmasim/experiments/feedforward.hpp"
 
 #include <fmt/format.h>
 
@@ -10,7 +10,7 @@
 #include <complex>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/experiments.hpp"
+#include "gmasim/experiments/experiments.hpp"
 #include "gmasim/physics/magnetic.hpp"
 
 namespace gmasim {

@@ -1,9 +1,9 @@
 // gmasim frf (Fig. 15): frequency response current -> displacement about a DC bias, by a
-// stepped sine (time-domain runs of step()) and by a small-signal linearisation of the
-// same model, and the modes of eq. (15). docs/experiments.md, "Frequency response".
+// stepped sine (time-domain runs of step()) beside the small-signal linearisation and the
+// modes of eq. (15) of the mechanics module (gmasim/mechanics/mechanics.hpp,
+// src/mechanics/). docs/experiments.md, "Frequency response".
 #include <fmt/format.h>
 
-#include <Eigen/Dense>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,16 +11,12 @@
 
 #include "experiments/frf_internal.hpp"
 #include "experiments/parallel.hpp"
-#include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/experiments.hpp"
-#include "gmasim/magnetisation/laws.hpp"
+#include "gmasim/experiments/claims.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/model/validate.hpp"
 #include "gmasim/physics/magnetic.hpp"
-#include "gmasim/physics/magnetostriction.hpp"
-#include "gmasim/physics/mechanics.hpp"
-#include "gmasim/rod_laws.hpp"
-#include "gmasim/run_loop.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/simulate/run_loop.hpp"
 
 namespace gmasim {
 namespace {
@@ -29,42 +25,6 @@ using namespace physics;
 using cd = std::complex<double>;
 
 constexpr double kTwoPi = 2.0 * kPi;
-
-// The eq. (3) permeability of rod i at magnetisation M (rod_laws.hpp, as step() evaluates it).
-double mu_at(const Model& m, std::size_t i, const RodConditions& rc, double M) {
-  return rod_permeability(rc, m.material.chi_m, M, 0.0, m.rods[i].name);
-}
-
-// Static fields H_c,i (eq. 7 first line) of every rod for coil current I and rod
-// magnetisations M (through mu(M), eq. 2-3, and the nodal solve of eq. 23).
-std::vector<double> static_fields(const Model& m, const Conditions& c, CircuitWorkspace& ws,
-                                  double I, const std::vector<double>& M) {
-  const std::size_t n = M.size();
-  std::vector<double> R(n), mu(n), Hc(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    mu[i] = mu_at(m, i, c.rods[i], M[i]);
-    R[i] = rod_reluctance(c.rods[i].length_m, mu[i], c.rods[i].area_m2);
-  }
-  if (!solve_circuit(m.circuit, R, I, c.pm_scale, ws, false))
-    throw DivergenceError(0.0, "", "nodal matrix of the circuit", 0.0, "not positive definite");
-  for (std::size_t i = 0; i < n; ++i) {
-    const double phi = ws.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
-    Hc[i] = static_field(phi, c.rods[i].k_f, mu[i], c.rods[i].area_m2);
-  }
-  return Hc;
-}
-
-// Rod force (eq. 11-14) and rod stiffness (eq. 17) at magnetisation M: update_rod_mechanics
-// of rod_laws.hpp, as step() does.
-struct ForceStiffness {
-  double F, k_rod;
-};
-ForceStiffness force_at(const Model& m, const RodConditions& rc, double M) {
-  RodState r;
-  r.M_A_per_m = M;
-  update_rod_mechanics(m.material, rc, r);
-  return {r.F_N, r.k_rod_N_per_m};
-}
 
 double unwrap_deg(double prev, double now) {
   while (now - prev > 180.0) now -= 360.0;
@@ -80,236 +40,6 @@ std::vector<double> log_grid(double f0, double f1, int n) {
 }
 
 }  // namespace
-
-// ---------------------------------------------------------------------------------------
-// Linearisation
-// ---------------------------------------------------------------------------------------
-namespace {
-
-// dM/dH with the irreversible state held: the magnetisation law's (the seam,
-// gmasim/magnetisation/laws.hpp).
-double reversible_susceptibility(const Model& m, const RodConditions& rc, const RodState& r) {
-  return with_magnetisation_law(m.options.magnetisation_law, [&](auto law) {
-    return decltype(law)::reversible_susceptibility(rc, r);
-  });
-}
-
-// Consistent magnetic state: the circuit seen from the rod branches. With rod reluctances R_p
-// and extra rod MMFs e, the rod fluxes solve (R_p + S) phi = b I + e (netlist.cpp), whatever
-// R_p; probe it. Then per rod the port constants, chi and tau.
-void linearise_ports(const Model& m, const Conditions& c, const State& s, CircuitWorkspace& ws,
-                     SmallSignalModel& L) {
-  const std::size_t n = s.rods.size();
-  L.consistent = true;
-  const auto N = static_cast<Eigen::Index>(n);
-  std::vector<double> Rp(n);
-  for (std::size_t i = 0; i < n; ++i)
-    Rp[i] = c.rods[i].length_m / (kMu0 * s.rods[i].mu_r * c.rods[i].area_m2);
-  auto rod_flux = [&](double I) {
-    if (!solve_circuit(m.circuit, Rp, I, 0.0, ws, false))
-      throw DivergenceError(0.0, "", "nodal matrix of the circuit", 0.0, "not positive definite");
-    Eigen::VectorXd phi(N);
-    for (std::size_t i = 0; i < n; ++i)
-      phi(static_cast<Eigen::Index>(i)) = ws.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
-    return phi;
-  };
-  Eigen::MatrixXd P(N, N);
-  for (std::size_t j = 0; j < n; ++j) {
-    std::fill(ws.rod_extra_mmf.begin(), ws.rod_extra_mmf.end(), 0.0);
-    ws.rod_extra_mmf[j] = 1.0;
-    P.col(static_cast<Eigen::Index>(j)) = rod_flux(0.0);
-  }
-  std::fill(ws.rod_extra_mmf.begin(), ws.rod_extra_mmf.end(), 0.0);
-  const Eigen::MatrixXd RS = P.inverse();  // R_p + S
-  const Eigen::VectorXd b = RS * rod_flux(1.0);
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto& rc = c.rods[i];
-    const auto& r = s.rods[i];
-    for (std::size_t j = 0; j < n; ++j)
-      L.port_S_per_H.push_back(RS(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) -
-                               (i == j ? Rp[i] - rc.series_reluctance_per_H : 0.0));
-    L.port_b_At_per_A.push_back(b(static_cast<Eigen::Index>(i)));
-    L.length_m.push_back(rc.length_m);
-    L.kappa_s_m_per_H.push_back(rc.eddy_geometry_s_m_per_H);
-    L.area_m2.push_back(rc.area_m2);
-    const double chi = reversible_susceptibility(m, rc, r);
-    L.chi.push_back(chi);
-    L.tau_s.push_back(kMu0 * (1.0 + chi) * rc.eddy_geometry_s_m_per_H);
-  }
-}
-
-// Printed magnetic state: the circuit's dHc/dI at fixed M (linear in I, so any step is
-// exact) and dHc/dM_j at fixed I; the eddy lag (eq. 7) and JA with M_irr pinned (eq. 9):
-// M = (1-c) M_irr + c M_an(H + alpha M).
-void linearise_circuit(const Model& m, const Conditions& c, const State& s, CircuitWorkspace& ws,
-                       const std::vector<double>& M0, SmallSignalModel& L) {
-  const std::size_t n = s.rods.size();
-  const double I0 = s.current_A;
-  const double dI = 1e-2;
-  const auto Hp = static_fields(m, c, ws, I0 + dI, M0);
-  const auto Hm = static_fields(m, c, ws, I0 - dI, M0);
-  for (std::size_t i = 0; i < n; ++i) L.g_A_per_m_per_A.push_back((Hp[i] - Hm[i]) / (2 * dI));
-  for (std::size_t j = 0; j < n; ++j) {
-    const double dM = 1e-5 * c.rods[j].MsT_mu;
-    auto Mp = M0, Mm = M0;
-    Mp[j] += dM;
-    Mm[j] -= dM;
-    const auto Hpj = static_fields(m, c, ws, I0, Mp);
-    const auto Hmj = static_fields(m, c, ws, I0, Mm);
-    for (std::size_t i = 0; i < n; ++i) L.G[i * n + j] = (Hpj[i] - Hmj[i]) / (2 * dM);
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto& rc = c.rods[i];
-    const auto& r = s.rods[i];
-    L.tau_s.push_back(mu_at(m, i, rc, r.M_A_per_m) * rc.eddy_geometry_s_m_per_H);
-    L.chi.push_back(reversible_susceptibility(m, rc, r));
-  }
-}
-
-// Force and stiffness: F_net,i = F_i(M_i) - K_i(M) x0_i (eq. 14-18 about the bias).
-void linearise_forces(const Model& m, const Conditions& c, const State& s,
-                      const std::vector<double>& M0, SmallSignalModel& L) {
-  const std::size_t n = s.rods.size();
-  L.D_N_per_A_per_m.assign(n * n, 0.0);
-  for (std::size_t j = 0; j < n; ++j) {
-    const double dM = 1e-5 * c.rods[j].MsT_mag;
-    State sp = s, sm = s;
-    const auto fp = force_at(m, c.rods[j], M0[j] + dM);
-    const auto fm = force_at(m, c.rods[j], M0[j] - dM);
-    sp.rods[j].k_rod_N_per_m = fp.k_rod;
-    sm.rods[j].k_rod_N_per_m = fm.k_rod;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double dK = (oscillator_stiffness(c, sp, static_cast<int>(i)) -
-                         oscillator_stiffness(c, sm, static_cast<int>(i))) /
-                        (2 * dM);
-      double d = -dK * s.rods[i].x_m;
-      if (i == j) d += (fp.F - fm.F) / (2 * dM);
-      L.D_N_per_A_per_m[i * n + j] = d;
-    }
-  }
-}
-
-}  // namespace
-
-SmallSignalModel linearise(const Model& m, const Conditions& c, const State& s) {
-  const std::size_t n = s.rods.size();
-  SmallSignalModel L;
-  L.temperature_C = c.temperature_C;
-  L.bias_A = s.current_A;
-  L.n = static_cast<int>(n);
-  L.y0_m = s.y_m;
-  std::vector<double> M0(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    M0[i] = s.rods[i].M_A_per_m;
-    L.M0_A_per_m.push_back(M0[i]);
-    L.H0_A_per_m.push_back(s.rods[i].H_A_per_m);
-    L.x0_m.push_back(s.rods[i].x_m);
-  }
-  CircuitWorkspace ws;
-  ws.resize(m.circuit);
-  if (m.sensor_mount.enabled) {
-    L.sensor_mount = true;
-    L.sm_mass_kg = m.sensor_mount.mass_kg;
-    L.sm_stiffness_N_per_m = m.sensor_mount.stiffness_N_per_m;
-    L.sm_damping_N_s_per_m = m.sensor_mount.damping_N_s_per_m;
-    for (std::size_t i = 0; i < n; ++i)
-      L.recoil_per_x.push_back(c.rods[i].momentum_mass_kg / m.sensor_mount.actuator_mass_kg);
-  }
-  L.G.assign(n * n, 0.0);
-  if (m.options.magnetic_state == MagneticState::Consistent) {
-    linearise_ports(m, c, s, ws, L);
-  } else {
-    linearise_circuit(m, c, s, ws, M0, L);
-  }
-  linearise_forces(m, c, s, M0, L);
-  for (std::size_t i = 0; i < n; ++i) {
-    L.mass_kg.push_back(c.rods[i].mass_osc_kg);
-    L.damping_N_s_per_m.push_back(c.rods[i].damping_osc_N_s_per_m);
-    L.stiffness_N_per_m.push_back(oscillator_stiffness(c, s, static_cast<int>(i)));
-  }
-  return L;
-}
-
-std::complex<double> SmallSignalModel::response(double f_Hz) const {
-  const auto N = static_cast<Eigen::Index>(n);
-  const cd sj(0.0, kTwoPi * f_Hz);
-  Eigen::MatrixXcd A = Eigen::MatrixXcd::Identity(N, N);
-  Eigen::VectorXcd b(N);
-  Eigen::VectorXcd dM(N);
-  if (consistent) {  // port equations of the rods (see the struct), solved for dH
-    for (Eigen::Index i = 0; i < N; ++i) {
-      const auto ui = static_cast<std::size_t>(i);
-      b(i) = port_b_At_per_A[ui];
-      for (Eigen::Index j = 0; j < N; ++j) {
-        const auto uj = static_cast<std::size_t>(j);
-        A(i, j) = port_S_per_H[ui * static_cast<std::size_t>(n) + uj] * area_m2[uj] * kMu0 *
-                  (1.0 + chi[uj]);
-      }
-      A(i, i) += length_m[ui] * (1.0 + kappa_s_m_per_H[ui] * sj * kMu0 * (1.0 + chi[ui]));
-    }
-    const Eigen::VectorXcd dH = A.partialPivLu().solve(b);
-    for (Eigen::Index i = 0; i < N; ++i) dM(i) = chi[static_cast<std::size_t>(i)] * dH(i);
-  } else {
-    for (Eigen::Index i = 0; i < N; ++i) {
-      const auto ui = static_cast<std::size_t>(i);
-      const cd lag_chi = chi[ui] / (1.0 + tau_s[ui] * sj);  // dM_i / dHc_i
-      b(i) = lag_chi * g_A_per_m_per_A[ui];
-      for (Eigen::Index j = 0; j < N; ++j)
-        A(i, j) -= lag_chi * G[ui * static_cast<std::size_t>(n) + static_cast<std::size_t>(j)];
-    }
-    dM = A.partialPivLu().solve(b);
-  }
-  cd Y = 0.0, Q = 0.0;
-  for (Eigen::Index i = 0; i < N; ++i) {
-    const auto ui = static_cast<std::size_t>(i);
-    cd dF = 0.0;
-    for (Eigen::Index j = 0; j < N; ++j)
-      dF += D_N_per_A_per_m[ui * static_cast<std::size_t>(n) + static_cast<std::size_t>(j)] * dM(j);
-    const cd X = dF / (mass_kg[ui] * sj * sj + damping_N_s_per_m[ui] * sj + stiffness_N_per_m[ui]);
-    Y += X;
-    if (sensor_mount) Q += recoil_per_x[ui] * X;
-  }
-  // The probe's deflection u = Q s^2 / (s^2 + (c/m) s + k/m) (model.hpp, SensorMountModel).
-  if (sensor_mount)
-    Y -= Q * sj * sj * sm_mass_kg /
-         (sm_mass_kg * sj * sj + sm_damping_N_s_per_m * sj + sm_stiffness_N_per_m);
-  return Y;
-}
-
-// ---------------------------------------------------------------------------------------
-// Modes of eq. (15)
-// ---------------------------------------------------------------------------------------
-std::vector<Mode> mechanical_modes(const Model& m, const Conditions& c, const State& s) {
-  (void)m;
-  const auto N = static_cast<Eigen::Index>(s.rods.size());
-  // Eq. (15) with the diagonal M, C, K of eq. (16), (24), (25); assembled as full
-  // matrices so a model with coupling terms would be handled the same way.
-  Eigen::MatrixXd Mm = Eigen::MatrixXd::Zero(N, N), Cm = Mm, Km = Mm;
-  for (Eigen::Index i = 0; i < N; ++i) {
-    const auto& rc = c.rods[static_cast<std::size_t>(i)];
-    Mm(i, i) = rc.mass_osc_kg;
-    Cm(i, i) = rc.damping_osc_N_s_per_m;
-    Km(i, i) = oscillator_stiffness(c, s, static_cast<int>(i));
-  }
-  // Undamped modes: K v = w^2 M v; classical modal damping zeta = v'Cv / (2 w v'Mv).
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> es(Km, Mm);
-  std::vector<Mode> modes;
-  for (Eigen::Index k = 0; k < N; ++k) {
-    const double w = std::sqrt(std::max(es.eigenvalues()(k), 0.0));
-    const Eigen::VectorXd v = es.eigenvectors().col(k);
-    Mode md;
-    md.frequency_Hz = w / kTwoPi;
-    md.damping_ratio = w > 0 ? v.dot(Cm * v) / (2.0 * w * v.dot(Mm * v)) : 0.0;
-    md.damped_frequency_Hz =
-        md.damping_ratio < 1.0
-            ? md.frequency_Hz * std::sqrt(1.0 - md.damping_ratio * md.damping_ratio)
-            : 0.0;
-    modes.push_back(md);
-  }
-  std::sort(modes.begin(), modes.end(),
-            [](const Mode& a, const Mode& b) { return a.frequency_Hz < b.frequency_Hz; });
-  return modes;
-}
 
 // ---------------------------------------------------------------------------------------
 // Measurement helpers

@@ -1,13 +1,13 @@
 // gmasim frf's bias point (Fig. 15): the actuator settled at a DC bias current, in the
 // anhysteretic state an AC shake-down leaves or on its virgin curve (settle_at_bias,
-// gmasim/experiments.hpp). docs/experiments.md, "Frequency response".
+// gmasim/experiments/experiments.hpp). docs/experiments.md, "Frequency response".
 #include <algorithm>
 #include <cmath>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/experiments.hpp"
+#include "gmasim/experiments/experiments.hpp"
 #include "gmasim/magnetisation/laws.hpp"
-#include "gmasim/run_loop.hpp"
+#include "gmasim/simulate/run_loop.hpp"
 
 namespace gmasim {
 namespace {
@@ -35,8 +35,8 @@ void anhysteretic_fixed_point(const Model& m, const Conditions& c, State& s, dou
       const auto& rc = c.rods[i];
       auto& r = s.rods[i];
       const double M = Law::anhysteretic_magnetisation(rc, r);
-      change = std::max(change, Law::hold_anhysteretic(r, M) / rc.MsT_mag);
-      r.M_prev_A_per_m = M;
+      change = std::max(change, Law::hold_anhysteretic(rc, r, M) / rc.MsT_mag);
+      r.M_prev_A_per_m = r.M_A_per_m;
     }
     run_dc(m, c, s, bias_A, std::max(5.0 * tau_max, 1e-3));
     if (change < 1e-10) break;
@@ -45,10 +45,6 @@ void anhysteretic_fixed_point(const Model& m, const Conditions& c, State& s, dou
 
 template <class Law>
 State settle_law(const Model& m, const Conditions& c, double bias_A, BiasState bias_state) {
-  if (bias_state == BiasState::Anhysteretic && !Law::kHasAnhysteretic)
-    throw InputError(
-        "the anhysteretic bias state is not available for options.magnetisation_law = "
-        "\"preisach\"; use the initial curve (frf --bias-state initial-curve)");
   State s;
   if (bias_state == BiasState::Anhysteretic &&
       m.options.magnetic_state == MagneticState::Consistent) {
@@ -56,12 +52,14 @@ State settle_law(const Model& m, const Conditions& c, double bias_A, BiasState b
     // reduced to its anhysteretic curve, M = M_an(H + alpha M) (c = 1, eq. 9), so that the
     // circuit, the fields and the magnetisations are solved together (the fixed point above
     // does not converge when a rod's series reluctance makes its branch nearly flux-driven).
-    // Then M_irr = M_an = M, where the full law of eq. (9) holds the same state.
+    // Then M_irr = M_an = M, where the full law of eq. (9) holds the same state (Preisach: the
+    // hysterons' coercive fields shrunk, then the AC-demagnetised state of the full law).
     Conditions anh = c;
     for (auto& rc : anh.rods) Law::reduce_to_anhysteretic(rc);
     s = make_state(m, anh, bias_A);
-    for (auto& r : s.rods) {
-      (void)Law::hold_anhysteretic(r, r.M_A_per_m);
+    for (std::size_t i = 0; i < s.rods.size(); ++i) {
+      auto& r = s.rods[i];
+      (void)Law::hold_anhysteretic(c.rods[i], r, r.M_A_per_m);
       r.M_prev_A_per_m = r.M_A_per_m;
     }
   } else {

@@ -6,7 +6,7 @@
 #include <complex>
 #include <vector>
 
-#include "gmasim/experiments.hpp"
+#include "gmasim/experiments/experiments.hpp"
 
 namespace gmasim::detail {
 

@@ -1,6 +1,6 @@
-// What the sensitivities say about identifiability (gmasim/sensitivity.hpp): the Jacobian in
-// units of each quantity's tolerance, its singular directions, and the correlations of the
-// parameters a fit to the quantities would have. docs/experiments.md, "Sensitivity".
+// What the sensitivities say about identifiability (gmasim/experiments/sensitivity.hpp): the
+// Jacobian in units of each quantity's tolerance, its singular directions, and the correlations of
+// the parameters a fit to the quantities would have. docs/experiments.md, "Sensitivity".
 #include <fmt/format.h>
 
 #include <Eigen/Dense>
@@ -10,7 +10,7 @@
 #include <numeric>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/sensitivity.hpp"
+#include "gmasim/experiments/sensitivity.hpp"
 
 namespace gmasim {
 namespace {

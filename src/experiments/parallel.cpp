@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/model/validate.hpp"
 
 namespace gmasim {
 

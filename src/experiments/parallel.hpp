@@ -6,7 +6,7 @@
 #include <cstddef>
 #include <functional>
 
-#include "gmasim/experiments.hpp"
+#include "gmasim/experiments/experiments.hpp"
 
 namespace gmasim::detail {
 

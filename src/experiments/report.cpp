@@ -2,7 +2,7 @@
 // units). Written as CSV and JSON by src/io/report_text.cpp.
 #include <cmath>
 
-#include "gmasim/experiments.hpp"
+#include "gmasim/experiments/experiments.hpp"
 #include "gmasim/physics/magnetic.hpp"
 
 namespace gmasim {

@@ -1,6 +1,6 @@
 // The whole study of the paper, and the claims table of READING-NOTES (the claims are data:
 // data/claims.toml; their extractors are src/experiments/claims.cpp).
-#include "gmasim/reproduce.hpp"
+#include "gmasim/experiments/reproduce.hpp"
 
 #include <fmt/format.h>
 

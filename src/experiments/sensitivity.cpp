@@ -1,7 +1,7 @@
 // gmasim sensitivity: d q / d ln p (or d q / d p) of every claim and metric quantity by
 // central differences at two step sizes, all evaluations' experiment points on one work
 // list. docs/experiments.md, "Sensitivity".
-#include "gmasim/sensitivity.hpp"
+#include "gmasim/experiments/sensitivity.hpp"
 
 #include <fmt/format.h>
 
@@ -14,7 +14,7 @@
 #include "experiments/claim_plan.hpp"
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/model/validate.hpp"
 
 namespace gmasim {
 namespace {

@@ -1,9 +1,9 @@
-// The metric quantities of `gmasim sensitivity` (gmasim/sensitivity.hpp): scalars a user
-// cares about beside the paper's claims, each read from a simulate run at one operating point
+// The metric quantities of `gmasim sensitivity` (gmasim/experiments/sensitivity.hpp): scalars a
+// user cares about beside the paper's claims, each read from a simulate run at one operating point
 // (the sweep's settings: a biased sine from -3 A, 3 periods, the last measured) with the
-// energy ledgers booked (gmasim/energy.hpp). A new scalar is one row; rows at the same
+// energy ledgers booked (gmasim/model/energy.hpp). A new scalar is one row; rows at the same
 // operating point share one run.
-#include "gmasim/sensitivity.hpp"
+#include "gmasim/experiments/sensitivity.hpp"
 
 namespace gmasim {
 

@@ -7,8 +7,8 @@
 
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/experiments.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/model/validate.hpp"
 
 namespace gmasim {
 namespace {

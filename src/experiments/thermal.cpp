@@ -1,6 +1,6 @@
 // Thermal expansion coefficient of the stack, eq. (21): the alpha*l products of the model.
-#include "gmasim/claims.hpp"
-#include "gmasim/experiments.hpp"
+#include "gmasim/experiments/claims.hpp"
+#include "gmasim/experiments/experiments.hpp"
 
 namespace gmasim {
 

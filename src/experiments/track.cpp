@@ -14,12 +14,12 @@
 #include "experiments/parallel.hpp"
 #include "experiments/track_loop.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/experiments.hpp"
-#include "gmasim/feedforward.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/experiments/feedforward.hpp"
+#include "gmasim/model/validate.hpp"
 #include "gmasim/physics/magnetic.hpp"
-#include "gmasim/run_loop.hpp"
-#include "gmasim/simulate.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/simulate/run_loop.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim {
 

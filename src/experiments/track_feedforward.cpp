@@ -1,6 +1,6 @@
 // The inverse feed-forward against plants that differ from its model (issue 20): the PID
 // alone, with the temperature feed-forward and with the inverse feed-forward, on the 16
-// mismatched plants of plant_mismatches(). gmasim/feedforward.hpp; docs/experiments.md,
+// mismatched plants of plant_mismatches(). gmasim/experiments/feedforward.hpp; docs/experiments.md,
 // "Inverse-model feed-forward".
 #include <fmt/format.h>
 
@@ -14,10 +14,10 @@
 
 #include "experiments/parallel.hpp"
 #include "experiments/track_loop.hpp"
-#include "gmasim/compensate.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/feedforward.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/experiments/compensate.hpp"
+#include "gmasim/experiments/feedforward.hpp"
+#include "gmasim/model/validate.hpp"
 
 namespace gmasim {
 namespace {

@@ -4,8 +4,8 @@
 
 #include <cstdint>
 
-#include "gmasim/experiments.hpp"
-#include "gmasim/feedforward.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/experiments/feedforward.hpp"
 
 namespace gmasim::detail {
 

@@ -22,7 +22,7 @@
 #include <utility>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/io/io.hpp"
 #include "identify/islands.hpp"
 #include "internal.hpp"
 

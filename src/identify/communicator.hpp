@@ -1,4 +1,4 @@
-// Internal: the collectives identify() runs over a Communicator (gmasim/identify.hpp): a
+// Internal: the collectives identify() runs over a Communicator (gmasim/identify/identify.hpp): a
 // single process, or MPI (OpenMPI) when the library is built with GMASIM_WITH_MPI. Only the
 // main thread calls them (MPI_THREAD_FUNNELED); islands and evaluation threads never do.
 #pragma once
@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "gmasim/identify.hpp"
+#include "gmasim/identify/identify.hpp"
 
 namespace gmasim::identify_detail {
 

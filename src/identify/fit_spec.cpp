@@ -14,10 +14,10 @@
 
 #include "common/text_io.hpp"
 #include "common/toml_io.hpp"
-#include "gmasim/claims.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/identify.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/experiments/claims.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/io/io.hpp"
 
 namespace gmasim {
 namespace {

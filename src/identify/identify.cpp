@@ -7,7 +7,7 @@
 #include <thread>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/model/validate.hpp"
 #include "internal.hpp"
 
 namespace gmasim {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "gmasim/identify.hpp"
+#include "gmasim/identify/identify.hpp"
 #include "identify/communicator.hpp"
 
 namespace gmasim::identify_detail {

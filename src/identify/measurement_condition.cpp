@@ -13,8 +13,8 @@
 #include "common/text_io.hpp"
 #include "common/toml_io.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/validate.hpp"
-#include "gmasim/validity.hpp"
+#include "gmasim/model/validate.hpp"
+#include "gmasim/model/validity.hpp"
 
 namespace gmasim {
 namespace identify_detail {

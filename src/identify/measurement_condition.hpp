@@ -8,7 +8,7 @@
 #include <string>
 #include <string_view>
 
-#include "gmasim/identify.hpp"
+#include "gmasim/identify/identify.hpp"
 
 namespace gmasim::identify_detail {
 

@@ -15,9 +15,9 @@
 #include "common/text_io.hpp"
 #include "common/toml_io.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/identify.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/validate.hpp"
 #include "identify/measurement_condition.hpp"
 
 namespace gmasim {

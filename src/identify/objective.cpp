@@ -9,8 +9,8 @@
 #include <span>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/identify.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/model/validate.hpp"
 #include "identify/objective_impl.hpp"
 
 namespace gmasim {

@@ -7,7 +7,7 @@
 #include <optional>
 #include <span>
 
-#include "gmasim/identify.hpp"
+#include "gmasim/identify/identify.hpp"
 #include "identify/objective_impl.hpp"
 
 namespace gmasim {

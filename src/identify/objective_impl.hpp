@@ -1,6 +1,7 @@
-// The identification objective's internals (gmasim/identify.hpp, Objective): its parameters,
-// records and targets, and the residual evaluation, shared by objective.cpp (construction,
-// evaluation) and objective_fits.cpp (the fit report's per-record and per-target view).
+// The identification objective's internals (gmasim/identify/identify.hpp, Objective): its
+// parameters, records and targets, and the residual evaluation, shared by objective.cpp
+// (construction, evaluation) and objective_fits.cpp (the fit report's per-record and per-target
+// view).
 #pragma once
 
 #include <fmt/format.h>
@@ -11,7 +12,7 @@
 #include <vector>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/identify.hpp"
+#include "gmasim/identify/identify.hpp"
 #include "identify/objective_runs.hpp"
 #include "identify/record_run.hpp"
 

@@ -8,9 +8,9 @@
 #include <cmath>
 #include <limits>
 
-#include "gmasim/experiments.hpp"
+#include "gmasim/experiments/experiments.hpp"
+#include "gmasim/model/validate.hpp"
 #include "gmasim/physics/magnetic.hpp"
-#include "gmasim/validate.hpp"
 #include "identify/record_run.hpp"
 
 namespace gmasim {

@@ -6,8 +6,8 @@
 #include <utility>
 #include <vector>
 
-#include "gmasim/identify.hpp"
-#include "gmasim/run_loop.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/simulate/run_loop.hpp"
 
 namespace gmasim::identify_detail {
 

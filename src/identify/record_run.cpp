@@ -11,9 +11,9 @@
 #include <cstdint>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/run_loop.hpp"
-#include "gmasim/validate.hpp"
-#include "gmasim/validity.hpp"
+#include "gmasim/model/validate.hpp"
+#include "gmasim/model/validity.hpp"
+#include "gmasim/simulate/run_loop.hpp"
 
 namespace gmasim::identify_detail {
 namespace {

@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "gmasim/identify.hpp"
+#include "gmasim/identify/identify.hpp"
 
 namespace gmasim::identify_detail {
 

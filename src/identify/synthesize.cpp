@@ -6,9 +6,9 @@
 #include <cstdint>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/identify.hpp"
+#include "gmasim/identify/identify.hpp"
+#include "gmasim/model/validate.hpp"
 #include "gmasim/physics/magnetic.hpp"
-#include "gmasim/validate.hpp"
 #include "identify/record_run.hpp"
 
 namespace gmasim {

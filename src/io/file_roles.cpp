@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/validate.hpp"
 
 namespace gmasim {
 namespace {

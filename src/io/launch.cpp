@@ -1,4 +1,4 @@
-// Running the Python package from C++ (figures): posix_spawnp, no shell (gmasim/io.hpp).
+// Running the Python package from C++ (figures): posix_spawnp, no shell (gmasim/io/io.hpp).
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "gmasim/io.hpp"
+#include "gmasim/io/io.hpp"
 
 namespace gmasim {
 

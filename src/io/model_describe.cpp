@@ -6,7 +6,7 @@
 
 #include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/io/io.hpp"
 #include "io/model_loader.hpp"
 #include "io/schema.hpp"
 

@@ -1,5 +1,5 @@
 // Model files: TOML -> ModelSpec. This file holds the generic readers, the reading of the
-// numbers and options by the parameter table (gmasim/parameters.hpp) and the public entry
+// numbers and options by the parameter table (gmasim/model/parameters.hpp) and the public entry
 // points; the structure sections are in model_structure.cpp, `model show` in
 // model_describe.cpp.
 #include "io/model_loader.hpp"
@@ -13,7 +13,7 @@
 #include "common/text_io.hpp"
 #include "common/toml_io.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/io/io.hpp"
 #include "io/schema.hpp"
 
 namespace gmasim {
@@ -308,6 +308,7 @@ void ModelLoader::read_options(const toml::table& root) {
   for (const auto& o : option_table()) keys.emplace_back(o.key);
   check_keys(*t, "[options]", keys);
   const long tl = node_line(*t);
+  spec_.option_lines["[options]"] = tl;  // model save adds an omitted option below it
   bool ok = true;
   for (const auto& o : option_table()) {
     if (!o.default_word.empty() && !t->get(o.key)) continue;  // omitted: its default stands

@@ -1,5 +1,5 @@
 // Internal: the model-file reader (TOML -> ModelSpec). The numbers and options are read by
-// the parameter table (gmasim/parameters.hpp); the structure (rods, circuit, sensor, load
+// the parameter table (gmasim/model/parameters.hpp); the structure (rods, circuit, sensor, load
 // chains) by the section readers of model_structure.cpp. Every problem of a file is
 // collected with its line and reported together. Not part of the public API.
 #pragma once
@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 
 namespace gmasim::io_detail {
 

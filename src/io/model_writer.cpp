@@ -12,8 +12,8 @@
 
 #include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/model/validate.hpp"
 #include "io/schema.hpp"
 
 namespace gmasim {
@@ -95,11 +95,68 @@ void replace_alternative(std::vector<std::string>& lines, const ModelSpec& origi
                      schema::toml_float(other->second.value));
 }
 
+// The table leaf of a magnetisation law's group ("ja", "preisach").
+std::string law_leaf(MagnetisationLaw law) {
+  for (const GroupDef& g : parameter_groups())
+    if (g.law && *g.law == law) return std::string(g.path.substr(g.path.rfind('.') + 1));
+  return {};
+}
+
+// A change of magnetisation law: each rod's table of the old law ([<rod>.ja]) is commented out
+// in place (its line numbers stay valid), with a note on its header line.
+void comment_out_law_tables(std::vector<std::string>& lines, const ModelSpec& original,
+                            const std::string& new_word, const std::string& why) {
+  const std::string leaf = law_leaf(original.options.magnetisation_law);
+  for (const auto& rod : original.rods) {
+    const std::string header = "[" + rod + "." + leaf + "]";
+    std::size_t k = 0;
+    while (k < lines.size() && !io_detail::trim(lines[k]).starts_with(header)) ++k;
+    if (k == lines.size())
+      throw InputError(fmt::format(
+          "{}: cannot change options.magnetisation_law: the law's table {} is not a table of "
+          "its own in the file (write it as a [{}.{}] section)",
+          original.source, header, rod, leaf));
+    lines[k] = fmt::format("# {}  # unused: options.magnetisation_law = \"{}\" (set: {})",
+                           io_detail::trim(lines[k]), new_word, why);
+    for (++k; k < lines.size() && !io_detail::trim(lines[k]).starts_with('['); ++k)
+      if (!io_detail::trim(lines[k]).empty()) lines[k] = "# " + lines[k];
+  }
+}
+// The changed options: on their lines, or (an omitted option) into `added` for [options].
+void write_options(std::vector<std::string>& lines,
+                   std::map<std::string, std::vector<std::string>>& added, const ModelSpec& spec,
+                   const ModelSpec& original, const std::string& why) {
+  auto leaf_of = [](const std::string& dotted) { return dotted.substr(dotted.rfind('.') + 1); };
+  for (const auto& def : option_table()) {
+    const std::string name = "options." + std::string(def.key);
+    const std::string value(option_word(def, spec.options));
+    const std::string was(option_word(def, original.options));
+    if (value == was) continue;
+    if (!original.option_lines.count(name)) {  // an omitted option: added to [options]
+      const std::string text = def.boolean ? value : "\"" + value + "\"";
+      added["options"].push_back(
+          fmt::format("{} = {}  # set: {}; was its default {}", def.key, text, why, was));
+      continue;
+    }
+    const long line_no = spec.line_of(name);
+    const std::string& line = lines.at(static_cast<std::size_t>(std::max(1L, line_no) - 1));
+    const auto span = schema::value_span(line, leaf_of(name));
+    const bool quoted = span && span->begin < line.size() && line[span->begin] == '"';
+    replace_value(lines, line_no, leaf_of(name), quoted ? "\"" + value + "\"" : value,
+                  fmt::format("set: {}; was {}", why, was), spec.source);
+  }
+}
 }  // namespace
 
 ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assignments,
                             std::string_view flag) {
+  // The options first, together (checked as a whole): a change of magnetisation law brings
+  // the new law's numbers into the spec (ModelSpec::set_options), which the numbers may set.
   std::vector<std::pair<std::string, std::string>> options;
+  struct Number {
+    std::string shown, name, value;
+  };
+  std::vector<Number> numbers;
   for (const std::string& a : assignments) {
     const std::string shown = clip_for_message(a);
     const auto eq = a.find('=');
@@ -116,9 +173,13 @@ ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assi
       if (value.empty() || value.find_first_of(" \t\"'#") != std::string::npos)
         throw InputError(
             fmt::format("{} '{}': an option value is one word (no spaces or quotes)", flag, shown));
-      options.emplace_back(name, value);  // set together below: checked as a whole
+      options.emplace_back(name, value);
       continue;
     }
+    numbers.push_back({shown, name, value});
+  }
+  if (!options.empty()) spec.set_options(options);
+  for (const auto& [shown, name, value] : numbers) {
     double v = 0;
     if (io_detail::parse_finite(value, v) != io_detail::CellError::None)
       throw InputError(
@@ -129,20 +190,30 @@ ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assi
       throw InputError(fmt::format("{} '{}': {}", flag, shown, e.what()));
     }
   }
-  if (!options.empty()) spec.set_options(options);
   return spec;
 }
 
 std::string model_toml(const ModelSpec& spec, const std::string& why) {
   if (spec.text.empty())
     throw InputError(fmt::format("{}: the model has no source text to save from", spec.source));
+  if (auto missing = schema::unset_message(spec))
+    throw InputError(fmt::format("{}: {}", spec.source, *missing));
   const ModelSpec original = parse_model_spec(spec.text, spec.source);
+  const bool law_changed = spec.options.magnetisation_law != original.options.magnetisation_law;
+  const std::string new_law_leaf = law_leaf(spec.options.magnetisation_law);
   const auto views = io_detail::split_lines(spec.text);
   std::vector<std::string> lines(views.begin(), views.end());
   auto leaf_of = [](const std::string& dotted) { return dotted.substr(dotted.rfind('.') + 1); };
   std::map<std::string, std::vector<std::string>> added;  // table -> new "key = value" lines
   for (const auto& [name, pv] : spec.params) {
     const auto it = original.params.find(name);
+    const std::string table = name.substr(0, name.rfind('.'));
+    if (it == original.params.end() && law_changed &&
+        table.ends_with("." + new_law_leaf)) {  // the new law's numbers: its new tables
+      added[table].push_back(
+          fmt::format("{} = {}  # set: {}", leaf_of(name), schema::toml_float(pv.value), why));
+      continue;
+    }
     if (it == original.params.end()) {
       replace_alternative(lines, original, name, pv.value, why);
       continue;
@@ -159,25 +230,13 @@ std::string model_toml(const ModelSpec& spec, const std::string& why) {
     replace_value(lines, was.line, leaf_of(name), schema::toml_float(pv.value), comment,
                   spec.source);
   }
-  for (const auto& def : option_table()) {
-    const std::string name = "options." + std::string(def.key);
-    const std::string value(option_word(def, spec.options));
-    const std::string was(option_word(def, original.options));
-    if (value == was) continue;
-    if (!original.option_lines.count(name))  // an omitted option with a default
-      throw InputError(fmt::format(
-          "{}: {} is not in the model file (its default stands); changing it needs the line in "
-          "[options] (and, for magnetisation_law, the law's tables: docs/model.md)",
-          spec.source, name));
-    const long line_no = spec.line_of(name);
-    const std::string& line = lines.at(static_cast<std::size_t>(std::max(1L, line_no) - 1));
-    const auto span = schema::value_span(line, leaf_of(name));
-    const bool quoted = span && span->begin < line.size() && line[span->begin] == '"';
-    replace_value(lines, line_no, leaf_of(name), quoted ? "\"" + value + "\"" : value,
-                  fmt::format("set: {}; was {}", why, was), spec.source);
-  }
-  // Defaulted keys: below their table's header if the file has one, else in a new table at
-  // the end (bottom-up, so earlier line numbers stay valid).
+  write_options(lines, added, spec, original, why);
+  if (law_changed)
+    comment_out_law_tables(
+        lines, original,
+        std::string(option_word(*find_option_def("options.magnetisation_law"), spec.options)), why);
+  // Defaulted keys and omitted options: below their table's header if the file has one, else
+  // in a new table at the end (bottom-up, so earlier line numbers stay valid).
   std::vector<std::pair<long, std::string>> inserts;
   std::string appended;
   for (const auto& [table, keys] : added) {

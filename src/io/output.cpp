@@ -27,7 +27,7 @@
 
 #include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
+#include "gmasim/io/io.hpp"
 #include "io/json.hpp"
 
 namespace gmasim {
@@ -352,7 +352,7 @@ void write_self_heating(JsonWriter& w, const Result& r) {
   w.end_object();
 }
 
-// The energy ledgers over the metrics window (gmasim/energy.hpp), as mean powers [W], and
+// The energy ledgers over the metrics window (gmasim/model/energy.hpp), as mean powers [W], and
 // the coil's terminal quantities.
 void write_energy(JsonWriter& w, const Model& m, const Result& r) {
   const auto& e = r.energy;

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <iterator>
 
-#include "gmasim/io.hpp"
+#include "gmasim/io/io.hpp"
 #include "io/json.hpp"
 
 namespace gmasim {

@@ -8,8 +8,8 @@
 
 #include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/reproduce.hpp"
+#include "gmasim/experiments/reproduce.hpp"
+#include "gmasim/io/io.hpp"
 
 namespace gmasim {
 namespace {

@@ -1,11 +1,11 @@
-// The files of `gmasim sensitivity` (gmasim/sensitivity.hpp): sensitivity.csv (long format),
-// sensitivity.json and identifiability.json. docs/experiments.md, "Sensitivity".
+// The files of `gmasim sensitivity` (gmasim/experiments/sensitivity.hpp): sensitivity.csv (long
+// format), sensitivity.json and identifiability.json. docs/experiments.md, "Sensitivity".
 #include <fmt/format.h>
 
 #include <cmath>
 
-#include "gmasim/io.hpp"
-#include "gmasim/sensitivity.hpp"
+#include "gmasim/experiments/sensitivity.hpp"
+#include "gmasim/io/io.hpp"
 #include "io/json.hpp"
 
 namespace gmasim {

@@ -8,8 +8,8 @@
 
 #include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/io.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/io/io.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim {
 

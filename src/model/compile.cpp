@@ -1,6 +1,6 @@
-// ModelSpec -> Model: the numbers land where the parameter table says (gmasim/parameters.hpp),
-// then the structure (circuit, sensor, load chains) is assembled and the derived quantities
-// formed.
+// ModelSpec -> Model: the numbers land where the parameter table says
+// (gmasim/model/parameters.hpp), then the structure (circuit, sensor, load chains) is assembled and
+// the derived quantities formed.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -8,8 +8,8 @@
 #include <numbers>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/model.hpp"
-#include "gmasim/validity.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/model/validity.hpp"
 #include "model/schema.hpp"
 
 namespace gmasim {
@@ -22,6 +22,7 @@ namespace {
 // The rules of every number and of the options, as the loader applies them: a spec built or
 // edited in code is held to the same rules as a file.
 void check_spec(const ModelSpec& spec) {
+  if (auto missing = schema::unset_message(spec)) fail(spec, 0, *missing);
   for (const auto& [name, pv] : spec.params)
     if (auto problem = schema::check_value(spec, name, pv.value)) fail(spec, pv.line, *problem);
   if (auto problem = check_options(spec.options))
@@ -232,7 +233,7 @@ Model compile(const ModelSpec& spec) {
   build_flux_sensor(spec, m);
   build_chains(spec, m);
   derive(spec, m);
-  check_model_validity(m);  // gmasim/validity.hpp: no rod under a crushing prestress
+  check_model_validity(m);  // gmasim/model/validity.hpp: no rod under a crushing prestress
   return m;
 }
 

@@ -8,10 +8,10 @@
 #include <string_view>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/model/validity.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/mechanics.hpp"
-#include "gmasim/validity.hpp"
 #include "model/conditions_detail.hpp"
 
 namespace gmasim {

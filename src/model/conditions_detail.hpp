@@ -2,7 +2,7 @@
 // scans temperatures with it; make_conditions wraps it).
 #pragma once
 
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 
 namespace gmasim::model_detail {
 

@@ -1,12 +1,12 @@
 // The energy ledgers: per-step booking (called by step()), the stored energies of a state,
 // and the balance between two snapshots. docs/model.md, "Energy ledgers".
-#include "gmasim/energy.hpp"
+#include "gmasim/model/energy.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include "gmasim/magnetisation/laws.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/mechanics.hpp"
 

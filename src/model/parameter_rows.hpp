@@ -6,7 +6,7 @@
 #include <span>
 #include <vector>
 
-#include "gmasim/parameters.hpp"
+#include "gmasim/model/parameters.hpp"
 
 // The land function and its text, from one spelling: GMASIM_LAND(in_rod, RodModel, length_m).
 #define GMASIM_LAND(fn, Struct, field) &fn<&Struct::field>, #Struct "::" #field

@@ -1,7 +1,7 @@
-// The parameter table (gmasim/parameters.hpp): the one place that says which numbers and
+// The parameter table (gmasim/model/parameters.hpp): the one place that says which numbers and
 // options a model file holds, their units, rules and meaning, and where each lands in
 // Model. To add a parameter: a row here, its line in the model files, and the Model field.
-#include "gmasim/parameters.hpp"
+#include "gmasim/model/parameters.hpp"
 
 #include <fmt/format.h>
 
@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 #include "model/parameter_rows.hpp"
 
 namespace gmasim {

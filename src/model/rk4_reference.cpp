@@ -5,11 +5,11 @@
 
 #include "gmasim/errors.hpp"
 #include "gmasim/magnetisation/laws.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
+#include "gmasim/model/rod_laws.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
-#include "gmasim/rod_laws.hpp"
 
 namespace gmasim {
 namespace {

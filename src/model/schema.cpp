@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "gmasim/errors.hpp"
@@ -15,7 +16,7 @@
 namespace gmasim {
 
 // =======================================================================================
-// Schema: the rows of gmasim/parameters.hpp applied to a spec
+// Schema: the rows of gmasim/model/parameters.hpp applied to a spec
 // =======================================================================================
 namespace schema {
 namespace {
@@ -132,6 +133,28 @@ std::vector<std::string> dependents(const ModelSpec& spec, const std::string& do
   return out;
 }
 
+bool is_unset(const ParamValue& pv) { return pv.line == 0 && std::isnan(pv.value); }
+
+std::vector<std::string> unset_parameters(const ModelSpec& spec) {
+  std::vector<std::string> names;
+  for (const auto& [name, pv] : spec.params)
+    if (is_unset(pv)) names.push_back(name);
+  return names;
+}
+
+std::optional<std::string> unset_message(const ModelSpec& spec) {
+  const auto names = unset_parameters(spec);
+  if (names.empty()) return std::nullopt;
+  std::string law;
+  for (const auto& def : option_table())
+    if (def.key == "magnetisation_law") law = option_word(def, spec.options);
+  return fmt::format(
+      "options.magnetisation_law = \"{}\": the model file has no numbers of this law; missing {} "
+      "(give each with --set name=value, e.g. --set {}=..., or write the law's table into the "
+      "file; docs/parameters.md lists them)",
+      law, fmt::join(names, ", "), names.front());
+}
+
 }  // namespace schema
 
 // =======================================================================================
@@ -239,6 +262,29 @@ bool swap_alternative(ModelSpec& spec, const std::string& dotted, double value) 
   return true;
 }
 
+// A change of magnetisation law swaps the rods' law groups: the old law's numbers leave the
+// spec, the new law's rows enter it unset (NaN, line 0: schema::is_unset) or at their default.
+void swap_law_groups(ModelSpec& spec, MagnetisationLaw from, MagnetisationLaw to) {
+  for (const GroupDef& g : parameter_groups()) {
+    if (!g.law || (*g.law != from && *g.law != to)) continue;
+    const std::string leaf(g.path.substr(g.path.rfind('.') + 1));
+    for (const auto& rod : spec.rods) {
+      const std::string prefix = rod + "." + leaf + ".";
+      if (*g.law == from) {
+        auto it = spec.params.lower_bound(prefix);
+        while (it != spec.params.end() && it->first.starts_with(prefix)) it = spec.params.erase(it);
+        continue;
+      }
+      for (const ParamDef& row : parameter_table()) {
+        if (row.group != g.group) continue;
+        ParamValue pv;
+        pv.value = row.default_value.value_or(std::numeric_limits<double>::quiet_NaN());
+        spec.params.emplace(prefix + std::string(row.key), pv);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 void ModelSpec::set(const std::string& dotted, double value) {
@@ -252,7 +298,7 @@ void ModelSpec::set(const std::string& dotted, double value) {
   for (auto& d : schema::dependents(*this, key)) to_check.push_back(std::move(d));
   for (const auto& k : to_check) {
     const auto it = params.find(k);
-    if (it == params.end()) continue;
+    if (it == params.end() || schema::is_unset(it->second)) continue;
     if (auto problem = schema::check_value(*this, k, it->second.value)) {
       pv.value = old;
       throw InputError(
@@ -277,6 +323,8 @@ void ModelSpec::set_options(const std::vector<std::pair<std::string, std::string
   }
   if (auto problem = check_options(changed))
     throw InputError(located(source, line_of(problem->key), problem->message));
+  if (changed.magnetisation_law != options.magnetisation_law)
+    swap_law_groups(*this, options.magnetisation_law, changed.magnetisation_law);
   options = changed;
 }
 

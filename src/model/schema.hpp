@@ -1,4 +1,4 @@
-// Internal: the rules of the parameter table (gmasim/parameters.hpp) applied to a ModelSpec,
+// Internal: the rules of the parameter table (gmasim/model/parameters.hpp) applied to a ModelSpec,
 // shared by the loader (src/io), compile() and ModelSpec::set. Not part of the public API.
 #pragma once
 
@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 
 namespace gmasim::schema {
 
@@ -34,5 +34,14 @@ std::vector<std::string> dependents(const ModelSpec& spec, const std::string& do
 
 // "name = value unit" formatted for messages ({:g}; unit omitted when "-").
 std::string value_with_unit(const std::string& dotted, double value, const std::string& unit);
+
+// A number the spec needs but nobody has given: the rows of a magnetisation law's group that
+// enter the spec when options.magnetisation_law changes to it (ModelSpec::set_options) and
+// that the file does not hold; NaN on line 0 until --set (ModelSpec::set) gives them.
+bool is_unset(const ParamValue& pv);
+// The unset numbers of a spec by dotted name, and the message that names them (nullopt if
+// none): compile() and `gmasim model save` refuse such a spec with it.
+std::vector<std::string> unset_parameters(const ModelSpec& spec);
+std::optional<std::string> unset_message(const ModelSpec& spec);
 
 }  // namespace gmasim::schema

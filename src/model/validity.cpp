@@ -1,6 +1,6 @@
-// Physical validity (gmasim/validity.hpp; issue 19, items 3 and 8): the run loop's guard, the
+// Physical validity (gmasim/model/validity.hpp; issue 19, items 3 and 8): the run loop's guard, the
 // model's hard limits and warnings, and its computable and validated temperature ranges.
-#include "gmasim/validity.hpp"
+#include "gmasim/model/validity.hpp"
 
 #include <fmt/format.h>
 

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "gmasim/physics/magnetic.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim {
 
@@ -24,7 +24,7 @@ MagneticStateCheck check_magnetic_state(const Model& m) {
         const auto where = [&](const std::string& rod, double t) {
           return fmt::format("{}, {:g} degC, {:g} A, {:g} Hz, t = {:.6f} s", rod, T, I, f, t);
         };
-        if (r.has_energy) {  // the worse ledger over the last period (gmasim/energy.hpp)
+        if (r.has_energy) {  // the worse ledger over the last period (gmasim/model/energy.hpp)
           const double res =
               std::max(r.energy.magnetic_residual_rel, r.energy.mechanical_residual_rel);
           if (res > out.energy_residual_rel || !std::isfinite(res)) {

@@ -6,7 +6,7 @@
 #include <utility>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim {
 

@@ -5,11 +5,11 @@
 #include <cmath>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/run_loop.hpp"
-#include "gmasim/self_heating.hpp"
-#include "gmasim/simulate.hpp"
-#include "gmasim/validate.hpp"
-#include "gmasim/validity.hpp"
+#include "gmasim/model/self_heating.hpp"
+#include "gmasim/model/validate.hpp"
+#include "gmasim/model/validity.hpp"
+#include "gmasim/simulate/run_loop.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim {
 namespace {
@@ -152,7 +152,7 @@ void check_record_memory(const Model& m, const SimulationSettings& s, const RunL
                              static_cast<double>(s.record_every) * factor));
 }
 
-// The slower thermal clock of self-heating (gmasim/self_heating.hpp): accumulates the
+// The slower thermal clock of self-heating (gmasim/model/self_heating.hpp): accumulates the
 // losses of each thermal step, advances the network, recomputes the Conditions at the rods'
 // new temperature. The per-step work is allocation-free; the Conditions update once per
 // thermal step is not (make_conditions).
@@ -237,7 +237,7 @@ struct SelfHeatingRun {
     y_sum += st.y_m;
     if (++in_interval < steps_per_interval && !last) return;
     // One thermal step: the interval's mean powers heat the network. The rods' losses are the
-    // energy ledger's hysteresis, eddy-current and damping terms (gmasim/energy.hpp), each
+    // energy ledger's hysteresis, eddy-current and damping terms (gmasim/model/energy.hpp), each
     // >= 0 by its own law.
     const double span = static_cast<double>(in_interval) * dt;
     double eddy = 0, hyst = 0, damp = 0;
@@ -456,7 +456,7 @@ Result simulate(const Model& m, const SimulationSettings& s) {
   try {
     State st = make_state(m, c, w.current_at(0.0));
     st.energy.enabled = energy.enabled;
-    check_physical_validity(m, c, st, 0.0);  // the rest state too (gmasim/validity.hpp)
+    check_physical_validity(m, c, st, 0.0);  // the rest state too (gmasim/model/validity.hpp)
     record(c, st, r.series);
     energy.open(m, c, st, 0);
     heat.begin(c, st, r);

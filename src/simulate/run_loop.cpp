@@ -1,6 +1,6 @@
-// The step grids of the run loop (gmasim/run_loop.hpp): where the step-count limit of every
-// time-stepping is applied.
-#include "gmasim/run_loop.hpp"
+// The step grids of the run loop (gmasim/simulate/run_loop.hpp): where the step-count limit of
+// every time-stepping is applied.
+#include "gmasim/simulate/run_loop.hpp"
 
 #include <fmt/format.h>
 
@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/validate.hpp"
+#include "gmasim/model/validate.hpp"
 
 namespace gmasim {
 namespace {

@@ -1,5 +1,5 @@
 // Stepper: the sample-by-sample session behind the C API and gmasim.Stepper.
-#include "gmasim/stepper.hpp"
+#include "gmasim/simulate/stepper.hpp"
 
 #include <fmt/format.h>
 
@@ -7,10 +7,10 @@
 #include <utility>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/run_loop.hpp"
-#include "gmasim/simulate.hpp"
-#include "gmasim/validate.hpp"
-#include "gmasim/validity.hpp"
+#include "gmasim/model/validate.hpp"
+#include "gmasim/model/validity.hpp"
+#include "gmasim/simulate/run_loop.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim {
 namespace {

@@ -7,7 +7,7 @@
 
 #include "gmasim/errors.hpp"
 #include "gmasim/physics/magnetic.hpp"
-#include "gmasim/simulate.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim {
 namespace {

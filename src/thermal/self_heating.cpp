@@ -1,5 +1,5 @@
 // Self-heating: the lumped thermal network and the loss laws (docs/model.md, "Self-heating").
-#include "gmasim/self_heating.hpp"
+#include "gmasim/model/self_heating.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>

@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "gmasim/gmasim_c.h"
+#include "gmasim/capi/gmasim_c.h"
 
 static int failures = 0;
 
@@ -30,7 +30,7 @@ static int failures = 0;
 
 static const double kPi = 3.14159265358979323846;
 
-/* i(t) = min + pp/2 (1 - cos 2 pi f t): the biased sine of gmasim/simulate.hpp. */
+/* i(t) = min + pp/2 (1 - cos 2 pi f t): the biased sine of gmasim/simulate/simulate.hpp. */
 static double biased_sine_A(double t_s) {
   const double min_A = -3.0, pp_A = 8.0, f_Hz = 10.0;
   return min_A + 0.5 * pp_A * (1.0 - cos(2.0 * kPi * f_Hz * t_s));

@@ -1,6 +1,8 @@
 /* The C API from an install prefix: the same 100 steps as main.cpp through libgmasim_c.so. */
 #include <stdio.h>
 
+/* The old flat path (a forwarding header) and the new one, together. */
+#include "gmasim/capi/gmasim_c.h"
 #include "gmasim/gmasim_c.h"
 
 int main(void) {

@@ -18,6 +18,8 @@ cmake --install "$build" --prefix "$prefix" > "$work/install.log"
 
 # What the package promises is there, and nothing in it points back at the build or source tree.
 for f in bin/gmasim include/gmasim/gmasim_c.h include/gmasim/model.hpp include/gmasim/version.h \
+         include/gmasim/capi/gmasim_c.h include/gmasim/model/model.hpp \
+         include/gmasim/simulate/run_loop.hpp include/gmasim/mechanics/mechanics.hpp \
          share/gmasim/models/mdma.toml share/gmasim/models/mdma_printed.toml \
          share/gmasim/models/single_rod.toml share/gmasim/models/single_rod_printed.toml; do
   [[ -e "$prefix/$f" ]] || { echo "package_consumer: $prefix/$f was not installed" >&2; exit 1; }

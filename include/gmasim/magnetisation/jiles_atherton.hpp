@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "gmasim/magnetisation/law_id.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 #include "gmasim/physics/jiles_atherton.hpp"
 
 namespace gmasim {
@@ -40,7 +40,7 @@ struct JilesAthertonLaw {
     return rc.ja.c * dMan / (1.0 - rc.ja.alpha * rc.ja.c * dMan);
   }
 
-  // The ledgers (gmasim/energy.hpp): the dissipation density of the step from (H0, M0) to r's
+  // The ledgers (gmasim/model/energy.hpp): the dissipation density of the step from (H0, M0) to r's
   // state, and the stored energy density of r's state [J/m^3].
   static double step_dissipation(const RodConditions& rc, double H0, double M0, const RodState& r) {
     return physics::ja_step_dissipation(H0, M0, r.H_A_per_m, r.M_A_per_m, rc.MsT_mag, rc.ja);
@@ -70,7 +70,6 @@ struct JilesAthertonLaw {
 
   // The FRF's anhysteretic bias (settle_at_bias): the law reduced to its anhysteretic curve
   // (c = 1: M = M_an(H + alpha M)), its magnetisation there, and the state that holds it.
-  static constexpr bool kHasAnhysteretic = true;
   static void reduce_to_anhysteretic(RodConditions& rc) { rc.ja.c = 1.0; }
   static double anhysteretic_magnetisation(const RodConditions& rc, const RodState& r) {
     physics::JaCoefficients anh = rc.ja;
@@ -78,7 +77,7 @@ struct JilesAthertonLaw {
     return physics::ja_total_magnetisation(r.H_A_per_m, r.M_A_per_m, r.M_A_per_m, rc.MsT_mag, anh);
   }
   // Returns how far the law's state moved (|change of M_irr|) [A/m].
-  static double hold_anhysteretic(RodState& r, double M) {
+  static double hold_anhysteretic(const RodConditions&, RodState& r, double M) {
     const double moved = std::fabs(M - r.Mirr_A_per_m);
     r.Mirr_A_per_m = M;
     r.M_A_per_m = M;

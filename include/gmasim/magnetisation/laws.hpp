@@ -4,9 +4,10 @@
 //   trial, commit         a move of the field H0 -> H1: M at H1 and dM/dH (the consistent
 //                         state's Newton solve), without / with changing the state
 //   reversible_susceptibility   dM/dH with the irreversible state held (the FRF)
-//   step_dissipation, stored_energy_density   the ledgers (gmasim/energy.hpp)
+//   step_dissipation, stored_energy_density   the ledgers (gmasim/model/energy.hpp)
 //   ode_*                 the law as an ODE for the RK4 reference
-//   kHasAnhysteretic ...  the FRF's anhysteretic bias state
+//   reduce_to_anhysteretic, anhysteretic_magnetisation, hold_anhysteretic
+//                         the FRF's anhysteretic bias state
 // Its constants land in RodModel through its parameter rows and reach RodConditions through
 // its temperature laws (src/model/magnetisation/<law>.cpp). The step is compiled once per
 // law (step_law<Law>); a run dispatches once, by with_magnetisation_law, not per step.

@@ -6,7 +6,7 @@
 #pragma once
 
 #include "gmasim/magnetisation/law_id.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 #include "gmasim/physics/preisach.hpp"
 
 namespace gmasim {
@@ -72,13 +72,31 @@ struct PreisachLaw {
     physics::preisach_commit(rc.preisach.dist, r.preisach, x1);
   }
 
-  // No anhysteretic bias state (settle_at_bias refuses it; use the initial curve).
-  static constexpr bool kHasAnhysteretic = false;
-  static void reduce_to_anhysteretic(RodConditions&) {}
-  static double anhysteretic_magnetisation(const RodConditions&, const RodState& r) {
-    return r.M_A_per_m;
+  // The FRF's anhysteretic bias (settle_at_bias; docs/model.md, "The Preisach law"): the state
+  // an AC demagnetisation about the bias leaves. reduce_to_anhysteretic shrinks every coercive
+  // field 1000-fold (the interaction fields stay): the hysterons then switch where their
+  // interaction field is passed and the law follows its anhysteretic curve 2 F_u(x) - 1 to
+  // within 1e-3 H_c, so make_state's ramp solves the circuit on that curve.
+  static void reduce_to_anhysteretic(RodConditions& rc) {
+    auto& d = rc.preisach.dist;
+    for (double& e : d.edge) e *= kAnhystereticShrink;
+    for (double& w : d.density) w /= kAnhystereticShrink;
   }
-  static double hold_anhysteretic(RodState&, double) { return 0.0; }
+  static double anhysteretic_magnetisation(const RodConditions& rc, const RodState& r) {
+    return physics::preisach_anhysteretic_magnetisation(r.H_A_per_m, rc.MsT_mag, rc.preisach,
+                                                        r.M_A_per_m);
+  }
+  // Puts the rod in the AC-demagnetised state at its field (physics::preisach_hold_anhysteretic,
+  // from M); returns how far M moved [A/m].
+  static double hold_anhysteretic(const RodConditions& rc, RodState& r, double M) {
+    const double held =
+        physics::preisach_hold_anhysteretic(r.H_A_per_m, rc.MsT_mag, rc.preisach, r.preisach, M);
+    const double moved = std::fabs(held - r.M_A_per_m);
+    r.M_A_per_m = held;
+    r.Mirr_A_per_m = rc.MsT_mag * (1.0 - rc.preisach.c) * (2.0 * r.preisach.mu_now - 1.0);
+    return moved;
+  }
+  static constexpr double kAnhystereticShrink = 1e-3;
 };
 
 }  // namespace gmasim

@@ -192,9 +192,10 @@ inline void preisach_commit(const PreisachDistribution& d, PreisachHistory& h, d
 
 // Positive then negative saturation (the two sentinels), then an AC demagnetisation about
 // x_center: reversals at x_center +/- A r^k from A = the distribution's reach down to the
-// smallest coercive field (below which nothing switches), ending at x_center.
-inline void preisach_demagnetise(const PreisachDistribution& d, PreisachHistory& h,
-                                 double x_center) {
+// smallest coercive field (below which nothing switches), ending at x_center. Each reversal
+// takes one stack entry: ln(reach / edge_0) / ln(1/r) of them must fit kPreisachCapacity.
+inline void preisach_ac_demagnetise(const PreisachDistribution& d, PreisachHistory& h,
+                                    double x_center, double ratio) {
   constexpr double inf = std::numeric_limits<double>::infinity();
   const Everett all = everett(d, inf, -inf);
   h = PreisachHistory{};
@@ -207,10 +208,37 @@ inline void preisach_demagnetise(const PreisachDistribution& d, PreisachHistory&
   h.x_now = -inf;
   const double reach = d.edge[kPreisachBins] + 6.0 * d.sigma_u;
   double sign = 1.0;
-  for (double A = reach; A > d.edge[0]; A *= 0.8, sign = -sign)
+  for (double A = reach; A > d.edge[0]; A *= ratio, sign = -sign)
     preisach_commit(d, h, x_center + sign * A);
   preisach_commit(d, h, x_center);
   h.last_dmc = 0.0;
+}
+
+// make_state's demagnetised rod: reversal ratio 0.8.
+inline void preisach_demagnetise(const PreisachDistribution& d, PreisachHistory& h,
+                                 double x_center) {
+  preisach_ac_demagnetise(d, h, x_center, 0.8);
+}
+
+// The anhysteretic state at a DC (reduced, effective) field x: an AC demagnetisation about x
+// whose amplitude decays slowly, with the finest reversal ratio whose reversals fit the stack
+// (kPreisachCapacity - 8 of them, leaving room for the small-signal reversals about it).
+inline double preisach_anhysteretic_ratio(const PreisachDistribution& d) {
+  const double reach = d.edge[kPreisachBins] + 6.0 * d.sigma_u;
+  return std::pow(d.edge[0] / reach, 1.0 / (kPreisachCapacity - 8));
+}
+inline void preisach_anhysteretic_history(const PreisachDistribution& d, PreisachHistory& h,
+                                          double x) {
+  preisach_ac_demagnetise(d, h, x, preisach_anhysteretic_ratio(d));
+}
+
+// Its closed form, the limit of ever slower decay (docs/model.md, "The Preisach law"): the
+// staircase of the reversals x +/- A_k tends to the line alpha + beta = 2 x of the Preisach
+// plane, i.e. h_u = x, below which every hysteron is up. With mu(h_c, h_u) = f_c(h_c) f_u(h_u)
+// the up-switched measure is then the interaction fields' CDF, whatever f_c:
+//   mu_an(x) = F_u(x) = Phi(x / sigma_u),  d mu_an / dx = f_u(x).
+inline double preisach_anhysteretic_mu(const PreisachDistribution& d, double x) {
+  return 0.5 * std::erfc(-x / (d.sigma_u * std::sqrt(2.0)));
 }
 
 // ---------------------------------------------------------------------------------------
@@ -284,6 +312,56 @@ inline double preisach_stored_energy_density(double H, double M, double MsT_A_pe
 inline double preisach_last_dissipation(double MsT_A_per_m, const PreisachCoefficients& p,
                                         const PreisachHistory& h) {
   return (1.0 - p.c) * 2.0 * kMu0 * MsT_A_per_m * p.Hc_A_per_m * h.last_dmc;
+}
+
+// The anhysteretic magnetisation of a rod at field H with the mean field (the closed form):
+//   M = M_s^T [(1 - c)(2 mu_an(x) - 1) + c L(H_e / a)],  x = H_e / H_c,  H_e = H + alpha M,
+// by Newton from M_guess (as preisach_magnetisation). dM_dH (if given): its slope.
+inline double preisach_anhysteretic_magnetisation(double H, double MsT_A_per_m,
+                                                  const PreisachCoefficients& p, double M_guess,
+                                                  double* dM_dH = nullptr) {
+  const double s = p.dist.sigma_u;
+  double M = M_guess;
+  for (int it = 0; it < 60; ++it) {
+    const double He = H + p.alpha * M, x = He / p.Hc_A_per_m;
+    const LangevinValue lv = langevin_pair(He / p.a_A_per_m);
+    const double f = std::exp(-0.5 * (x / s) * (x / s)) / (s * std::sqrt(2.0 * kPi));
+    const double Mnew =
+        MsT_A_per_m *
+        ((1.0 - p.c) * (2.0 * preisach_anhysteretic_mu(p.dist, x) - 1.0) + p.c * lv.L);
+    const double chi_e =
+        MsT_A_per_m * ((1.0 - p.c) * 2.0 * f / p.Hc_A_per_m + p.c * lv.dL / p.a_A_per_m);
+    const double g = M - Mnew;
+    if (std::fabs(g) <= 1e-12 * MsT_A_per_m || it == 59) {
+      if (dM_dH) *dM_dH = chi_e / (1.0 - p.alpha * chi_e);
+      return Mnew;
+    }
+    M -= g / std::max(1.0 - p.alpha * chi_e, 0.2);
+  }
+  return M;
+}
+
+// The rod put in the AC-demagnetised state at field H (the FRF's anhysteretic bias): the
+// history of preisach_anhysteretic_history about x = (H + alpha M)/H_c, with M the law's
+// magnetisation of that history at x (the mean field closes the loop; Newton with the
+// closed form's slope, which the staircase follows to within its steps). Returns M.
+inline double preisach_hold_anhysteretic(double H, double MsT_A_per_m,
+                                         const PreisachCoefficients& p, PreisachHistory& h,
+                                         double M_guess) {
+  double dM_dH = 0.0;
+  (void)preisach_anhysteretic_magnetisation(H, MsT_A_per_m, p, M_guess, &dM_dH);
+  const double chi_e = dM_dH / (1.0 + p.alpha * dM_dH);  // the slope in H_e
+  double M = M_guess;
+  for (int it = 0; it < 60; ++it) {
+    const double He = H + p.alpha * M;
+    preisach_anhysteretic_history(p.dist, h, He / p.Hc_A_per_m);
+    const double Mnew =
+        MsT_A_per_m * ((1.0 - p.c) * (2.0 * h.mu_now - 1.0) + p.c * langevin(He / p.a_A_per_m));
+    const double g = M - Mnew;
+    if (std::fabs(g) <= 1e-12 * MsT_A_per_m) return Mnew;
+    M -= g / std::max(1.0 - p.alpha * chi_e, 0.2);
+  }
+  return M;
 }
 
 }  // namespace gmasim::physics

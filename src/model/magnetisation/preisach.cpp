@@ -14,7 +14,7 @@
 #include <cmath>
 
 #include "gmasim/errors.hpp"
-#include "gmasim/model.hpp"
+#include "gmasim/model/model.hpp"
 #include "model/conditions_detail.hpp"
 #include "model/parameter_rows.hpp"
 
