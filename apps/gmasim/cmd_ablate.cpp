@@ -6,23 +6,20 @@
 #include "commands.hpp"
 #include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/io/io.hpp"
+#include "request_options.hpp"
 
 namespace gmasim::cli {
 namespace {
 
-struct AblateArgs {
-  bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
-  ModelArgs model;
-  std::string out = "out/ablate", frequencies = "10,200";
-  AblateRequest req;
-};
+using AblateArgs = ExperimentArgs<AblateRequest>;
 
 int run_ablate_cmd(AblateArgs& a) {
   const Model model = load_model_args(a.model);
+  a.options.apply();
   warn_temperatures(model, {a.req.temperature_C}, "--temperature");
-  a.req.frequencies_Hz = parse_list(a.frequencies, "--frequencies", "Hz");
   prepare_output_dir(a.out, {"ablate"}, model_inputs(a.model));
   const AblateResult res = run_ablate(model, a.req);
   auto files = write_report(a.out, "ablate", ablate_report(model, a.req, res));
@@ -57,28 +54,15 @@ int run_ablate_cmd(AblateArgs& a) {
 }  // namespace
 
 Runner add_ablate(CLI::App& app) {
-  auto a = std::make_shared<AblateArgs>();
-  auto* sub = app.add_subcommand(
-      "ablate", fmt::format("Freeze the temperature dependence of each law ({}) at 20 degC one "
-                            "at a time, then all; deviation from the full model (Fig. 20). "
-                            "Writes ablate.csv, ablate.json",
-                            freeze_name_list()));
-  add_model_options(sub, a->model);
-  sub->add_option("--temperature", a->req.temperature_C, "Operating temperature [degC]")
-      ->capture_default_str();
-  sub->add_option("--frequencies", a->frequencies, "Excitation frequencies [Hz]; list or range")
-      ->capture_default_str();
-  sub->add_option("--current-pp", a->req.current_pp_A, "Current peak-to-peak [A]")
-      ->capture_default_str();
-  sub->add_option("--current-min", a->req.current_min_A, "Minimum of the biased sine [A]")
-      ->capture_default_str();
-  sub->add_option("--periods", a->req.periods, "Periods per run [-]; errors over the last")
-      ->capture_default_str();
-  sub->add_option("--threads", a->req.threads, "Worker threads [-]; 0 = all cores")
-      ->capture_default_str();
-  sub->add_flag("--plot", a->plot, "Also draw <out>/ablate.png and .svg (matplotlib)");
-  sub->add_option("--out", a->out, "Output directory")->capture_default_str();
-  return [a, sub]() -> int { return sub->parsed() ? run_ablate_cmd(*a) : -1; };
+  return add_experiment<AblateArgs>(
+      app,
+      {"ablate",
+       fmt::format("Freeze the temperature dependence of each law ({}) at 20 degC one at a time, "
+                   "then all; deviation from the full model (Fig. 20). Writes ablate.csv, "
+                   "ablate.json",
+                   freeze_name_list()),
+       "out/ablate", "Also draw <out>/ablate.png and .svg (matplotlib)", false},
+      [](CLI::App*, AblateArgs&) {}, run_ablate_cmd);
 }
 
 }  // namespace gmasim::cli

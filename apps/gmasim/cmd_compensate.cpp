@@ -9,18 +9,18 @@
 #include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/compensate.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/io/io.hpp"
+#include "request_options.hpp"
 
 namespace gmasim::cli {
 namespace {
 
-struct CompensateArgs {
-  ModelArgs model;
-  std::string out = "out/compensate", temperatures = "20:10:150", adjust = "amplitude";
+struct CompensateArgs : ExperimentArgs<CompensateRequest> {
+  std::string adjust = "amplitude";
   std::string track_temperatures, track_amplitudes = "10,20", track_frequencies = "10,100";
-  CompensateRequest req;
   TrackRequest track;
-  bool no_track = false, progress = false, plot = false;
+  bool no_track = false;
 };
 
 void print_schedule(const CompensateArgs& a, const CompensateResult& res) {
@@ -78,7 +78,7 @@ void print_track(const CompensatedTrack& t) {
 
 int run_compensate_cmd(CompensateArgs& a) {
   const Model model = load_model_args(a.model);
-  a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
+  a.options.apply();
   warn_temperatures(model, a.req.temperatures_C, "--temperatures");
   warn_temperatures(model, {a.req.reference_temperature_C}, "--reference-temperature");
   a.req.adjust = parse_compensation_adjust(a.adjust);
@@ -115,59 +115,32 @@ int run_compensate_cmd(CompensateArgs& a) {
 }  // namespace
 
 Runner add_compensate(CLI::App& app) {
-  auto a = std::make_shared<CompensateArgs>();
-  auto* sub = app.add_subcommand(
-      "compensate",
-      "Temperature compensation: the drive current that restores a target stroke at each "
-      "temperature (gain schedule), and PID tracking with that schedule as feed-forward beside "
-      "the plain PID. Writes compensate.csv (schedule), compensate_track.csv, compensate.json");
-  add_model_options(sub, a->model);
-  auto& r = a->req;
-  sub->add_option("--reference-temperature", r.reference_temperature_C,
-                  "Temperature whose stroke is the target [degC]")
-      ->capture_default_str();
-  sub->add_option("--reference-current-pp", r.reference_current_pp_A,
-                  "Reference drive: biased-sine current peak-to-peak [A]")
-      ->capture_default_str();
-  sub->add_option("--current-min", r.current_min_A, "Reference drive: current minimum [A]")
-      ->capture_default_str();
-  sub->add_option("--target-stroke", r.target_stroke_um,
-                  "Target stroke [um]; 0 = the reference drive's stroke at the reference "
-                  "temperature")
-      ->capture_default_str();
-  sub->add_option("--temperatures", a->temperatures,
-                  "Temperatures of the schedule [degC]: list or start:step:stop")
-      ->capture_default_str();
-  sub->add_option("--frequency", r.frequency_Hz, "Drive frequency [Hz]")->capture_default_str();
-  sub->add_option("--periods", r.periods, "Periods per run; the stroke is over the last [-]")
-      ->capture_default_str();
-  sub->add_option("--adjust", a->adjust,
-                  "amplitude: change the p-p with the minimum held; swing: the p-p about the "
-                  "mean; scale: scale the whole waveform (an amplifier gain)")
-      ->check(CLI::IsMember({"amplitude", "swing", "scale"}))
-      ->capture_default_str();
-  sub->add_option("--max-current", r.max_current_A, "Largest |current| any drive may reach [A]")
-      ->capture_default_str();
-  sub->add_option("--tolerance", r.tolerance_um, "Stroke tolerance of the solved drive [um]")
-      ->capture_default_str();
-  sub->add_option("--dt", r.dt_s, "Time step [s]; 0 = automatic rule")->capture_default_str();
-  sub->add_option("--threads", r.threads, "Worker threads [-]; 0 = all cores")
-      ->capture_default_str();
-  sub->add_flag("--no-track", a->no_track, "Skip the tracking comparison");
-  sub->add_option("--track-temperatures", a->track_temperatures,
-                  "Tracking temperatures [degC]; default: the schedule's");
-  sub->add_option("--track-amplitudes", a->track_amplitudes, "Tracking amplitudes [um]")
-      ->capture_default_str();
-  sub->add_option("--track-frequencies", a->track_frequencies, "Tracking frequencies [Hz]")
-      ->capture_default_str();
-  sub->add_option("--bias", a->track.bias_A, "Tracking: coil bias current [A]")
-      ->capture_default_str();
-  sub->add_option("--current-limit", a->track.current_limit_A, "Tracking: amplifier limit +- [A]")
-      ->capture_default_str();
-  sub->add_flag("--progress", a->progress, "Progress on stderr even when it is not a terminal");
-  sub->add_flag("--plot", a->plot, "Also draw compensate.png (matplotlib)");
-  sub->add_option("--out", a->out, "Output directory")->capture_default_str();
-  return [a, sub]() -> int { return sub->parsed() ? run_compensate_cmd(*a) : -1; };
+  auto own = [](CLI::App* sub, CompensateArgs& a) {
+    sub->add_option("--adjust", a.adjust,
+                    "amplitude: change the p-p with the minimum held; swing: the p-p about the "
+                    "mean; scale: scale the whole waveform (an amplifier gain)")
+        ->check(CLI::IsMember({"amplitude", "swing", "scale"}))
+        ->capture_default_str();
+    sub->add_flag("--no-track", a.no_track, "Skip the tracking comparison");
+    sub->add_option("--track-temperatures", a.track_temperatures,
+                    "Tracking temperatures [degC]; default: the schedule's");
+    sub->add_option("--track-amplitudes", a.track_amplitudes, "Tracking amplitudes [um]")
+        ->capture_default_str();
+    sub->add_option("--track-frequencies", a.track_frequencies, "Tracking frequencies [Hz]")
+        ->capture_default_str();
+    sub->add_option("--bias", a.track.bias_A, "Tracking: coil bias current [A]")
+        ->capture_default_str();
+    sub->add_option("--current-limit", a.track.current_limit_A, "Tracking: amplifier limit +- [A]")
+        ->capture_default_str();
+  };
+  return add_experiment<CompensateArgs>(
+      app,
+      {"compensate",
+       "Temperature compensation: the drive current that restores a target stroke at each "
+       "temperature (gain schedule), and PID tracking with that schedule as feed-forward beside "
+       "the plain PID. Writes compensate.csv (schedule), compensate_track.csv, compensate.json",
+       "out/compensate", "Also draw compensate.png (matplotlib)"},
+      own, run_compensate_cmd);
 }
 
 }  // namespace gmasim::cli

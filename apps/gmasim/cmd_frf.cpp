@@ -9,8 +9,10 @@
 #include "commands.hpp"
 #include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/io/io.hpp"
+#include "request_options.hpp"
 
 namespace gmasim::cli {
 namespace {
@@ -18,12 +20,8 @@ namespace {
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 constexpr double kMismatchWarnPct = 5.0;  // stepped sine vs linearisation: warn above
 
-struct FrfArgs {
-  bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
-  ModelArgs model;
-  std::string out = "out/frf", temperatures = "20,70", method = "both", bias_state = "anhysteretic";
-  FrfRequest req;
-  bool progress = false;
+struct FrfArgs : ExperimentArgs<FrfRequest> {
+  std::string method = "both", bias_state = "anhysteretic";
 };
 
 // The resonance's shift and the change of its amplitude across the temperatures (Fig. 15:
@@ -87,7 +85,7 @@ void print_signal_regime(const FrfRequest& req, const FrfCurve& c) {
 
 int run_frf_cmd(FrfArgs& a) {
   const Model model = load_model_args(a.model);
-  a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
+  a.options.apply();
   warn_temperatures(model, a.req.temperatures_C, "--temperatures");
   a.req.stepped_sine = a.method != "linear";
   a.req.small_signal = a.method != "stepped";
@@ -157,49 +155,24 @@ int run_frf_cmd(FrfArgs& a) {
 }  // namespace
 
 Runner add_frf(CLI::App& app) {
-  auto a = std::make_shared<FrfArgs>();
-  auto* sub = app.add_subcommand(
-      "frf",
-      "Frequency response current -> displacement (Fig. 15): stepped sine and/or small-signal "
-      "linearisation about a DC bias, first resonance, -3 dB bandwidth, eq. (15) modes. Writes "
-      "frf.csv, frf_summary.csv, frf_modes.csv, frf_eddy.csv and frf.json");
-  add_model_options(sub, a->model);
-  sub->add_option("--temperatures", a->temperatures, "Temperatures [degC]; list or range")
-      ->capture_default_str();
-  sub->add_option("--f-min", a->req.f_min_Hz, "Lowest frequency [Hz]")->capture_default_str();
-  sub->add_option("--f-max", a->req.f_max_Hz, "Highest frequency [Hz]")->capture_default_str();
-  sub->add_option("--points", a->req.points, "Log-spaced frequencies [-]")->capture_default_str();
-  sub->add_option("--bias", a->req.bias_A, "DC bias current [A] (1 A: middle of the 8 A sine)")
-      ->capture_default_str();
-  sub->add_option("--amplitude", a->req.amplitude_A,
-                  "Stepped-sine current amplitude [A]; above the small-signal limit (printed per "
-                  "temperature, about 2 mA for the built-in model) the FRF is large-signal "
-                  "(docs/experiments.md)")
-      ->capture_default_str();
-  sub->add_option("--method", a->method, "stepped, linear or both")
-      ->check(CLI::IsMember({"stepped", "linear", "both"}))
-      ->capture_default_str();
-  sub->add_option("--bias-state", a->bias_state,
-                  "Magnetic state at the bias: anhysteretic (after AC shake-down) or "
-                  "initial-curve (virgin curve; the JA minor loop then creeps)")
-      ->check(CLI::IsMember({"anhysteretic", "initial-curve"}))
-      ->capture_default_str();
-  sub->add_option("--peak-refinements", a->req.peak_refinements,
-                  "Stepped sine: golden-section evaluations refining the largest |Y/I| peak "
-                  "(and one point at the linearisation's peak) [-]; 0 = off, at most 100")
-      ->capture_default_str();
-  sub->add_option("--settle-periods", a->req.settle_periods,
-                  "Stepped sine: minimum settling periods [-] (also >= 10 time constants)")
-      ->capture_default_str();
-  sub->add_option("--measure-periods", a->req.measure_periods,
-                  "Stepped sine: periods in the first-harmonic measurement [-]")
-      ->capture_default_str();
-  sub->add_option("--threads", a->req.threads, "Worker threads [-]; 0 = all cores")
-      ->capture_default_str();
-  sub->add_flag("--progress", a->progress, "Progress on stderr even when it is not a terminal");
-  sub->add_flag("--plot", a->plot, "Also draw <out>/frf.png and .svg (matplotlib)");
-  sub->add_option("--out", a->out, "Output directory")->capture_default_str();
-  return [a, sub]() -> int { return sub->parsed() ? run_frf_cmd(*a) : -1; };
+  auto own = [](CLI::App* sub, FrfArgs& a) {
+    sub->add_option("--method", a.method, "stepped, linear or both")
+        ->check(CLI::IsMember({"stepped", "linear", "both"}))
+        ->capture_default_str();
+    sub->add_option("--bias-state", a.bias_state,
+                    "Magnetic state at the bias: anhysteretic (after AC shake-down) or "
+                    "initial-curve (virgin curve; the JA minor loop then creeps)")
+        ->check(CLI::IsMember({"anhysteretic", "initial-curve"}))
+        ->capture_default_str();
+  };
+  return add_experiment<FrfArgs>(
+      app,
+      {"frf",
+       "Frequency response current -> displacement (Fig. 15): stepped sine and/or small-signal "
+       "linearisation about a DC bias, first resonance, -3 dB bandwidth, eq. (15) modes. Writes "
+       "frf.csv, frf_summary.csv, frf_modes.csv, frf_eddy.csv and frf.json",
+       "out/frf", "Also draw <out>/frf.png and .svg (matplotlib)"},
+      own, run_frf_cmd);
 }
 
 }  // namespace gmasim::cli

@@ -7,18 +7,15 @@
 #include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/claims.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/io/io.hpp"
+#include "request_options.hpp"
 
 namespace gmasim::cli {
 namespace {
 
-struct ParamsArgs {
-  bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
-  ModelArgs model;
-  std::string out = "out/params", temperatures = "20,40,60,80,100,120,150", retention = "6,8,10,12";
-  ParamsVsTemperatureRequest req;
-};
+using ParamsArgs = ExperimentArgs<ParamsVsTemperatureRequest>;
 
 void print_thermal(const ThermalExpansionResult& t) {
   fmt::print(
@@ -31,9 +28,8 @@ void print_thermal(const ThermalExpansionResult& t) {
 
 int run_params_cmd(ParamsArgs& a) {
   const Model model = load_model_args(a.model);
-  a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
+  a.options.apply();
   warn_temperatures(model, a.req.temperatures_C, "--temperatures");
-  a.req.retention_currents_pp_A = parse_list(a.retention, "--retention-currents", "A");
   prepare_output_dir(a.out, {"params", "thermal"}, model_inputs(a.model));
   const auto res = run_params_vs_temperature(model, a.req);
   auto files = write_report(a.out, "params", params_report(model, a.req, res));
@@ -77,32 +73,14 @@ int run_params_cmd(ParamsArgs& a) {
 }  // namespace
 
 Runner add_params(CLI::App& app) {
-  auto a = std::make_shared<ParamsArgs>();
-  auto* sub = app.add_subcommand(
-      "params-vs-temperature",
-      "mu_G, rho_G, M_G, E_G and E_t against temperature (Fig. 19), stroke retention (Fig. 18) "
-      "and the thermal expansion coefficient (eq. 21). Writes params*.csv, params.json, "
-      "thermal.csv, thermal.json");
-  add_model_options(sub, a->model);
-  sub->add_option("--temperatures", a->temperatures, "Temperatures [degC]; list or range")
-      ->capture_default_str();
-  sub->add_option("--current-pp", a->req.current_pp_A,
-                  "Current peak-to-peak of the Fig. 19 operating point [A]")
-      ->capture_default_str();
-  sub->add_option("--frequency", a->req.frequency_Hz, "Excitation frequency [Hz]")
-      ->capture_default_str();
-  sub->add_option("--retention-currents", a->retention,
-                  "Current peak-to-peak values of the retention table [A]; list or range")
-      ->capture_default_str();
-  sub->add_option("--current-min", a->req.current_min_A, "Minimum of the biased sine [A]")
-      ->capture_default_str();
-  sub->add_option("--periods", a->req.periods, "Periods per run [-]; statistics over the last")
-      ->capture_default_str();
-  sub->add_option("--threads", a->req.threads, "Worker threads [-]; 0 = all cores")
-      ->capture_default_str();
-  sub->add_flag("--plot", a->plot, "Also draw <out>/params.png and .svg (matplotlib)");
-  sub->add_option("--out", a->out, "Output directory")->capture_default_str();
-  return [a, sub]() -> int { return sub->parsed() ? run_params_cmd(*a) : -1; };
+  return add_experiment<ParamsArgs>(
+      app,
+      {"params-vs-temperature",
+       "mu_G, rho_G, M_G, E_G and E_t against temperature (Fig. 19), stroke retention (Fig. 18) "
+       "and the thermal expansion coefficient (eq. 21). Writes params*.csv, params.json, "
+       "thermal.csv, thermal.json",
+       "out/params", "Also draw <out>/params.png and .svg (matplotlib)", false},
+      [](CLI::App*, ParamsArgs&) {}, run_params_cmd);
 }
 
 Runner add_thermal(CLI::App& app) {

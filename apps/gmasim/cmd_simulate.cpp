@@ -197,11 +197,15 @@ void warn_zero_crossing(const Model& m, const SimulateArgs& a, const Waveform& w
 
 void print_metrics(const Result& r, const SimulationSettings& s, const Model& model) {
   const char* window = s.waveform.periodic() ? "over the last period" : "over the whole run";
-  fmt::print("  stroke      {:9.3f} um   (peak-to-peak of y {})\n", r.metrics.stroke_um, window);
-  fmt::print("  hysteresis  {:9.3f} um   (widest rising/falling gap at equal current)\n",
-             r.metrics.hysteresis_um);
-  fmt::print("  B p-p       {:9.4f} T    (induction coil)\n", r.metrics.B_pp_T);
-  fmt::print("  y mean      {:9.3f} um\n", r.metrics.y_mean_um);
+  for (const MetricRow& row : kMetricRows) {  // the table of Metrics (gmasim/simulate.hpp)
+    if (row.label.empty()) continue;
+    const std::string value =
+        fmt::format("  {:<12}{:9.{}f} ", row.label, r.metrics.*row.member, row.precision);
+    if (row.note.empty())
+      fmt::print("{}{}\n", value, row.unit);
+    else
+      fmt::print("{}{:<5}{}\n", value, row.unit, fmt::format(fmt::runtime(row.note), window));
+  }
   fmt::print(
       "  drift       {:9.3f} um   (thermal offset x_T vs T_ref {:g} degC at the end, {} y; "
       "{:+.3f} um over the run)\n",

@@ -7,21 +7,17 @@
 #include "commands.hpp"
 #include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/experiments/feedforward.hpp"
 #include "gmasim/io/io.hpp"
 #include "gmasim/model/validate.hpp"
+#include "request_options.hpp"
 
 namespace gmasim::cli {
 namespace {
 
-struct TrackArgs {
-  bool plot = false;  // --plot: draw the figure (gmasim.command_figures)
-  ModelArgs model;
-  std::string out = "out/track", temperatures = "20:10:70", amplitudes = "10,20",
-              frequencies = "10,100";
-  TrackRequest req;
-  bool progress = false;
+struct TrackArgs : ExperimentArgs<TrackRequest> {
   // --feedforward inverse: the evaluation against mismatched plants
   // (gmasim/experiments/feedforward.hpp)
   std::string feedforward = "none", mismatch = "all",
@@ -82,10 +78,8 @@ int run_feedforward_cmd(TrackArgs& a, const Model& model) {
 
 int run_track_cmd(TrackArgs& a) {
   const Model model = load_model_args(a.model);
-  a.req.temperatures_C = parse_list(a.temperatures, "--temperatures", "degC");
+  a.options.apply();
   warn_temperatures(model, a.req.temperatures_C, "--temperatures");
-  a.req.amplitudes_um = parse_list(a.amplitudes, "--amplitudes", "um");
-  a.req.frequencies_Hz = parse_list(a.frequencies, "--frequencies", "Hz");
   if (a.feedforward != "none") return run_feedforward_cmd(a, model);
   for (const CLI::Option* o : a.feedforward_only)
     if (o->count() > 0)
@@ -144,79 +138,33 @@ int run_track_cmd(TrackArgs& a) {
 }  // namespace
 
 Runner add_track(CLI::App& app) {
-  auto a = std::make_shared<TrackArgs>();
-  auto* sub = app.add_subcommand(
-      "track",
-      "Closed-loop displacement tracking with the paper's discrete PID (Fig. 16): RMS and peak "
-      "tracking error against temperature. Writes track.csv, track.json, track_example.csv");
-  add_model_options(sub, a->model);
-  sub->add_option("--temperatures", a->temperatures, "Temperatures [degC]; list or range")
-      ->capture_default_str();
-  sub->add_option("--amplitudes", a->amplitudes, "Reference amplitudes [um] (sine about y_bias)")
-      ->capture_default_str();
-  sub->add_option("--frequencies", a->frequencies, "Reference frequencies [Hz]")
-      ->capture_default_str();
-  sub->add_option("--kp", a->req.gains.kp, "Proportional gain [unit/um]")->capture_default_str();
-  sub->add_option("--amplifier-gain", a->req.amplifier_A_per_unit,
-                  "Coil current per unit of PID output [A/unit] (the amplifier; the paper does not "
-                  "print it: docs/experiments.md)")
-      ->capture_default_str();
-  sub->add_option("--ki", a->req.gains.ki,
-                  "Integral gain [A/um per sample at --gain-rate]: u += ki * sum(e)")
-      ->capture_default_str();
-  sub->add_option("--kd", a->req.gains.kd,
-                  "Derivative gain [A/um per sample at --gain-rate]: u += kd * (e_k - e_k-1)")
-      ->capture_default_str();
-  sub->add_option("--gain-rate", a->req.gains.reference_rate_Hz,
-                  "Sample rate [Hz] at which ki and kd are per-sample gains; other sample rates "
-                  "rescale them so the continuous controller is unchanged")
-      ->capture_default_str();
-  sub->add_option("--sample-rate", a->req.sample_rate_Hz,
-                  "Controller and sensor sample rate [Hz]; must be >= 2x every reference "
-                  "frequency")
-      ->capture_default_str();
-  sub->add_option("--bias", a->req.bias_A, "Coil bias current the PID output is added to [A]")
-      ->capture_default_str();
-  sub->add_option("--current-limit", a->req.current_limit_A,
-                  "Amplifier saturation: coil current clipped to +- this [A]")
-      ->capture_default_str();
-  sub->add_option("--sensor-noise", a->req.sensor_noise_um,
-                  "White noise of the displacement sensor [um RMS]")
-      ->capture_default_str();
-  sub->add_option("--seed", a->req.noise_seed, "Seed of the sensor-noise generator [-]")
-      ->capture_default_str();
-  sub->add_option("--periods", a->req.periods,
-                  "Reference periods per run [-]; errors over the last")
-      ->capture_default_str();
-  sub->add_option("--dt", a->req.dt_s,
-                  "Plant time step [s]; 0 = automatic (<= 10 us, <= T/2000, divides 1/fs)")
-      ->capture_default_str();
-  sub->add_option("--threads", a->req.threads, "Worker threads [-]; 0 = all cores")
-      ->capture_default_str();
-  sub->add_option("--feedforward", a->feedforward,
-                  "none: the PID alone (track.csv per point); inverse: the inverse-model "
-                  "feed-forward evaluated against plants that differ from the model (track.csv "
-                  "per run: temperature_C, frequency_Hz, amplitude_um, mismatch, controller, "
-                  "rms_error_um; track_ratios.csv); inverse_static: the same with the "
-                  "quasi-static inverse alone. docs/experiments.md")
-      ->check(CLI::IsMember({"none", "inverse", "inverse_static"}))
-      ->capture_default_str();
-  a->feedforward_only.push_back(
-      sub->add_option("--mismatch", a->mismatch,
-                      "With --feedforward: the plants: all (M_s, k, lambda_s x (1 +- 0.1), "
-                      "temperature +-10 degC: 16), none (the model itself), both (17)")
-          ->capture_default_str());
-  a->feedforward_only.push_back(
-      sub->add_option("--controllers", a->controllers,
-                      "With --feedforward: pid, pid_temperature, pid_inverse (comma-separated)")
-          ->capture_default_str());
-  a->feedforward_only.push_back(sub->add_option("--feedforward-band", a->req.inverse.band_Hz,
-                                                "Fit band of the linear part's inverse [Hz]")
-                                    ->capture_default_str());
-  sub->add_flag("--progress", a->progress, "Progress on stderr even when it is not a terminal");
-  sub->add_flag("--plot", a->plot, "Also draw <out>/track.png and .svg (matplotlib)");
-  sub->add_option("--out", a->out, "Output directory")->capture_default_str();
-  return [a, sub]() -> int { return sub->parsed() ? run_track_cmd(*a) : -1; };
+  auto own = [](CLI::App* sub, TrackArgs& a) {
+    sub->add_option("--feedforward", a.feedforward,
+                    "none: the PID alone (track.csv per point); inverse: the inverse-model "
+                    "feed-forward evaluated against plants that differ from the model (track.csv "
+                    "per run: temperature_C, frequency_Hz, amplitude_um, mismatch, controller, "
+                    "rms_error_um; track_ratios.csv); inverse_static: the same with the "
+                    "quasi-static inverse alone. docs/experiments.md")
+        ->check(CLI::IsMember({"none", "inverse", "inverse_static"}))
+        ->capture_default_str();
+    a.feedforward_only.push_back(
+        sub->add_option("--mismatch", a.mismatch,
+                        "With --feedforward: the plants: all (M_s, k, lambda_s x (1 +- 0.1), "
+                        "temperature +-10 degC: 16), none (the model itself), both (17)")
+            ->capture_default_str());
+    a.feedforward_only.push_back(
+        sub->add_option("--controllers", a.controllers,
+                        "With --feedforward: pid, pid_temperature, pid_inverse (comma-separated)")
+            ->capture_default_str());
+    a.feedforward_only.push_back(a.options.option("--feedforward-band"));
+  };
+  return add_experiment<TrackArgs>(
+      app,
+      {"track",
+       "Closed-loop displacement tracking with the paper's discrete PID (Fig. 16): RMS and peak "
+       "tracking error against temperature. Writes track.csv, track.json, track_example.csv",
+       "out/track", "Also draw <out>/track.png and .svg (matplotlib)"},
+      own, run_track_cmd);
 }
 
 }  // namespace gmasim::cli

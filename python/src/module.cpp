@@ -34,12 +34,7 @@ py::dict series_dict(const TimeSeries& ts) {
 
 py::dict metrics_dict(const Metrics& m) {
   py::dict d;
-  d["stroke_um"] = m.stroke_um;
-  d["hysteresis_um"] = m.hysteresis_um;
-  d["B_pp_T"] = m.B_pp_T;
-  d["y_mean_um"] = m.y_mean_um;
-  d["window_start_s"] = m.window_start_s;
-  d["window_end_s"] = m.window_end_s;
+  for (const MetricRow& row : kMetricRows) d[py::str(row.name.data())] = m.*row.member;
   return d;
 }
 

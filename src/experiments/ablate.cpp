@@ -8,6 +8,7 @@
 
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/model/validate.hpp"
 
@@ -97,6 +98,7 @@ AblationRow compare(const Run& full, const Run& fr, const std::string& law, doub
 
 AblateResult run_ablate(const Model& m, const AblateRequest& r) {
   check_request(m, r);
+  fields::check_request_fields(r);  // the table's rules (gmasim/experiments/experiment_fields.hpp)
   const auto laws = ablation_laws();
   const std::size_t per_f = laws.size() + 1;  // the full model, then each law
   const std::size_t n = r.frequencies_Hz.size() * per_f;

@@ -15,8 +15,10 @@
 
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/model/validate.hpp"
 #include "gmasim/simulate/simulate.hpp"
+#include "request_meta.hpp"
 
 namespace gmasim {
 namespace {
@@ -108,6 +110,7 @@ void validate_request(const Model& m, const CompensateRequest& r) {
   s.periods = r.periods;
   s.dt_s = r.dt_s;
   validate(s);
+  fields::check_request_fields(r);  // the table's rules (gmasim/experiments/experiment_fields.hpp)
 }
 
 // The drive x in (0, x_hi] whose stroke at temperature T is the target (a root of
@@ -294,15 +297,10 @@ Report compensate_report(const Model& m, const CompensateRequest& req, const Com
   Report r;
   r.experiment = "compensate";
   r.meta.emplace_back("model", m.spec.source);
-  r.meta.emplace_back("adjust", compensation_adjust_name(req.adjust));
-  r.meta.emplace_back("reference_temperature_C", req.reference_temperature_C);
-  r.meta.emplace_back("reference_current_pp_A", req.reference_current_pp_A);
-  r.meta.emplace_back("reference_current_min_A", req.current_min_A);
-  r.meta.emplace_back("frequency_Hz", req.frequency_Hz);
-  r.meta.emplace_back("target_stroke_um", res.target_stroke_um);
-  r.meta.emplace_back("reference_stroke_um", res.reference.stroke_um);
-  r.meta.emplace_back("max_current_A", req.max_current_A);
-  r.meta.emplace_back("tolerance_um", req.tolerance_um);
+  fields::add_request_meta(r,
+                           req);  // the request's table (gmasim/experiments/experiment_fields.hpp)
+  fields::insert_meta_after(r, "frequency_Hz", "target_stroke_um", res.target_stroke_um);
+  fields::insert_meta_after(r, "target_stroke_um", "reference_stroke_um", res.reference.stroke_um);
   r.meta.emplace_back("wall_time_s", res.wall_time_s);
   Table t;
   t.name = "schedule";

@@ -13,7 +13,9 @@
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/claims.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/experiments.hpp"
+#include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/model/validate.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/simulate/run_loop.hpp"
@@ -268,6 +270,7 @@ LinearFrfMarkers linear_frf_markers(const Model& m, double T_C, double bias_A) {
 
 FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progress) {
   check_request(r);
+  fields::check_request_fields(r);  // the table's rules (gmasim/experiments/experiment_fields.hpp)
   std::vector<Conditions> conds;
   for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
 

@@ -7,6 +7,7 @@
 
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/model/validate.hpp"
 
@@ -133,6 +134,7 @@ void add_law_rows(const Model& m, const ParamsVsTemperatureRequest& r,
 ParamsVsTemperatureResult run_params_vs_temperature(const Model& m,
                                                     const ParamsVsTemperatureRequest& r) {
   check_request(r);
+  fields::check_request_fields(r);  // the table's rules (gmasim/experiments/experiment_fields.hpp)
   std::vector<Conditions> conds;
   for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
 

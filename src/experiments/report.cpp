@@ -2,8 +2,10 @@
 // units). Written as CSV and JSON by src/io/report_text.cpp.
 #include <cmath>
 
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/physics/magnetic.hpp"
+#include "request_meta.hpp"
 
 namespace gmasim {
 namespace {
@@ -22,10 +24,7 @@ Report base(const std::string& experiment, const Model& m) {
 // ---------------------------------------------------------------------------------------
 Report sweep_report(const Model& m, const SweepRequest& req, const SweepResult& res) {
   Report r = base("sweep", m);
-  r.meta.emplace_back("reference_temperature_C", req.reference_temperature_C);
-  r.meta.emplace_back("current_min_A", req.current_min_A);
-  r.meta.emplace_back("periods", req.periods);
-  r.meta.emplace_back("dt_s", req.dt_s);
+  fields::add_request_meta(r, req);
   r.meta.emplace_back("threads", res.threads);
   r.meta.emplace_back("simulations", static_cast<double>(res.simulations));
   r.meta.emplace_back("wall_time_s", res.wall_time_s);
@@ -55,15 +54,7 @@ Report sweep_report(const Model& m, const SweepRequest& req, const SweepResult& 
 
 Report frf_report(const Model& m, const FrfRequest& req, const FrfResult& res) {
   Report r = base("frf", m);
-  r.meta.emplace_back("bias_A", req.bias_A);
-  r.meta.emplace_back("amplitude_A", req.amplitude_A);
-  r.meta.emplace_back("peak_refinements", req.peak_refinements);
-  r.meta.emplace_back("bias_state",
-                      req.bias_state == BiasState::Anhysteretic ? "anhysteretic" : "initial_curve");
-  r.meta.emplace_back("stepped_sine", req.stepped_sine);
-  r.meta.emplace_back("small_signal", req.small_signal);
-  r.meta.emplace_back("settle_periods_min", req.settle_periods);
-  r.meta.emplace_back("measure_periods", req.measure_periods);
+  fields::add_request_meta(r, req);
   r.meta.emplace_back("paper_first_resonance_Hz", res.paper_first_resonance_Hz);
   r.meta.emplace_back("paper_bandwidth_Hz_at_least", res.paper_bandwidth_Hz);
   if (!res.curves.empty()) r.meta.emplace_back("wall_time_s", res.curves.front().wall_time_s);
@@ -119,18 +110,8 @@ Report frf_report(const Model& m, const FrfRequest& req, const FrfResult& res) {
 
 Report track_report(const Model& m, const TrackRequest& req, const TrackResult& res) {
   Report r = base("track", m);
-  r.meta.emplace_back("kp_A_per_um", req.gains.kp);
-  r.meta.emplace_back("ki_A_per_um_per_sample_at_reference_rate", req.gains.ki);
-  r.meta.emplace_back("kd_A_per_um_per_sample_at_reference_rate", req.gains.kd);
-  r.meta.emplace_back("gains_reference_rate_Hz", req.gains.reference_rate_Hz);
-  r.meta.emplace_back("sample_rate_Hz", req.sample_rate_Hz);
-  r.meta.emplace_back("plant_dt_s", res.plant_dt_s);
-  r.meta.emplace_back("bias_A", req.bias_A);
-  r.meta.emplace_back("current_limit_A", req.current_limit_A);
-  r.meta.emplace_back("amplifier_A_per_unit", req.amplifier_A_per_unit);
-  r.meta.emplace_back("sensor_noise_um_rms", req.sensor_noise_um);
-  r.meta.emplace_back("noise_seed", static_cast<double>(req.noise_seed));
-  r.meta.emplace_back("periods", req.periods);
+  fields::add_request_meta(r, req);
+  fields::insert_meta_after(r, "sample_rate_Hz", "plant_dt_s", res.plant_dt_s);
   r.meta.emplace_back("error_window", "the last whole period of the reference, every plant step");
   r.meta.emplace_back("threads", res.threads);
   r.meta.emplace_back("wall_time_s", res.wall_time_s);
@@ -149,10 +130,7 @@ Report track_report(const Model& m, const TrackRequest& req, const TrackResult& 
 
 Report ablate_report(const Model& m, const AblateRequest& req, const AblateResult& res) {
   Report r = base("ablate", m);
-  r.meta.emplace_back("temperature_C", req.temperature_C);
-  r.meta.emplace_back("current_pp_A", req.current_pp_A);
-  r.meta.emplace_back("current_min_A", req.current_min_A);
-  r.meta.emplace_back("periods", req.periods);
+  fields::add_request_meta(r, req);
   r.meta.emplace_back("frozen_at_C", m.T_ref_C);
   r.meta.emplace_back("error_definition",
                       "RMS over the last period of y_frozen(t) - y_full(t) on the same time grid");
@@ -179,10 +157,7 @@ Report ablate_report(const Model& m, const AblateRequest& req, const AblateResul
 Report params_report(const Model& m, const ParamsVsTemperatureRequest& req,
                      const ParamsVsTemperatureResult& res) {
   Report r = base("params-vs-temperature", m);
-  r.meta.emplace_back("current_pp_A", req.current_pp_A);
-  r.meta.emplace_back("frequency_Hz", req.frequency_Hz);
-  r.meta.emplace_back("current_min_A", req.current_min_A);
-  r.meta.emplace_back("periods", req.periods);
+  fields::add_request_meta(r, req);
   Table p{"parameters",
           {"temperature_C", "rod", "mu_r_mean", "rho_ohm_m", "M_peak_A_per_m", "MsT_A_per_m",
            "E_G_mean_GPa", "E_t_GPa", "mu_r_change_pct", "rho_change_pct", "M_peak_change_pct",

@@ -7,6 +7,7 @@
 
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/model/validate.hpp"
 
@@ -99,6 +100,7 @@ void add_changes(const SweepRequest& r, bool ref_in_grid, std::size_t grid,
 
 SweepResult run_sweep(const Model& m, const SweepRequest& r, const ProgressFn& progress) {
   check_request(m, r);
+  fields::check_request_fields(r);  // the table's rules (gmasim/experiments/experiment_fields.hpp)
   // The work list: the grid, then the reference temperature if it is not in the grid.
   std::vector<Job> jobs;
   for (double T : r.temperatures_C)

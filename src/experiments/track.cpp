@@ -14,6 +14,7 @@
 #include "experiments/parallel.hpp"
 #include "experiments/track_loop.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/experiments/feedforward.hpp"
 #include "gmasim/model/validate.hpp"
@@ -167,6 +168,7 @@ void detail::check_track_request(const TrackRequest& r) {
   require_in(r.inverse.band_Hz, 0.0, 1e5, "feed-forward band (--feedforward-band)", "Hz");
   Pid probe(r.gains, r.sample_rate_Hz, -1.0, 1.0);  // validates the gains' reference rate
   (void)probe;
+  fields::check_request_fields(r);  // the table's rules (gmasim/experiments/experiment_fields.hpp)
 }
 
 // The plant steps per controller sample: dt divides the sample period, dt <= 10 us and

@@ -440,12 +440,7 @@ std::string metrics_json(const Result& r, const SimulationSettings& s, const Mod
   w.end_array();
   if (r.has_metrics) {
     w.key("metrics").begin_object();
-    w.numbers({{"stroke_um", r.metrics.stroke_um},
-               {"hysteresis_um", r.metrics.hysteresis_um},
-               {"B_pp_T", r.metrics.B_pp_T},
-               {"y_mean_um", r.metrics.y_mean_um},
-               {"window_start_s", r.metrics.window_start_s},
-               {"window_end_s", r.metrics.window_end_s}});
+    for (const MetricRow& row : kMetricRows) w.key(row.name).number(r.metrics.*row.member);
     if (r.step.valid) {
       w.numbers({{"step_y_initial_um", r.step.y_initial_um},
                  {"step_y_final_um", r.step.y_final_um},

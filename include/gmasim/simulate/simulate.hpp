@@ -5,6 +5,7 @@
 #include <limits>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gmasim/model/model.hpp"
@@ -96,6 +97,28 @@ struct Metrics {
   double hysteresis_um = 0;                     // max |y_rising - y_falling| at equal current
   double B_pp_T = 0;                            // peak-to-peak of B
   double y_mean_um = 0;
+};
+
+// The table of Metrics (issue 21, item 3), as kFreezeSwitches: one row per field, in the order of
+// the metrics.json object and the Python dict. From it: metrics.json (src/io/output.cpp), the
+// `gmasim simulate` summary (the rows with a label; `note`'s {} is the metrics window) and the
+// Python dict (python/src/module.cpp metrics_dict, gmasim._gmasim.metric_rows()).
+struct MetricRow {
+  std::string_view name;  // JSON / Python key, unit-suffixed
+  std::string_view unit;
+  double Metrics::*member;
+  std::string_view label;  // the CLI summary's label ("" : not printed there)
+  int precision;           // the CLI summary's decimals
+  std::string_view note;   // the CLI summary's note ("{}" : the metrics window)
+};
+inline constexpr MetricRow kMetricRows[] = {
+    {"stroke_um", "um", &Metrics::stroke_um, "stroke", 3, "(peak-to-peak of y {})"},
+    {"hysteresis_um", "um", &Metrics::hysteresis_um, "hysteresis", 3,
+     "(widest rising/falling gap at equal current)"},
+    {"B_pp_T", "T", &Metrics::B_pp_T, "B p-p", 4, "(induction coil)"},
+    {"y_mean_um", "um", &Metrics::y_mean_um, "y mean", 3, ""},
+    {"window_start_s", "s", &Metrics::window_start_s, "", 0, ""},
+    {"window_end_s", "s", &Metrics::window_end_s, "", 0, ""},
 };
 
 // Step response of a Step waveform (y over the run after the step time): 10-90 % rise time,
