@@ -169,6 +169,19 @@ std::complex<double> first_harmonic_ratio(const std::vector<double>& t_s,
 double find_resonance_Hz(const std::vector<double>& f_Hz, const std::vector<double>& mag);
 double find_bandwidth_3dB_Hz(const std::vector<double>& f_Hz, const std::vector<double>& mag);
 
+// The linearisation's first resonance and -3 dB bandwidth [Hz], as run_frf() marks them on a
+// curve without the stepped sine: |Y(f)| on a 4000-point log grid over [f_min_Hz, f_max_Hz]
+// (find_resonance_Hz, find_bandwidth_3dB_Hz). run_frf's markers and linear_frf_markers() of
+// the same bias point are the same numbers.
+struct LinearFrfMarkers {
+  double first_resonance_Hz = 0, bandwidth_3dB_Hz = 0;
+};
+LinearFrfMarkers linear_frf_markers(const SmallSignalModel& lin, double f_min_Hz, double f_max_Hz);
+// At temperature T_C and DC bias bias_A with FrfRequest's default band and bias state: the
+// cost of one settle_at_bias() and the dense grid, without the rest of run_frf's curve (the
+// identify objective's frf_peak_Hz and bandwidth_Hz targets).
+LinearFrfMarkers linear_frf_markers(const Model& m, double T_C, double bias_A);
+
 // ---------------------------------------------------------------------------------------
 // Closed-loop tracking with the paper's PID (Fig. 16).
 // ---------------------------------------------------------------------------------------
