@@ -99,19 +99,6 @@ struct FrfRequest {
 // until H, M and x are at rest). Returns the state; throws DivergenceError.
 State settle_at_bias(const Model& m, const Conditions& c, double bias_A, BiasState bias_state);
 
-// The linearisation's first resonance and -3 dB bandwidth [Hz], as run_frf() marks them on a
-// curve without the stepped sine: |Y(f)| on a 4000-point log grid over [f_min_Hz, f_max_Hz]
-// (find_resonance_Hz, find_bandwidth_3dB_Hz). run_frf's markers and linear_frf_markers() of
-// the same bias point are the same numbers.
-struct LinearFrfMarkers {
-  double first_resonance_Hz = 0, bandwidth_3dB_Hz = 0;
-};
-LinearFrfMarkers linear_frf_markers(const SmallSignalModel& lin, double f_min_Hz, double f_max_Hz);
-// At temperature T_C and DC bias bias_A with FrfRequest's default band and bias state: the
-// cost of one settle_at_bias() and the dense grid, without the rest of run_frf's curve (the
-// identify objective's frf_peak_Hz and bandwidth_Hz targets).
-LinearFrfMarkers linear_frf_markers(const Model& m, double T_C, double bias_A);
-
 struct FrfCurve {
   double temperature_C = 0;
   std::vector<double> f_Hz;
