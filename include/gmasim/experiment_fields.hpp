@@ -14,14 +14,14 @@ namespace gmasim::fields {
 
 inline constexpr unsigned kCliPy = Cli | Python;
 inline constexpr unsigned kCliMeta = Cli | Meta;
-inline constexpr Rule kThreads = in(0, kMaxThreads);
 inline constexpr Rule kCurrent = in(-kMaxCurrent_A, kMaxCurrent_A);
 inline constexpr Rule kPeriods = in(1.0, kMaxPeriods);
 
 // Rows that several requests share, spelled once.
+// threads: resolve_thread_count() checks it (0 or 1..kMaxThreads) with its own message.
 template <class R>
 constexpr auto threads_row(unsigned where) {
-  return field<R>("threads", "-", kThreads, "--threads", "Worker threads [-]; 0 = all cores", where,
+  return field<R>("threads", "-", any(), "--threads", "Worker threads [-]; 0 = all cores", where,
                   GMASIM_REF(R, threads));
 }
 template <class R>
