@@ -196,6 +196,7 @@ struct RequestFields<CompensateRequest> {
   static constexpr std::string_view experiment = "compensate";
   static constexpr auto rows = std::tuple{
       field<R>("adjust", "-", any(), "", "", Meta, GMASIM_REF(R, adjust)),
+      temperatures_row<R>("Temperatures of the schedule [degC]: list or start:step:stop"),
       field<R>("reference_temperature_C", "degC", finite(), "--reference-temperature",
                "Temperature whose stroke is the target [degC]", All,
                GMASIM_REF(R, reference_temperature_C)),
@@ -208,7 +209,6 @@ struct RequestFields<CompensateRequest> {
       field<R>("target_stroke_um", "um", in(0.0, kMaxTrackAmplitude_um), "--target-stroke",
                "Target stroke [um]; 0 = the reference drive's stroke at the reference temperature",
                kCliPy, GMASIM_REF(R, target_stroke_um)),
-      temperatures_row<R>("Temperatures of the schedule [degC]: list or start:step:stop"),
       field<R>("frequency_Hz", "Hz", in(0.0, kMaxFrequency_Hz), "--frequency",
                "Drive frequency [Hz]", All, GMASIM_REF(R, frequency_Hz)),
       field<R>("periods", "-", kPeriods, "--periods",
