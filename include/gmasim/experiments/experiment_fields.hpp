@@ -15,14 +15,14 @@ namespace gmasim::fields {
 
 inline constexpr unsigned kCliPy = Cli | Python;
 inline constexpr unsigned kCliMeta = Cli | Meta;
-inline constexpr Rule kThreads = in(0, kMaxThreads);
 inline constexpr Rule kCurrent = in(-kMaxCurrent_A, kMaxCurrent_A);
 inline constexpr Rule kPeriods = in(1.0, kMaxPeriods);
 
 // Rows that several requests share, spelled once.
+// threads: resolve_thread_count() checks it (0 or 1..kMaxThreads) with its own message.
 template <class R>
 constexpr auto threads_row(unsigned where) {
-  return field<R>("threads", "-", kThreads, "--threads", "Worker threads [-]; 0 = all cores", where,
+  return field<R>("threads", "-", any(), "--threads", "Worker threads [-]; 0 = all cores", where,
                   GMASIM_REF(R, threads));
 }
 template <class R>
@@ -197,6 +197,7 @@ struct RequestFields<CompensateRequest> {
   static constexpr std::string_view experiment = "compensate";
   static constexpr auto rows = std::tuple{
       field<R>("adjust", "-", any(), "", "", Meta, GMASIM_REF(R, adjust)),
+      temperatures_row<R>("Temperatures of the schedule [degC]: list or start:step:stop"),
       field<R>("reference_temperature_C", "degC", finite(), "--reference-temperature",
                "Temperature whose stroke is the target [degC]", All,
                GMASIM_REF(R, reference_temperature_C)),
@@ -209,7 +210,6 @@ struct RequestFields<CompensateRequest> {
       field<R>("target_stroke_um", "um", in(0.0, kMaxTrackAmplitude_um), "--target-stroke",
                "Target stroke [um]; 0 = the reference drive's stroke at the reference temperature",
                kCliPy, GMASIM_REF(R, target_stroke_um)),
-      temperatures_row<R>("Temperatures of the schedule [degC]: list or start:step:stop"),
       field<R>("frequency_Hz", "Hz", in(0.0, kMaxFrequency_Hz), "--frequency",
                "Drive frequency [Hz]", All, GMASIM_REF(R, frequency_Hz)),
       field<R>("periods", "-", kPeriods, "--periods",
