@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <utility>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/model/validity.hpp"
@@ -136,8 +137,12 @@ std::vector<Result> simulate_lanes(const Model& m, std::span<const SimulationSet
                                    bool metrics_only) {
   std::vector<Result> out(settings.size());
   const bool model_ok = lanes_supported(m);
-  std::map<long, std::vector<std::size_t>> groups;  // step count -> settings
-  std::map<long, Plan> plans;
+  // A group shares the step count and the step (the lanes' time grid). Every periodic run
+  // takes the lanes, whatever else is in the batch: a point's numbers never depend on which
+  // other points it was run with (RunClaims.MatchesTheFullStudy).
+  using Key = std::pair<long, double>;
+  std::map<Key, std::vector<std::size_t>> groups;  // (step count, step) -> settings
+  std::map<Key, Plan> plans;
   for (std::size_t i = 0; i < settings.size(); ++i) {
     const SimulationSettings& s = settings[i];
     validate(s);
@@ -147,12 +152,7 @@ std::vector<Result> simulate_lanes(const Model& m, std::span<const SimulationSet
       continue;
     }
     const Plan p = periodic_plan(s);
-    // A group shares the step count and the step (the lanes' time grid).
-    const long key = p.steps;
-    if (plans.count(key) && plans[key].dt_s != p.dt_s) {
-      out[i] = simulate(m, s);
-      continue;
-    }
+    const Key key{p.steps, p.dt_s};
     plans[key] = p;
     groups[key].push_back(i);
   }
