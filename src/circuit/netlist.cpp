@@ -160,6 +160,11 @@ void set_lowrank_pieces(const Circuit& c, const Eigen::LLT<Eigen::MatrixXd>& llt
 
 }  // namespace
 
+CircuitLowRankView circuit_lowrank_view(const Circuit& c) {
+  const CircuitMatrices& L = *c.matrices;
+  return {L.S8.data(), L.bt_coil8.data(), L.bt_pm8.data()};
+}
+
 void finalize_circuit(Circuit& c, int rod_count, const std::string& where) {
   const int n = c.node_count();
   if (n == 0) throw InputError(located(where, 0, "circuit has no nodes besides the reference"));

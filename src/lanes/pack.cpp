@@ -2,10 +2,8 @@
 // structure of arrays (lanes/lane_data.hpp), unpacking, and each lane's diagnosis.
 #include <fmt/format.h>
 
-#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <map>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/model/validity.hpp"
@@ -39,50 +37,6 @@ int lanes_width() { return lanes::dispatch_lanes(); }
 
 namespace {
 
-// The low-rank pieces of the circuit (circuit/netlist.cpp, set_lowrank_pieces): with G0 the
-// fixed branches' Laplacian and B the rod branches' incidence, S = B^T G0^-1 B and
-// B^T G0^-1 b for the coil (per ampere) and the magnets (per unit scale).
-struct LowRank {
-  Eigen::MatrixXd S;
-  Eigen::VectorXd bt_coil, bt_pm;
-};
-LowRank lowrank_pieces(const Circuit& c) {
-  const auto n = static_cast<Eigen::Index>(c.node_count());
-  const auto k = static_cast<Eigen::Index>(c.rod_branch.size());
-  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n), B = Eigen::MatrixXd::Zero(n, k);
-  Eigen::VectorXd b_coil = Eigen::VectorXd::Zero(n), b_pm = Eigen::VectorXd::Zero(n);
-  for (Eigen::Index r = 0; r < k; ++r) {
-    const auto& br =
-        c.branches[static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)])];
-    if (br.from >= 0) B(br.from, r) += 1.0;
-    if (br.to >= 0) B(br.to, r) -= 1.0;
-  }
-  for (const auto& br : c.branches) {
-    if (br.rod >= 0) continue;
-    const double g = 1.0 / br.fixed_reluctance_per_H;
-    if (br.from >= 0) {
-      G(br.from, br.from) += g;
-      b_coil(br.from) -= br.coil_turns * g;
-      b_pm(br.from) -= br.pm_mmf_At * g;
-    }
-    if (br.to >= 0) {
-      G(br.to, br.to) += g;
-      b_coil(br.to) += br.coil_turns * g;
-      b_pm(br.to) += br.pm_mmf_At * g;
-    }
-    if (br.from >= 0 && br.to >= 0) {
-      G(br.from, br.to) -= g;
-      G(br.to, br.from) -= g;
-    }
-  }
-  const Eigen::LLT<Eigen::MatrixXd> llt(G);
-  LowRank L;
-  L.S = B.transpose() * llt.solve(B);
-  L.bt_coil = B.transpose() * llt.solve(b_coil);
-  L.bt_pm = B.transpose() * llt.solve(b_pm);
-  return L;
-}
-
 lanes::Structure structure_of(const Model& m, const Conditions& c) {
   lanes::Structure st;
   st.rods = m.rod_count();
@@ -107,7 +61,7 @@ bool same_structure(const lanes::Structure& a, const lanes::Structure& b) {
 
 // Lane j's numbers from its model, conditions and state.
 void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, const State& s,
-               const LowRank& lr) {
+               const CircuitLowRankView& lr) {
   using namespace lanes;
   auto rod = [&](int f, int i) -> double& { return L.rod(f, i)[j]; };
   auto glob = [&](int f) -> double& { return L.glob(f)[j]; };
@@ -157,9 +111,9 @@ void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, 
         kStrainGuardFactor * m.material.lambda_s * q * q,
         std::max(m.material.Ms_A_per_m, rc.MsT_mag)};
     for (int f = kRodStateCount; f < kRodFieldCount; ++f) rod(f, i) = constants[f - kRodStateCount];
-    for (int b = 0; b < n; ++b) L.S(i, b)[j] = lr.S(i, b);
-    L.bt_coil(i)[j] = lr.bt_coil(i);
-    L.bt_pm(i)[j] = lr.bt_pm(i);
+    for (int b = 0; b < n; ++b) L.S(i, b)[j] = lr.S8[static_cast<std::size_t>(8 * i + b)];
+    L.bt_coil(i)[j] = lr.bt_coil8[i];
+    L.bt_pm(i)[j] = lr.bt_pm8[i];
   }
   const double globals[] = {s.t_s,
                             s.current_A,
@@ -196,7 +150,6 @@ LaneBatch::LaneBatch(std::span<const Model* const> models,
     if (!lanes_supported(*m, &why)) throw InputError("lanes: " + why);
   d_->resize(n);
   d_->st = structure_of(*models[0], *conditions[0]);
-  std::map<const Model*, LowRank> lowrank;
   for (std::size_t j = 0; j < d_->npad; ++j) {
     const std::size_t src = j < n ? j : 0;  // padding repeats lane 0
     const Model& m = *models[src];
@@ -205,9 +158,7 @@ LaneBatch::LaneBatch(std::span<const Model* const> models,
           fmt::format("lanes: simulation {} has another structure than simulation 0 "
                       "(rods, load chains, sensor, mount)",
                       j));
-    auto it = lowrank.find(&m);
-    if (it == lowrank.end()) it = lowrank.emplace(&m, lowrank_pieces(m.circuit)).first;
-    pack_lane(*d_, j, m, *conditions[src], *states[src], it->second);
+    pack_lane(*d_, j, m, *conditions[src], *states[src], circuit_lowrank_view(m.circuit));
   }
   for (const auto& r : models[0]->rods) rod_names_.push_back(r.name);
   in_current_.assign(d_->npad, 0.0);

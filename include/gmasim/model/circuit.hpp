@@ -62,6 +62,18 @@ struct Circuit {
 // the message.
 void finalize_circuit(Circuit& c, int rod_count, const std::string& where);
 
+// The low-rank (Woodbury) pieces finalize_circuit precomputed, for a circuit on the low-rank
+// path (c.lowrank.enabled; k = the rod count <= 8): with G0 the fixed branches' Laplacian and B
+// the rod branches' incidence, S = B^T G0^-1 B (row-major, row stride 8) and B^T G0^-1 b for
+// the coil (per ampere) and the magnets (per unit scale). The views live as long as c. Used by
+// the SIMD lanes (src/lanes/pack.cpp), which copy them into every lane.
+struct CircuitLowRankView {
+  const double* S8;        // S(r, q) = S8[8 r + q]
+  const double* bt_coil8;  // B^T G0^-1 b_coil, per rod
+  const double* bt_pm8;    // B^T G0^-1 b_pm, per rod
+};
+CircuitLowRankView circuit_lowrank_view(const Circuit& c);
+
 // Owns a workspace's NodalBuffers and copies them with it, so that a State stays a copyable
 // value. Defined in src/circuit/netlist.cpp.
 class NodalBuffersPtr {
