@@ -224,14 +224,14 @@ std::string LaneBatch::error(std::size_t j) const {
   const std::string rod =
       rod_index >= 0 ? rod_names_[static_cast<std::size_t>(rod_index)] : std::string();
   // step()'s check(): |value| <= limit
-  auto check = [&](const std::string& where, const char* quantity) {
+  auto check = [&](const std::string& where, const char* quantity) -> std::string {
     return DivergenceError(t, where, quantity, v,
                            std::isfinite(v) ? fmt::format("|value| exceeds {:g}", bound)
                                             : std::string("not finite"))
         .what();
   };
   // check_physical_validity's beyond()
-  auto beyond = [&](const char* quantity, const char* rule) {
+  auto beyond = [&](const char* quantity, const char* rule) -> std::string {
     return DivergenceError(t, rod, quantity, v,
                            fmt::format("beyond the physical bound {:.4g}: {}; the model is "
                                        "outside its range (check the values `gmasim model "
