@@ -7,6 +7,7 @@
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/magnetisation/laws.hpp"
+#include "gmasim/model/step_stages.hpp"
 #include "gmasim/simulate/run_loop.hpp"
 
 namespace gmasim {
@@ -36,7 +37,7 @@ void anhysteretic_fixed_point(const Model& m, const Conditions& c, State& s, dou
       auto& r = s.rods[i];
       const double M = Law::anhysteretic_magnetisation(rc, r);
       change = std::max(change, Law::hold_anhysteretic(rc, r, M) / rc.MsT_mag);
-      r.M_prev_A_per_m = r.M_prev2_A_per_m = r.M_A_per_m;
+      hold_history(r);
     }
     run_dc(m, c, s, bias_A, std::max(5.0 * tau_max, 1e-3));
     if (change < 1e-10) break;
@@ -60,7 +61,7 @@ State settle_law(const Model& m, const Conditions& c, double bias_A, BiasState b
     for (std::size_t i = 0; i < s.rods.size(); ++i) {
       auto& r = s.rods[i];
       (void)Law::hold_anhysteretic(c.rods[i], r, r.M_A_per_m);
-      r.M_prev_A_per_m = r.M_A_per_m;
+      hold_history(r);
     }
   } else {
     s = make_state(m, c, bias_A);  // virgin curve, static equilibrium

@@ -206,8 +206,7 @@ void settle_at_rest(const Model& m, const Conditions& c, State& s) {
   const std::size_t n = s.rods.size();
   for (std::size_t i = 0; i < n; ++i) {
     auto& r = s.rods[i];
-    r.M_prev2_A_per_m = r.M_prev_A_per_m = r.M_A_per_m;
-    r.H_prev2_A_per_m = r.H_prev_A_per_m = r.H_A_per_m;
+    hold_history(r);
     if (!consistent) r.tau_s = r.mu_r * kMu0 * c.rods[i].eddy_geometry_s_m_per_H;
     update_rod_mechanics(m.material, c.rods[i], r);
   }

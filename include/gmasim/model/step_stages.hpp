@@ -29,6 +29,14 @@ struct StepScratch {
 };
 
 // Sets t1_s and current0_A (and, with the ledgers enabled, their start values).
+// A rod at rest: the histories of the consistent state's first guess (H and M one and two
+// steps earlier) all equal the present values. Every place that puts a rod at rest calls it,
+// so no history is left stale (make_state's settle_at_rest, the FRF's bias states).
+inline void hold_history(RodState& r) {
+  r.M_prev2_A_per_m = r.M_prev_A_per_m = r.M_A_per_m;
+  r.H_prev2_A_per_m = r.H_prev_A_per_m = r.H_A_per_m;
+}
+
 void stage_begin(State& s, const StepInput& in, StepScratch& w);
 template <class Law>
 void stage_magnetic(const Model& m, const Conditions& c, State& s, const StepInput& in,
