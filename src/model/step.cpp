@@ -231,15 +231,6 @@ void settle_at_rest(const Model& m, const Conditions& c, State& s) {
   finish_outputs(m, c, s);
 }
 
-}  // namespace
-
-double oscillator_stiffness(const Conditions& c, const State& s, int rod) {
-  const auto i = static_cast<std::size_t>(rod);
-  return s.rods[i].k_rod_N_per_m + load_stiffness(c.rods[i], s);  // eq. (16)
-}
-
-namespace {
-
 template <class Law>
 State make_state_law(const Model& m, const Conditions& c, double current_A) {
   State s;
