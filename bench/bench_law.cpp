@@ -27,21 +27,14 @@ const Model& single_rod(bool preisach) {
 
 // Arg(0): step(); Arg(1): step_law<JilesAthertonLaw> (the built-in model, 8 A, 400 Hz, 70 degC).
 void BM_LawSeamJaStep(benchmark::State& bs) {
-  const Model& m = bench::mdma();
-  const Conditions c = make_conditions(m, 70.0);
   const Waveform w = biased_sine(8.0, 400.0);
-  State s = make_state(m, c, w.current_at(0.0));
-  const double dt = auto_dt(w);
-  long k = 0;
-  for (auto _ : bs) {
-    ++k;
-    const StepInput in{w.current_at(static_cast<double>(k) * dt), dt};
-    if (bs.range(0) == 0)
-      step(m, c, s, in);
-    else
-      step_law<JilesAthertonLaw>(m, c, s, in);
-    benchmark::DoNotOptimize(s.y_m);
-  }
+  if (bs.range(0) == 0)
+    bench::step_loop(bs, bench::mdma(), 70.0, w);
+  else
+    bench::step_loop(bs, bench::mdma(), 70.0, w, false,
+                     [](const Model& m, const Conditions& c, State& s, const StepInput& in) {
+                       step_law<JilesAthertonLaw>(m, c, s, in);
+                     });
 }
 BENCHMARK(BM_LawSeamJaStep)->Arg(0)->Arg(1)->Arg(0)->Arg(1);
 
@@ -83,17 +76,7 @@ BENCHMARK(BM_LawSeamJaMove)->Arg(0)->Arg(1)->Arg(0)->Arg(1)->Arg(0)->Arg(1);
 
 // One step of the single-rod template: Arg(0) Jiles-Atherton, Arg(1) Preisach (8 A, 50 Hz).
 void BM_LawSingleRodStep(benchmark::State& bs) {
-  const Model& m = single_rod(bs.range(0) == 1);
-  const Conditions c = make_conditions(m, 20.0);
-  const Waveform w = biased_sine(8.0, 50.0);
-  State s = make_state(m, c, w.current_at(0.0));
-  const double dt = auto_dt(w);
-  long k = 0;
-  for (auto _ : bs) {
-    ++k;
-    step(m, c, s, {w.current_at(static_cast<double>(k) * dt), dt});
-    benchmark::DoNotOptimize(s.y_m);
-  }
+  bench::step_loop(bs, single_rod(bs.range(0) == 1), 20.0, biased_sine(8.0, 50.0));
 }
 BENCHMARK(BM_LawSingleRodStep)->Arg(0)->Arg(1);
 

@@ -19,17 +19,8 @@ using bench::mdma;
 // One step of the built-in model (consistent magnetic state: a Newton solve on the rods'
 // fields) or, with Arg(1), of the printed reading.
 void BM_FullModelStep(benchmark::State& bs) {
-  const Model& m = bs.range(0) == 0 ? mdma() : bench::mdma_printed();
-  const Conditions c = make_conditions(m, 70.0);
-  const Waveform w = biased_sine(8.0, 400.0);
-  State s = make_state(m, c, w.current_at(0.0));
-  const double dt = auto_dt(w);
-  long k = 0;
-  for (auto _ : bs) {
-    ++k;
-    step(m, c, s, {w.current_at(static_cast<double>(k) * dt), dt});
-    benchmark::DoNotOptimize(s.y_m);
-  }
+  bench::step_loop(bs, bs.range(0) == 0 ? mdma() : bench::mdma_printed(), 70.0,
+                   biased_sine(8.0, 400.0));
 }
 BENCHMARK(BM_FullModelStep)->Arg(0)->Arg(1);
 
@@ -37,18 +28,7 @@ BENCHMARK(BM_FullModelStep)->Arg(0)->Arg(1);
 // every branch of the circuit solved, each rod's dissipation along the step's path and its
 // oscillator's power by Gauss-Legendre), against BM_FullModelStep/0 (issue 18).
 void BM_FullModelStepWithLedger(benchmark::State& bs) {
-  const Model& m = mdma();
-  const Conditions c = make_conditions(m, 70.0);
-  const Waveform w = biased_sine(8.0, 400.0);
-  State s = make_state(m, c, w.current_at(0.0));
-  s.energy.enabled = true;
-  const double dt = auto_dt(w);
-  long k = 0;
-  for (auto _ : bs) {
-    ++k;
-    step(m, c, s, {w.current_at(static_cast<double>(k) * dt), dt});
-    benchmark::DoNotOptimize(s.y_m);
-  }
+  bench::step_loop(bs, mdma(), 70.0, biased_sine(8.0, 400.0), true);
 }
 BENCHMARK(BM_FullModelStepWithLedger);
 

@@ -239,7 +239,8 @@ template <int K>
 bool rod_solve(const CircuitMatrices& L, const double* R, const double* mmf, double current_A,
                double pm_scale, int k_any, NodalBuffers& ws) {
   const int k = K > 0 ? K : k_any;
-  double A[64], DF[8], Btu[8], x[8], piv[8];  // written before read (no zero fill: hot path)
+  // Written before read (no zero fill: hot path).
+  double A[64], DF[8], Btu[8], x[8], piv[8], inv_piv[8];
   const double* S = L.S8.data();
   for (int r = 0; r < k; ++r) {
     DF[r] = mmf[r] / R[r];
@@ -255,16 +256,17 @@ bool rod_solve(const CircuitMatrices& L, const double* R, const double* mmf, dou
     for (int p = 0; p < j; ++p) d -= A[8 * j + p] * A[8 * j + p] * piv[p];
     if (!(d > 0.0)) return false;
     piv[j] = d;
+    inv_piv[j] = 1.0 / d;  // one division per pivot
     for (int i = j + 1; i < k; ++i) {
       double a = S[8 * i + j];
       for (int p = 0; p < j; ++p) a -= A[8 * i + p] * A[8 * j + p] * piv[p];
-      A[8 * i + j] = a / d;
+      A[8 * i + j] = a * inv_piv[j];
     }
   }
   for (int i = 0; i < k; ++i)
     for (int p = 0; p < i; ++p) x[i] -= A[8 * i + p] * x[p];
   for (int i = k - 1; i >= 0; --i) {
-    x[i] /= piv[i];
+    x[i] *= inv_piv[i];
     for (int p = i + 1; p < k; ++p) x[i] -= A[8 * p + i] * x[p];
   }
   bool finite = true;

@@ -1,0 +1,14 @@
+// The mechanics module: the static stiffness of a rod's oscillator
+// (gmasim/mechanics/stiffness.hpp).
+#include "gmasim/mechanics/stiffness.hpp"
+
+#include "gmasim/model/rod_laws.hpp"
+
+namespace gmasim {
+
+double oscillator_stiffness(const Conditions& c, const State& s, int rod) {
+  const auto i = static_cast<std::size_t>(rod);
+  return s.rods[i].k_rod_N_per_m + load_stiffness(c.rods[i], s);  // eq. (16)
+}
+
+}  // namespace gmasim
