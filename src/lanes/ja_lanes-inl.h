@@ -127,23 +127,39 @@ struct JaLaneConstants {
   V<D> MsT, a, alpha, c, k;
 };
 
-// One step of eq. (9) from H0 to H1 (jiles_atherton.hpp, ja_step): Newton's method on
-// g(M1) = M1 - (1-c) M_irr1(M1) - c M_an(H1 + alpha M1), per lane and masked: a lane whose
-// |g| <= tol keeps the values of that iterate while the others iterate (at most 60). Mirr and
-// M are read (the state at H0) and receive the values at H1; chi receives dM1/dH1's chi_e.
+// What a move depends on at its start only (jiles_atherton.hpp, ja_move_start): H_e0 and
+// M_an(H_e0), fixed while the consistent state's Newton solve tries several end fields.
 template <class D>
-HWY_INLINE void ja_step(D d, V<D> H0, V<D> H1, const JaLaneConstants<D>& p, V<D>& Mirr, V<D>& M,
-                        V<D> M_guess, V<D>& chi_e_out) {
+struct JaLaneStart {
+  V<D> He0, Man0;
+};
+template <class D>
+HWY_INLINE JaLaneStart<D> ja_move_start(D d, V<D> H0, V<D> M0, const JaLaneConstants<D>& p) {
+  const V<D> He0 = hn::Add(H0, hn::Mul(p.alpha, M0));
+  V<D> L, dL;
+  langevin_pair(d, hn::Mul(He0, hn::Div(C(d, 1.0), p.a)), L, dL);
+  return {He0, hn::Mul(p.MsT, L)};
+}
+
+// One step of eq. (9) from H0 to H1 (jiles_atherton.hpp, ja_step_from): Newton's method on
+// g(M1) = M1 - (1-c) M_irr1(M1) - c M_an(H1 + alpha M1), per lane and masked: a lane whose
+// |g| <= tol keeps the values of that iterate while the others iterate (at most 60). Mirr1 and
+// M1 receive the values at H1, chi_e the step's (1-c) dM_irr1/dH_e + c dM_an/dH_e; at
+// H1 == H0 nothing moves and chi_e is the reversible c dM_an/dH_e.
+template <class D>
+HWY_INLINE void ja_step_from(D d, V<D> H0, const JaLaneStart<D>& st, V<D> H1,
+                             const JaLaneConstants<D>& p, V<D> Mirr0, V<D> M0, V<D> M_guess,
+                             V<D>& Mirr1_out, V<D>& M1_out, V<D>& chi_e_out) {
   const V<D> inv_a = hn::Div(C(d, 1.0), p.a);
   const Mk<D> same = hn::Eq(H1, H0);
-  const V<D> He0 = hn::Add(H0, hn::Mul(p.alpha, M));
-  V<D> L0, dL0;
-  langevin_pair(d, hn::Mul(He0, inv_a), L0, dL0);
-  // H1 == H0: M_irr pinned, the reversible slope.
-  V<D> chi = hn::Mul(hn::Mul(hn::Mul(p.c, p.MsT), inv_a), dL0);
-  const V<D> Man0 = hn::Mul(p.MsT, L0);
+  V<D> chi = hn::Zero(d);
+  if (!hn::AllFalse(d, same)) {  // only where a lane needs it (its value is per lane)
+    V<D> L0, dL0;
+    langevin_pair(d, hn::Mul(hn::Add(H0, hn::Mul(p.alpha, M0)), inv_a), L0, dL0);
+    chi = hn::Mul(hn::Mul(hn::Mul(p.c, p.MsT), inv_a), dL0);
+  }
   const V<D> tol = hn::Mul(C(d, 1e-12), p.MsT);
-  V<D> M1 = M_guess, Mirr_out = Mirr, M_out = M;
+  V<D> M1 = M_guess, Mirr_out = Mirr0, M_out = M0;
   Mk<D> done = same;
   for (int it = 0; it < 60 && !hn::AllTrue(d, done); ++it) {
     const V<D> He1 = hn::Add(H1, hn::Mul(p.alpha, M1));
@@ -153,7 +169,7 @@ HWY_INLINE void ja_step(D d, V<D> H0, V<D> H1, const JaLaneConstants<D>& p, V<D>
     const V<D> dMan = hn::Mul(hn::Mul(p.MsT, inv_a), dL1);
     V<D> dMirr;
     const V<D> Mirr1 =
-        ja_irreversible_update(d, Mirr, Man0, Man1, dMan, hn::Sub(He1, He0), p.k, dMirr);
+        ja_irreversible_update(d, Mirr0, st.Man0, Man1, dMan, hn::Sub(He1, st.He0), p.k, dMirr);
     const V<D> Mnew = hn::Add(hn::Mul(hn::Sub(C(d, 1.0), p.c), Mirr1), hn::Mul(p.c, Man1));
     const V<D> g = hn::Sub(M1, Mnew);
     const V<D> chi_e = hn::Add(hn::Mul(hn::Sub(C(d, 1.0), p.c), dMirr), hn::Mul(p.c, dMan));
@@ -168,25 +184,33 @@ HWY_INLINE void ja_step(D d, V<D> H0, V<D> H1, const JaLaneConstants<D>& p, V<D>
     dg = hn::IfThenElse(hn::Lt(dg, C(d, 0.2)), C(d, 0.2), dg);  // alpha > 0: damped step
     M1 = hn::IfThenElse(done, M1, hn::Sub(M1, hn::Div(g, dg)));
   }
-  Mirr = Mirr_out;
-  M = M_out;
-  chi_e_out = hn::Div(chi, hn::Sub(C(d, 1.0), hn::Mul(p.alpha, chi)));  // dM1/dH1
+  Mirr1_out = Mirr_out;
+  M1_out = M_out;
+  chi_e_out = chi;
 }
 
-// The law's lane entry (gmasim/magnetisation/jiles_atherton.hpp, JilesAthertonLaw): trial
-// and commit of a move H0 -> H1 over the lanes; its state per rod is M_irr (kMirr).
+// The law's lane entry (gmasim/magnetisation/jiles_atherton.hpp, JilesAthertonLaw): the
+// consistent state's begin_move / trial_from / commit_trial over the lanes; its state per rod
+// is M_irr (kMirr). A trial is M, dM/dH (ja_slope) and the M_irr the move leaves at H1.
 struct JilesAthertonLanes {
   template <class D>
-  static V<D> trial(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> Mirr0, V<D> M0, V<D> H1,
-                    V<D> M_guess, V<D>& dM_dH) {
-    V<D> Mirr = Mirr0, M = M0;
-    ja_step(d, H0, H1, p, Mirr, M, M_guess, dM_dH);
-    return M;
+  using Start = JaLaneStart<D>;
+  template <class D>
+  struct Trial {
+    V<D> M, dM_dH, Mirr;
+  };
+  template <class D>
+  static Start<D> begin_move(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> M0) {
+    return ja_move_start(d, H0, M0, p);
   }
   template <class D>
-  static void commit(D d, const JaLaneConstants<D>& p, V<D> H0, V<D>& Mirr, V<D>& M, V<D> H1,
-                     V<D> M_guess, V<D>& dM_dH) {
-    ja_step(d, H0, H1, p, Mirr, M, M_guess, dM_dH);
+  static Trial<D> trial_from(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> Mirr0, V<D> M0,
+                             const Start<D>& st, V<D> H1, V<D> M_guess) {
+    Trial<D> t;
+    V<D> chi_e;
+    ja_step_from(d, H0, st, H1, p, Mirr0, M0, M_guess, t.Mirr, t.M, chi_e);
+    t.dM_dH = hn::Div(chi_e, hn::Sub(C(d, 1.0), hn::Mul(p.alpha, chi_e)));  // ja_slope
+    return t;
   }
 };
 

@@ -23,6 +23,8 @@ enum RodField : int {
   kHc,
   kHprev,
   kMprev,
+  kHprev2,
+  kMprev2,
   kX,
   kV,
   kF,

@@ -74,11 +74,26 @@ void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, 
   for (int i = 0; i < n; ++i) {
     const RodState& r = s.rods[static_cast<std::size_t>(i)];
     const RodConditions& rc = c.rods[static_cast<std::size_t>(i)];
-    const double state[kRodStateCount] = {
-        r.H_A_per_m,      r.Mirr_A_per_m,  r.M_A_per_m, r.Hc_A_per_m, r.H_prev_A_per_m,
-        r.M_prev_A_per_m, r.x_m,           r.v_m_per_s, r.F_N,        r.mu_r,
-        r.E_Pa,           r.lambda,        r.tau_s,     r.phi_Wb,     r.k_rod_N_per_m,
-        r.k_load_N_per_m, r.K_osc_N_per_m, r.B_T};
+    const double state[kRodStateCount] = {r.H_A_per_m,
+                                          r.Mirr_A_per_m,
+                                          r.M_A_per_m,
+                                          r.Hc_A_per_m,
+                                          r.H_prev_A_per_m,
+                                          r.M_prev_A_per_m,
+                                          r.H_prev2_A_per_m,
+                                          r.M_prev2_A_per_m,
+                                          r.x_m,
+                                          r.v_m_per_s,
+                                          r.F_N,
+                                          r.mu_r,
+                                          r.E_Pa,
+                                          r.lambda,
+                                          r.tau_s,
+                                          r.phi_Wb,
+                                          r.k_rod_N_per_m,
+                                          r.k_load_N_per_m,
+                                          r.K_osc_N_per_m,
+                                          r.B_T};
     for (int f = 0; f < kRodStateCount; ++f) rod(f, i) = state[f];
     const auto& br =
         m.circuit
@@ -196,16 +211,56 @@ void LaneBatch::unpack(std::size_t j, State& s) const {
   LaneData& L = *d_;
   for (int i = 0; i < L.st.rods; ++i) {
     RodState& r = s.rods[static_cast<std::size_t>(i)];
-    double* const fields[kRodStateCount] = {
-        &r.H_A_per_m,      &r.Mirr_A_per_m,  &r.M_A_per_m, &r.Hc_A_per_m, &r.H_prev_A_per_m,
-        &r.M_prev_A_per_m, &r.x_m,           &r.v_m_per_s, &r.F_N,        &r.mu_r,
-        &r.E_Pa,           &r.lambda,        &r.tau_s,     &r.phi_Wb,     &r.k_rod_N_per_m,
-        &r.k_load_N_per_m, &r.K_osc_N_per_m, &r.B_T};
+    double* const fields[kRodStateCount] = {&r.H_A_per_m,
+                                            &r.Mirr_A_per_m,
+                                            &r.M_A_per_m,
+                                            &r.Hc_A_per_m,
+                                            &r.H_prev_A_per_m,
+                                            &r.M_prev_A_per_m,
+                                            &r.H_prev2_A_per_m,
+                                            &r.M_prev2_A_per_m,
+                                            &r.x_m,
+                                            &r.v_m_per_s,
+                                            &r.F_N,
+                                            &r.mu_r,
+                                            &r.E_Pa,
+                                            &r.lambda,
+                                            &r.tau_s,
+                                            &r.phi_Wb,
+                                            &r.k_rod_N_per_m,
+                                            &r.k_load_N_per_m,
+                                            &r.K_osc_N_per_m,
+                                            &r.B_T};
     for (int f = 0; f < kRodStateCount; ++f) *fields[f] = L.rod(f, i)[j];
   }
   double* const globals[kGlobalStateCount] = {&s.t_s, &s.current_A, &s.y_m,         &s.y_stack_m,
                                               &s.q_m, &s.z_m,       &s.z_v_m_per_s, &s.B_T};
   for (int f = 0; f < kGlobalStateCount; ++f) *globals[f] = L.glob(f)[j];
+}
+
+void LaneBatch::record(std::size_t j, double thermal_expansion_m, TimeSeries& ts) const {
+  using namespace lanes;
+  LaneData& L = *d_;
+  auto& col = ts.columns;
+  col[0].push_back(L.glob(kT)[j]);
+  col[1].push_back(L.glob(kCurrent)[j]);
+  col[2].push_back(L.glob(kY)[j] * 1e6);
+  col[3].push_back(L.glob(kBSensor)[j]);
+  col[4].push_back(thermal_expansion_m * 1e6);
+  col[5].push_back(L.glob(kYStack)[j] * 1e6);
+  constexpr std::size_t kGlobalColumns = 6, kPerRodColumns = 9;
+  for (int i = 0; i < L.st.rods; ++i) {
+    const std::size_t b = kGlobalColumns + static_cast<std::size_t>(i) * kPerRodColumns;
+    col[b + 0].push_back(L.rod(kH, i)[j]);
+    col[b + 1].push_back(L.rod(kM, i)[j]);
+    col[b + 2].push_back(L.rod(kMuR, i)[j]);
+    col[b + 3].push_back(L.rod(kE, i)[j] * 1e-9);
+    col[b + 4].push_back(L.rod(kLambda, i)[j] * 1e6);
+    col[b + 5].push_back(L.rod(kF, i)[j]);
+    col[b + 6].push_back(L.rod(kX, i)[j] * 1e6);
+    col[b + 7].push_back(L.rod(kTau, i)[j] * 1e3);
+    col[b + 8].push_back(L.rod(kB, i)[j]);
+  }
 }
 
 double LaneBatch::y_m(std::size_t lane) const { return d_->glob(lanes::kY)[lane]; }

@@ -116,8 +116,7 @@ void run_group(const Model& m, std::span<const SimulationSettings> settings,
         r.steps = k;
         if (k >= lr.first_recorded &&
             (k % settings[lr.setting].record_every == 0 || k == p.steps)) {
-          batch.unpack(l, lr.st);
-          record(lr.c, lr.st, r.series);
+          batch.record(l, lr.c.thermal_expansion_m, r.series);
         }
       }
     }

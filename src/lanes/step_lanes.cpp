@@ -122,9 +122,9 @@ HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
   const Mk<D> alive = hn::Not(fails.failed);
   const V<D> I = hn::LoadU(d, in.current_A + j), h = hn::LoadU(d, in.dt_s + j);
   const V<D> t1 = hn::Add(g[kT], h);  // step()'s t1 = s.t_s + h
-  V<D> H[kMaxRods], M[kMaxRods], B0[kMaxRods];
-  newton_fields<JilesAthertonLanes>(c, s, I, c.glob(kPmScale), h, t1, H, M, B0, fails);
-  commit_fields<JilesAthertonLanes>(c, s, h, H, M, B0);
+  Magnetic<JilesAthertonLanes, D> mg;
+  newton_fields<JilesAthertonLanes>(c, s, I, c.glob(kPmScale), h, t1, mg, fails);
+  commit_fields<JilesAthertonLanes>(c, s, h, mg);
   for (int i = 0; i < c.n; ++i) {
     fails.check(d, s.f[kH][i], C(d, 1e9), kFailH, i, t1);
     fails.check(d, s.f[kM][i], hn::Mul(C(d, 1.5), c.rod(kMsTMag, i)), kFailM, i, t1);

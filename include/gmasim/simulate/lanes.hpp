@@ -56,6 +56,10 @@ class LaneBatch {
   // The lane's state as step() leaves it, into s (sized by make_state for the lane's model:
   // no allocation).
   void unpack(std::size_t lane, State& s) const;
+  // One row of simulate()'s series (src/simulate/run.cpp, record(): the same columns and
+  // values) from the lane's state, without unpacking it; thermal_expansion_m is the lane's
+  // Conditions::thermal_expansion_m.
+  void record(std::size_t lane, double thermal_expansion_m, TimeSeries& ts) const;
   // The lane's outputs without unpacking: y and B of the coil (State::y_m, B_T), and one
   // rod's displacement x.
   double y_m(std::size_t lane) const;
