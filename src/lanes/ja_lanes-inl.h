@@ -99,14 +99,16 @@ HWY_INLINE V<D> ja_irreversible_update(D d, V<D> Mirr0, V<D> Man0, V<D> Man1, V<
   const V<D> d1 = hn::Mul(hn::Sub(Man1, Mirr0), delta);
   const Mk<D> still = hn::Or(hn::Eq(dHe, zero), hn::And(hn::Le(d0, zero), hn::Le(d1, zero)));
   const Mk<D> cross = hn::Le(d0, zero);  // M_an crosses M_irr inside the step
-  V<D> s = hn::Abs(dHe);
-  const V<D> frac = hn::Div(d1, hn::Sub(d1, d0));
-  const V<D> d10 = hn::Sub(d1, d0);
-  const V<D> ds_cross =
-      hn::Sub(hn::Mul(delta, frac),
-              hn::Div(hn::Mul(hn::Mul(hn::Mul(s, d0), delta), dMan1), hn::Mul(d10, d10)));
-  const V<D> ds = hn::IfThenElse(cross, ds_cross, delta);
-  s = hn::IfThenElse(cross, hn::Mul(s, frac), s);
+  V<D> s = hn::Abs(dHe), ds = delta;
+  if (!hn::AllFalse(d, hn::AndNot(still, cross))) {  // only where a lane needs it
+    const V<D> frac = hn::Div(d1, hn::Sub(d1, d0));
+    const V<D> d10 = hn::Sub(d1, d0);
+    const V<D> ds_cross =
+        hn::Sub(hn::Mul(delta, frac),
+                hn::Div(hn::Mul(hn::Mul(hn::Mul(s, d0), delta), dMan1), hn::Mul(d10, d10)));
+    ds = hn::IfThenElse(cross, ds_cross, delta);
+    s = hn::IfThenElse(cross, hn::Mul(s, frac), s);
+  }
   const V<D> u0 = hn::IfThenElse(cross, Mirr0, Man0);
   const V<D> r = hn::Div(s, k);
   V<D> E, q;

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "gmasim/errors.hpp"
@@ -238,29 +239,37 @@ void LaneBatch::unpack(std::size_t j, State& s) const {
   for (int f = 0; f < kGlobalStateCount; ++f) *globals[f] = L.glob(f)[j];
 }
 
-void LaneBatch::record(std::size_t j, double thermal_expansion_m, TimeSeries& ts) const {
+std::size_t LaneBatch::record_width() const {
+  return 6 + 9 * static_cast<std::size_t>(d_->st.rods);  // run.cpp's kGlobal + kPerRod per rod
+}
+
+void LaneBatch::record_row(std::size_t j, double thermal_expansion_m, double* row) const {
   using namespace lanes;
   LaneData& L = *d_;
-  auto& col = ts.columns;
-  col[0].push_back(L.glob(kT)[j]);
-  col[1].push_back(L.glob(kCurrent)[j]);
-  col[2].push_back(L.glob(kY)[j] * 1e6);
-  col[3].push_back(L.glob(kBSensor)[j]);
-  col[4].push_back(thermal_expansion_m * 1e6);
-  col[5].push_back(L.glob(kYStack)[j] * 1e6);
-  constexpr std::size_t kGlobalColumns = 6, kPerRodColumns = 9;
+  row[0] = L.glob(kT)[j];
+  row[1] = L.glob(kCurrent)[j];
+  row[2] = L.glob(kY)[j] * 1e6;
+  row[3] = L.glob(kBSensor)[j];
+  row[4] = thermal_expansion_m * 1e6;
+  row[5] = L.glob(kYStack)[j] * 1e6;
   for (int i = 0; i < L.st.rods; ++i) {
-    const std::size_t b = kGlobalColumns + static_cast<std::size_t>(i) * kPerRodColumns;
-    col[b + 0].push_back(L.rod(kH, i)[j]);
-    col[b + 1].push_back(L.rod(kM, i)[j]);
-    col[b + 2].push_back(L.rod(kMuR, i)[j]);
-    col[b + 3].push_back(L.rod(kE, i)[j] * 1e-9);
-    col[b + 4].push_back(L.rod(kLambda, i)[j] * 1e6);
-    col[b + 5].push_back(L.rod(kF, i)[j]);
-    col[b + 6].push_back(L.rod(kX, i)[j] * 1e6);
-    col[b + 7].push_back(L.rod(kTau, i)[j] * 1e3);
-    col[b + 8].push_back(L.rod(kB, i)[j]);
+    double* b = row + 6 + 9 * i;
+    b[0] = L.rod(kH, i)[j];
+    b[1] = L.rod(kM, i)[j];
+    b[2] = L.rod(kMuR, i)[j];
+    b[3] = L.rod(kE, i)[j] * 1e-9;
+    b[4] = L.rod(kLambda, i)[j] * 1e6;
+    b[5] = L.rod(kF, i)[j];
+    b[6] = L.rod(kX, i)[j] * 1e6;
+    b[7] = L.rod(kTau, i)[j] * 1e3;
+    b[8] = L.rod(kB, i)[j];
   }
+}
+
+void LaneBatch::record(std::size_t j, double thermal_expansion_m, TimeSeries& ts) const {
+  std::array<double, 6 + 9 * lanes::kMaxRods> row{};
+  record_row(j, thermal_expansion_m, row.data());
+  for (std::size_t q = 0; q < record_width(); ++q) ts.columns[q].push_back(row[q]);
 }
 
 double LaneBatch::y_m(std::size_t lane) const { return d_->glob(lanes::kY)[lane]; }

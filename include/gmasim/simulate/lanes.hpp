@@ -60,6 +60,11 @@ class LaneBatch {
   // values) from the lane's state, without unpacking it; thermal_expansion_m is the lane's
   // Conditions::thermal_expansion_m.
   void record(std::size_t lane, double thermal_expansion_m, TimeSeries& ts) const;
+  // The same row into row[0 .. record_width()): what a caller stages before appending a block of
+  // rows column by column (many lanes appending to their columns step by step write to as many
+  // page-aligned streams at once, which the L1 cache cannot hold).
+  void record_row(std::size_t lane, double thermal_expansion_m, double* row) const;
+  std::size_t record_width() const;
   // The lane's outputs without unpacking: y and B of the coil (State::y_m, B_T), and one
   // rod's displacement x.
   double y_m(std::size_t lane) const;
@@ -79,7 +84,8 @@ class LaneBatch {
 // grouped by their step count; the others run simulate(). Results in the order of the
 // settings; the same validation and errors as simulate(). metrics_only: a lane's series holds
 // only the rows of its metrics window (the last period) and the one before it, enough for the
-// metrics, which are those of the full record (what a sweep keeps).
+// metrics, which are those of the full record (what a sweep keeps), and of the run's global
+// columns only (t_s .. y_stack_um: the rods' columns are empty).
 std::vector<Result> simulate_lanes(const Model& m, std::span<const SimulationSettings> settings,
                                    bool metrics_only = false);
 
