@@ -315,6 +315,62 @@ TEST(Lanes, RecordIsTheUnpackedStatesRow) {
   }
 }
 
+// make_states: make_state's ramp in lanes. Each lane's rest state equals the width-1
+// instance's bit for bit, and make_state's to the lanes' rounding (Highway's exp against
+X
+// every rod's H, M and x; tolerance 5e-12. The ramp's increment allocates nothing.
+TEST(Lanes, MakeStatesMatchMakeState) {
+  const Runs runs(9);
+  std::vector<const Model*> m(9, &builtin());
+  std::vector<const Conditions*> c;
+  std::vector<double> I0;
+  for (std::size_t i = 0; i < 9; ++i) {
+    c.push_back(&runs.c[i]);
+    I0.push_back(0.5 * static_cast<double>(i));
+  }
+  const std::vector<State> got = make_states(m, c, I0);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < 9; ++i) {
+    const State ref = make_state(builtin(), runs.c[i], I0[i]);
+    auto rel = [&](double x, double r, double scale) {
+      const double e = std::fabs(x - r) / scale;
+      worst = std::max(worst, e);
+      EXPECT_LE(e, 7e-13) << "lane " << i;
+    };
+    rel(got[i].y_m, ref.y_m, 1e-6);
+    rel(got[i].B_T, ref.B_T, 1.0);
+    for (std::size_t r = 0; r < ref.rods.size(); ++r) {
+      rel(got[i].rods[r].H_A_per_m, ref.rods[r].H_A_per_m, 1e4);
+      rel(got[i].rods[r].M_A_per_m, ref.rods[r].M_A_per_m, 8e5);
+      rel(got[i].rods[r].x_m, ref.rods[r].x_m, 1e-6);
+    }
+  }
+  std::printf("make_states vs make_state: largest relative difference %.3g\n", worst);
+  EXPECT_GT(std::fabs(got[8].B_T - got[0].B_T), 0.0);  // the currents differ
+  // The increment: each lane equals the width-1 instance, without allocating.
+  LaneBatch a = runs.batch(), b = runs.batch();
+  std::vector<double> cur(9), pm(9);
+  gmasim_test::g_allocations = 0;
+  gmasim_test::g_counting = true;
+  for (int k = 1; k <= 40; ++k) {
+    for (std::size_t i = 0; i < 9; ++i) {
+      cur[i] = 0.1 * k * static_cast<double>(i);
+      pm[i] = runs.c[i].pm_scale;
+    }
+    a.rest_increment(cur, pm);
+    b.rest_increment(cur, pm, true);
+  }
+  gmasim_test::g_counting = false;
+  EXPECT_EQ(gmasim_test::g_allocations.load(), 0);
+  State sa = runs.s[0], sb = runs.s[0];
+  for (std::size_t i = 0; i < 9; ++i) {
+    a.unpack(i, sa);
+    b.unpack(i, sb);
+    const auto va = numbers(sa), vb = numbers(sb);
+    ASSERT_EQ(0, std::memcmp(va.data(), vb.data(), va.size() * sizeof(double))) << "lane " << i;
+  }
+}
+
 // simulate_lanes: each setting's metrics as simulate() gives them, to the lanes' tolerance.
 TEST(Lanes, SimulateLanesMatchesSimulate) {
   std::vector<SimulationSettings> set;

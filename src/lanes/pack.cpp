@@ -180,6 +180,7 @@ LaneBatch::LaneBatch(std::span<const Model* const> models,
   in_current_.assign(d_->npad, 0.0);
   in_dt_.assign(d_->npad, 1.0);
   in_t1_.assign(d_->npad, 0.0);
+  in_pm_.assign(d_->npad, 0.0);
 }
 
 LaneBatch::~LaneBatch() = default;
@@ -194,15 +195,29 @@ void LaneBatch::step(std::span<const double> current_A, std::span<const double> 
   if (current_A.size() != n || dt_s.size() != n || t1_s.size() != n)
     throw InputError(fmt::format("lanes: step with {} currents, {} steps, {} times for {} lanes",
                                  current_A.size(), dt_s.size(), t1_s.size(), n));
-  std::copy(current_A.begin(), current_A.end(), in_current_.begin());
-  std::copy(dt_s.begin(), dt_s.end(), in_dt_.begin());
-  std::copy(t1_s.begin(), t1_s.end(), in_t1_.begin());
-  for (std::size_t j = n; j < d_->npad; ++j) {  // padding: lane 0's inputs
-    in_current_[j] = current_A[0];
-    in_dt_[j] = dt_s[0];
-    in_t1_[j] = t1_s[0];
-  }
-  lanes::step_dispatch(*d_, {in_current_.data(), in_dt_.data(), in_t1_.data()}, width_one);
+  pad_inputs(current_A, in_current_);
+  pad_inputs(dt_s, in_dt_);
+  pad_inputs(t1_s, in_t1_);
+  lanes::step_dispatch(*d_, {in_current_.data(), in_dt_.data(), in_t1_.data(), false, nullptr},
+                       width_one);
+}
+
+// The inputs of the lanes, padding lanes repeating lane 0's.
+void LaneBatch::pad_inputs(std::span<const double> a, std::vector<double>& to) const {
+  std::copy(a.begin(), a.end(), to.begin());
+  std::fill(to.begin() + static_cast<std::ptrdiff_t>(a.size()), to.end(), a[0]);
+}
+
+void LaneBatch::rest_increment(std::span<const double> current_A, std::span<const double> pm_scale,
+                               bool width_one) {
+  const std::size_t n = d_->n;
+  if (current_A.size() != n || pm_scale.size() != n)
+    throw InputError(fmt::format("lanes: rest increment with {} currents, {} scales for {} lanes",
+                                 current_A.size(), pm_scale.size(), n));
+  pad_inputs(current_A, in_current_);
+  pad_inputs(pm_scale, in_pm_);
+  lanes::step_dispatch(*d_, {in_current_.data(), in_dt_.data(), in_t1_.data(), true, in_pm_.data()},
+                       width_one);
 }
 
 bool LaneBatch::diverged(std::size_t lane) const { return d_->glob(lanes::kFail)[lane] != 0.0; }

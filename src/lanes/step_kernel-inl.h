@@ -130,9 +130,11 @@ struct Magnetic {
 // 1e-7 A/m + 1e-11 |H| keeps that iterate and its trial (the last iterate is committed); the
 // loop ends when every lane has converged or failed, or at the cap (60), where a lane within
 // 1 mA/m is accepted and the others fail (kFailNewton, the rod of the largest step).
+// quasi_static (make_state's ramp, consistent_magnetic_update's quasi_static): no eddy term,
+// the first guess at H_n and M_n.
 template <class Law, class D>
 HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, V<D> pm, V<D> h,
-                              V<D> t1, Magnetic<Law, D>& mg, Fails<D>& fails) {
+                              V<D> t1, bool quasi_static, Magnetic<Law, D>& mg, Fails<D>& fails) {
   const D d = c.d;
   const int n = c.n;
   constexpr double kMu0 = physics::kMu0;
@@ -143,6 +145,12 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
     mg.B0[i] = hn::Mul(C(d, kMu0), hn::Add(s.f[kH][i], s.f[kM][i]));
     l_A[i] = hn::Div(c.rod(kLength, i), c.rod(kArea, i));
     inv_A[i] = hn::Div(C(d, 1.0), c.rod(kArea, i));
+    if (quasi_static) {
+      e0[i] = g[i] = hn::Zero(d);
+      mg.H[i] = s.f[kH][i];
+      mg.Mg[i] = s.f[kM][i];
+      continue;
+    }
     e0[i] = hn::Sub(s.f[kHc][i], s.f[kH][i]);
     g[i] = hn::Div(hn::Mul(C(d, 2.0), c.rod(kKappa, i)), h);
     mg.H[i] = hn::Add(hn::Mul(C(d, 3.0), hn::Sub(s.f[kH][i], s.f[kHprev][i])), s.f[kHprev2][i]);
@@ -209,7 +217,7 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
 // trial at H1 as it is (its M, M_irr and flux density B1), the eddy field (eq. 7,
 // trapezoidal), the first guess's histories, mu_r = 1 + dM/dH and the rod's flux.
 template <class Law, class D>
-HWY_INLINE void commit_fields(const Chunk<D>& c, RodStates<D>& s, V<D> h,
+HWY_INLINE void commit_fields(const Chunk<D>& c, RodStates<D>& s, V<D> h, bool quasi_static,
                               const Magnetic<Law, D>& mg) {
   const D d = c.d;
   constexpr double kMu0 = physics::kMu0;
@@ -220,10 +228,13 @@ HWY_INLINE void commit_fields(const Chunk<D>& c, RodStates<D>& s, V<D> h,
     s.f[kMprev][i] = s.f[kM][i];
     s.f[kMirr][i] = tr.Mirr;
     s.f[kM][i] = tr.M;
-    // eddy_static_field_trapezoid: H1 + 2 kappa (B1 - B0)/h - (Hc0 - H0)
+    // eddy_static_field_trapezoid: H1 + 2 kappa (B1 - B0)/h - (Hc0 - H0); at rest H_c = H1
     s.f[kHc][i] =
-        hn::Sub(hn::Add(H1, hn::Div(hn::Mul(hn::Mul(C(d, 2.0), kappa), hn::Sub(B1, mg.B0[i])), h)),
-                hn::Sub(s.f[kHc][i], s.f[kH][i]));
+        quasi_static
+            ? H1
+            : hn::Sub(hn::Add(H1, hn::Div(hn::Mul(hn::Mul(C(d, 2.0), kappa), hn::Sub(B1, mg.B0[i])),
+                                          h)),
+                      hn::Sub(s.f[kHc][i], s.f[kH][i]));
     s.f[kHprev2][i] = s.f[kHprev][i];
     s.f[kHprev][i] = s.f[kH][i];
     s.f[kH][i] = H1;
