@@ -92,15 +92,17 @@ void commit_rod(const RodConditions& rc, RodState& r, const typename Law::Trial&
 //   phi_i = A_i B_i,  B_i = mu0 (H_i + M_i(H_i)),  U_i = l_i H_c,i + R_s,i phi_i  (eq. 7, first
 //   line, with k_f's series reluctance R_s: physics::series_reluctance)
 //   H_c,i = H_i + kappa_i dB_i/dt  (eq. 7's eddy field, trapezoidal over the step)
-// Newton's method on the rods' fields: each rod is linearised at the iterate H* (slope
-// dM/dH of the magnetisation law's move, Law::trial_from) into a branch  U = R_eff phi + U_off,
-// the circuit is solved with R_eff and the MMF -U_off, and H* moves to the field that flux
-// implies. Quadratic; damped after 8 iterations (the JA slope jumps where M_irr starts or stops
-// moving). Converged when every correction is below 1e-7 A/m + 1e-11 |H|; the last iterate,
-// whose law evaluation the solve used, is committed as it is (Law::commit_trial). First guess:
-// H and M extrapolated quadratically from the last three steps (H = 3 H_n - 3 H_n-1 + H_n-2),
-// so that one correction usually converges (two solves a step); the law's inner solve starts
-// each later iterate on its tangent, M + dM/dH dH.
+// Newton's method on the rods' fields and magnetisations jointly: at the iterate (H*, M*) each
+// rod's law is evaluated once (Law::joint_trial: no inner solve), its magnetisation corrected
+// by the law's own Newton step to M_next and linearised (slope dM/dH) into a branch
+// U = R_eff phi + U_off, the circuit is solved with R_eff and the MMF -U_off, H* moves to the
+// field that flux implies and M* to M_next + dM/dH dH (the law's tangent). Quadratic; damped
+// after 8 iterations (the JA slope jumps where M_irr starts or stops moving). Converged when
+// every field correction is below 1e-7 A/m + 1e-11 |H| and every law holds at its iterate
+// (JA: |M* - F(M*)| <= 1e-12 M_s^T); the last evaluation, which the solve used, is committed as
+// it is (Law::commit_trial). First guess: H and M extrapolated quadratically from the last
+// three steps (H = 3 H_n - 3 H_n-1 + H_n-2), so that one correction usually converges (two
+// solves and two law evaluations a step).
 // quasi_static drops the eddy term (the at-rest ramp of make_state) and starts at H_n.
 template <class Law>
 void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, double current_A,
@@ -108,7 +110,7 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
   const std::size_t n = s.rods.size();
   std::array<double, 8> H{}, Mg{}, inv_mud{}, B0{}, e0{}, g{}, Bs{}, l_A{}, inv_A{};
   std::array<typename Law::MoveStart, 8> start{};
-  std::array<typename Law::Trial, 8> trial{};
+  std::array<typename Law::JointTrial, 8> trial{};
   for (std::size_t i = 0; i < n; ++i) {
     const auto& r = s.rods[i];
     const auto& rc = c.rods[i];
@@ -130,9 +132,9 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
   for (int it = 0;; ++it) {
     for (std::size_t i = 0; i < n; ++i) {
       const auto& rc = c.rods[i];
-      trial[i] = Law::trial_from(rc, s.rods[i], start[i], H[i], Mg[i]);
-      Bs[i] = flux_density(H[i], trial[i].M);
-      inv_mud[i] = 1.0 / (kMu0 * (1.0 + trial[i].dM_dH));
+      Law::joint_trial(rc, s.rods[i], start[i], H[i], Mg[i], trial[i]);
+      Bs[i] = flux_density(H[i], trial[i].M_next);
+      inv_mud[i] = trial[i].inv_mu_r * (1.0 / kMu0);
       s.rod_reluctance[i] = l_A[i] * (inv_mud[i] + g[i]) + rc.series_reluctance_per_H;
       s.circuit.rod_extra_mmf[i] =
           -rc.length_m * (H[i] - Bs[i] * inv_mud[i] - g[i] * B0[i] - e0[i]);
@@ -148,11 +150,15 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
     for (std::size_t i = 0; i < n; ++i) {
       const double phi = s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
       dH[i] = (phi * inv_A[i] - Bs[i]) * inv_mud[i];
-      if (std::fabs(dH[i]) > worst) {
-        worst = std::fabs(dH[i]);
+      // The rod's Newton step: its field's and its law's (A/m both); NaN propagates.
+      const double dM = std::fabs(trial[i].M_next - Mg[i]);
+      const double step = dM <= std::fabs(dH[i]) ? std::fabs(dH[i]) : dM;
+      if (!(step <= worst)) {
+        worst = step;
         worst_rod = static_cast<int>(i);
       }
-      if (!(std::fabs(dH[i]) <= 1e-7 + 1e-11 * std::fabs(H[i]))) converged = false;
+      if (!(std::fabs(dH[i]) <= 1e-7 + 1e-11 * std::fabs(H[i])) || !trial[i].converged)
+        converged = false;
     }
     if (converged) break;  // the last iterate: its correction is below the tolerance
     if (it == kMaxIterations || !std::isfinite(worst)) {
@@ -164,11 +170,12 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
     const double damping = it < 8 ? 1.0 : 0.5;
     for (std::size_t i = 0; i < n; ++i) {
       H[i] += damping * dH[i];
-      Mg[i] = trial[i].M + trial[i].dM_dH * damping * dH[i];  // on the law's tangent
+      Mg[i] = trial[i].M_next + trial[i].dM_dH * damping * dH[i];  // on the law's tangent
     }
   }
   for (std::size_t i = 0; i < n; ++i) {  // commit the end-of-step state: the last iterate
-    commit_rod<Law>(c.rods[i], s.rods[i], trial[i], H[i], B0[i], Bs[i], quasi_static, h_s);
+    commit_rod<Law>(c.rods[i], s.rods[i], trial[i], H[i], B0[i], flux_density(H[i], trial[i].M),
+                    quasi_static, h_s);
     s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])] = s.rods[i].phi_Wb;
   }
 }

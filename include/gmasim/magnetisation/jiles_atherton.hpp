@@ -47,6 +47,38 @@ struct JilesAthertonLaw {
     t.dM_dH = physics::ja_slope(chi_e, rc.ja);
     return t;
   }
+  // The consistent state's joint Newton solve in (H, M): one evaluation of the law at the end
+  // field H1 and the iterate M_iter (physics::ja_evaluate), no inner solve. JointTrial holds
+  // the law's state there (M = F(M_iter), M_irr; what commit_trial commits), the slope dM/dH,
+  // 1/mu_r = 1/(1 + dM/dH), the Newton-corrected magnetisation M_next = M_iter - g/(1 - alpha
+  // chi_e) the circuit is linearised about, and whether eq. (9) holds at M_iter to its
+  // tolerance (|g| <= 1e-12 M_s^T). At H1 == H0 nothing moves (ja_step_from): M = M_next = M0.
+  struct JointTrial : Trial {
+    double inv_mu_r, M_next;
+    bool converged;
+  };
+  static void joint_trial(const RodConditions& rc, const RodState& r, const MoveStart& st,
+                          double H1, double M_iter, JointTrial& t) {
+    double chi_e = 0.0;
+    double g = 0.0;
+    if (H1 == r.H_A_per_m) {
+      physics::ja_step_from(r.H_A_per_m, st, H1, rc.MsT_mag, rc.ja, r.Mirr_A_per_m, r.M_A_per_m,
+                            M_iter, t.Mirr, t.M, chi_e);
+      M_iter = t.M;
+    } else {
+      const physics::JaEvaluation e = physics::ja_evaluate(st, H1, M_iter, rc.MsT_mag, rc.ja,
+                                                           r.Mirr_A_per_m, 1.0 / rc.ja.a_A_per_m);
+      t.Mirr = e.Mirr1;
+      t.M = e.M;
+      chi_e = e.chi_e;
+      g = M_iter - e.M;
+    }
+    const physics::JaSlopeTerms sl = physics::ja_slope_terms(chi_e, rc.ja);
+    t.dM_dH = sl.dM_dH;
+    t.inv_mu_r = sl.inv_mu_r;
+    t.M_next = M_iter - g * sl.inv_dg;
+    t.converged = std::fabs(g) <= physics::ja_magnetisation_tolerance(rc.MsT_mag);
+  }
   static void commit_trial(const RodConditions&, RodState& r, const Trial& t) {
     r.Mirr_A_per_m = t.Mirr;
     r.M_A_per_m = t.M;

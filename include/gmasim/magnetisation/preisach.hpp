@@ -50,6 +50,19 @@ struct PreisachLaw {
                                           &t.dM_dH, &t.x1);
     return t;
   }
+  // The consistent state's joint Newton solve (as JilesAthertonLaw's): the law's own inner
+  // solve converges within trial_from, so M_next = M and the trial is always converged.
+  struct JointTrial : Trial {
+    double inv_mu_r, M_next;
+    bool converged;
+  };
+  static void joint_trial(const RodConditions& rc, const RodState& r, const MoveStart& st,
+                          double H1, double M_iter, JointTrial& t) {
+    static_cast<Trial&>(t) = trial_from(rc, r, st, H1, M_iter);
+    t.inv_mu_r = 1.0 / (1.0 + t.dM_dH);
+    t.M_next = t.M;
+    t.converged = true;
+  }
   static void commit_trial(const RodConditions& rc, RodState& r, const Trial& t) {
     if (!t.moved) {
       r.preisach.last_dmc = 0.0;

@@ -156,6 +156,29 @@ inline JaMoveStart ja_move_start(double H0, double M0, double MsT_A_per_m,
   const double He0 = H0 + p.alpha * M0;
   return {He0, MsT_A_per_m * langevin(He0 * (1.0 / p.a_A_per_m))};
 }
+// One evaluation of eq. (9) at the end field H1 and a magnetisation iterate M1 (inv_a = 1/a):
+// M_irr1 from ja_irreversible_update, the magnetisation the law gives there,
+//   F(M1) = (1-c) M_irr1 + c M_an(H1 + alpha M1),
+// and chi_e = dF/dH_e. Eq. (9) holds where g = M1 - F(M1) = 0; its Newton step in M1 is
+// -g / (1 - alpha chi_e) (ja_step_from iterates it; the consistent state's joint Newton solve
+// takes one per circuit solve).
+struct JaEvaluation {
+  double Mirr1, M, chi_e;
+};
+inline JaEvaluation ja_evaluate(const JaMoveStart& st, double H1, double M1, double MsT_A_per_m,
+                                const JaCoefficients& p, double Mirr0, double inv_a) {
+  const double He1 = H1 + p.alpha * M1;
+  const LangevinValue lv = langevin_pair(He1 * inv_a);
+  const double Man1 = MsT_A_per_m * lv.L;
+  const double dMan = MsT_A_per_m * inv_a * lv.dL;
+  double dMirr = 0.0;
+  const double Mirr1 =
+      ja_irreversible_update(Mirr0, st.Man0, Man1, dMan, He1 - st.He0, p.k_A_per_m, dMirr);
+  return {Mirr1, (1.0 - p.c) * Mirr1 + p.c * Man1, (1.0 - p.c) * dMirr + p.c * dMan};
+}
+// The tolerance on g = M1 - F(M1) at which eq. (9) counts as solved [A/m]: 1e-12 M_s^T.
+inline double ja_magnetisation_tolerance(double MsT_A_per_m) { return 1e-12 * MsT_A_per_m; }
+
 inline void ja_step_from(double H0, const JaMoveStart& st, double H1, double MsT_A_per_m,
                          const JaCoefficients& p, double Mirr0, double M0, double M_guess,
                          double& Mirr1_out, double& M1_out, double& chi_e_out) {
@@ -167,26 +190,18 @@ inline void ja_step_from(double H0, const JaMoveStart& st, double H1, double MsT
     chi_e_out = p.c * MsT_A_per_m * inv_a * lv.dL;
     return;
   }
-  const double tol = 1e-12 * MsT_A_per_m;
+  const double tol = ja_magnetisation_tolerance(MsT_A_per_m);
   double M1 = M_guess;
   for (int it = 0; it < 60; ++it) {
-    const double He1 = H1 + p.alpha * M1;
-    const LangevinValue lv = langevin_pair(He1 * inv_a);
-    const double Man1 = MsT_A_per_m * lv.L;
-    const double dMan = MsT_A_per_m * inv_a * lv.dL;
-    double dMirr = 0.0;
-    const double Mirr1 =
-        ja_irreversible_update(Mirr0, st.Man0, Man1, dMan, He1 - st.He0, p.k_A_per_m, dMirr);
-    const double Mnew = (1.0 - p.c) * Mirr1 + p.c * Man1;
-    const double g = M1 - Mnew;
-    const double chi_e = (1.0 - p.c) * dMirr + p.c * dMan;
+    const JaEvaluation e = ja_evaluate(st, H1, M1, MsT_A_per_m, p, Mirr0, inv_a);
+    const double g = M1 - e.M;
     if (std::fabs(g) <= tol || it == 59) {
-      Mirr1_out = Mirr1;
-      M1_out = Mnew;
-      chi_e_out = chi_e;
+      Mirr1_out = e.Mirr1;
+      M1_out = e.M;
+      chi_e_out = e.chi_e;
       return;
     }
-    double dg = 1.0 - p.alpha * chi_e;
+    double dg = 1.0 - p.alpha * e.chi_e;
     if (dg < 0.2) dg = 0.2;  // alpha > 0 (positive feedback): damp the Newton step
     M1 -= g / dg;
   }
@@ -194,6 +209,20 @@ inline void ja_step_from(double H0, const JaMoveStart& st, double H1, double MsT
 // The slope dM/dH = chi_e / (1 - alpha chi_e) along a step (ja_step_from's chi_e).
 inline double ja_slope(double chi_e, const JaCoefficients& p) {
   return chi_e / (1.0 - p.alpha * chi_e);
+}
+
+// The same slope with what the consistent state's Newton solve needs beside it, from one
+// division: with d = 1 - alpha chi_e,
+//   dM/dH = chi_e / d,   1/mu_r = 1/(1 + dM/dH) = d / (d + chi_e),   1/d,
+// the last for the Newton step -g/d of eq. (9) in M (ja_evaluate), d held >= 0.2 as in
+// ja_step_from (alpha > 0 is positive feedback).
+struct JaSlopeTerms {
+  double dM_dH, inv_mu_r, inv_dg;
+};
+inline JaSlopeTerms ja_slope_terms(double chi_e, const JaCoefficients& p) {
+  const double d = 1.0 - p.alpha * chi_e, dc = d + chi_e;
+  const double inv = 1.0 / (d * dc);
+  return {chi_e * dc * inv, d * d * inv, d >= 0.2 ? dc * inv : 5.0};
 }
 
 // One step of eq. (9) from H0 to H1 (ja_step_from from the start (H0, Mirr, M)).
