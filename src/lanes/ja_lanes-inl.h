@@ -143,28 +143,37 @@ HWY_INLINE JaLaneStart<D> ja_move_start(D d, V<D> H0, V<D> M0, const JaLaneConst
   return {He0, hn::Mul(p.MsT, L)};
 }
 
-// One step of eq. (9) from H0 to H1 (jiles_atherton.hpp, ja_step_from): Newton's method on
-// g(M1) = M1 - (1-c) M_irr1(M1) - c M_an(H1 + alpha M1), per lane and masked: a lane whose
-// |g| <= tol keeps the values of that iterate while the others iterate (at most 60). Mirr1 and
-// M1 receive the values at H1, chi_e the step's (1-c) dM_irr1/dH_e + c dM_an/dH_e; at
-// H1 == H0 nothing moves and chi_e is the reversible c dM_an/dH_e.
-template <class D>
-HWY_INLINE void ja_step_from(D d, V<D> H0, const JaLaneStart<D>& st, V<D> H1,
-                             const JaLaneConstants<D>& p, V<D> Mirr0, V<D> M0, V<D> M_guess,
-                             V<D>& Mirr1_out, V<D>& M1_out, V<D>& chi_e_out) {
-  const V<D> inv_a = hn::Div(C(d, 1.0), p.a);
-  const Mk<D> same = hn::Eq(H1, H0);
-  V<D> chi = hn::Zero(d);
-  if (!hn::AllFalse(d, same)) {  // only where a lane needs it (its value is per lane)
-    V<D> L0, dL0;
-    langevin_pair(d, hn::Mul(hn::Add(H0, hn::Mul(p.alpha, M0)), inv_a), L0, dL0);
-    chi = hn::Mul(hn::Mul(hn::Mul(p.c, p.MsT), inv_a), dL0);
+// The law's lane entry (gmasim/magnetisation/jiles_atherton.hpp, JilesAthertonLaw): the
+// consistent state's begin_move / joint_trial over the lanes; its state per rod is M_irr
+// (kMirr). A joint trial is one evaluation of eq. (9) at (H1, M_iter) (physics::ja_evaluate,
+// no inner solve): M = F(M_iter), M_irr, the slope dM/dH and 1/mu_r (ja_slope_terms), the
+// law's Newton step M_next = M_iter - g / (1 - alpha chi_e) and whether |g| <= 1e-12 M_s^T.
+struct JilesAthertonLanes {
+  template <class D>
+  using Start = JaLaneStart<D>;
+  template <class D>
+  struct Trial {
+    V<D> M, dM_dH, Mirr, inv_mu_r, M_next;
+    Mk<D> converged;
+  };
+  template <class D>
+  static Start<D> begin_move(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> M0) {
+    return ja_move_start(d, H0, M0, p);
   }
-  const V<D> tol = hn::Mul(C(d, 1e-12), p.MsT);
-  V<D> M1 = M_guess, Mirr_out = Mirr0, M_out = M0;
-  Mk<D> done = same;
-  for (int it = 0; it < 60 && !hn::AllTrue(d, done); ++it) {
-    const V<D> He1 = hn::Add(H1, hn::Mul(p.alpha, M1));
+  template <class D>
+  static Trial<D> joint_trial(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> Mirr0, V<D> M0,
+                              const Start<D>& st, V<D> H1, V<D> M_iter) {
+    Trial<D> t;
+    const V<D> inv_a = hn::Div(C(d, 1.0), p.a);
+    const Mk<D> same = hn::Eq(H1, H0);  // ja_step_from's H1 == H0: nothing moves
+    V<D> chi_same = hn::Zero(d);
+    if (!hn::AllFalse(d, same)) {
+      V<D> L0, dL0;
+      langevin_pair(d, hn::Mul(hn::Add(H0, hn::Mul(p.alpha, M0)), inv_a), L0, dL0);
+      chi_same = hn::Mul(hn::Mul(hn::Mul(p.c, p.MsT), inv_a), dL0);
+    }
+    // ja_evaluate
+    const V<D> He1 = hn::Add(H1, hn::Mul(p.alpha, M_iter));
     V<D> L1, dL1;
     langevin_pair(d, hn::Mul(He1, inv_a), L1, dL1);
     const V<D> Man1 = hn::Mul(p.MsT, L1);
@@ -172,46 +181,22 @@ HWY_INLINE void ja_step_from(D d, V<D> H0, const JaLaneStart<D>& st, V<D> H1,
     V<D> dMirr;
     const V<D> Mirr1 =
         ja_irreversible_update(d, Mirr0, st.Man0, Man1, dMan, hn::Sub(He1, st.He0), p.k, dMirr);
-    const V<D> Mnew = hn::Add(hn::Mul(hn::Sub(C(d, 1.0), p.c), Mirr1), hn::Mul(p.c, Man1));
-    const V<D> g = hn::Sub(M1, Mnew);
-    const V<D> chi_e = hn::Add(hn::Mul(hn::Sub(C(d, 1.0), p.c), dMirr), hn::Mul(p.c, dMan));
-    const Mk<D> fin = hn::AndNot(
-        done,
-        hn::Or(hn::Le(hn::Abs(g), tol), it == 59 ? hn::FirstN(d, hn::Lanes(d)) : hn::FirstN(d, 0)));
-    Mirr_out = hn::IfThenElse(fin, Mirr1, Mirr_out);
-    M_out = hn::IfThenElse(fin, Mnew, M_out);
-    chi = hn::IfThenElse(fin, chi_e, chi);
-    done = hn::Or(done, fin);
-    V<D> dg = hn::Sub(C(d, 1.0), hn::Mul(p.alpha, chi_e));
-    dg = hn::IfThenElse(hn::Lt(dg, C(d, 0.2)), C(d, 0.2), dg);  // alpha > 0: damped step
-    M1 = hn::IfThenElse(done, M1, hn::Sub(M1, hn::Div(g, dg)));
-  }
-  Mirr1_out = Mirr_out;
-  M1_out = M_out;
-  chi_e_out = chi;
-}
-
-// The law's lane entry (gmasim/magnetisation/jiles_atherton.hpp, JilesAthertonLaw): the
-// consistent state's begin_move / trial_from / commit_trial over the lanes; its state per rod
-// is M_irr (kMirr). A trial is M, dM/dH (ja_slope) and the M_irr the move leaves at H1.
-struct JilesAthertonLanes {
-  template <class D>
-  using Start = JaLaneStart<D>;
-  template <class D>
-  struct Trial {
-    V<D> M, dM_dH, Mirr;
-  };
-  template <class D>
-  static Start<D> begin_move(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> M0) {
-    return ja_move_start(d, H0, M0, p);
-  }
-  template <class D>
-  static Trial<D> trial_from(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> Mirr0, V<D> M0,
-                             const Start<D>& st, V<D> H1, V<D> M_guess) {
-    Trial<D> t;
-    V<D> chi_e;
-    ja_step_from(d, H0, st, H1, p, Mirr0, M0, M_guess, t.Mirr, t.M, chi_e);
-    t.dM_dH = hn::Div(chi_e, hn::Sub(C(d, 1.0), hn::Mul(p.alpha, chi_e)));  // ja_slope
+    const V<D> one_c = hn::Sub(C(d, 1.0), p.c);
+    const V<D> F = hn::Add(hn::Mul(one_c, Mirr1), hn::Mul(p.c, Man1));
+    const V<D> chi =
+        hn::IfThenElse(same, chi_same, hn::Add(hn::Mul(one_c, dMirr), hn::Mul(p.c, dMan)));
+    t.Mirr = hn::IfThenElse(same, Mirr0, Mirr1);
+    t.M = hn::IfThenElse(same, M0, F);
+    M_iter = hn::IfThenElse(same, M0, M_iter);
+    const V<D> g = hn::IfThenElse(same, hn::Zero(d), hn::Sub(M_iter, F));
+    // ja_slope_terms: d = 1 - alpha chi_e, one division
+    const V<D> dd = hn::Sub(C(d, 1.0), hn::Mul(p.alpha, chi)), dc = hn::Add(dd, chi);
+    const V<D> inv = hn::Div(C(d, 1.0), hn::Mul(dd, dc));
+    t.dM_dH = hn::Mul(hn::Mul(chi, dc), inv);
+    t.inv_mu_r = hn::Mul(hn::Mul(dd, dd), inv);
+    const V<D> inv_dg = hn::IfThenElse(hn::Ge(dd, C(d, 0.2)), hn::Mul(dc, inv), C(d, 5.0));
+    t.M_next = hn::Sub(M_iter, hn::Mul(g, inv_dg));
+    t.converged = hn::Le(hn::Abs(g), hn::Mul(C(d, 1e-12), p.MsT));
     return t;
   }
 };

@@ -122,14 +122,16 @@ struct Magnetic {
   typename Law::template Trial<D> trial[kMaxRods];
 };
 
-// Newton's method on the rods' fields (model/step.cpp, consistent_magnetic_update): the first
-// guess extrapolated quadratically from the last three steps (H = 3 (H_n - H_n-1) + H_n-2, M
-// likewise); each rod linearised at its iterate through the law's trial_from into a branch
-// U = R_eff phi + U_off, the circuit solved, the field moved to the one its flux implies and the
-// law's next first guess put on its tangent. Per lane: a lane whose corrections are all below
-// 1e-7 A/m + 1e-11 |H| keeps that iterate and its trial (the last iterate is committed); the
-// loop ends when every lane has converged or failed, or at the cap (60), where a lane within
-// 1 mA/m is accepted and the others fail (kFailNewton, the rod of the largest step).
+// Newton's method on the rods' fields and magnetisations jointly (model/step.cpp,
+// consistent_magnetic_update): the first guess extrapolated quadratically from the last three
+// steps (H = 3 (H_n - H_n-1) + H_n-2, M likewise); at each iterate (H*, M*) each rod's law
+// evaluated once (joint_trial: no inner solve), its magnetisation corrected by the law's Newton
+// step to M_next and linearised into a branch U = R_eff phi + U_off, the circuit solved, H* moved
+// to the field its flux implies and M* to M_next + dM/dH dH. Per lane: a lane whose field
+// corrections are all below 1e-7 A/m + 1e-11 |H| and whose laws all hold (|g| <= 1e-12 M_s^T)
+// keeps that iterate and its trial (the last evaluation is committed); the loop ends when every
+// lane has converged or failed, or at the cap (60), where a lane whose largest step (field or
+// law) is within 1 mA/m is accepted and the others fail (kFailNewton, the rod of that step).
 // quasi_static (make_state's ramp, consistent_magnetic_update's quasi_static): no eddy term,
 // the first guess at H_n and M_n.
 template <class Law, class D>
@@ -161,14 +163,17 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
     V<D> R[kMaxRods], mmf[kMaxRods], phi[kMaxRods];
     for (int i = 0; i < n; ++i) {
       // a lane that has stopped keeps the trial of the iterate it stopped at
-      const auto t = Law::trial_from(d, ja_constants(c, i), s.f[kH][i], s.f[kMirr][i], s.f[kM][i],
-                                     start[i], mg.H[i], mg.Mg[i]);
+      const auto t = Law::joint_trial(d, ja_constants(c, i), s.f[kH][i], s.f[kMirr][i], s.f[kM][i],
+                                      start[i], mg.H[i], mg.Mg[i]);
       auto& tr = mg.trial[i];
       tr.M = hn::IfThenElse(done, tr.M, t.M);
       tr.dM_dH = hn::IfThenElse(done, tr.dM_dH, t.dM_dH);
       tr.Mirr = hn::IfThenElse(done, tr.Mirr, t.Mirr);
-      mg.Bs[i] = hn::Mul(C(d, kMu0), hn::Add(mg.H[i], tr.M));
-      inv_mud[i] = hn::Div(C(d, 1.0), hn::Mul(C(d, kMu0), hn::Add(C(d, 1.0), tr.dM_dH)));
+      tr.inv_mu_r = hn::IfThenElse(done, tr.inv_mu_r, t.inv_mu_r);
+      tr.M_next = hn::IfThenElse(done, tr.M_next, t.M_next);
+      tr.converged = hn::Or(hn::And(done, tr.converged), hn::AndNot(done, t.converged));
+      mg.Bs[i] = hn::Mul(C(d, kMu0), hn::Add(mg.H[i], tr.M_next));
+      inv_mud[i] = hn::Mul(tr.inv_mu_r, C(d, 1.0 / kMu0));
       R[i] = hn::Add(hn::Mul(l_A[i], hn::Add(inv_mud[i], g[i])), c.rod(kRs, i));
       const V<D> extra = hn::Mul(
           hn::Neg(c.rod(kLength, i)),
@@ -185,10 +190,13 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
     for (int i = 0; i < n; ++i) {
       dH[i] = hn::Mul(hn::Sub(hn::Mul(phi[i], inv_A[i]), mg.Bs[i]), inv_mud[i]);
       const V<D> adH = hn::Abs(dH[i]);
-      const Mk<D> larger = hn::Gt(adH, worst);
-      worst = hn::IfThenElse(larger, adH, worst);
+      // the rod's Newton step: its field's and its law's; NaN propagates
+      const V<D> dM = hn::Abs(hn::Sub(mg.trial[i].M_next, mg.Mg[i]));
+      const V<D> step = hn::IfThenElse(hn::Le(dM, adH), adH, dM);
+      const Mk<D> larger = hn::Not(hn::Le(step, worst));
+      worst = hn::IfThenElse(larger, step, worst);
       worst_rod = hn::IfThenElse(larger, C(d, static_cast<double>(i)), worst_rod);
-      converged = hn::And(converged,
+      converged = hn::And(hn::And(converged, mg.trial[i].converged),
                           hn::Le(adH, hn::Add(C(d, 1e-7), hn::Mul(C(d, 1e-11), hn::Abs(mg.H[i])))));
     }
     done = hn::Or(done, converged);
@@ -208,7 +216,7 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
       const V<D> step = hn::Mul(damping, dH[i]);
       mg.H[i] = hn::IfThenElse(done, mg.H[i], hn::Add(mg.H[i], step));
       const auto& tr = mg.trial[i];
-      mg.Mg[i] = hn::IfThenElse(done, mg.Mg[i], hn::Add(tr.M, hn::Mul(tr.dM_dH, step)));
+      mg.Mg[i] = hn::IfThenElse(done, mg.Mg[i], hn::Add(tr.M_next, hn::Mul(tr.dM_dH, step)));
     }
   }
 }
@@ -223,7 +231,7 @@ HWY_INLINE void commit_fields(const Chunk<D>& c, RodStates<D>& s, V<D> h, bool q
   constexpr double kMu0 = physics::kMu0;
   for (int i = 0; i < c.n; ++i) {
     const auto& tr = mg.trial[i];
-    const V<D> H1 = mg.H[i], B1 = mg.Bs[i], kappa = c.rod(kKappa, i);
+    const V<D> H1 = mg.H[i], B1 = hn::Mul(C(d, kMu0), hn::Add(H1, tr.M)), kappa = c.rod(kKappa, i);
     s.f[kMprev2][i] = s.f[kMprev][i];
     s.f[kMprev][i] = s.f[kM][i];
     s.f[kMirr][i] = tr.Mirr;
