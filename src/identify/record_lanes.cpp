@@ -116,35 +116,12 @@ void set_up(LaneRecord& lr, const Model& m, std::deque<Model>& preloaded,
   if (lr.B) lr.B->resize(meas.t_s.size());
 }
 
-}  // namespace
-
-void run_records_lanes(const Model& m, const std::vector<const Measurement*>& records,
-                       const std::vector<bool>& flux, const ObjectiveSettings& s,
-                       std::vector<std::vector<double>>& response,
-                       std::vector<std::vector<double>>& B_T) {
-  const std::size_t n = records.size();
-  response.resize(n);
-  B_T.resize(n);
-  std::vector<LaneRecord> runs(n);
-  std::deque<Model> preloaded;  // stable addresses
-  std::vector<const Model*> models(n);
-  std::vector<const Conditions*> conds(n);
-  std::vector<const State*> states(n);
-  std::vector<double> I0(n);
-  long longest = 0;
-  for (std::size_t k = 0; k < n; ++k) {
-    LaneRecord& lr = runs[k];
-    lr.meas = records[k];
-    lr.response = &response[k];
-    lr.B = flux[k] ? &B_T[k] : nullptr;
-    set_up(lr, m, preloaded, s);
-    models[k] = lr.model;
-    conds[k] = &lr.c;
-    I0[k] = lr.I0;
-    longest = std::max(longest, lr.total);
-  }
-  // The rest states, one per distinct (model, temperature, I0) as StartCache shares them.
-  std::vector<std::size_t> start_of(n);
+// The records' rest states in lanes (make_states), one per distinct (model, temperature, I0)
+// as StartCache shares them; start_of[k] is record k's.
+std::vector<State> rest_states(const std::vector<const Model*>& models,
+                               const std::vector<const Conditions*>& conds,
+                               const std::vector<double>& I0, std::vector<std::size_t>& start_of) {
+  const std::size_t n = models.size();
   std::vector<const Model*> um;
   std::vector<const Conditions*> uc;
   std::vector<double> ui;
@@ -160,7 +137,38 @@ void run_records_lanes(const Model& m, const std::vector<const Measurement*>& re
     }
     start_of[k] = u;
   }
-  const std::vector<State> rest = make_states(um, uc, ui);
+  return make_states(um, uc, ui);
+}
+
+}  // namespace
+
+void run_records_lanes(const Model& m, const std::vector<const Measurement*>& records,
+                       const std::vector<bool>& flux, const ObjectiveSettings& s,
+                       std::vector<std::vector<double>>& response,
+                       std::vector<std::vector<double>>& B_T) {
+  const std::size_t n = records.size();
+  response.resize(n);
+  B_T.resize(n);
+  std::vector<LaneRecord> runs(n);
+  std::deque<Model> preloaded;  // stable addresses
+  std::vector<const Model*> models(n);
+  std::vector<const Conditions*> conds(n);
+  std::vector<const State*> states(n);
+  std::vector<double> I0(n);
+  std::vector<std::size_t> start_of(n);
+  long longest = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    LaneRecord& lr = runs[k];
+    lr.meas = records[k];
+    lr.response = &response[k];
+    lr.B = flux[k] ? &B_T[k] : nullptr;
+    set_up(lr, m, preloaded, s);
+    models[k] = lr.model;
+    conds[k] = &lr.c;
+    I0[k] = lr.I0;
+    longest = std::max(longest, lr.total);
+  }
+  const std::vector<State> rest = rest_states(models, conds, I0, start_of);
   for (std::size_t k = 0; k < n; ++k) {
     LaneRecord& lr = runs[k];
     lr.st = rest[start_of[k]];

@@ -60,12 +60,36 @@ bool same_structure(const lanes::Structure& a, const lanes::Structure& b) {
          a.chain_count == b.chain_count;
 }
 
+// Lane j's State scalars and constants (the GlobalField numbers), its failure record cleared.
+void pack_globals(LaneData& L, std::size_t j, const Model& m, const Conditions& c, const State& s,
+                  double sensor_area) {
+  using namespace lanes;
+  auto glob = [&](int f) -> double& { return L.glob(f)[j]; };
+  const double globals[] = {s.t_s,
+                            s.current_A,
+                            s.y_m,
+                            s.y_stack_m,
+                            s.q_m,
+                            s.z_m,
+                            s.z_v_m_per_s,
+                            s.B_T,
+                            c.pm_scale,
+                            c.thermal_expansion_m,
+                            m.sensor_mount.mass_kg,
+                            m.sensor_mount.stiffness_N_per_m,
+                            m.sensor_mount.damping_N_s_per_m,
+                            m.sensor_mount.actuator_mass_kg,
+                            m.material.lambda_s,
+                            sensor_area};
+  for (int f = 0; f <= kSensorArea; ++f) glob(f) = globals[f];
+  for (int f = kFail; f < kGlobalFieldCount; ++f) glob(f) = 0.0;
+}
+
 // Lane j's numbers from its model, conditions and state.
 void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, const State& s,
                const CircuitLowRankView& lr) {
   using namespace lanes;
   auto rod = [&](int f, int i) -> double& { return L.rod(f, i)[j]; };
-  auto glob = [&](int f) -> double& { return L.glob(f)[j]; };
   const int n = m.rod_count();
   double sensor_area = 0.0;
   for (int b : m.flux_sensor_branches)
@@ -131,24 +155,7 @@ void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, 
     L.bt_coil(i)[j] = lr.bt_coil8[i];
     L.bt_pm(i)[j] = lr.bt_pm8[i];
   }
-  const double globals[] = {s.t_s,
-                            s.current_A,
-                            s.y_m,
-                            s.y_stack_m,
-                            s.q_m,
-                            s.z_m,
-                            s.z_v_m_per_s,
-                            s.B_T,
-                            c.pm_scale,
-                            c.thermal_expansion_m,
-                            m.sensor_mount.mass_kg,
-                            m.sensor_mount.stiffness_N_per_m,
-                            m.sensor_mount.damping_N_s_per_m,
-                            m.sensor_mount.actuator_mass_kg,
-                            m.material.lambda_s,
-                            sensor_area};
-  for (int f = 0; f <= kSensorArea; ++f) glob(f) = globals[f];
-  for (int f = kFail; f < kGlobalFieldCount; ++f) glob(f) = 0.0;
+  pack_globals(L, j, m, c, s, sensor_area);
 }
 
 }  // namespace

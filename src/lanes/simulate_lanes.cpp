@@ -56,6 +56,11 @@ struct LaneRun {
 constexpr std::size_t kStagedRows = 64;
 constexpr std::size_t kGlobalColumns = 6;  // run.cpp's make_columns: t_s .. y_stack_um
 
+// metrics_only: the rods' columns hold at most the rest state's row: none.
+void drop_rod_columns(TimeSeries& ts) {
+  for (std::size_t q = kGlobalColumns; q < ts.columns.size(); ++q) ts.columns[q].clear();
+}
+
 void finish(const SimulationSettings& s, const Plan& p, Result& r) {
   if (r.series.rows() > 0) r.thermal_expansion_um = r.series.column("xT_um").back();
   if (!r.diverged) {
@@ -141,9 +146,7 @@ void run_group(const Model& m, std::span<const SimulationSettings> settings,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   for (const LaneRun& lr : runs) {
     Result& r = out[lr.setting];
-    if (metrics_only)  // the rods' columns hold at most the rest state's row: none
-      for (std::size_t q = kGlobalColumns; q < r.series.columns.size(); ++q)
-        r.series.columns[q].clear();
+    if (metrics_only) drop_rod_columns(r.series);
     r.wall_time_s = wall / static_cast<double>(runs.size());
     finish(settings[lr.setting], p, r);
   }

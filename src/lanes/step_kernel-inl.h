@@ -115,6 +115,17 @@ HWY_INLINE JaLaneConstants<D> ja_constants(const Chunk<D>& c, int i) {
   return {c.rod(kMsTMag, i), c.rod(kJaA, i), c.rod(kJaAlpha, i), c.rod(kJaC, i), c.rod(kJaK, i)};
 }
 
+// A lane that has stopped keeps the trial of the iterate it stopped at; the others take t.
+template <class M, class T>
+HWY_INLINE void take_trial(M done, const T& t, T& tr) {
+  tr.M = hn::IfThenElse(done, tr.M, t.M);
+  tr.dM_dH = hn::IfThenElse(done, tr.dM_dH, t.dM_dH);
+  tr.Mirr = hn::IfThenElse(done, tr.Mirr, t.Mirr);
+  tr.inv_mu_r = hn::IfThenElse(done, tr.inv_mu_r, t.inv_mu_r);
+  tr.M_next = hn::IfThenElse(done, tr.M_next, t.M_next);
+  tr.converged = hn::Or(hn::And(done, tr.converged), hn::AndNot(done, t.converged));
+}
+
 // Per rod, what the Newton solve fixes at the step's start and what it ends with.
 template <class Law, class D>
 struct Magnetic {
@@ -162,16 +173,10 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
   for (int it = 0; !hn::AllTrue(d, done); ++it) {
     V<D> R[kMaxRods], mmf[kMaxRods], phi[kMaxRods];
     for (int i = 0; i < n; ++i) {
-      // a lane that has stopped keeps the trial of the iterate it stopped at
       const auto t = Law::joint_trial(d, ja_constants(c, i), s.f[kH][i], s.f[kMirr][i], s.f[kM][i],
                                       start[i], mg.H[i], mg.Mg[i]);
       auto& tr = mg.trial[i];
-      tr.M = hn::IfThenElse(done, tr.M, t.M);
-      tr.dM_dH = hn::IfThenElse(done, tr.dM_dH, t.dM_dH);
-      tr.Mirr = hn::IfThenElse(done, tr.Mirr, t.Mirr);
-      tr.inv_mu_r = hn::IfThenElse(done, tr.inv_mu_r, t.inv_mu_r);
-      tr.M_next = hn::IfThenElse(done, tr.M_next, t.M_next);
-      tr.converged = hn::Or(hn::And(done, tr.converged), hn::AndNot(done, t.converged));
+      take_trial(done, t, tr);
       mg.Bs[i] = hn::Mul(C(d, kMu0), hn::Add(mg.H[i], tr.M_next));
       inv_mud[i] = hn::Mul(tr.inv_mu_r, C(d, 1.0 / kMu0));
       R[i] = hn::Add(hn::Mul(l_A[i], hn::Add(inv_mud[i], g[i])), c.rod(kRs, i));
