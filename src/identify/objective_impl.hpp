@@ -100,7 +100,7 @@ struct Objective::Impl {
         recs.push_back(&data.items[cd.index]);
         flux.push_back(cd.flux);
       }
-      identify_detail::run_records_lanes(model, starts, recs, flux, settings, ys, Bs);
+      identify_detail::run_records_lanes(model, recs, flux, settings, ys, Bs);
     }
     for (std::size_t k = 0; k < conds.size(); ++k) {
       const CondData& cd = conds[k];

@@ -32,7 +32,7 @@ struct LaneRecord {
   long passes = 1, total = 0;
   std::size_t rod = 0, j = 0, table_j = 1;
   bool strain = false;
-  double length_m = 1, r_prev = 0, B_prev = 0, t_prev = 0;
+  double length_m = 1, r_prev = 0, B_prev = 0, t_prev = 0, I0 = 0;
   std::vector<double>* response = nullptr;
   std::vector<double>* B = nullptr;
 
@@ -86,22 +86,21 @@ struct LaneRecord {
   }
 };
 
-void set_up(LaneRecord& lr, const Model& m, StartCache& starts, std::deque<Model>& preloaded,
+// The record's model, conditions, current at its start (I0), grid and outputs; its rest state
+// comes after (make_states, for all the records at once).
+void set_up(LaneRecord& lr, const Model& m, std::deque<Model>& preloaded,
             const ObjectiveSettings& s) {
   const Measurement& meas = *lr.meas;
   const auto& cond = meas.condition;
-  const double T = cond.temperature_C, I0 = record_initial_current(meas);
+  const double T = cond.temperature_C;
+  lr.I0 = record_initial_current(meas);
   if (std::isnan(cond.prestress_MPa)) {
     lr.model = &m;
-    const auto& [c, st] = starts.get(T, I0);
-    lr.c = c;
-    lr.st = st;
   } else {
     preloaded.push_back(with_record_preload(m, cond));
     lr.model = &preloaded.back();
-    lr.c = make_conditions(*lr.model, T);
-    lr.st = make_state(*lr.model, lr.c, I0);
   }
+  lr.c = make_conditions(*lr.model, T);
   lr.rod = record_rod(*lr.model, meas);
   lr.strain = meas.response_kind == ResponseOutput::Strain;
   lr.length_m = lr.c.rods[lr.rod].length_m;
@@ -115,14 +114,35 @@ void set_up(LaneRecord& lr, const Model& m, StartCache& starts, std::deque<Model
   lr.total = lr.passes * lr.grid.steps;
   lr.response->resize(meas.t_s.size());
   if (lr.B) lr.B->resize(meas.t_s.size());
-  lr.st.t_s = t0;
-  lr.begin_pass(lr.passes == 1);
+}
+
+// The records' rest states in lanes (make_states), one per distinct (model, temperature, I0)
+// as StartCache shares them; start_of[k] is record k's.
+std::vector<State> rest_states(const std::vector<const Model*>& models,
+                               const std::vector<const Conditions*>& conds,
+                               const std::vector<double>& I0, std::vector<std::size_t>& start_of) {
+  const std::size_t n = models.size();
+  std::vector<const Model*> um;
+  std::vector<const Conditions*> uc;
+  std::vector<double> ui;
+  for (std::size_t k = 0; k < n; ++k) {
+    std::size_t u = 0;
+    while (u < um.size() && !(um[u] == models[k] &&
+                              uc[u]->temperature_C == conds[k]->temperature_C && ui[u] == I0[k]))
+      ++u;
+    if (u == um.size()) {
+      um.push_back(models[k]);
+      uc.push_back(conds[k]);
+      ui.push_back(I0[k]);
+    }
+    start_of[k] = u;
+  }
+  return make_states(um, uc, ui);
 }
 
 }  // namespace
 
-void run_records_lanes(const Model& m, StartCache& starts,
-                       const std::vector<const Measurement*>& records,
+void run_records_lanes(const Model& m, const std::vector<const Measurement*>& records,
                        const std::vector<bool>& flux, const ObjectiveSettings& s,
                        std::vector<std::vector<double>>& response,
                        std::vector<std::vector<double>>& B_T) {
@@ -134,17 +154,27 @@ void run_records_lanes(const Model& m, StartCache& starts,
   std::vector<const Model*> models(n);
   std::vector<const Conditions*> conds(n);
   std::vector<const State*> states(n);
+  std::vector<double> I0(n);
+  std::vector<std::size_t> start_of(n);
   long longest = 0;
   for (std::size_t k = 0; k < n; ++k) {
     LaneRecord& lr = runs[k];
     lr.meas = records[k];
     lr.response = &response[k];
     lr.B = flux[k] ? &B_T[k] : nullptr;
-    set_up(lr, m, starts, preloaded, s);
+    set_up(lr, m, preloaded, s);
     models[k] = lr.model;
     conds[k] = &lr.c;
-    states[k] = &lr.st;
+    I0[k] = lr.I0;
     longest = std::max(longest, lr.total);
+  }
+  const std::vector<State> rest = rest_states(models, conds, I0, start_of);
+  for (std::size_t k = 0; k < n; ++k) {
+    LaneRecord& lr = runs[k];
+    lr.st = rest[start_of[k]];
+    lr.st.t_s = lr.meas->t_s.front();
+    lr.begin_pass(lr.passes == 1);
+    states[k] = &lr.st;
   }
   LaneBatch batch(models, conds, states);
   std::vector<double> current(n), dt(n), t1(n);

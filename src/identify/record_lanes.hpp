@@ -17,10 +17,9 @@ namespace gmasim::identify_detail {
 bool record_in_lanes(const Model& m, const Measurement& meas);
 
 // Runs the records (each record_in_lanes) in lanes: response[k] (and B_T[k] if flux[k]) as
-// run_record_from_start gives them. Throws the DivergenceError of the first record (in the
-// given order) that diverges, as the scalar loop would.
-void run_records_lanes(const Model& m, StartCache& starts,
-                       const std::vector<const Measurement*>& records,
+// run_record_from_start gives them, their rest states made in lanes too (make_states).
+// Throws the DivergenceError of the first record (in time) that diverges.
+void run_records_lanes(const Model& m, const std::vector<const Measurement*>& records,
                        const std::vector<bool>& flux, const ObjectiveSettings& s,
                        std::vector<std::vector<double>>& response,
                        std::vector<std::vector<double>>& B_T);

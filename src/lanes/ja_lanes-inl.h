@@ -99,14 +99,16 @@ HWY_INLINE V<D> ja_irreversible_update(D d, V<D> Mirr0, V<D> Man0, V<D> Man1, V<
   const V<D> d1 = hn::Mul(hn::Sub(Man1, Mirr0), delta);
   const Mk<D> still = hn::Or(hn::Eq(dHe, zero), hn::And(hn::Le(d0, zero), hn::Le(d1, zero)));
   const Mk<D> cross = hn::Le(d0, zero);  // M_an crosses M_irr inside the step
-  V<D> s = hn::Abs(dHe);
-  const V<D> frac = hn::Div(d1, hn::Sub(d1, d0));
-  const V<D> d10 = hn::Sub(d1, d0);
-  const V<D> ds_cross =
-      hn::Sub(hn::Mul(delta, frac),
-              hn::Div(hn::Mul(hn::Mul(hn::Mul(s, d0), delta), dMan1), hn::Mul(d10, d10)));
-  const V<D> ds = hn::IfThenElse(cross, ds_cross, delta);
-  s = hn::IfThenElse(cross, hn::Mul(s, frac), s);
+  V<D> s = hn::Abs(dHe), ds = delta;
+  if (!hn::AllFalse(d, hn::AndNot(still, cross))) {  // only where a lane needs it
+    const V<D> frac = hn::Div(d1, hn::Sub(d1, d0));
+    const V<D> d10 = hn::Sub(d1, d0);
+    const V<D> ds_cross =
+        hn::Sub(hn::Mul(delta, frac),
+                hn::Div(hn::Mul(hn::Mul(hn::Mul(s, d0), delta), dMan1), hn::Mul(d10, d10)));
+    ds = hn::IfThenElse(cross, ds_cross, delta);
+    s = hn::IfThenElse(cross, hn::Mul(s, frac), s);
+  }
   const V<D> u0 = hn::IfThenElse(cross, Mirr0, Man0);
   const V<D> r = hn::Div(s, k);
   V<D> E, q;
@@ -127,66 +129,75 @@ struct JaLaneConstants {
   V<D> MsT, a, alpha, c, k;
 };
 
-// One step of eq. (9) from H0 to H1 (jiles_atherton.hpp, ja_step): Newton's method on
-// g(M1) = M1 - (1-c) M_irr1(M1) - c M_an(H1 + alpha M1), per lane and masked: a lane whose
-// |g| <= tol keeps the values of that iterate while the others iterate (at most 60). Mirr and
-// M are read (the state at H0) and receive the values at H1; chi receives dM1/dH1's chi_e.
+// What a move depends on at its start only (jiles_atherton.hpp, ja_move_start): H_e0 and
+// M_an(H_e0), fixed while the consistent state's Newton solve tries several end fields.
 template <class D>
-HWY_INLINE void ja_step(D d, V<D> H0, V<D> H1, const JaLaneConstants<D>& p, V<D>& Mirr, V<D>& M,
-                        V<D> M_guess, V<D>& chi_e_out) {
-  const V<D> inv_a = hn::Div(C(d, 1.0), p.a);
-  const Mk<D> same = hn::Eq(H1, H0);
-  const V<D> He0 = hn::Add(H0, hn::Mul(p.alpha, M));
-  V<D> L0, dL0;
-  langevin_pair(d, hn::Mul(He0, inv_a), L0, dL0);
-  // H1 == H0: M_irr pinned, the reversible slope.
-  V<D> chi = hn::Mul(hn::Mul(hn::Mul(p.c, p.MsT), inv_a), dL0);
-  const V<D> Man0 = hn::Mul(p.MsT, L0);
-  const V<D> tol = hn::Mul(C(d, 1e-12), p.MsT);
-  V<D> M1 = M_guess, Mirr_out = Mirr, M_out = M;
-  Mk<D> done = same;
-  for (int it = 0; it < 60 && !hn::AllTrue(d, done); ++it) {
-    const V<D> He1 = hn::Add(H1, hn::Mul(p.alpha, M1));
+struct JaLaneStart {
+  V<D> He0, Man0;
+};
+template <class D>
+HWY_INLINE JaLaneStart<D> ja_move_start(D d, V<D> H0, V<D> M0, const JaLaneConstants<D>& p) {
+  const V<D> He0 = hn::Add(H0, hn::Mul(p.alpha, M0));
+  V<D> L, dL;
+  langevin_pair(d, hn::Mul(He0, hn::Div(C(d, 1.0), p.a)), L, dL);
+  return {He0, hn::Mul(p.MsT, L)};
+}
+
+// The law's lane entry (gmasim/magnetisation/jiles_atherton.hpp, JilesAthertonLaw): the
+// consistent state's begin_move / joint_trial over the lanes; its state per rod is M_irr
+// (kMirr). A joint trial is one evaluation of eq. (9) at (H1, M_iter) (physics::ja_evaluate,
+// no inner solve): M = F(M_iter), M_irr, the slope dM/dH and 1/mu_r (ja_slope_terms), the
+// law's Newton step M_next = M_iter - g / (1 - alpha chi_e) and whether |g| <= 1e-12 M_s^T.
+struct JilesAthertonLanes {
+  template <class D>
+  using Start = JaLaneStart<D>;
+  template <class D>
+  struct Trial {
+    V<D> M, dM_dH, Mirr, inv_mu_r, M_next;
+    Mk<D> converged;
+  };
+  template <class D>
+  static Start<D> begin_move(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> M0) {
+    return ja_move_start(d, H0, M0, p);
+  }
+  template <class D>
+  static Trial<D> joint_trial(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> Mirr0, V<D> M0,
+                              const Start<D>& st, V<D> H1, V<D> M_iter) {
+    Trial<D> t;
+    const V<D> inv_a = hn::Div(C(d, 1.0), p.a);
+    const Mk<D> same = hn::Eq(H1, H0);  // ja_step_from's H1 == H0: nothing moves
+    V<D> chi_same = hn::Zero(d);
+    if (!hn::AllFalse(d, same)) {
+      V<D> L0, dL0;
+      langevin_pair(d, hn::Mul(hn::Add(H0, hn::Mul(p.alpha, M0)), inv_a), L0, dL0);
+      chi_same = hn::Mul(hn::Mul(hn::Mul(p.c, p.MsT), inv_a), dL0);
+    }
+    // ja_evaluate
+    const V<D> He1 = hn::Add(H1, hn::Mul(p.alpha, M_iter));
     V<D> L1, dL1;
     langevin_pair(d, hn::Mul(He1, inv_a), L1, dL1);
     const V<D> Man1 = hn::Mul(p.MsT, L1);
     const V<D> dMan = hn::Mul(hn::Mul(p.MsT, inv_a), dL1);
     V<D> dMirr;
     const V<D> Mirr1 =
-        ja_irreversible_update(d, Mirr, Man0, Man1, dMan, hn::Sub(He1, He0), p.k, dMirr);
-    const V<D> Mnew = hn::Add(hn::Mul(hn::Sub(C(d, 1.0), p.c), Mirr1), hn::Mul(p.c, Man1));
-    const V<D> g = hn::Sub(M1, Mnew);
-    const V<D> chi_e = hn::Add(hn::Mul(hn::Sub(C(d, 1.0), p.c), dMirr), hn::Mul(p.c, dMan));
-    const Mk<D> fin = hn::AndNot(
-        done,
-        hn::Or(hn::Le(hn::Abs(g), tol), it == 59 ? hn::FirstN(d, hn::Lanes(d)) : hn::FirstN(d, 0)));
-    Mirr_out = hn::IfThenElse(fin, Mirr1, Mirr_out);
-    M_out = hn::IfThenElse(fin, Mnew, M_out);
-    chi = hn::IfThenElse(fin, chi_e, chi);
-    done = hn::Or(done, fin);
-    V<D> dg = hn::Sub(C(d, 1.0), hn::Mul(p.alpha, chi_e));
-    dg = hn::IfThenElse(hn::Lt(dg, C(d, 0.2)), C(d, 0.2), dg);  // alpha > 0: damped step
-    M1 = hn::IfThenElse(done, M1, hn::Sub(M1, hn::Div(g, dg)));
-  }
-  Mirr = Mirr_out;
-  M = M_out;
-  chi_e_out = hn::Div(chi, hn::Sub(C(d, 1.0), hn::Mul(p.alpha, chi)));  // dM1/dH1
-}
-
-// The law's lane entry (gmasim/magnetisation/jiles_atherton.hpp, JilesAthertonLaw): trial
-// and commit of a move H0 -> H1 over the lanes; its state per rod is M_irr (kMirr).
-struct JilesAthertonLanes {
-  template <class D>
-  static V<D> trial(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> Mirr0, V<D> M0, V<D> H1,
-                    V<D> M_guess, V<D>& dM_dH) {
-    V<D> Mirr = Mirr0, M = M0;
-    ja_step(d, H0, H1, p, Mirr, M, M_guess, dM_dH);
-    return M;
-  }
-  template <class D>
-  static void commit(D d, const JaLaneConstants<D>& p, V<D> H0, V<D>& Mirr, V<D>& M, V<D> H1,
-                     V<D> M_guess, V<D>& dM_dH) {
-    ja_step(d, H0, H1, p, Mirr, M, M_guess, dM_dH);
+        ja_irreversible_update(d, Mirr0, st.Man0, Man1, dMan, hn::Sub(He1, st.He0), p.k, dMirr);
+    const V<D> one_c = hn::Sub(C(d, 1.0), p.c);
+    const V<D> F = hn::Add(hn::Mul(one_c, Mirr1), hn::Mul(p.c, Man1));
+    const V<D> chi =
+        hn::IfThenElse(same, chi_same, hn::Add(hn::Mul(one_c, dMirr), hn::Mul(p.c, dMan)));
+    t.Mirr = hn::IfThenElse(same, Mirr0, Mirr1);
+    t.M = hn::IfThenElse(same, M0, F);
+    M_iter = hn::IfThenElse(same, M0, M_iter);
+    const V<D> g = hn::IfThenElse(same, hn::Zero(d), hn::Sub(M_iter, F));
+    // ja_slope_terms: d = 1 - alpha chi_e, one division
+    const V<D> dd = hn::Sub(C(d, 1.0), hn::Mul(p.alpha, chi)), dc = hn::Add(dd, chi);
+    const V<D> inv = hn::Div(C(d, 1.0), hn::Mul(dd, dc));
+    t.dM_dH = hn::Mul(hn::Mul(chi, dc), inv);
+    t.inv_mu_r = hn::Mul(hn::Mul(dd, dd), inv);
+    const V<D> inv_dg = hn::IfThenElse(hn::Ge(dd, C(d, 0.2)), hn::Mul(dc, inv), C(d, 5.0));
+    t.M_next = hn::Sub(M_iter, hn::Mul(g, inv_dg));
+    t.converged = hn::Le(hn::Abs(g), hn::Mul(C(d, 1e-12), p.MsT));
+    return t;
   }
 };
 

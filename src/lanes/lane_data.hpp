@@ -23,6 +23,8 @@ enum RodField : int {
   kHc,
   kHprev,
   kMprev,
+  kHprev2,
+  kMprev2,
   kX,
   kV,
   kF,
@@ -150,6 +152,10 @@ struct StepInputs {
   const double* current_A;
   const double* dt_s;
   const double* t1_s;
+  // make_state's ramp (quasi_static): one increment at rest, the magnets' MMF scaled by
+  // pm_scale (per lane); dt_s and t1_s are not read.
+  bool quasi_static = false;
+  const double* pm_scale = nullptr;
 };
 
 // The kernel, dispatched to the best target of this CPU (src/lanes/step_lanes.cpp); width_one

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "gmasim/errors.hpp"
@@ -59,12 +60,36 @@ bool same_structure(const lanes::Structure& a, const lanes::Structure& b) {
          a.chain_count == b.chain_count;
 }
 
+// Lane j's State scalars and constants (the GlobalField numbers), its failure record cleared.
+void pack_globals(LaneData& L, std::size_t j, const Model& m, const Conditions& c, const State& s,
+                  double sensor_area) {
+  using namespace lanes;
+  auto glob = [&](int f) -> double& { return L.glob(f)[j]; };
+  const double globals[] = {s.t_s,
+                            s.current_A,
+                            s.y_m,
+                            s.y_stack_m,
+                            s.q_m,
+                            s.z_m,
+                            s.z_v_m_per_s,
+                            s.B_T,
+                            c.pm_scale,
+                            c.thermal_expansion_m,
+                            m.sensor_mount.mass_kg,
+                            m.sensor_mount.stiffness_N_per_m,
+                            m.sensor_mount.damping_N_s_per_m,
+                            m.sensor_mount.actuator_mass_kg,
+                            m.material.lambda_s,
+                            sensor_area};
+  for (int f = 0; f <= kSensorArea; ++f) glob(f) = globals[f];
+  for (int f = kFail; f < kGlobalFieldCount; ++f) glob(f) = 0.0;
+}
+
 // Lane j's numbers from its model, conditions and state.
 void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, const State& s,
                const CircuitLowRankView& lr) {
   using namespace lanes;
   auto rod = [&](int f, int i) -> double& { return L.rod(f, i)[j]; };
-  auto glob = [&](int f) -> double& { return L.glob(f)[j]; };
   const int n = m.rod_count();
   double sensor_area = 0.0;
   for (int b : m.flux_sensor_branches)
@@ -74,11 +99,26 @@ void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, 
   for (int i = 0; i < n; ++i) {
     const RodState& r = s.rods[static_cast<std::size_t>(i)];
     const RodConditions& rc = c.rods[static_cast<std::size_t>(i)];
-    const double state[kRodStateCount] = {
-        r.H_A_per_m,      r.Mirr_A_per_m,  r.M_A_per_m, r.Hc_A_per_m, r.H_prev_A_per_m,
-        r.M_prev_A_per_m, r.x_m,           r.v_m_per_s, r.F_N,        r.mu_r,
-        r.E_Pa,           r.lambda,        r.tau_s,     r.phi_Wb,     r.k_rod_N_per_m,
-        r.k_load_N_per_m, r.K_osc_N_per_m, r.B_T};
+    const double state[kRodStateCount] = {r.H_A_per_m,
+                                          r.Mirr_A_per_m,
+                                          r.M_A_per_m,
+                                          r.Hc_A_per_m,
+                                          r.H_prev_A_per_m,
+                                          r.M_prev_A_per_m,
+                                          r.H_prev2_A_per_m,
+                                          r.M_prev2_A_per_m,
+                                          r.x_m,
+                                          r.v_m_per_s,
+                                          r.F_N,
+                                          r.mu_r,
+                                          r.E_Pa,
+                                          r.lambda,
+                                          r.tau_s,
+                                          r.phi_Wb,
+                                          r.k_rod_N_per_m,
+                                          r.k_load_N_per_m,
+                                          r.K_osc_N_per_m,
+                                          r.B_T};
     for (int f = 0; f < kRodStateCount; ++f) rod(f, i) = state[f];
     const auto& br =
         m.circuit
@@ -115,24 +155,7 @@ void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, 
     L.bt_coil(i)[j] = lr.bt_coil8[i];
     L.bt_pm(i)[j] = lr.bt_pm8[i];
   }
-  const double globals[] = {s.t_s,
-                            s.current_A,
-                            s.y_m,
-                            s.y_stack_m,
-                            s.q_m,
-                            s.z_m,
-                            s.z_v_m_per_s,
-                            s.B_T,
-                            c.pm_scale,
-                            c.thermal_expansion_m,
-                            m.sensor_mount.mass_kg,
-                            m.sensor_mount.stiffness_N_per_m,
-                            m.sensor_mount.damping_N_s_per_m,
-                            m.sensor_mount.actuator_mass_kg,
-                            m.material.lambda_s,
-                            sensor_area};
-  for (int f = 0; f <= kSensorArea; ++f) glob(f) = globals[f];
-  for (int f = kFail; f < kGlobalFieldCount; ++f) glob(f) = 0.0;
+  pack_globals(L, j, m, c, s, sensor_area);
 }
 
 }  // namespace
@@ -164,6 +187,7 @@ LaneBatch::LaneBatch(std::span<const Model* const> models,
   in_current_.assign(d_->npad, 0.0);
   in_dt_.assign(d_->npad, 1.0);
   in_t1_.assign(d_->npad, 0.0);
+  in_pm_.assign(d_->npad, 0.0);
 }
 
 LaneBatch::~LaneBatch() = default;
@@ -178,15 +202,29 @@ void LaneBatch::step(std::span<const double> current_A, std::span<const double> 
   if (current_A.size() != n || dt_s.size() != n || t1_s.size() != n)
     throw InputError(fmt::format("lanes: step with {} currents, {} steps, {} times for {} lanes",
                                  current_A.size(), dt_s.size(), t1_s.size(), n));
-  std::copy(current_A.begin(), current_A.end(), in_current_.begin());
-  std::copy(dt_s.begin(), dt_s.end(), in_dt_.begin());
-  std::copy(t1_s.begin(), t1_s.end(), in_t1_.begin());
-  for (std::size_t j = n; j < d_->npad; ++j) {  // padding: lane 0's inputs
-    in_current_[j] = current_A[0];
-    in_dt_[j] = dt_s[0];
-    in_t1_[j] = t1_s[0];
-  }
-  lanes::step_dispatch(*d_, {in_current_.data(), in_dt_.data(), in_t1_.data()}, width_one);
+  pad_inputs(current_A, in_current_);
+  pad_inputs(dt_s, in_dt_);
+  pad_inputs(t1_s, in_t1_);
+  lanes::step_dispatch(*d_, {in_current_.data(), in_dt_.data(), in_t1_.data(), false, nullptr},
+                       width_one);
+}
+
+// The inputs of the lanes, padding lanes repeating lane 0's.
+void LaneBatch::pad_inputs(std::span<const double> a, std::vector<double>& to) const {
+  std::copy(a.begin(), a.end(), to.begin());
+  std::fill(to.begin() + static_cast<std::ptrdiff_t>(a.size()), to.end(), a[0]);
+}
+
+void LaneBatch::rest_increment(std::span<const double> current_A, std::span<const double> pm_scale,
+                               bool width_one) {
+  const std::size_t n = d_->n;
+  if (current_A.size() != n || pm_scale.size() != n)
+    throw InputError(fmt::format("lanes: rest increment with {} currents, {} scales for {} lanes",
+                                 current_A.size(), pm_scale.size(), n));
+  pad_inputs(current_A, in_current_);
+  pad_inputs(pm_scale, in_pm_);
+  lanes::step_dispatch(*d_, {in_current_.data(), in_dt_.data(), in_t1_.data(), true, in_pm_.data()},
+                       width_one);
 }
 
 bool LaneBatch::diverged(std::size_t lane) const { return d_->glob(lanes::kFail)[lane] != 0.0; }
@@ -196,16 +234,64 @@ void LaneBatch::unpack(std::size_t j, State& s) const {
   LaneData& L = *d_;
   for (int i = 0; i < L.st.rods; ++i) {
     RodState& r = s.rods[static_cast<std::size_t>(i)];
-    double* const fields[kRodStateCount] = {
-        &r.H_A_per_m,      &r.Mirr_A_per_m,  &r.M_A_per_m, &r.Hc_A_per_m, &r.H_prev_A_per_m,
-        &r.M_prev_A_per_m, &r.x_m,           &r.v_m_per_s, &r.F_N,        &r.mu_r,
-        &r.E_Pa,           &r.lambda,        &r.tau_s,     &r.phi_Wb,     &r.k_rod_N_per_m,
-        &r.k_load_N_per_m, &r.K_osc_N_per_m, &r.B_T};
+    double* const fields[kRodStateCount] = {&r.H_A_per_m,
+                                            &r.Mirr_A_per_m,
+                                            &r.M_A_per_m,
+                                            &r.Hc_A_per_m,
+                                            &r.H_prev_A_per_m,
+                                            &r.M_prev_A_per_m,
+                                            &r.H_prev2_A_per_m,
+                                            &r.M_prev2_A_per_m,
+                                            &r.x_m,
+                                            &r.v_m_per_s,
+                                            &r.F_N,
+                                            &r.mu_r,
+                                            &r.E_Pa,
+                                            &r.lambda,
+                                            &r.tau_s,
+                                            &r.phi_Wb,
+                                            &r.k_rod_N_per_m,
+                                            &r.k_load_N_per_m,
+                                            &r.K_osc_N_per_m,
+                                            &r.B_T};
     for (int f = 0; f < kRodStateCount; ++f) *fields[f] = L.rod(f, i)[j];
   }
   double* const globals[kGlobalStateCount] = {&s.t_s, &s.current_A, &s.y_m,         &s.y_stack_m,
                                               &s.q_m, &s.z_m,       &s.z_v_m_per_s, &s.B_T};
   for (int f = 0; f < kGlobalStateCount; ++f) *globals[f] = L.glob(f)[j];
+}
+
+std::size_t LaneBatch::record_width() const {
+  return 6 + 9 * static_cast<std::size_t>(d_->st.rods);  // run.cpp's kGlobal + kPerRod per rod
+}
+
+void LaneBatch::record_row(std::size_t j, double thermal_expansion_m, double* row) const {
+  using namespace lanes;
+  LaneData& L = *d_;
+  row[0] = L.glob(kT)[j];
+  row[1] = L.glob(kCurrent)[j];
+  row[2] = L.glob(kY)[j] * 1e6;
+  row[3] = L.glob(kBSensor)[j];
+  row[4] = thermal_expansion_m * 1e6;
+  row[5] = L.glob(kYStack)[j] * 1e6;
+  for (int i = 0; i < L.st.rods; ++i) {
+    double* b = row + 6 + 9 * i;
+    b[0] = L.rod(kH, i)[j];
+    b[1] = L.rod(kM, i)[j];
+    b[2] = L.rod(kMuR, i)[j];
+    b[3] = L.rod(kE, i)[j] * 1e-9;
+    b[4] = L.rod(kLambda, i)[j] * 1e6;
+    b[5] = L.rod(kF, i)[j];
+    b[6] = L.rod(kX, i)[j] * 1e6;
+    b[7] = L.rod(kTau, i)[j] * 1e3;
+    b[8] = L.rod(kB, i)[j];
+  }
+}
+
+void LaneBatch::record(std::size_t j, double thermal_expansion_m, TimeSeries& ts) const {
+  std::array<double, 6 + 9 * lanes::kMaxRods> row{};
+  record_row(j, thermal_expansion_m, row.data());
+  for (std::size_t q = 0; q < record_width(); ++q) ts.columns[q].push_back(row[q]);
 }
 
 double LaneBatch::y_m(std::size_t lane) const { return d_->glob(lanes::kY)[lane]; }

@@ -43,7 +43,23 @@ struct LaneRun {
   State st;
   bool live = false;
   long first_recorded = 0;  // metrics_only: the step before the last period's window
+  // Rows staged before they are appended to the series column by column (LaneBatch::record_row).
+  std::vector<double> rows;
+  std::size_t staged = 0;
+  // Appends the staged rows' first `columns` values (of `width`) to the series.
+  void flush(TimeSeries& ts, std::size_t width, std::size_t columns) {
+    for (std::size_t q = 0; q < columns; ++q)
+      for (std::size_t k = 0; k < staged; ++k) ts.columns[q].push_back(rows[k * width + q]);
+    staged = 0;
+  }
 };
+constexpr std::size_t kStagedRows = 64;
+constexpr std::size_t kGlobalColumns = 6;  // run.cpp's make_columns: t_s .. y_stack_um
+
+// metrics_only: the rods' columns hold at most the rest state's row: none.
+void drop_rod_columns(TimeSeries& ts) {
+  for (std::size_t q = kGlobalColumns; q < ts.columns.size(); ++q) ts.columns[q].clear();
+}
 
 void finish(const SimulationSettings& s, const Plan& p, Result& r) {
   if (r.series.rows() > 0) r.thermal_expansion_um = r.series.column("xT_um").back();
@@ -91,7 +107,10 @@ void run_group(const Model& m, std::span<const SimulationSettings> settings,
   }
   if (!lane_of.empty()) {
     LaneBatch batch(models, conds, states);
-    const std::size_t n = lane_of.size();
+    const std::size_t n = lane_of.size(), width = batch.record_width();
+    // metrics_only: the global columns (t_s .. y_stack_um), all the metrics read
+    const std::size_t columns = metrics_only ? kGlobalColumns : width;
+    for (std::size_t l = 0; l < n; ++l) runs[lane_of[l]].rows.resize(kStagedRows * width);
     std::vector<double> current(n), dt(n, p.dt_s), t1(n);
     std::size_t live = n;
 
@@ -107,6 +126,7 @@ void run_group(const Model& m, std::span<const SimulationSettings> settings,
         if (!lr.live) continue;
         Result& r = out[lr.setting];
         if (batch.diverged(l)) {
+          lr.flush(r.series, width, columns);
           r.diverged = true;
           r.error = batch.error(l);
           lr.live = false;
@@ -116,8 +136,8 @@ void run_group(const Model& m, std::span<const SimulationSettings> settings,
         r.steps = k;
         if (k >= lr.first_recorded &&
             (k % settings[lr.setting].record_every == 0 || k == p.steps)) {
-          batch.unpack(l, lr.st);
-          record(lr.c, lr.st, r.series);
+          batch.record_row(l, lr.c.thermal_expansion_m, lr.rows.data() + lr.staged * width);
+          if (++lr.staged == kStagedRows || k == p.steps) lr.flush(r.series, width, columns);
         }
       }
     }
@@ -126,6 +146,7 @@ void run_group(const Model& m, std::span<const SimulationSettings> settings,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   for (const LaneRun& lr : runs) {
     Result& r = out[lr.setting];
+    if (metrics_only) drop_rod_columns(r.series);
     r.wall_time_s = wall / static_cast<double>(runs.size());
     finish(settings[lr.setting], p, r);
   }

@@ -57,56 +57,55 @@ struct RodStates {
   V<D> f[kRodStateCount][kMaxRods];
 };
 
-// The low-rank circuit solve (circuit/netlist.cpp, rod_solve) per lane: with D = diag(1/R),
-// F the rods' MMFs and u = I psi_coil + pm psi_pm:  (D^-1 + S) z' = B^T u - S D F,
-// z = z' + D F, phi_r = (B^T u - S z)_r + F_r) / R_r. Cholesky in place; ok is false where
-// the matrix is not positive definite or z is not finite.
+// The low-rank circuit solve (circuit/netlist.cpp, rod_solve and set_flux) per lane: with
+// D = diag(1/R), F the rods' MMFs and u = I psi_coil + pm psi_pm:  v = B^T u - S D F,
+// (D^-1 + S) z' = v (L D L^T, no square roots), z = z' + D F,
+// phi_r = ((B^T u - S z)_r + F_r) / R_r. ok is false where a pivot is not positive or z is
+// not finite.
 template <class D>
 HWY_INLINE Mk<D> circuit_solve(const Chunk<D>& c, const V<D>* R, const V<D>* mmf, V<D> I, V<D> pm,
                                V<D>* phi) {
   const D d = c.d;
   const int n = c.n;
-  V<D> A[kMaxRods][kMaxRods], DF[kMaxRods], Btu[kMaxRods], y[kMaxRods];
+  V<D> S[kMaxRods][kMaxRods], A[kMaxRods][kMaxRods], DF[kMaxRods], Btu[kMaxRods], x[kMaxRods],
+      piv[kMaxRods];
   for (int a = 0; a < n; ++a) {
     DF[a] = hn::Div(mmf[a], R[a]);
     Btu[a] = hn::Add(hn::Mul(I, hn::LoadU(d, c.L.bt_coil(a) + c.j)),
                      hn::Mul(pm, hn::LoadU(d, c.L.bt_pm(a) + c.j)));
-    for (int b = 0; b < n; ++b) A[a][b] = hn::LoadU(d, c.L.S(a, b) + c.j);
+    for (int b = 0; b < n; ++b) S[a][b] = hn::LoadU(d, c.L.S(a, b) + c.j);
   }
   for (int a = 0; a < n; ++a) {
-    V<D> s = hn::Zero(d);
-    for (int b = 0; b < n; ++b) s = hn::Add(s, hn::Mul(A[a][b], DF[b]));
-    y[a] = hn::Sub(Btu[a], s);
+    V<D> sdf = hn::Zero(d);
+    for (int b = 0; b < n; ++b) sdf = hn::Add(sdf, hn::Mul(S[a][b], DF[b]));
+    x[a] = hn::Sub(Btu[a], sdf);
   }
-  for (int a = 0; a < n; ++a) A[a][a] = hn::Add(A[a][a], R[a]);
   Mk<D> ok = hn::FirstN(d, hn::Lanes(d));
-  for (int a = 0; a < n; ++a) {  // A = L L^T, L in the lower triangle
-    V<D> dd = A[a][a];
-    for (int k = 0; k < a; ++k) dd = hn::Sub(dd, hn::Mul(A[a][k], A[a][k]));
+  for (int j = 0; j < n; ++j) {  // L D L^T of S + diag(R), unit L below the diagonal of A
+    V<D> dd = hn::Add(S[j][j], R[j]);
+    for (int p = 0; p < j; ++p) dd = hn::Sub(dd, hn::Mul(hn::Mul(A[j][p], A[j][p]), piv[p]));
     ok = hn::And(ok, hn::Gt(dd, hn::Zero(d)));
-    A[a][a] = hn::Sqrt(dd);
-    for (int b = a + 1; b < n; ++b) {
-      V<D> s = A[b][a];
-      for (int k = 0; k < a; ++k) s = hn::Sub(s, hn::Mul(A[b][k], A[a][k]));
-      A[b][a] = hn::Div(s, A[a][a]);
+    piv[j] = dd;
+    for (int i = j + 1; i < n; ++i) {
+      V<D> a = S[i][j];
+      for (int p = 0; p < j; ++p) a = hn::Sub(a, hn::Mul(hn::Mul(A[i][p], A[j][p]), piv[p]));
+      A[i][j] = hn::Div(a, dd);
     }
   }
-  for (int a = 0; a < n; ++a) {  // L w = y
-    for (int k = 0; k < a; ++k) y[a] = hn::Sub(y[a], hn::Mul(A[a][k], y[k]));
-    y[a] = hn::Div(y[a], A[a][a]);
-  }
-  for (int a = n - 1; a >= 0; --a) {  // L^T z' = w, then z = z' + D F
-    for (int k = a + 1; k < n; ++k) y[a] = hn::Sub(y[a], hn::Mul(A[k][a], y[k]));
-    y[a] = hn::Div(y[a], A[a][a]);
+  for (int i = 0; i < n; ++i)
+    for (int p = 0; p < i; ++p) x[i] = hn::Sub(x[i], hn::Mul(A[i][p], x[p]));
+  for (int i = n - 1; i >= 0; --i) {
+    x[i] = hn::Div(x[i], piv[i]);
+    for (int p = i + 1; p < n; ++p) x[i] = hn::Sub(x[i], hn::Mul(A[p][i], x[p]));
   }
   for (int a = 0; a < n; ++a) {
-    y[a] = hn::Add(y[a], DF[a]);
-    ok = hn::And(ok, hn::IsFinite(y[a]));
+    x[a] = hn::Add(x[a], DF[a]);
+    ok = hn::And(ok, hn::IsFinite(x[a]));
   }
   for (int a = 0; a < n; ++a) {
-    V<D> v = Btu[a];
-    for (int b = 0; b < n; ++b) v = hn::Sub(v, hn::Mul(hn::LoadU(d, c.L.S(a, b) + c.j), y[b]));
-    phi[a] = hn::Div(hn::Add(v, mmf[a]), R[a]);
+    V<D> sz = hn::Zero(d);
+    for (int b = 0; b < n; ++b) sz = hn::Add(sz, hn::Mul(S[a][b], x[b]));
+    phi[a] = hn::Div(hn::Add(hn::Sub(Btu[a], sz), mmf[a]), R[a]);
   }
   return ok;
 }
@@ -116,62 +115,94 @@ HWY_INLINE JaLaneConstants<D> ja_constants(const Chunk<D>& c, int i) {
   return {c.rod(kMsTMag, i), c.rod(kJaA, i), c.rod(kJaAlpha, i), c.rod(kJaC, i), c.rod(kJaK, i)};
 }
 
-// Newton's method on the rods' fields (model/step.cpp, consistent_magnetic_update): each rod
-// linearised at its iterate into a branch U = R_eff phi + U_off, the circuit solved, the
-// field moved to the one its flux implies. Per lane: a converged lane stops moving; the loop
-// ends when every lane has converged or failed, or at the cap (60), where a lane within
-// 1 mA/m is accepted and the others fail (kFailNewton, the rod of the largest step).
+// A lane that has stopped keeps the trial of the iterate it stopped at; the others take t.
+template <class M, class T>
+HWY_INLINE void take_trial(M done, const T& t, T& tr) {
+  tr.M = hn::IfThenElse(done, tr.M, t.M);
+  tr.dM_dH = hn::IfThenElse(done, tr.dM_dH, t.dM_dH);
+  tr.Mirr = hn::IfThenElse(done, tr.Mirr, t.Mirr);
+  tr.inv_mu_r = hn::IfThenElse(done, tr.inv_mu_r, t.inv_mu_r);
+  tr.M_next = hn::IfThenElse(done, tr.M_next, t.M_next);
+  tr.converged = hn::Or(hn::And(done, tr.converged), hn::AndNot(done, t.converged));
+}
+
+// Per rod, what the Newton solve fixes at the step's start and what it ends with.
 template <class Law, class D>
-HWY_INLINE void newton_fields(const Chunk<D>& c, RodStates<D>& s, V<D> I, V<D> pm, V<D> h, V<D> t1,
-                              V<D>* H, V<D>* M, V<D>* B0, Fails<D>& fails) {
+struct Magnetic {
+  V<D> H[kMaxRods], Mg[kMaxRods], B0[kMaxRods], Bs[kMaxRods];
+  typename Law::template Trial<D> trial[kMaxRods];
+};
+
+// Newton's method on the rods' fields and magnetisations jointly (model/step.cpp,
+// consistent_magnetic_update): the first guess extrapolated quadratically from the last three
+// steps (H = 3 (H_n - H_n-1) + H_n-2, M likewise); at each iterate (H*, M*) each rod's law
+// evaluated once (joint_trial: no inner solve), its magnetisation corrected by the law's Newton
+// step to M_next and linearised into a branch U = R_eff phi + U_off, the circuit solved, H* moved
+// to the field its flux implies and M* to M_next + dM/dH dH. Per lane: a lane whose field
+// corrections are all below 1e-7 A/m + 1e-11 |H| and whose laws all hold (|g| <= 1e-12 M_s^T)
+// keeps that iterate and its trial (the last evaluation is committed); the loop ends when every
+// lane has converged or failed, or at the cap (60), where a lane whose largest step (field or
+// law) is within 1 mA/m is accepted and the others fail (kFailNewton, the rod of that step).
+// quasi_static (make_state's ramp, consistent_magnetic_update's quasi_static): no eddy term,
+// the first guess at H_n and M_n.
+template <class Law, class D>
+HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, V<D> pm, V<D> h,
+                              V<D> t1, bool quasi_static, Magnetic<Law, D>& mg, Fails<D>& fails) {
   const D d = c.d;
   const int n = c.n;
   constexpr double kMu0 = physics::kMu0;
-  V<D> g[kMaxRods], e0[kMaxRods], Bs[kMaxRods], mud[kMaxRods];
+  V<D> g[kMaxRods], e0[kMaxRods], inv_mud[kMaxRods], l_A[kMaxRods], inv_A[kMaxRods];
+  typename Law::template Start<D> start[kMaxRods];
   for (int i = 0; i < n; ++i) {
-    B0[i] = hn::Mul(C(d, kMu0), hn::Add(s.f[kH][i], s.f[kM][i]));
+    start[i] = Law::begin_move(d, ja_constants(c, i), s.f[kH][i], s.f[kM][i]);
+    mg.B0[i] = hn::Mul(C(d, kMu0), hn::Add(s.f[kH][i], s.f[kM][i]));
+    l_A[i] = hn::Div(c.rod(kLength, i), c.rod(kArea, i));
+    inv_A[i] = hn::Div(C(d, 1.0), c.rod(kArea, i));
+    if (quasi_static) {
+      e0[i] = g[i] = hn::Zero(d);
+      mg.H[i] = s.f[kH][i];
+      mg.Mg[i] = s.f[kM][i];
+      continue;
+    }
     e0[i] = hn::Sub(s.f[kHc][i], s.f[kH][i]);
     g[i] = hn::Div(hn::Mul(C(d, 2.0), c.rod(kKappa, i)), h);
-    H[i] = hn::Sub(hn::Mul(C(d, 2.0), s.f[kH][i]), s.f[kHprev][i]);
-    M[i] =
-        hn::Add(s.f[kM][i], hn::Mul(hn::Sub(s.f[kMuR][i], C(d, 1.0)), hn::Sub(H[i], s.f[kH][i])));
+    mg.H[i] = hn::Add(hn::Mul(C(d, 3.0), hn::Sub(s.f[kH][i], s.f[kHprev][i])), s.f[kHprev2][i]);
+    mg.Mg[i] = hn::Add(hn::Mul(C(d, 3.0), hn::Sub(s.f[kM][i], s.f[kMprev][i])), s.f[kMprev2][i]);
   }
   Mk<D> done = fails.failed;
   for (int it = 0; !hn::AllTrue(d, done); ++it) {
     V<D> R[kMaxRods], mmf[kMaxRods], phi[kMaxRods];
     for (int i = 0; i < n; ++i) {
-      V<D> chi;
-      // a lane that has converged keeps the iterate it converged at
-      M[i] = hn::IfThenElse(done, M[i],
-                            Law::trial(d, ja_constants(c, i), s.f[kH][i], s.f[kMirr][i], s.f[kM][i],
-                                       H[i], M[i], chi));
-      Bs[i] = hn::Mul(C(d, kMu0), hn::Add(H[i], M[i]));
-      mud[i] = hn::Mul(C(d, kMu0), hn::Add(C(d, 1.0), chi));
-      const V<D> l = c.rod(kLength, i);
-      R[i] =
-          hn::Add(hn::Mul(hn::Div(l, c.rod(kArea, i)), hn::Add(hn::Div(C(d, 1.0), mud[i]), g[i])),
-                  c.rod(kRs, i));
+      const auto t = Law::joint_trial(d, ja_constants(c, i), s.f[kH][i], s.f[kMirr][i], s.f[kM][i],
+                                      start[i], mg.H[i], mg.Mg[i]);
+      auto& tr = mg.trial[i];
+      take_trial(done, t, tr);
+      mg.Bs[i] = hn::Mul(C(d, kMu0), hn::Add(mg.H[i], tr.M_next));
+      inv_mud[i] = hn::Mul(tr.inv_mu_r, C(d, 1.0 / kMu0));
+      R[i] = hn::Add(hn::Mul(l_A[i], hn::Add(inv_mud[i], g[i])), c.rod(kRs, i));
       const V<D> extra = hn::Mul(
-          hn::Neg(l),
-          hn::Sub(hn::Sub(hn::Sub(H[i], hn::Div(Bs[i], mud[i])), hn::Mul(g[i], B0[i])), e0[i]));
+          hn::Neg(c.rod(kLength, i)),
+          hn::Sub(hn::Sub(hn::Sub(mg.H[i], hn::Mul(mg.Bs[i], inv_mud[i])), hn::Mul(g[i], mg.B0[i])),
+                  e0[i]));
       mmf[i] =
           hn::Add(hn::Add(hn::Mul(c.rod(kCoilTurns, i), I), hn::Mul(c.rod(kPmMmf, i), pm)), extra);
     }
     const Mk<D> ok = circuit_solve(c, R, mmf, I, pm, phi);
     fails.mark(d, hn::AndNot(done, hn::Not(ok)), kFailCircuit, hn::Zero(d), -1, t1, hn::Zero(d));
     done = hn::Or(done, fails.failed);
-    V<D> worst = hn::Zero(d), worst_rod = hn::Zero(d);
+    V<D> worst = hn::Zero(d), worst_rod = hn::Zero(d), dH[kMaxRods];
     Mk<D> converged = hn::FirstN(d, hn::Lanes(d));
-    const V<D> damping = C(d, it < 8 ? 1.0 : 0.5);
     for (int i = 0; i < n; ++i) {
-      const V<D> dH = hn::Div(hn::Sub(hn::Div(phi[i], c.rod(kArea, i)), Bs[i]), mud[i]);
-      const V<D> adH = hn::Abs(dH);
-      const Mk<D> larger = hn::Gt(adH, worst);
-      worst = hn::IfThenElse(larger, adH, worst);
+      dH[i] = hn::Mul(hn::Sub(hn::Mul(phi[i], inv_A[i]), mg.Bs[i]), inv_mud[i]);
+      const V<D> adH = hn::Abs(dH[i]);
+      // the rod's Newton step: its field's and its law's; NaN propagates
+      const V<D> dM = hn::Abs(hn::Sub(mg.trial[i].M_next, mg.Mg[i]));
+      const V<D> step = hn::IfThenElse(hn::Le(dM, adH), adH, dM);
+      const Mk<D> larger = hn::Not(hn::Le(step, worst));
+      worst = hn::IfThenElse(larger, step, worst);
       worst_rod = hn::IfThenElse(larger, C(d, static_cast<double>(i)), worst_rod);
-      converged =
-          hn::And(converged, hn::Le(adH, hn::Add(C(d, 1e-7), hn::Mul(C(d, 1e-11), hn::Abs(H[i])))));
-      H[i] = hn::IfThenElse(done, H[i], hn::Add(H[i], hn::Mul(damping, dH)));
+      converged = hn::And(hn::And(converged, mg.trial[i].converged),
+                          hn::Le(adH, hn::Add(C(d, 1e-7), hn::Mul(C(d, 1e-11), hn::Abs(mg.H[i])))));
     }
     done = hn::Or(done, converged);
     const Mk<D> stop =
@@ -185,32 +216,42 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, RodStates<D>& s, V<D> I, V<D> p
                    worst, i, t1, hn::Zero(d));
     }
     done = hn::Or(done, stop);
+    const V<D> damping = C(d, it < 8 ? 1.0 : 0.5);
+    for (int i = 0; i < n; ++i) {  // the lanes still iterating: the next iterate
+      const V<D> step = hn::Mul(damping, dH[i]);
+      mg.H[i] = hn::IfThenElse(done, mg.H[i], hn::Add(mg.H[i], step));
+      const auto& tr = mg.trial[i];
+      mg.Mg[i] = hn::IfThenElse(done, mg.Mg[i], hn::Add(tr.M_next, hn::Mul(tr.dM_dH, step)));
+    }
   }
 }
 
-// Commit of the end-of-step magnetic state (model/step.cpp, consistent_magnetic_update's
-// last loop): the law's move to H1, the eddy field (eq. 7, trapezoidal), the rod's flux.
+// Commit of the end-of-step magnetic state (model/step.cpp, commit_rod): the last Newton
+// trial at H1 as it is (its M, M_irr and flux density B1), the eddy field (eq. 7,
+// trapezoidal), the first guess's histories, mu_r = 1 + dM/dH and the rod's flux.
 template <class Law, class D>
-HWY_INLINE void commit_fields(const Chunk<D>& c, RodStates<D>& s, V<D> h, const V<D>* H,
-                              const V<D>* M, const V<D>* B0) {
+HWY_INLINE void commit_fields(const Chunk<D>& c, RodStates<D>& s, V<D> h, bool quasi_static,
+                              const Magnetic<Law, D>& mg) {
   const D d = c.d;
   constexpr double kMu0 = physics::kMu0;
   for (int i = 0; i < c.n; ++i) {
-    V<D> chi;
-    V<D> Mirr = s.f[kMirr][i], Mr = s.f[kM][i];
-    Law::commit(d, ja_constants(c, i), s.f[kH][i], Mirr, Mr, H[i], M[i], chi);
-    const V<D> B1 = hn::Mul(C(d, kMu0), hn::Add(H[i], Mr));
-    const V<D> kappa = c.rod(kKappa, i);
-    // eddy_static_field_trapezoid: H1 + 2 kappa (B1 - B0)/h - (Hc0 - H0)
+    const auto& tr = mg.trial[i];
+    const V<D> H1 = mg.H[i], B1 = hn::Mul(C(d, kMu0), hn::Add(H1, tr.M)), kappa = c.rod(kKappa, i);
+    s.f[kMprev2][i] = s.f[kMprev][i];
+    s.f[kMprev][i] = s.f[kM][i];
+    s.f[kMirr][i] = tr.Mirr;
+    s.f[kM][i] = tr.M;
+    // eddy_static_field_trapezoid: H1 + 2 kappa (B1 - B0)/h - (Hc0 - H0); at rest H_c = H1
     s.f[kHc][i] =
-        hn::Sub(hn::Add(H[i], hn::Div(hn::Mul(hn::Mul(C(d, 2.0), kappa), hn::Sub(B1, B0[i])), h)),
-                hn::Sub(s.f[kHc][i], s.f[kH][i]));
+        quasi_static
+            ? H1
+            : hn::Sub(hn::Add(H1, hn::Div(hn::Mul(hn::Mul(C(d, 2.0), kappa), hn::Sub(B1, mg.B0[i])),
+                                          h)),
+                      hn::Sub(s.f[kHc][i], s.f[kH][i]));
+    s.f[kHprev2][i] = s.f[kHprev][i];
     s.f[kHprev][i] = s.f[kH][i];
-    s.f[kH][i] = H[i];
-    s.f[kMirr][i] = Mirr;
-    s.f[kM][i] = Mr;
-    s.f[kMprev][i] = Mr;
-    s.f[kMuR][i] = hn::Add(C(d, 1.0), chi);
+    s.f[kH][i] = H1;
+    s.f[kMuR][i] = hn::Add(C(d, 1.0), tr.dM_dH);
     s.f[kTau][i] = hn::Mul(hn::Mul(C(d, kMu0), s.f[kMuR][i]), kappa);
     s.f[kPhi][i] = hn::Mul(B1, c.rod(kArea, i));
   }

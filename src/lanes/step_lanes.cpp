@@ -103,6 +103,25 @@ HWY_INLINE void run_loop_checks(const Chunk<D>& c, const RodStates<D>& s, const 
   }
 }
 
+// The lanes' failure records (kFail ...) in and out of a chunk.
+template <class D>
+HWY_INLINE Fails<D> load_fails(const Chunk<D>& c) {
+  return {hn::Ne(c.glob(kFail), hn::Zero(c.d)),
+          c.glob(kFail),
+          c.glob(kFailValue),
+          c.glob(kFailRod),
+          c.glob(kFailT),
+          c.glob(kFailBound)};
+}
+template <class D>
+HWY_INLINE void store_fails(const Chunk<D>& c, const Fails<D>& f) {
+  hn::StoreU(f.code, c.d, c.L.glob(kFail) + c.j);
+  hn::StoreU(f.value, c.d, c.L.glob(kFailValue) + c.j);
+  hn::StoreU(f.rod, c.d, c.L.glob(kFailRod) + c.j);
+  hn::StoreU(f.t, c.d, c.L.glob(kFailT) + c.j);
+  hn::StoreU(f.bound, c.d, c.L.glob(kFailBound) + c.j);
+}
+
 // One step of lanes [j, j + Lanes(d)): load, the stages, store where the lane is still alive
 // (a lane that fails keeps its state before the step, as simulate() records it).
 template <class D>
@@ -113,18 +132,13 @@ HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
     for (int i = 0; i < c.n; ++i) s.f[f][i] = c.rod(f, i);
   V<D> g[kGlobalStateCount];
   for (int f = 0; f < kGlobalStateCount; ++f) g[f] = c.glob(f);
-  Fails<D> fails{hn::Ne(c.glob(kFail), hn::Zero(d)),
-                 c.glob(kFail),
-                 c.glob(kFailValue),
-                 c.glob(kFailRod),
-                 c.glob(kFailT),
-                 c.glob(kFailBound)};
+  Fails<D> fails = load_fails(c);
   const Mk<D> alive = hn::Not(fails.failed);
   const V<D> I = hn::LoadU(d, in.current_A + j), h = hn::LoadU(d, in.dt_s + j);
   const V<D> t1 = hn::Add(g[kT], h);  // step()'s t1 = s.t_s + h
-  V<D> H[kMaxRods], M[kMaxRods], B0[kMaxRods];
-  newton_fields<JilesAthertonLanes>(c, s, I, c.glob(kPmScale), h, t1, H, M, B0, fails);
-  commit_fields<JilesAthertonLanes>(c, s, h, H, M, B0);
+  Magnetic<JilesAthertonLanes, D> mg;
+  newton_fields<JilesAthertonLanes>(c, s, I, c.glob(kPmScale), h, t1, false, mg, fails);
+  commit_fields<JilesAthertonLanes>(c, s, h, false, mg);
   for (int i = 0; i < c.n; ++i) {
     fails.check(d, s.f[kH][i], C(d, 1e9), kFailH, i, t1);
     fails.check(d, s.f[kM][i], hn::Mul(C(d, 1.5), c.rod(kMsTMag, i)), kFailM, i, t1);
@@ -138,23 +152,49 @@ HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
   for (int f = 0; f < kRodStateCount; ++f)
     for (int i = 0; i < c.n; ++i) hn::BlendedStore(s.f[f][i], keep, d, L.rod(f, i) + j);
   for (int f = 0; f < kGlobalStateCount; ++f) hn::BlendedStore(g[f], keep, d, L.glob(f) + j);
-  hn::StoreU(fails.code, d, L.glob(kFail) + j);
-  hn::StoreU(fails.value, d, L.glob(kFailValue) + j);
-  hn::StoreU(fails.rod, d, L.glob(kFailRod) + j);
-  hn::StoreU(fails.t, d, L.glob(kFailT) + j);
-  hn::StoreU(fails.bound, d, L.glob(kFailBound) + j);
+  store_fails(c, fails);
+}
+
+// One increment of make_state's ramp (model/step.cpp, quasi_static_magnetic_update on the
+// consistent state) for lanes [j, j + Lanes(d)): the magnetic state at rest at the current and
+// the magnets' scale of the increment; a lane that fails keeps its state.
+template <class D>
+HWY_INLINE void ramp_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in) {
+  const Chunk<D> c{d, L, j, L.st.rods};
+  RodStates<D> s;
+  for (int f = 0; f < kRodStateCount; ++f)
+    for (int i = 0; i < c.n; ++i) s.f[f][i] = c.rod(f, i);
+  Fails<D> fails = load_fails(c);
+  const Mk<D> alive = hn::Not(fails.failed);
+  const V<D> I = hn::LoadU(d, in.current_A + j), pm = hn::LoadU(d, in.pm_scale + j);
+  const V<D> one = C(d, 1.0), t = hn::Zero(d);
+  Magnetic<JilesAthertonLanes, D> mg;
+  newton_fields<JilesAthertonLanes>(c, s, I, pm, one, t, true, mg, fails);
+  commit_fields<JilesAthertonLanes>(c, s, one, true, mg);
+  const Mk<D> keep = hn::AndNot(fails.failed, alive);
+  for (int f = 0; f < kRodStateCount; ++f)
+    for (int i = 0; i < c.n; ++i) hn::BlendedStore(s.f[f][i], keep, d, L.rod(f, i) + j);
+  store_fails(c, fails);
+}
+
+template <class D>
+HWY_INLINE void chunk(D d, LaneData& L, std::size_t j, const StepInputs& in) {
+  if (in.quasi_static)
+    ramp_chunk(d, L, j, in);
+  else
+    step_chunk(d, L, j, in);
 }
 
 // All lanes, in chunks of the target's width (or of 1: the reference instance).
 void StepAll(LaneData& L, const StepInputs& in, bool width_one) {
   if (width_one) {
     const hn::CappedTag<double, 1> d1;
-    for (std::size_t j = 0; j < L.npad; ++j) step_chunk(d1, L, j, in);
+    for (std::size_t j = 0; j < L.npad; ++j) chunk(d1, L, j, in);
     return;
   }
   const hn::ScalableTag<double> d;
   const std::size_t w = hn::Lanes(d);
-  for (std::size_t j = 0; j < L.npad; j += w) step_chunk(d, L, j, in);
+  for (std::size_t j = 0; j < L.npad; j += w) chunk(d, L, j, in);
 }
 
 int WidthOf() { return static_cast<int>(hn::Lanes(hn::ScalableTag<double>())); }

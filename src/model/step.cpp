@@ -205,6 +205,8 @@ void quasi_static_magnetic_update(const Model& m, const Conditions& c, State& s,
   }
 }
 
+}  // namespace
+
 // The actuator at rest at its magnetic state: the hold values for the next step, each rod's
 // modulus, strain and force (eq. 11-14), and the static equilibrium x = F / K of eq. (15)
 // with x'' = x' = 0; the output stage rests on the stack.
@@ -231,8 +233,10 @@ void settle_at_rest(const Model& m, const Conditions& c, State& s) {
   finish_outputs(m, c, s);
 }
 
+namespace {
+
 template <class Law>
-State make_state_law(const Model& m, const Conditions& c, double current_A) {
+State demagnetised_state_law(const Model& m, const Conditions& c, double current_A) {
   State s;
   const std::size_t n = m.rods.size();
   s.rods.assign(n, RodState{});
@@ -241,9 +245,15 @@ State make_state_law(const Model& m, const Conditions& c, double current_A) {
   s.energy.phi_prev_Wb.assign(m.circuit.branches.size(), 0.0);
   s.current_A = current_A;
   for (std::size_t i = 0; i < n; ++i) Law::init_state(c.rods[i], s.rods[i]);
+  return s;
+}
+
+template <class Law>
+State make_state_law(const Model& m, const Conditions& c, double current_A) {
+  State s = demagnetised_state_law<Law>(m, c, current_A);
   // Quasi-static ramp of the total MMF from zero (demagnetised rods, no field) to its
   // value at t = 0, along the initial magnetisation curve; no eddy lag (at rest).
-  const int ramp_steps = 400;
+  const int ramp_steps = kRestRampSteps;
   for (int k = 1; k <= ramp_steps; ++k) {
     const double f = static_cast<double>(k) / ramp_steps;
     s.energy.enabled = k == ramp_steps;  // the last increment solves every branch (the ledger's
@@ -267,6 +277,12 @@ void quasi_static_step_law(const Model& m, const Conditions& c, State& s, double
     check(s.rods[i].M_A_per_m, s.t_s, m.rods[i].name, "M [A/m]", 1.5 * c.rods[i].MsT_mag);
     check(s.rods[i].x_m, s.t_s, m.rods[i].name, "x [m]", 1.0);
   }
+}
+
+State demagnetised_state(const Model& m, const Conditions& c, double current_A) {
+  return with_magnetisation_law(m.options.magnetisation_law, [&](auto law) {
+    return demagnetised_state_law<decltype(law)>(m, c, current_A);
+  });
 }
 
 State make_state(const Model& m, const Conditions& c, double current_A) {

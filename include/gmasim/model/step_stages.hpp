@@ -37,6 +37,15 @@ inline void hold_history(RodState& r) {
   r.H_prev2_A_per_m = r.H_prev_A_per_m = r.H_A_per_m;
 }
 
+// make_state's pieces (src/model/step.cpp), for callers that run its quasi-static ramp
+// themselves (the lanes' make_states, gmasim/simulate/lanes.hpp): the state before the ramp
+// (demagnetised rods, no field, buffers sized), the ramp's increments (increment k moves
+// the current and the magnets' MMF to k / kRestRampSteps of their values) and the actuator
+// settled at rest after it (histories, mechanics at rest, outputs).
+inline constexpr int kRestRampSteps = 400;
+State demagnetised_state(const Model& m, const Conditions& c, double current_A);
+void settle_at_rest(const Model& m, const Conditions& c, State& s);
+
 void stage_begin(State& s, const StepInput& in, StepScratch& w);
 template <class Law>
 void stage_magnetic(const Model& m, const Conditions& c, State& s, const StepInput& in,

@@ -49,6 +49,11 @@ class LaneBatch {
   // the same kernel (the reference a lane is compared with). Allocation-free.
   void step(std::span<const double> current_A, std::span<const double> dt_s,
             std::span<const double> t1_s, bool width_one = false);
+  // One increment of make_state's quasi-static ramp (model/step.cpp: the magnetic state at
+  // rest, no eddy lag) of every live lane, at the current and the magnets' scale given per
+  // lane (size() values each). Allocation-free. A lane whose solve fails stops (diverged()).
+  void rest_increment(std::span<const double> current_A, std::span<const double> pm_scale,
+                      bool width_one = false);
   // Whether the lane stopped, and why: the DivergenceError text step() or run_loop() would
   // have thrown (time, rod, quantity, value). A stopped lane keeps its last good state.
   bool diverged(std::size_t lane) const;
@@ -56,6 +61,15 @@ class LaneBatch {
   // The lane's state as step() leaves it, into s (sized by make_state for the lane's model:
   // no allocation).
   void unpack(std::size_t lane, State& s) const;
+  // One row of simulate()'s series (src/simulate/run.cpp, record(): the same columns and
+  // values) from the lane's state, without unpacking it; thermal_expansion_m is the lane's
+  // Conditions::thermal_expansion_m.
+  void record(std::size_t lane, double thermal_expansion_m, TimeSeries& ts) const;
+  // The same row into row[0 .. record_width()): what a caller stages before appending a block of
+  // rows column by column (many lanes appending to their columns step by step write to as many
+  // page-aligned streams at once, which the L1 cache cannot hold).
+  void record_row(std::size_t lane, double thermal_expansion_m, double* row) const;
+  std::size_t record_width() const;
   // The lane's outputs without unpacking: y and B of the coil (State::y_m, B_T), and one
   // rod's displacement x.
   double y_m(std::size_t lane) const;
@@ -67,15 +81,26 @@ class LaneBatch {
  private:
   std::unique_ptr<lanes::LaneData> d_;
   std::vector<std::string> rod_names_;
-  std::vector<double> in_current_, in_dt_, in_t1_;  // padded inputs
+  std::vector<double> in_current_, in_dt_, in_t1_, in_pm_;  // padded inputs
+  void pad_inputs(std::span<const double> a, std::vector<double>& to) const;
 };
+
+// make_state() for many (model, conditions, current at t = 0) at once: make_state's ramp in
+// lanes (kRestRampSteps increments, gmasim/model/step_stages.hpp), then each state settled at
+// rest as make_state settles it; equal to make_state to the lanes' rounding. The models share a
+// structure and are lanes_supported (LaneBatch). A lane whose ramp fails runs make_state itself,
+// which throws the DivergenceError make_state throws.
+std::vector<State> make_states(std::span<const Model* const> models,
+                               std::span<const Conditions* const> conditions,
+                               std::span<const double> current_A);
 
 // simulate() for many settings of one model: the settings the lanes can run (no
 // self-heating, no energy ledger, a model lanes_supported) advance together in lanes,
 // grouped by their step count; the others run simulate(). Results in the order of the
 // settings; the same validation and errors as simulate(). metrics_only: a lane's series holds
 // only the rows of its metrics window (the last period) and the one before it, enough for the
-// metrics, which are those of the full record (what a sweep keeps).
+// metrics, which are those of the full record (what a sweep keeps), and of the run's global
+// columns only (t_s .. y_stack_um: the rods' columns are empty).
 std::vector<Result> simulate_lanes(const Model& m, std::span<const SimulationSettings> settings,
                                    bool metrics_only = false);
 
