@@ -181,6 +181,30 @@ def close(a: float, b: float, rel_tol: float) -> bool:
     return abs(a - b) <= rel_tol * max(abs(a), abs(b), 1e-300)
 
 
+# The committed calibration's search is a long chain of comparisons of objective values: a
+# change in their last digits (a faster step, lanes instead of scalar runs) sends it along
+# another path to another optimum. Its first evaluation, the start model's, is in the committed
+# fit report to the last digit; the smoke run evaluates the same start model with the same fit
+# spec, so a difference beyond rounding means `calibrate.py <reading>` no longer reproduces the
+# committed model.
+STALE_REL_TOL = 1e-14  # a few units in the last place: the same evaluation gives the same bits
+
+
+def stale_calibration(name: str, start_rms: float) -> list[str]:
+    committed = HERE / "models" / f"{name}_report" / "fit_report.json"
+    if not committed.is_file():
+        return [f"{rel(committed)} does not exist: run calibrate.py {name}"]
+    with open(committed) as f:
+        was = json.load(f)["start_rms_pct"]
+    if close(start_rms, was, STALE_REL_TOL):
+        return []
+    return [f"the start model's fit RMS is {start_rms!r} %, the committed calibration saw {was!r} % "
+            f"({rel(committed)}; rel. diff {abs(start_rms - was) / abs(was):.2g} > {STALE_REL_TOL:g}): "
+            f"the objective moved since it ran, so `calibrate.py {name}` no longer reproduces the "
+            f"committed model; rerun it and commit its outputs with the reproduction doc "
+            f"(docs/calibration.md)"]
+
+
 def smoke(bin_: str, cfg: dict, work: pathlib.Path | None, write_reference: bool) -> int:
     sm = dict(cfg.get("smoke", {}))
     if "reading" not in sm:
@@ -198,6 +222,8 @@ def smoke(bin_: str, cfg: dict, work: pathlib.Path | None, write_reference: bool
         work = pathlib.Path(tmp)
     try:
         got = calibrate(bin_, reading, sm, work, quick=True)
+        with open(work / f"{name}_report" / "fit_report.json") as f:
+            start_rms = json.load(f)["start_rms_pct"]
     finally:
         if tmp:
             shutil.rmtree(tmp, ignore_errors=True)
@@ -236,6 +262,7 @@ def smoke(bin_: str, cfg: dict, work: pathlib.Path | None, write_reference: bool
         problems.append(f"fit RMS {result['fit_rms_pct']!r} %, reference {ref['fit_rms_pct']!r} %")
     if result["claims"] != ref["claims"]:
         problems.append(f"claims {result['claims']} != reference {ref['claims']}")
+    problems += stale_calibration(name, start_rms)
     if problems:
         print(f"calibrate.py --smoke: {name} does not reproduce {rel(ref_path)}:", file=sys.stderr)
         for p in problems:

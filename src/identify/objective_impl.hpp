@@ -13,6 +13,7 @@
 
 #include "gmasim/errors.hpp"
 #include "gmasim/identify/identify.hpp"
+#include "gmasim/simulate/lanes.hpp"
 #include "identify/objective_runs.hpp"
 #include "identify/record_lanes.hpp"
 #include "identify/record_run.hpp"
@@ -132,10 +133,14 @@ struct Objective::Impl {
   // The simulations of the scalar targets. Throws InputError / DivergenceError.
   void target_runs(const Model& model, StartCache& starts, std::vector<SineMetrics>& sm,
                    std::vector<double>& res) const {
-    std::vector<double> I, yy, BB;
-    sm.resize(sine_runs.size());
-    for (std::size_t k = 0; k < sine_runs.size(); ++k)
-      sm[k] = identify_detail::run_sine(model, sine_runs[k], settings, I, yy, BB, starts);
+    if (settings.lanes && sine_runs.size() > 1 && lanes_supported(model)) {
+      sm = identify_detail::run_sines_lanes(model, sine_runs, settings, starts);
+    } else {
+      std::vector<double> I, yy, BB;
+      sm.resize(sine_runs.size());
+      for (std::size_t k = 0; k < sine_runs.size(); ++k)
+        sm[k] = identify_detail::run_sine(model, sine_runs[k], settings, I, yy, BB, starts);
+    }
     res.resize(res_runs.size());
     for (std::size_t k = 0; k < res_runs.size(); ++k)
       res[k] = identify_detail::lowest_resonance_Hz(model, res_runs[k]);

@@ -52,6 +52,12 @@ SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings
                      std::vector<double>& I, std::vector<double>& y, std::vector<double>& B,
                      StartCache& starts);
 
+// run_sine for every run (all of one model), the runs advancing together in SIMD lanes
+// (gmasim/simulate/lanes.hpp; the model lanes_supported): the metrics in the order of runs.
+// Throws the DivergenceError of the first run (in that order) that diverges.
+std::vector<SineMetrics> run_sines_lanes(const Model& m, const std::vector<SineRun>& runs,
+                                         const ObjectiveSettings& s, StartCache& starts);
+
 // A resonance_Hz (lowest eq. 15 oscillator frequency at the bias), frf_peak_Hz or
 // bandwidth_Hz (the small-signal frequency response of Fig. 15) target.
 struct ResonanceRun {

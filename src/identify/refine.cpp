@@ -164,6 +164,10 @@ RefineOutcome refine_lm(const Objective& obj, BatchEvaluator& ev, const std::vec
   so.function_tolerance = 1e-7;
   so.gradient_tolerance = 1e-12;
   so.parameter_tolerance = 1e-8;
+  // With the bounds Ceres runs a projected Armijo line search along every step; its default
+  // cubic interpolation asks for the gradient at each trial point, a full finite-difference
+  // Jacobian (2n + 1 evaluations) here. The quadratic interpolation needs the values only.
+  so.line_search_interpolation_type = ceres::QUADRATIC;
   so.num_threads = 1;  // parallelism is inside the Jacobian batch
   so.logging_type = ceres::SILENT;
   so.minimizer_progress_to_stdout = false;

@@ -35,11 +35,12 @@ namespace {
 // Samples of one monotone branch of y(I), sorted by current, for interpolation.
 struct Branch {
   std::vector<double> I, y;
-  double at(double i) const {
-    const auto it = std::lower_bound(I.begin(), I.end(), i);
-    if (it == I.begin()) return y.front();
-    if (it == I.end()) return y.back();
-    const auto j = static_cast<std::size_t>(it - I.begin());
+  // y at current i by linear interpolation; j is the first sample with I[j] >= i of the
+  // previous call (std::lower_bound's answer), walked forward: the calls come with i rising.
+  double at(double i, std::size_t& j) const {
+    while (j < I.size() && I[j] < i) ++j;
+    if (j == 0) return y.front();
+    if (j == I.size()) return y.back();
     const double f = (i - I[j - 1]) / (I[j] - I[j - 1]);
     return y[j - 1] + f * (y[j] - y[j - 1]);
   }
@@ -90,9 +91,10 @@ double hysteresis_width(const std::vector<double>& current_A, const std::vector<
   if (!(hi > lo)) return 0.0;
   const int grid = 2001;
   double gap = 0.0;
+  std::size_t jr = 0, jf = 0;  // the grid rises: each branch is walked once
   for (int g = 0; g < grid; ++g) {
     const double i = lo + (hi - lo) * g / (grid - 1);
-    gap = std::max(gap, std::fabs(rise.at(i) - fall.at(i)));
+    gap = std::max(gap, std::fabs(rise.at(i, jr) - fall.at(i, jf)));
   }
   return gap;
 }

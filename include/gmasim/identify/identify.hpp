@@ -202,7 +202,8 @@ struct ObjectiveSettings {
   // (tests/test_identify_records.cpp).
   double quasi_static_increments = 500.0;
   // The records advance together in SIMD lanes (gmasim/simulate/lanes.hpp) where the model and
-  // the records allow (timed, current-driven, from rest); false: one scalar run per record.
+  // the records allow (timed, current-driven, from rest), and so do the scalar targets' sine
+  // runs; false: one scalar run per record and per sine run.
   bool lanes = true;
 };
 // The rules of ObjectiveSettings (steps per period in [8, 1e6], dt >= 0, target periods in
