@@ -8,6 +8,7 @@
 
 #include "gmasim/experiments/compensate.hpp"
 #include "gmasim/experiments/experiments.hpp"
+#include "gmasim/experiments/feedforward.hpp"
 #include "gmasim/experiments/request_table.hpp"
 #include "gmasim/experiments/sensitivity.hpp"
 #include "gmasim/model/validate.hpp"
@@ -222,6 +223,30 @@ struct RequestFields<CompensateRequest> {
       field<R>("dt_s", "s", nonnegative(), "--dt", "Time step [s]; 0 = automatic rule", Cli,
                GMASIM_REF(R, dt_s)),
       threads_row<R>(kCliPy),
+  };
+};
+
+// The feed-forward evaluation (track --feedforward inverse): its grid, gains and drive are the
+// track request's (the CLI's and Python's options are the track table's); the report records
+// these of its rows. The plants and controllers are track's own options (words).
+template <>
+struct RequestFields<FeedforwardEvaluationRequest> {
+  using R = FeedforwardEvaluationRequest;
+  using T = TrackRequest;
+  static constexpr std::string_view experiment = "track --feedforward";
+  static constexpr auto rows = std::tuple{
+      GMASIM_NESTED(R, track, T, "kp", Meta),
+      GMASIM_NESTED(R, track, T, "ki", Meta),
+      GMASIM_NESTED(R, track, T, "kd", Meta),
+      GMASIM_NESTED(R, track, T, "sample_rate_Hz", Meta),
+      GMASIM_NESTED(R, track, T, "bias_A", Meta),
+      GMASIM_NESTED(R, track, T, "current_limit_A", Meta),
+      GMASIM_NESTED(R, track, T, "amplifier_A_per_unit", Meta),
+      GMASIM_NESTED(R, track, T, "periods", Meta),
+      GMASIM_NESTED(R, track, T, "feedforward_band_Hz", Meta, "inverse_band_Hz"),
+      field<R>("inverse_dynamic", "-", any(), "", "", Meta, GMASIM_REF(R, track.inverse.dynamic)),
+      field<R>("schedule_frequency_Hz", "Hz", in(0.0, kMaxFrequency_Hz), "", "", Meta,
+               GMASIM_REF(R, schedule_frequency_Hz)),
   };
 };
 
