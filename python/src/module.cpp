@@ -385,6 +385,24 @@ PYBIND11_MODULE(_gmasim, mod) {
       Extra<std::vector<std::string>>{"freeze", {}},
       Extra<std::vector<std::string>>{"quantities", {}}, Extra<py::object>{"ambient_C", py::none()},
       Extra<py::object>{"current_A", py::none()}, Extra<py::object>{"current_dt_s", py::none()});
+  // The table of Metrics (gmasim/simulate/simulate.hpp kMetricRows): the keys of simulate()'s
+  // "metrics" dict in order; gmasim's SimulationResult prints those with a label.
+  mod.def(
+      "metric_rows",
+      [] {
+        py::list rows;
+        for (const MetricRow& row : kMetricRows) {
+          py::dict d;
+          d["name"] = std::string(row.name);
+          d["unit"] = std::string(row.unit);
+          d["label"] = std::string(row.label);
+          d["precision"] = row.precision;
+          rows.append(d);
+        }
+        return rows;
+      },
+      "The table of simulate()'s metrics: [{name, unit, label, precision}] in the dict's order; "
+      "label: the CLI summary's ('' : not printed there)");
   // The names freeze=[...] takes (simulate, Stepper, sweep), from the C++ table.
   py::list laws;
   for (const auto& sw : gmasim::kFreezeSwitches) laws.append(sw.name);
