@@ -91,9 +91,9 @@ constexpr std::size_t row_index(std::string_view name) {
   return found;
 }
 
-// Row `Name` of the table of S, as a row of R that holds its S at member `Inner` (a request
-// made of another's fields: name, unit, rule, option and help are the inner row's, so they are
-// spelled once), shown in `where` under `meta_key` ("": the inner row's key).
+// Row I of the table of S (GMASIM_NESTED: the row by name) as a row of R, which holds its S at
+// member `Inner` (a request made of another's fields: name, unit, rule, option and help are the
+// inner row's, spelled once), shown in `where` under `meta_key` ("": the inner row's key).
 template <class R, auto Inner, class S, std::size_t I>
 constexpr auto nested_row(unsigned where, std::string_view meta_key = {}) {
   const auto& row = std::get<I>(RequestFields<S>::rows);
