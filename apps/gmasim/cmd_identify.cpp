@@ -19,7 +19,9 @@
 #include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/identify/identify.hpp"
+#include "gmasim/identify/synthetic_fields.hpp"
 #include "gmasim/io/io.hpp"
+#include "request_options.hpp"
 
 namespace gmasim::cli {
 namespace {
@@ -47,6 +49,7 @@ struct SynthArgs {
   std::string out;
   ModelArgs model;
   SyntheticRequest req;
+  RequestOptions<SyntheticRequest> options;  // its table's options
   bool no_flux = false;
   std::string drive = "current", response = "displacement", offset = "absolute";
   std::string initial_state = "demagnetised";
@@ -402,42 +405,11 @@ void add_run_options(CLI::App* sub, IdentifyArgs& a) {
   sub->add_flag("--quiet", a.quiet, "No progress on stderr, no summary");
 }
 
-// identify synthesize: the conditions, the record length and the noise.
-void add_synthetic_conditions(CLI::App* syn, SynthArgs& s) {
-  syn->add_option("--temperatures", s.req.temperatures_C, "Temperatures [degC]")
-      ->delimiter(',')
-      ->capture_default_str();
-  syn->add_option("--currents", s.req.currents_pp_A, "Current peak-to-peak values [A]")
-      ->delimiter(',')
-      ->capture_default_str();
-  syn->add_option("--frequencies", s.req.frequencies_Hz, "Frequencies [Hz]")
-      ->delimiter(',')
-      ->capture_default_str();
-  syn->add_option("--current-min", s.req.current_min_A, "Current minimum [A] (Fig. 11)")
-      ->capture_default_str();
-  syn->add_option("--periods", s.req.periods, "Record length [periods]; the first is not compared")
-      ->capture_default_str();
-  syn->add_option("--samples-per-period", s.req.samples_per_period, "Samples per period")
-      ->capture_default_str();
-  syn->add_option("--noise", s.req.noise_pct,
-                  "Displacement noise: Gaussian sigma in % of each condition's p-p")
-      ->capture_default_str();
-  syn->add_option("--flux-noise", s.req.flux_noise_pct, "Flux noise: sigma in % of p-p")
-      ->capture_default_str();
+// identify synthesize: the request table's options (gmasim/identify/synthetic_fields.hpp), then
+// the choices of the record format (docs/data.md).
+void add_synthetic_options(CLI::App* syn, SynthArgs& s) {
+  s.options.add(syn, s.req, RequestOptions<SyntheticRequest>::Lists::Comma);
   syn->add_flag("--no-flux", s.no_flux, "Do not write the flux_T column");
-  syn->add_option("--seed", s.req.seed, "Noise seed")->capture_default_str();
-}
-
-// identify synthesize: the simulation and the record format (docs/data.md).
-void add_synthetic_records(CLI::App* syn, SynthArgs& s) {
-  syn->add_option("--dt", s.req.objective.dt_s, "Simulation time step [s]; 0: period / steps")
-      ->capture_default_str();
-  syn->add_option("--steps-per-period", s.req.objective.steps_per_period,
-                  "Time steps per period (use the same value for identify)")
-      ->capture_default_str();
-  syn->add_flag("--quasi-static", s.req.quasi_static,
-                "Quasi-static records: the sine's samples as equilibria, no t_s column (one "
-                "record per temperature x current; --frequencies is ignored)");
   syn->add_option("--drive", s.drive,
                   "Drive column: current (current_A) or field (field_A_per_m: the rod's applied "
                   "field that the current produced)")
@@ -448,22 +420,15 @@ void add_synthetic_records(CLI::App* syn, SynthArgs& s) {
                   "the rod)")
       ->check(CLI::IsMember({"displacement", "strain"}))
       ->capture_default_str();
-  syn->add_option("--rod", s.req.rod, "Rod of the field / strain columns (default: the first)");
   syn->add_option("--offset", s.offset,
                   "Response reference: absolute, first_sample (written relative to the first "
                   "sample) or fitted (shifted by --response-offset)")
       ->check(CLI::IsMember({"absolute", "first_sample", "fitted"}))
       ->capture_default_str();
-  syn->add_option("--response-offset", s.req.response_offset,
-                  "Constant added to the response with --offset fitted [um or ppm]")
-      ->capture_default_str();
   syn->add_option("--initial-state", s.initial_state,
                   "Magnetic state the records start from (written as their initial_state key): "
                   "demagnetised, negative_remanence or positive_remanence")
       ->check(CLI::IsMember({"demagnetised", "negative_remanence", "positive_remanence"}))
-      ->capture_default_str();
-  syn->add_option("--precycles", s.req.precycles,
-                  "Pre-cycles written into each record (then every period is compared)")
       ->capture_default_str();
 }
 
@@ -489,8 +454,7 @@ Runner add_identify(CLI::App& app) {
       "temperature x current x frequency, with Gaussian noise");
   syn->add_option("--out", s->out, "Output directory")->required();
   add_model_options(syn, s->model);
-  add_synthetic_conditions(syn, *s);
-  add_synthetic_records(syn, *s);
+  add_synthetic_options(syn, *s);
 
   return [a, s, sub, syn]() -> int {
     if (syn->parsed()) return run_synthesize(*s);

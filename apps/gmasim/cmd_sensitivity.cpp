@@ -12,9 +12,11 @@
 #include "commands.hpp"
 #include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/sensitivity.hpp"
 #include "gmasim/identify/identify.hpp"
 #include "gmasim/io/io.hpp"
+#include "request_options.hpp"
 
 namespace gmasim::cli {
 namespace {
@@ -26,6 +28,7 @@ struct SensitivityArgs {
   std::vector<std::string> params, quantities;
   std::string fit, claims, out, json, csv;
   SensitivityRequest req;
+  RequestOptions<SensitivitySettings> options;
   bool plot = false, progress = false;
 };
 
@@ -162,8 +165,8 @@ void print_summary(const SensitivityArgs& a, const SensitivityResult& r, std::FI
   fmt::print(f,
              "  {} parameters x {} quantities; central differences at h = {:g} and {:g} "
              "(agreement {:g} %); {} models, {} work items on {} threads in {:.1f} s\n",
-             r.parameters.size(), r.quantities.size(), r.step_large, r.step_small,
-             100 * r.agreement, r.evaluations, r.runs, r.threads, r.wall_time_s);
+             r.parameters.size(), r.quantities.size(), r.settings.step_large, r.settings.step_small,
+             100 * r.settings.agreement, r.evaluations, r.runs, r.threads, r.wall_time_s);
   for (const auto& p : r.parameters)
     fmt::print(f, "    {:<44} {:>12.6g} {:<8} {}\n", p.name, p.value, p.unit,
                p.step == StepKind::Log ? "d/d ln p" : fmt::format("d/d p, step h x {:g}", p.scale));
@@ -246,23 +249,9 @@ void add_flags(CLI::App* sub, SensitivityArgs& a) {
                   "default: every applicable claim and metric quantity");
   sub->add_option("--claims", a.claims,
                   "Claims file (the format of data/claims.toml) instead of the built-in claims");
-  sub->add_option("--step-large", a.req.step_large, "The larger relative step h [-]")
-      ->capture_default_str();
-  sub->add_option("--step-small", a.req.step_small, "The smaller relative step h [-]")
-      ->capture_default_str();
-  sub->add_option("--agreement", a.req.agreement,
-                  "Flag an entry whose two estimates differ by more than this fraction [-]")
-      ->capture_default_str();
-  sub->add_option("--floor", a.req.floor_fraction,
-                  "Derivatives below this fraction of the quantity's tolerance count as zero [-]")
-      ->capture_default_str();
-  sub->add_option("--near-null", a.req.near_null_ratio,
-                  "A singular direction below this fraction of the largest is near-null [-]")
-      ->capture_default_str();
-  sub->add_flag("--quick", a.req.quick,
-                "Score the claims on the quick study's grids (reproduce --quick)");
-  sub->add_option("--threads", a.req.threads, "Worker threads [-]; 0 = all cores")
-      ->capture_default_str();
+  // --step-large ... --threads: the table of SensitivitySettings
+  // (gmasim/experiments/experiment_fields.hpp).
+  a.options.add(sub, a.req);
   sub->add_option("--out", a.out,
                   "Output directory (sensitivity.csv, sensitivity.json, identifiability.json); "
                   "default out/sensitivity unless --json or --csv is given");

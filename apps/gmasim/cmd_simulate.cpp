@@ -13,9 +13,11 @@
 #include "commands.hpp"
 #include "experiment_cli.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments/simulate_fields.hpp"
 #include "gmasim/io/io.hpp"
 #include "gmasim/model/validate.hpp"
 #include "gmasim/simulate/simulate.hpp"
+#include "request_options.hpp"
 
 namespace gmasim::cli {
 namespace {
@@ -48,19 +50,16 @@ void print_energy(const Result& r, bool periodic) {
       c.copper_W, c.power_peak_W, c.apparent_VA);
 }
 
-struct SimulateArgs {
+// The options of the table (gmasim/experiments/simulate_fields.hpp) and the command's own.
+struct SimulateArgs : SimulateOptions {
+  RequestOptions<SimulateOptions> options;
   ModelArgs model;
-  std::string waveform_csv, kind = "sine", out = "out/simulate";
-  std::string temperatures = "20";  // one or several (comma list, start:step:stop) [degC]
-  double temperature_C = 20.0;      // the one of this run
+  std::string waveform_csv, out = "out/simulate";
+  // one or several (comma list, start:step:stop) [degC]; temperature_C: the one of this run
+  std::string temperatures = fmt::format("{:g}", SimulateOptions{}.temperature_C);
   bool record_every_given = false, current_min_given = false;
-  double pp_A = 8.0, min_A = -3.0, frequency_Hz = 10.0, periods = 3.0;
-  double dt_s = 0.0, level_A = 0.0, step_to_A = 0.0, step_time_s = 0.0;
-  double f0_Hz = 1.0, f1_Hz = 1000.0, amplitude_A = 1.0, offset_A = 0.0, duration_s = 0.0;
-  int record_every = 1;
-  bool plot = false;
-  bool self_heating = false, progress = false;
-  double thermal_step_s = 0.0, ambient_C = std::nan("");
+  bool plot = false, progress = false;
+  double ambient_C = std::nan("");
   std::vector<std::string> quantities, freeze;
 };
 
@@ -68,7 +67,7 @@ Waveform make_waveform(const SimulateArgs& a) {
   if (!a.waveform_csv.empty()) return load_waveform_csv(a.waveform_csv);
   Waveform w;
   if (a.kind == "sine") {
-    w = biased_sine(a.pp_A, a.frequency_Hz, a.min_A);
+    w = biased_sine(a.current_pp_A, a.frequency_Hz, a.current_min_A);
   } else if (a.kind == "dc") {
     w.kind = WaveformKind::DC;
     w.level_A = a.level_A;
@@ -382,41 +381,11 @@ Runner add_simulate(CLI::App& app) {
                   "Operating temperature [degC]; several (20,150 or 20:65:150) run one after "
                   "the other, each into <out>/T<temperature>C, loops overlaid with --plot")
       ->capture_default_str();
-  sub->add_option("--waveform-kind", a->kind,
-                  "Current waveform: sine (biased, Fig. 11), dc, step, chirp")
-      ->check(CLI::IsMember({"sine", "dc", "step", "chirp"}))
-      ->capture_default_str();
-  sub->add_option("--current-pp", a->pp_A, "Biased sine: current peak-to-peak [A]")
-      ->capture_default_str();
-  sub->add_option("--current-min", a->min_A, "Biased sine: current minimum [A] (paper: -3 A)")
-      ->capture_default_str();
-  sub->add_option("--frequency", a->frequency_Hz, "Biased sine: frequency [Hz]")
-      ->capture_default_str();
-  sub->add_option("--periods", a->periods,
-                  "Biased sine: number of periods to run [-]; metrics use the last")
-      ->capture_default_str();
-  sub->add_option("--level", a->level_A, "DC level, or step initial level [A]")
-      ->capture_default_str();
-  sub->add_option("--step-to", a->step_to_A, "Step: level after the step [A]")
-      ->capture_default_str();
-  sub->add_option("--step-time", a->step_time_s, "Step: time of the step [s]")
-      ->capture_default_str();
-  sub->add_option("--f0", a->f0_Hz, "Chirp: start frequency [Hz]")->capture_default_str();
-  sub->add_option("--f1", a->f1_Hz, "Chirp: end frequency [Hz]")->capture_default_str();
-  sub->add_option("--amplitude", a->amplitude_A, "Chirp: current amplitude [A]")
-      ->capture_default_str();
-  sub->add_option("--offset", a->offset_A, "Chirp: current offset [A]")->capture_default_str();
-  sub->add_option("--duration", a->duration_s,
-                  "Run length for dc/step/chirp/CSV waveforms [s] (CSV: default its last time)")
-      ->capture_default_str();
+  // --current-pp ... --thermal-step: the table's options, in its order.
+  a->options.add(sub, *a);
+  a->options.option("--waveform-kind")->check(CLI::IsMember({"sine", "dc", "step", "chirp"}));
   sub->add_option("--waveform", a->waveform_csv,
                   "Arbitrary current waveform, CSV with header t_s,current_A [s, A]");
-  sub->add_option("--dt", a->dt_s, "Time step [s]; 0 = automatic rule (T/2000, at most 10 us)")
-      ->capture_default_str();
-  sub->add_option("--record-every", a->record_every,
-                  "Record every N-th step [-]; not given, a run over 10000 rows writes one "
-                  "row in ceil(rows/10000) to timeseries.csv (the metrics use every step)")
-      ->capture_default_str();
   sub->add_option(
       "--quantity", a->quantities,
       "Also report RMS, peak, p-p and mean of these columns (e.g. rod1_F_N) [column units]");
@@ -428,13 +397,6 @@ Runner add_simulate(CLI::App& app) {
   sub->add_flag("--progress", a->progress,
                 "Progress with ETA on stderr even when it is not a terminal (a terminal gets it "
                 "for runs over 2 s), a line every 2 s at most");
-  sub->add_flag("--self-heating", a->self_heating,
-                "Let the actuator heat itself: coil copper loss and rod eddy/hysteresis losses "
-                "drive the [thermal_network] (coil, rods, housing, ambient); the rods' "
-                "temperature updates the model every thermal step. Writes self_heating.csv");
-  sub->add_option("--thermal-step", a->thermal_step_s,
-                  "Self-heating: thermal step [s]; 0 = whole periods spanning >= 0.1 s")
-      ->capture_default_str();
   sub->add_option("--ambient", a->ambient_C,
                   "Self-heating: ambient temperature [degC]; default: --temperature");
   sub->add_flag("--plot", a->plot, "Also draw <out>/simulate.png and .svg (matplotlib)");

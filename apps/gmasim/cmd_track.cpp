@@ -1,5 +1,6 @@
 // gmasim track: closed-loop displacement tracking with the paper's PID (Fig. 16).
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <filesystem>
 #include <memory>
@@ -21,7 +22,10 @@ struct TrackArgs : ExperimentArgs<TrackRequest> {
   // --feedforward inverse: the evaluation against mismatched plants
   // (gmasim/experiments/feedforward.hpp)
   std::string feedforward = "none", mismatch = "all",
-              controllers = "pid,pid_temperature,pid_inverse";
+              controllers = fmt::format(
+                  "{}",
+                  fmt::join(track_controller_names(FeedforwardEvaluationRequest{}.controllers),
+                            ","));
   std::vector<CLI::Option*> feedforward_only;  // refused without --feedforward inverse*
 };
 

@@ -24,14 +24,25 @@ namespace gmasim::cli {
 template <class R>
 class RequestOptions {
  public:
-  // Adds every Cli row of R's table to `sub`, bound to `req` (which must outlive the parse).
-  void add(CLI::App* sub, R& req) {
+  // Adds every Cli row of R's table to `sub`, bound to `req` (which must outlive the parse). A
+  // bool row is a flag. Lists::Comma binds a list row to CLI11's own comma-separated list (no
+  // ranges), for commands that took their lists so before the table.
+  enum class Lists { Ranges, Comma };
+  void add(CLI::App* sub, R& req, Lists lists = Lists::Ranges) {
     fields::for_each_field<R>([&](const auto& row) {
       if (!row.in_cli()) return;
       using T = typename std::remove_cvref_t<decltype(row)>::Value;
       const std::string flag(row.cli), help(row.help);
       CLI::Option* o = nullptr;
-      if constexpr (std::is_same_v<T, std::vector<double>>) {
+      if constexpr (std::is_same_v<T, bool>) {
+        options_.emplace_back(row.cli, sub->add_flag(flag, row.ref(req), help));
+        return;
+      } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+        if (lists == Lists::Comma) {
+          o = sub->add_option(flag, row.ref(req), help)->delimiter(',')->capture_default_str();
+          options_.emplace_back(row.cli, o);
+          return;
+        }
         auto& text = lists_.emplace_back(
             ListOption{fmt::format("{:g}", fmt::join(row.default_value(), ",")), nullptr,
                        [&req, row](const std::string& s) {

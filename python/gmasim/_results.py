@@ -9,6 +9,12 @@ import functools
 
 import numpy as np
 
+from . import _gmasim
+
+# The metrics the summary shows: the rows of the C++ table of Metrics with a label (those the
+# `gmasim simulate` summary prints), in its order (gmasim/simulate/simulate.hpp kMetricRows).
+SUMMARY_METRICS = tuple(row["name"] for row in _gmasim.metric_rows() if row["label"])
+
 
 def _shape(value) -> str:
     if isinstance(value, dict):
@@ -23,7 +29,7 @@ class SimulationResult(dict):
     def __repr__(self) -> str:
         parts = []
         m = self.get("metrics") or {}
-        for key in ("stroke_um", "hysteresis_um", "B_pp_T", "y_mean_um"):
+        for key in SUMMARY_METRICS:
             if key in m:
                 parts.append(f"{key}={m[key]:.4g}")
         if "thermal_expansion_um" in self:

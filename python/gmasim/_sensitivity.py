@@ -2,6 +2,7 @@
 to the model's parameters (the C++ run_sensitivity; docs/experiments.md, "Sensitivity")."""
 from __future__ import annotations
 
+import inspect
 import tomllib
 from typing import Iterable, Sequence
 
@@ -46,12 +47,13 @@ def _parameters(model, params, fit) -> tuple[list[str], list[float]]:
 
 
 def sensitivity(model, params: Sequence | str | None = None, claims: Iterable[str] | None = None,
-                *, fit=None, claims_file: str = "", use_claims: bool = True, metrics: bool = True,
-                step_large: float = 1e-2, step_small: float = 2.5e-3, agreement: float = 0.10,
-                floor_fraction: float = 1e-3, near_null_ratio: float = 1e-3, quick: bool = False,
-                threads: int = 0) -> dict:
+                *, fit=None, claims_file: str = "", metrics: bool = True, **settings) -> dict:
     """Sensitivities S[i, j] of quantity i to parameter j by central differences at two
     relative steps (``step_large``, ``step_small``), on all cores (``threads=0``).
+
+    The settings (keyword arguments ``use_claims``, ``step_large``, ``step_small``,
+    ``agreement``, ``floor_fraction``, ``near_null_ratio``, ``quick``, ``threads``) and their
+    defaults are the C++ table's (SensitivitySettings; the signature shows them).
 
     Parameters
     ----------
@@ -89,9 +91,11 @@ def sensitivity(model, params: Sequence | str | None = None, claims: Iterable[st
         ``evaluations``, ``threads``, ``wall_time_s``
     """
     names, scales = _parameters(model, params, fit)
-    r = _gmasim._sensitivity(model, names, scales, list(claims or []), claims_file, use_claims,
-                             metrics, step_large, step_small, agreement, floor_fraction,
-                             near_null_ratio, quick, threads)
+    unknown = sorted(set(settings) - set(_SETTINGS))
+    if unknown:
+        raise TypeError(f"sensitivity() got an unexpected keyword argument {unknown[0]!r}")
+    r = _gmasim._sensitivity(model, params=names, scales=scales, only=list(claims or []),
+                             claims_file=claims_file, use_metrics=metrics, **settings)
     for k in ("derivative", "derivative_small", "scaled", "scaled_small", "disagreement"):
         r[k] = np.array(r[k], dtype=float).reshape(len(r["quantities"]), len(r["parameters"]))
     r["flags"] = np.array(r["flags"], dtype=str).reshape(r["derivative"].shape)
@@ -105,3 +109,11 @@ def sensitivity(model, params: Sequence | str | None = None, claims: Iterable[st
     ident["near_null"] = np.array(ident["near_null"], dtype=bool)
     ident["weak"] = np.array(ident["weak"], dtype=bool)
     return r
+
+
+# The settings' keyword arguments with their defaults, from the C++ table (one place for both).
+_SETTINGS = _gmasim._sensitivity_defaults()
+_sig = inspect.signature(sensitivity)
+sensitivity.__signature__ = _sig.replace(parameters=[
+    *(p for p in _sig.parameters.values() if p.kind != inspect.Parameter.VAR_KEYWORD),
+    *(inspect.Parameter(k, inspect.Parameter.KEYWORD_ONLY, default=v) for k, v in _SETTINGS.items())])

@@ -119,7 +119,8 @@ void bind_track(py::module_& mod) {
         return report_dict(track_report(m, r, res));
       },
       Extra<std::string>{"feedforward", "none"}, Extra<std::string>{"mismatch", "all"},
-      Extra<std::vector<std::string>>{"controllers", {"pid", "pid_temperature", "pid_inverse"}});
+      Extra<std::vector<std::string>>{
+          "controllers", track_controller_names(FeedforwardEvaluationRequest{}.controllers)});
 }
 
 // compensate(): the drive schedule that restores the stroke, and its tracking.

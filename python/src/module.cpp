@@ -10,9 +10,11 @@
 
 #include "bindings.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments/simulate_fields.hpp"
 #include "gmasim/io/io.hpp"
 #include "gmasim/model/validity.hpp"
 #include "gmasim/simulate/simulate.hpp"
+#include "request_args.hpp"
 
 namespace py = pybind11;
 using namespace gmasim;
@@ -208,27 +210,28 @@ std::shared_ptr<Model> checked_model(Model m) {
   throw py::error_already_set();
 }
 
-py::dict simulate_py(const Model& m, double temperature_C, double current_pp_A, double frequency_Hz,
-                     double periods, double current_min_A, double dt_s, int record_every,
-                     const std::string& kind, py::object waveform, double duration_s,
+// simulate(): the options' keyword arguments and defaults are the Python rows of their table
+// (gmasim/experiments/simulate_fields.hpp), then the arguments below.
+py::dict simulate_py(const Model& m, const SimulateOptions& o, py::object waveform,
                      const std::vector<std::string>& freeze,
-                     const std::vector<std::string>& quantities, bool self_heating,
-                     double thermal_step_s, py::object ambient_C, py::object current_A,
-                     py::object current_dt_s) {
+                     const std::vector<std::string>& quantities, py::object ambient_C,
+                     py::object current_A, py::object current_dt_s) {
+  const double temperature_C = o.temperature_C;
+  const bool self_heating = o.self_heating;
   if (auto w = temperature_warning(m, temperature_C)) warn(*w);
   SimulationSettings s;
   s.energy_ledger = true;
   s.self_heating.enabled = self_heating;
-  s.self_heating.thermal_step_s = thermal_step_s;
+  s.self_heating.thermal_step_s = o.thermal_step_s;
   if (!ambient_C.is_none()) s.self_heating.ambient_C = optional_number(ambient_C, "ambient_C");
   s.temperature_C = temperature_C;
-  s.periods = periods;
-  s.dt_s = dt_s;
-  s.record_every = record_every;
-  s.duration_s = duration_s;
+  s.periods = o.periods;
+  s.dt_s = o.dt_s;
+  s.record_every = o.record_every;
+  s.duration_s = o.duration_s;
   s.freeze = parse_freeze(freeze);
-  s.waveform =
-      drive_of(waveform, current_A, current_dt_s, kind, current_pp_A, frequency_Hz, current_min_A);
+  s.waveform = drive_of(waveform, current_A, current_dt_s, o.kind, o.current_pp_A, o.frequency_Hz,
+                        o.current_min_A);
   Result r;
   {
     py::gil_scoped_release release;
@@ -359,31 +362,47 @@ PYBIND11_MODULE(_gmasim, mod) {
 
   bind_model(mod);
 
-  mod.def("simulate", &simulate_py, py::arg("model"), py::arg("temperature_C") = 20.0,
-          py::arg("current_pp_A") = 8.0, py::arg("frequency_Hz") = 10.0, py::arg("periods") = 3.0,
-          py::arg("current_min_A") = -3.0, py::arg("dt_s") = 0.0, py::arg("record_every") = 1,
-          py::arg("kind") = "sine", py::arg("waveform") = py::none(), py::arg("duration_s") = 0.0,
-          py::arg("freeze") = std::vector<std::string>{},
-          py::arg("quantities") = std::vector<std::string>{}, py::arg("self_heating") = false,
-          py::arg("thermal_step_s") = 0.0, py::arg("ambient_C") = py::none(),
-          py::arg("current_A") = py::none(), py::arg("current_dt_s") = py::none(),
-          "Time-domain run.\n\n"
-          "The coil current is one of:\n"
-          "  * kind='sine' (default): the biased sine of Fig. 11, current_min_A + current_pp_A/2 "
-          "(1 - cos 2 pi f t), run for `periods` periods;\n"
-          "  * kind='dc': a constant current_pp_A for duration_s;\n"
-          "  * current_A=ndarray, current_dt_s=spacing: samples at t = 0, dt, 2 dt, ... [A, s] "
-          "(linear between samples, held after the last; the run lasts to the last sample "
-          "unless duration_s is given);\n"
-          "  * waveform=(t_s, current_A): a pair of equally long 1-D arrays, t_s strictly "
-          "increasing from 0 [s, A].\n\n"
-          "Returns a dict (printed as a short summary): 'series' {column: ndarray}, 'metrics' "
-          "(stroke_um, hysteresis_um, B_pp_T, y_mean_um over the last period or the whole run), "
-          "'quantities' {column: {rms, peak, pp, mean}} (default: current_A, y_um, B_T; or the "
-          "columns named in quantities=), 'thermal_expansion_um' (eq. 21 at the end of the run; "
-          "'thermal_expansion_start_um' at its start), 'energy', dt_s, steps; with "
-          "self_heating=True also 'heating' (one row per thermal step: node temperatures, losses, "
-          "stroke) and the energy balance (energy_in_J = energy_stored_J + energy_out_J)");
+  def_request<SimulateOptions>(
+      mod, "simulate",
+      "Time-domain run.\n\n"
+      "The coil current is one of:\n"
+      "  * kind='sine' (default): the biased sine of Fig. 11, current_min_A + current_pp_A/2 "
+      "(1 - cos 2 pi f t), run for `periods` periods;\n"
+      "  * kind='dc': a constant current_pp_A for duration_s;\n"
+      "  * current_A=ndarray, current_dt_s=spacing: samples at t = 0, dt, 2 dt, ... [A, s] "
+      "(linear between samples, held after the last; the run lasts to the last sample "
+      "unless duration_s is given);\n"
+      "  * waveform=(t_s, current_A): a pair of equally long 1-D arrays, t_s strictly "
+      "increasing from 0 [s, A].\n\n"
+      "Returns a dict (printed as a short summary): 'series' {column: ndarray}, 'metrics' "
+      "(stroke_um, hysteresis_um, B_pp_T, y_mean_um over the last period or the whole run), "
+      "'quantities' {column: {rms, peak, pp, mean}} (default: current_A, y_um, B_T; or the "
+      "columns named in quantities=), 'thermal_expansion_um' (eq. 21 at the end of the run; "
+      "'thermal_expansion_start_um' at its start), 'energy', dt_s, steps; with "
+      "self_heating=True also 'heating' (one row per thermal step: node temperatures, losses, "
+      "stroke) and the energy balance (energy_in_J = energy_stored_J + energy_out_J)",
+      &simulate_py, Extra<py::object>{"waveform", py::none()},
+      Extra<std::vector<std::string>>{"freeze", {}},
+      Extra<std::vector<std::string>>{"quantities", {}}, Extra<py::object>{"ambient_C", py::none()},
+      Extra<py::object>{"current_A", py::none()}, Extra<py::object>{"current_dt_s", py::none()});
+  // The table of Metrics (gmasim/simulate/simulate.hpp kMetricRows): the keys of simulate()'s
+  // "metrics" dict in order; gmasim's SimulationResult prints those with a label.
+  mod.def(
+      "metric_rows",
+      [] {
+        py::list rows;
+        for (const MetricRow& row : kMetricRows) {
+          py::dict d;
+          d["name"] = std::string(row.name);
+          d["unit"] = std::string(row.unit);
+          d["label"] = std::string(row.label);
+          d["precision"] = row.precision;
+          rows.append(d);
+        }
+        return rows;
+      },
+      "The table of simulate()'s metrics: [{name, unit, label, precision}] in the dict's order; "
+      "label: the CLI summary's ('' : not printed there)");
   // The names freeze=[...] takes (simulate, Stepper, sweep), from the C++ table.
   py::list laws;
   for (const auto& sw : gmasim::kFreezeSwitches) laws.append(sw.name);

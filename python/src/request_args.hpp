@@ -84,4 +84,15 @@ void def_request(pybind11::module_& mod, const char* name, const char* doc, Run 
       extras...);
 }
 
+// {name: default} of the request's Python rows, in the table's order (for a Python wrapper that
+// passes them on: its signature and docstring).
+template <class R>
+pybind11::dict request_defaults() {
+  pybind11::dict d;
+  fields::for_each_field<R>([&](const auto& row) {
+    if (row.in_python()) d[pybind11::str(row.name.data(), row.name.size())] = row.default_value();
+  });
+  return d;
+}
+
 }  // namespace gmasim::py_bind

@@ -7,6 +7,8 @@
 #include "bindings.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/claims.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
+#include "request_args.hpp"
 
 namespace py = pybind11;
 
@@ -106,8 +108,8 @@ py::dict result_dict(const SensitivityResult& r) {
   d["disagreement"] = matrix(dis);
   d["flags"] = flags;
   d["identifiability"] = identifiability_dict(r);
-  d["step_large"] = r.step_large;
-  d["step_small"] = r.step_small;
+  d["step_large"] = r.settings.step_large;
+  d["step_small"] = r.settings.step_small;
   d["evaluations"] = r.evaluations;
   d["threads"] = r.threads;
   d["wall_time_s"] = r.wall_time_s;
@@ -117,29 +119,23 @@ py::dict result_dict(const SensitivityResult& r) {
 }  // namespace
 
 void bind_sensitivity(py::module_& mod) {
-  mod.def(
-      "_sensitivity",
-      [](const Model& m, const std::vector<std::string>& params, const std::vector<double>& scales,
-         const std::vector<std::string>& only, const std::string& claims_file, bool use_claims,
-         bool use_metrics, double step_large, double step_small, double agreement,
-         double floor_fraction, double near_null_ratio, bool quick, int threads) {
+  // The settings' keyword arguments and defaults are the Python rows of their table
+  // (gmasim/experiments/experiment_fields.hpp); gmasim.sensitivity() passes them on.
+  def_request<SensitivitySettings>(
+      mod, "_sensitivity", "run_sensitivity; use gmasim.sensitivity()",
+      [](const Model& m, const SensitivitySettings& settings,
+         const std::vector<std::string>& params, const std::vector<double>& scales,
+         const std::vector<std::string>& only, const std::string& claims_file, bool use_metrics) {
         SensitivityRequest r;
+        static_cast<SensitivitySettings&>(r) = settings;
         if (params.size() != scales.size())
           throw InputError("sensitivity: params and scales differ in length");
         for (std::size_t k = 0; k < params.size(); ++k)
           r.parameters.push_back({params[k], scales[k]});
         ClaimsData claims = claims_file.empty() ? builtin_claims() : load_claims(claims_file);
         r.claims = &claims;
-        r.use_claims = use_claims;
         if (!use_metrics) r.metrics.clear();
         r.only = only;
-        r.step_large = step_large;
-        r.step_small = step_small;
-        r.agreement = agreement;
-        r.floor_fraction = floor_fraction;
-        r.near_null_ratio = near_null_ratio;
-        r.quick = quick;
-        r.threads = threads;
         SensitivityResult res;
         {
           py::gil_scoped_release release;
@@ -147,11 +143,11 @@ void bind_sensitivity(py::module_& mod) {
         }
         return result_dict(res);
       },
-      py::arg("model"), py::arg("params"), py::arg("scales"), py::arg("only"),
-      py::arg("claims_file"), py::arg("use_claims"), py::arg("use_metrics"), py::arg("step_large"),
-      py::arg("step_small"), py::arg("agreement"), py::arg("floor_fraction"),
-      py::arg("near_null_ratio"), py::arg("quick"), py::arg("threads"),
-      "run_sensitivity; use gmasim.sensitivity()");
+      Extra<std::vector<std::string>>{"params", {}}, Extra<std::vector<double>>{"scales", {}},
+      Extra<std::vector<std::string>>{"only", {}}, Extra<std::string>{"claims_file", ""},
+      Extra<bool>{"use_metrics", true});
+  mod.def("_sensitivity_defaults", &request_defaults<SensitivitySettings>,
+          "The settings of sensitivity() and their defaults, from the C++ table");
   mod.def(
       "_model_parameters",
       [](const Model& m) {

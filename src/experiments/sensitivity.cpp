@@ -14,6 +14,7 @@
 #include "experiments/claim_plan.hpp"
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/model/validate.hpp"
 
 namespace gmasim {
@@ -39,6 +40,7 @@ void check_request(const SensitivityRequest& r) {
     throw InputError(fmt::format("floor_fraction {}: must be in [0, 1)", r.floor_fraction));
   fraction(r.near_null_ratio, "near_null_ratio", 0.0, 1.0);
   if (r.threads < 0) throw InputError(fmt::format("threads {}: must be >= 0", r.threads));
+  fields::check_request_fields<SensitivitySettings>(r);  // every row's rule, after these
   if (r.parameters.empty()) throw InputError("sensitivity: no parameter given");
   if (static_cast<double>(r.parameters.size()) > kMaxListValues)
     throw InputError(fmt::format("sensitivity: {} parameters: too many (limit {:g})",
@@ -374,11 +376,7 @@ SensitivityResult run_sensitivity(const Model& m, const SensitivityRequest& r,
   for (std::size_t i = 0; i < res.quantities.size(); ++i)
     for (std::size_t j = 0; j < res.parameters.size(); ++j)
       res.entries[i].push_back(entry(r, res.parameters[j], res.quantities[i], ev, v, i, j));
-  res.step_large = r.step_large;
-  res.step_small = r.step_small;
-  res.agreement = r.agreement;
-  res.floor_fraction = r.floor_fraction;
-  res.quick = r.quick;
+  res.settings = r;
   res.evaluations = static_cast<long>(ev.models.size());
   res.runs = static_cast<long>(tasks.size());
   res.identifiability = identify_from(r, res);

@@ -13,9 +13,11 @@
 #include <utility>
 
 #include "experiments/parallel.hpp"
+#include "experiments/request_meta.hpp"
 #include "experiments/track_loop.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/compensate.hpp"
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/feedforward.hpp"
 #include "gmasim/model/validate.hpp"
 
@@ -75,6 +77,7 @@ std::vector<FeedforwardRatio> ratios(const FeedforwardEvaluationRequest& r,
 
 void check_evaluation(const FeedforwardEvaluationRequest& r) {
   detail::check_track_request(r.track);
+  fields::check_request_fields(r);
   if (r.mismatches.empty())
     throw InputError("feed-forward evaluation: no plant mismatch given: give at least one");
   if (r.controllers.empty())
@@ -95,6 +98,12 @@ const char* track_controller_name(TrackController c) {
   for (const auto& [mode, name] : kControllerNames)
     if (mode == c) return name;
   return "?";
+}
+
+std::vector<std::string> track_controller_names(const std::vector<TrackController>& cs) {
+  std::vector<std::string> out;
+  for (TrackController c : cs) out.emplace_back(track_controller_name(c));
+  return out;
 }
 
 TrackController parse_track_controller(const std::string& name) {
@@ -221,17 +230,7 @@ Report feedforward_report(const Model& m, const FeedforwardEvaluationRequest& re
   r.meta.emplace_back("model", m.spec.source);
   r.meta.emplace_back("feedforward", "inverse");
   const TrackRequest& t = req.track;
-  r.meta.emplace_back("kp_A_per_um", t.gains.kp);
-  r.meta.emplace_back("ki_A_per_um_per_sample_at_reference_rate", t.gains.ki);
-  r.meta.emplace_back("kd_A_per_um_per_sample_at_reference_rate", t.gains.kd);
-  r.meta.emplace_back("sample_rate_Hz", t.sample_rate_Hz);
-  r.meta.emplace_back("bias_A", t.bias_A);
-  r.meta.emplace_back("current_limit_A", t.current_limit_A);
-  r.meta.emplace_back("amplifier_A_per_unit", t.amplifier_A_per_unit);
-  r.meta.emplace_back("periods", t.periods);
-  r.meta.emplace_back("inverse_band_Hz", t.inverse.band_Hz);
-  r.meta.emplace_back("inverse_dynamic", t.inverse.dynamic);
-  r.meta.emplace_back("schedule_frequency_Hz", req.schedule_frequency_Hz);
+  fields::add_request_meta(r, req);  // its table (gmasim/experiments/experiment_fields.hpp)
   r.meta.emplace_back("mismatch",
                       "the plant: M_s, k (every rod), lambda_s times (1 +- 0.1); its temperature "
                       "the loop's +- 10 degC; the feed-forward's model at the loop's temperature");

@@ -7,6 +7,7 @@
 
 #include "gmasim/errors.hpp"
 #include "gmasim/identify/identify.hpp"
+#include "gmasim/identify/synthetic_fields.hpp"
 #include "gmasim/model/validate.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "identify/record_run.hpp"
@@ -45,6 +46,7 @@ void check_request(const SyntheticRequest& r) {
                           static_cast<double>(r.currents_pp_A.size()) *
                           static_cast<double>(r.frequencies_Hz.size()),
                       kMaxListValues, "synthetic records");
+  fields::check_request_fields(r);  // every row's rule (gmasim/identify/synthetic_fields.hpp)
 }
 
 // Gaussian noise from splitmix64 and Box-Muller: the same numbers on every platform.

@@ -3,7 +3,10 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <string_view>
+#include <type_traits>
 
+#include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/sensitivity.hpp"
 #include "gmasim/io/io.hpp"
 #include "io/json.hpp"
@@ -34,14 +37,33 @@ std::string derivative_unit(const QuantityInfo& q, const ParameterInfo& p) {
   return fmt::format("{}/({})", q.unit, p.unit);
 }
 
+// The Meta rows of the settings' table (gmasim/experiments/experiment_fields.hpp), in its order;
+// a dotted key ("steps.large") is a member of an inline object ("steps").
+void write_request_settings(JsonWriter& w, const SensitivitySettings& s) {
+  std::string_view group;
+  fields::for_each_field<SensitivitySettings>([&](const auto& row) {
+    if (!row.in_meta()) return;
+    const std::string_view key = row.meta_name();
+    const std::size_t dot = key.find('.');
+    const std::string_view g =
+        dot == std::string_view::npos ? std::string_view{} : key.substr(0, dot);
+    if (g != group) {
+      if (!group.empty()) w.end_object();
+      if (!g.empty()) w.key(g).begin_object(JsonLayout::Inline);
+      group = g;
+    }
+    w.key(g.empty() ? key : key.substr(dot + 1));
+    if constexpr (std::is_same_v<std::remove_cvref_t<decltype(row.get(s))>, bool>)
+      w.boolean(row.get(s));
+    else
+      w.number(static_cast<double>(row.get(s)));
+  });
+  if (!group.empty()) w.end_object();
+}
+
 void write_settings(JsonWriter& w, const SensitivityResult& r, const std::string& model) {
   w.key("model").string(model);
-  w.key("steps").begin_object(JsonLayout::Inline);
-  w.key("large").number(r.step_large).key("small").number(r.step_small);
-  w.end_object();
-  w.key("agreement").number(r.agreement);
-  w.key("floor_fraction").number(r.floor_fraction);
-  w.key("quick").boolean(r.quick);
+  write_request_settings(w, r.settings);
   w.key("evaluations").integer(r.evaluations);
   w.key("work_items").integer(r.runs);
   w.key("threads").integer(r.threads);

@@ -8,7 +8,9 @@
 
 #include "gmasim/experiments/compensate.hpp"
 #include "gmasim/experiments/experiments.hpp"
+#include "gmasim/experiments/feedforward.hpp"
 #include "gmasim/experiments/request_table.hpp"
+#include "gmasim/experiments/sensitivity.hpp"
 #include "gmasim/model/validate.hpp"
 
 namespace gmasim::fields {
@@ -220,6 +222,60 @@ struct RequestFields<CompensateRequest> {
                "Stroke tolerance of the solved drive [um]", All, GMASIM_REF(R, tolerance_um)),
       field<R>("dt_s", "s", nonnegative(), "--dt", "Time step [s]; 0 = automatic rule", Cli,
                GMASIM_REF(R, dt_s)),
+      threads_row<R>(kCliPy),
+  };
+};
+
+// The feed-forward evaluation (track --feedforward inverse): its grid, gains and drive are the
+// track request's (the CLI's and Python's options are the track table's); the report records
+// these of its rows. The plants and controllers are track's own options (words).
+template <>
+struct RequestFields<FeedforwardEvaluationRequest> {
+  using R = FeedforwardEvaluationRequest;
+  using T = TrackRequest;
+  static constexpr std::string_view experiment = "track --feedforward";
+  static constexpr auto rows = std::tuple{
+      GMASIM_NESTED(R, track, T, "kp", Meta),
+      GMASIM_NESTED(R, track, T, "ki", Meta),
+      GMASIM_NESTED(R, track, T, "kd", Meta),
+      GMASIM_NESTED(R, track, T, "sample_rate_Hz", Meta),
+      GMASIM_NESTED(R, track, T, "bias_A", Meta),
+      GMASIM_NESTED(R, track, T, "current_limit_A", Meta),
+      GMASIM_NESTED(R, track, T, "amplifier_A_per_unit", Meta),
+      GMASIM_NESTED(R, track, T, "periods", Meta),
+      GMASIM_NESTED(R, track, T, "feedforward_band_Hz", Meta, "inverse_band_Hz"),
+      field<R>("inverse_dynamic", "-", any(), "", "", Meta, GMASIM_REF(R, track.inverse.dynamic)),
+      field<R>("schedule_frequency_Hz", "Hz", in(0.0, kMaxFrequency_Hz), "", "", Meta,
+               GMASIM_REF(R, schedule_frequency_Hz)),
+  };
+};
+
+// The sensitivity's settings (the rest of SensitivityRequest, parameters and quantities, are the
+// command's own options and Python's own arguments). The CLI keeps its own checks and messages
+// (apps/gmasim/cmd_sensitivity.cpp), run_sensitivity its own; the rules here are no stricter.
+// The Meta rows are sensitivity.json's settings; a dotted key is a member of an inline object.
+template <>
+struct RequestFields<SensitivitySettings> {
+  using R = SensitivitySettings;
+  static constexpr std::string_view experiment = "sensitivity";
+  static constexpr auto rows = std::tuple{
+      field<R>("step_large", "-", in(0.0, 0.5), "--step-large", "The larger relative step h [-]",
+               All, GMASIM_REF(R, step_large), "steps.large"),
+      field<R>("step_small", "-", in(0.0, 0.5), "--step-small", "The smaller relative step h [-]",
+               All, GMASIM_REF(R, step_small), "steps.small"),
+      field<R>("agreement", "-", in(0.0, 1.0), "--agreement",
+               "Flag an entry whose two estimates differ by more than this fraction [-]", All,
+               GMASIM_REF(R, agreement)),
+      field<R>("floor_fraction", "-", in(0.0, 1.0), "--floor",
+               "Derivatives below this fraction of the quantity's tolerance count as zero [-]", All,
+               GMASIM_REF(R, floor_fraction)),
+      field<R>("near_null_ratio", "-", in(0.0, 1.0), "--near-null",
+               "A singular direction below this fraction of the largest is near-null [-]", kCliPy,
+               GMASIM_REF(R, near_null_ratio)),
+      field<R>("quick", "-", any(), "--quick",
+               "Score the claims on the quick study's grids (reproduce --quick)", All,
+               GMASIM_REF(R, quick)),
+      field<R>("use_claims", "-", any(), "", "", Python, GMASIM_REF(R, use_claims)),
       threads_row<R>(kCliPy),
   };
 };

@@ -93,6 +93,8 @@ enum class TrackController { Pid, PidTemperature, PidInverse };
 // "pid", "pid_temperature", "pid_inverse"; parse_track_controller throws InputError naming them.
 const char* track_controller_name(TrackController c);
 TrackController parse_track_controller(const std::string& name);
+// Their names, in order (the CLI's and Python's default: FeedforwardEvaluationRequest{}'s).
+std::vector<std::string> track_controller_names(const std::vector<TrackController>& cs);
 
 // A plant that differs from the model: M_s (material.Ms_A_per_m), the JA pinning k of every
 // rod (rodN.ja.k0_A_per_m) and lambda_s (material.lambda_s) scaled, and the plant at the loop's

@@ -81,6 +81,36 @@ void for_each_field(F&& f) {
   std::apply([&](const auto&... row) { (f(row), ...); }, RequestFields<R>::rows);
 }
 
+// The index of the row named `name` in R's table (a compile error when there is none).
+template <class R>
+constexpr std::size_t row_index(std::string_view name) {
+  std::size_t found = std::tuple_size_v<Rows<R>>, i = 0;
+  std::apply([&](const auto&... row) { ((found = row.name == name ? i : found, ++i), ...); },
+             RequestFields<R>::rows);
+  if (found == std::tuple_size_v<Rows<R>>) throw "no such row";  // not constant: a compile error
+  return found;
+}
+
+// Row I of the table of S (GMASIM_NESTED: the row by name) as a row of R, which holds its S at
+// member `Inner` (a request made of another's fields: name, unit, rule, option and help are the
+// inner row's, spelled once), shown in `where` under `meta_key` ("": the inner row's key).
+template <class R, auto Inner, class S, std::size_t I>
+constexpr auto nested_row(unsigned where, std::string_view meta_key = {}) {
+  const auto& row = std::get<I>(RequestFields<S>::rows);
+  using T = typename std::remove_cvref_t<decltype(row)>::Value;
+  constexpr auto ref = [](R& r) -> T& { return std::get<I>(RequestFields<S>::rows).ref(r.*Inner); };
+  return Field<R, T>{row.name,
+                     row.unit,
+                     row.rule,
+                     row.cli,
+                     row.help,
+                     where,
+                     meta_key.empty() ? row.meta_name() : meta_key,
+                     +ref};
+}
+#define GMASIM_NESTED(R, member, S, name, ...) \
+  ::gmasim::fields::nested_row<R, &R::member, S, ::gmasim::fields::row_index<S>(name)>(__VA_ARGS__)
+
 // The value's rule: throws InputError "<name> (<cli>) = <v> <unit>: <rule>".
 void check_rule(double v, const Rule& rule, std::string_view name, std::string_view cli,
                 std::string_view unit);

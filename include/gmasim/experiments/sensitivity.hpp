@@ -80,17 +80,10 @@ struct SensitivityParameter {
   double scale = 0.0;  // Absolute steps: s [the parameter's unit]; 0: |p| (an error if p = 0)
 };
 
-struct SensitivityRequest {
-  std::vector<SensitivityParameter> parameters;
-  // Claims: of `claims` (nullptr: the built-in data/claims.toml); the not-applicable ones are
-  // never quantities. With use_claims false, none.
-  const ClaimsData* claims = nullptr;
-  bool use_claims = true;
-  std::vector<MetricQuantity> metrics = builtin_metric_quantities();
-  std::vector<FunctionQuantity> functions;
-  // Keep only the quantities with these names (claim ids, metric or function names); empty:
-  // all. An unknown name is an InputError.
-  std::vector<std::string> only;
+// The numeric settings of a run: the rows of its request table
+// (gmasim/experiments/experiment_fields.hpp), from which the CLI options, the Python keyword
+// arguments and sensitivity.json's settings are generated. The defaults are typed here only.
+struct SensitivitySettings {
   // The two relative steps h (docs/experiments.md, "Sensitivity": the rule and why these).
   double step_large = 1e-2, step_small = 2.5e-3;
   // An entry is flagged when its two estimates differ by more than `agreement` x the larger
@@ -102,7 +95,20 @@ struct SensitivityRequest {
   // own points run either way, and the quick grids hold every built-in claim's point, so for
   // the built-in claims this changes neither the numbers nor the cost.
   bool quick = false;
+  // Claims: of `claims` (nullptr: the built-in data/claims.toml); the not-applicable ones are
+  // never quantities. With use_claims false, none.
+  bool use_claims = true;
   int threads = 0;  // 0: all hardware threads
+};
+
+struct SensitivityRequest : SensitivitySettings {
+  std::vector<SensitivityParameter> parameters;
+  const ClaimsData* claims = nullptr;  // see use_claims
+  std::vector<MetricQuantity> metrics = builtin_metric_quantities();
+  std::vector<FunctionQuantity> functions;
+  // Keep only the quantities with these names (claim ids, metric or function names); empty:
+  // all. An unknown name is an InputError.
+  std::vector<std::string> only;
 };
 
 // "All numeric parameters of the model that a user would vary": every number of the spec,
@@ -186,10 +192,9 @@ struct SensitivityResult {
   // entries[i][j]: quantity i, parameter j
   std::vector<std::vector<SensitivityEntry>> entries;
   Identifiability identifiability;
-  double step_large = 0, step_small = 0, agreement = 0, floor_fraction = 0;
-  bool quick = false;
-  long evaluations = 0;  // models evaluated: 1 + 4 per parameter
-  long runs = 0;         // work items run: experiment parts (a sweep, the FRF, ...) x models
+  SensitivitySettings settings;  // the request's (threads: as asked; the count used below)
+  long evaluations = 0;          // models evaluated: 1 + 4 per parameter
+  long runs = 0;  // work items run: experiment parts (a sweep, the FRF, ...) x models
   int threads = 0;
   double wall_time_s = 0;
   int flagged() const;  // entries not Ok
