@@ -122,14 +122,28 @@ HWY_INLINE void store_fails(const Chunk<D>& c, const Fails<D>& f) {
   hn::StoreU(f.bound, c.d, c.L.glob(kFailBound) + c.j);
 }
 
+// The rods' state of lanes [j, j + Lanes(d)), loaded field by field.
+template <class D>
+HWY_INLINE RodStates<D> load_rods(const Chunk<D>& c) {
+  RodStates<D> s;
+  for (int f = 0; f < kRodStateCount; ++f)
+    for (int i = 0; i < c.n; ++i) s.f[f][i] = c.rod(f, i);
+  return s;
+}
+
+// Stores the rods' state back where `keep` holds (a lane that failed keeps its old state).
+template <class D>
+HWY_INLINE void store_rods(const Chunk<D>& c, const RodStates<D>& s, Mk<D> keep) {
+  for (int f = 0; f < kRodStateCount; ++f)
+    for (int i = 0; i < c.n; ++i) hn::BlendedStore(s.f[f][i], keep, c.d, c.L.rod(f, i) + c.j);
+}
+
 // One step of lanes [j, j + Lanes(d)): load, the stages, store where the lane is still alive
 // (a lane that fails keeps its state before the step, as simulate() records it).
 template <class D>
 HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in) {
   const Chunk<D> c{d, L, j, L.st.rods};
-  RodStates<D> s;
-  for (int f = 0; f < kRodStateCount; ++f)
-    for (int i = 0; i < c.n; ++i) s.f[f][i] = c.rod(f, i);
+  RodStates<D> s = load_rods(c);
   V<D> g[kGlobalStateCount];
   for (int f = 0; f < kGlobalStateCount; ++f) g[f] = c.glob(f);
   Fails<D> fails = load_fails(c);
@@ -149,8 +163,7 @@ HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
   g[kCurrent] = I;
   run_loop_checks(c, s, g, g[kT], fails);
   const Mk<D> keep = hn::AndNot(fails.failed, alive);  // alive and not failed now
-  for (int f = 0; f < kRodStateCount; ++f)
-    for (int i = 0; i < c.n; ++i) hn::BlendedStore(s.f[f][i], keep, d, L.rod(f, i) + j);
+  store_rods(c, s, keep);
   for (int f = 0; f < kGlobalStateCount; ++f) hn::BlendedStore(g[f], keep, d, L.glob(f) + j);
   store_fails(c, fails);
 }
@@ -161,9 +174,7 @@ HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
 template <class D>
 HWY_INLINE void ramp_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in) {
   const Chunk<D> c{d, L, j, L.st.rods};
-  RodStates<D> s;
-  for (int f = 0; f < kRodStateCount; ++f)
-    for (int i = 0; i < c.n; ++i) s.f[f][i] = c.rod(f, i);
+  RodStates<D> s = load_rods(c);
   Fails<D> fails = load_fails(c);
   const Mk<D> alive = hn::Not(fails.failed);
   const V<D> I = hn::LoadU(d, in.current_A + j), pm = hn::LoadU(d, in.pm_scale + j);
@@ -172,8 +183,7 @@ HWY_INLINE void ramp_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
   newton_fields<JilesAthertonLanes>(c, s, I, pm, one, t, true, mg, fails);
   commit_fields<JilesAthertonLanes>(c, s, one, true, mg);
   const Mk<D> keep = hn::AndNot(fails.failed, alive);
-  for (int f = 0; f < kRodStateCount; ++f)
-    for (int i = 0; i < c.n; ++i) hn::BlendedStore(s.f[f][i], keep, d, L.rod(f, i) + j);
+  store_rods(c, s, keep);
   store_fails(c, fails);
 }
 
