@@ -176,6 +176,8 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
       const auto t = Law::joint_trial(d, ja_constants(c, i), s.f[kH][i], s.f[kMirr][i], s.f[kM][i],
                                       start[i], mg.H[i], mg.Mg[i]);
       auto& tr = mg.trial[i];
+      if (!hn::AllFalse(d, t.solved))
+        c.L.full_solves += hn::CountTrue(d, hn::AndNot(done, t.solved));
       take_trial(done, t, tr);
       mg.Bs[i] = hn::Mul(C(d, kMu0), hn::Add(mg.H[i], tr.M_next));
       inv_mud[i] = hn::Mul(tr.inv_mu_r, C(d, 1.0 / kMu0));
