@@ -127,6 +127,7 @@ HWY_INLINE V<D> ja_irreversible_update(D d, V<D> Mirr0, V<D> Man0, V<D> Man1, V<
 template <class D>
 struct JaLaneConstants {
   V<D> MsT, a, alpha, c, k;
+  V<D> inv_a;  // 1/a, once per step (the scalar law's 1.0 / a_A_per_m)
 };
 
 // What a move depends on at its start only (jiles_atherton.hpp, ja_move_start): H_e0 and
@@ -139,7 +140,7 @@ template <class D>
 HWY_INLINE JaLaneStart<D> ja_move_start(D d, V<D> H0, V<D> M0, const JaLaneConstants<D>& p) {
   const V<D> He0 = hn::Add(H0, hn::Mul(p.alpha, M0));
   V<D> L, dL;
-  langevin_pair(d, hn::Mul(He0, hn::Div(C(d, 1.0), p.a)), L, dL);
+  langevin_pair(d, hn::Mul(He0, p.inv_a), L, dL);
   return {He0, hn::Mul(p.MsT, L)};
 }
 
@@ -215,7 +216,7 @@ struct JilesAthertonLanes {
   static Trial<D> joint_trial(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> Mirr0, V<D> M0,
                               const Start<D>& st, V<D> H1, V<D> M_iter) {
     Trial<D> t;
-    const V<D> inv_a = hn::Div(C(d, 1.0), p.a);
+    const V<D> inv_a = p.inv_a;
     const Mk<D> same = hn::Eq(H1, H0);  // ja_step_from's H1 == H0: nothing moves
     V<D> chi_same = hn::Zero(d);
     if (!hn::AllFalse(d, same)) {
