@@ -118,9 +118,11 @@ HWY_INLINE JaLaneConstants<D> ja_constants(const Chunk<D>& c, int i) {
           hn::Div(C(c.d, 1.0), a)};
 }
 
-// A lane that has stopped keeps the trial of the iterate it stopped at; the others take t.
-template <class M, class T>
-HWY_INLINE void take_trial(M done, const T& t, T& tr) {
+// A lane that has stopped keeps the trial of the iterate it stopped at; the others take t
+// (and count its full solves of the law, LaneData::full_solves).
+template <class D, class M, class T>
+HWY_INLINE void take_trial(D d, M done, const T& t, T& tr, std::size_t& full_solves) {
+  if (!hn::AllFalse(d, t.solved)) full_solves += hn::CountTrue(d, hn::AndNot(done, t.solved));
   tr.M = hn::IfThenElse(done, tr.M, t.M);
   tr.dM_dH = hn::IfThenElse(done, tr.dM_dH, t.dM_dH);
   tr.Mirr = hn::IfThenElse(done, tr.Mirr, t.Mirr);
@@ -181,9 +183,7 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
       const auto t = Law::joint_trial(d, ja[i], s.f[kH][i], s.f[kMirr][i], s.f[kM][i], start[i],
                                       mg.H[i], mg.Mg[i]);
       auto& tr = mg.trial[i];
-      if (!hn::AllFalse(d, t.solved))
-        c.L.full_solves += hn::CountTrue(d, hn::AndNot(done, t.solved));
-      take_trial(done, t, tr);
+      take_trial(d, done, t, tr, c.L.full_solves);
       mg.Bs[i] = hn::Mul(C(d, kMu0), hn::Add(mg.H[i], tr.M_next));
       inv_mud[i] = hn::Mul(tr.inv_mu_r, C(d, 1.0 / kMu0));
       R[i] = hn::Add(hn::Mul(l_A[i], hn::Add(inv_mud[i], g[i])), c.rod(kRs, i));
