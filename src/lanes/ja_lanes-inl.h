@@ -169,11 +169,12 @@ HWY_INLINE JaLaneEvaluation<D> ja_evaluate(D d, const JaLaneStart<D>& st, V<D> H
 // Eq. (9) solved at H1 by Newton's method in the lanes of `todo` (jiles_atherton.hpp,
 // ja_step_from for H1 != H0): from M_guess, steps -g / max(1 - alpha chi_e, 0.2), each lane
 // stopping where |g| <= 1e-12 M_s^T or at the 60th evaluation with that evaluation's M_irr1,
-// M and chi_e. The lanes outside todo keep e's values.
+// M and chi_e. The lanes outside todo keep e's values. Out of line: the rare path, so that
+// joint_trial's common one inlines into the Newton loop.
 template <class D>
-HWY_INLINE void ja_solve(D d, Mk<D> todo, const JaLaneStart<D>& st, V<D> H1, V<D> M_guess,
-                         const JaLaneConstants<D>& p, V<D> Mirr0, V<D> inv_a,
-                         JaLaneEvaluation<D>& e) {
+HWY_NOINLINE void ja_solve(D d, Mk<D> todo, const JaLaneStart<D>& st, V<D> H1, V<D> M_guess,
+                           const JaLaneConstants<D>& p, V<D> Mirr0, V<D> inv_a,
+                           JaLaneEvaluation<D>& e) {
   const V<D> tol = hn::Mul(C(d, 1e-12), p.MsT);
   V<D> M1 = M_guess;
   Mk<D> left = todo;
@@ -213,8 +214,8 @@ struct JilesAthertonLanes {
     return ja_move_start(d, H0, M0, p);
   }
   template <class D>
-  static Trial<D> joint_trial(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> Mirr0, V<D> M0,
-                              const Start<D>& st, V<D> H1, V<D> M_iter) {
+  static HWY_INLINE Trial<D> joint_trial(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> Mirr0,
+                                         V<D> M0, const Start<D>& st, V<D> H1, V<D> M_iter) {
     Trial<D> t;
     const V<D> inv_a = p.inv_a;
     const Mk<D> same = hn::Eq(H1, H0);  // ja_step_from's H1 == H0: nothing moves
