@@ -375,7 +375,7 @@ TEST(Lanes, RecordIsTheUnpackedStatesRow) {
 }
 
 // make_states: make_state's ramp in lanes. Each lane's rest state equals the width-1
-// instance's bit for bit, and make_state's to the lanes' rounding: observed 6.1e-14 relative
+// instance's bit for bit, and make_state's to the lanes' rounding: observed 5.4e-14 relative
 // over y, B and every rod's H, M and x, with the lanes mirroring the scalar law's safeguard
 // (eq. 9 solved fully where the joint step's residual exceeds 1e-5 M_s; 4.2e-10 without it);
 // tolerance 6e-13. The ramp's increment allocates nothing.
