@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "experiments/lane_runs.hpp"
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/experiment_fields.hpp"
@@ -102,25 +103,25 @@ AblateResult run_ablate(const Model& m, const AblateRequest& r) {
   const auto laws = ablation_laws();
   const std::size_t per_f = laws.size() + 1;  // the full model, then each law
   const std::size_t n = r.frequencies_Hz.size() * per_f;
+  std::vector<SimulationSettings> settings(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t fi = i / per_f, li = i % per_f;
+    SimulationSettings& s = settings[i];
+    s.temperature_C = r.temperature_C;
+    s.waveform = biased_sine(r.current_pp_A, r.frequencies_Hz[fi], r.current_min_A);
+    s.periods = r.periods;
+    if (li > 0) s.freeze = laws[li - 1].freeze;
+  }
   std::vector<Run> runs(n);
-  detail::parallel_for(n, resolve_thread_count(r.threads, n),
-                       [&](std::size_t i) {
-                         const std::size_t fi = i / per_f, li = i % per_f;
-                         SimulationSettings s;
-                         s.temperature_C = r.temperature_C;
-                         s.waveform =
-                             biased_sine(r.current_pp_A, r.frequencies_Hz[fi], r.current_min_A);
-                         s.periods = r.periods;
-                         if (li > 0) s.freeze = laws[li - 1].freeze;
-                         Result out = simulate(m, s);
-                         Run& run = runs[i];
-                         run.diverged = out.diverged;
-                         run.error = out.error;
-                         run.metrics = out.metrics;
-                         run.t = out.series.column("t_s");
-                         run.y = out.series.column("y_um");
-                       },
-                       {});
+  detail::simulate_settings(m, settings, resolve_thread_count(r.threads, n), r.lanes, false,
+                            [&](std::size_t i, Result&& out) {
+                              Run& run = runs[i];
+                              run.diverged = out.diverged;
+                              run.error = out.error;
+                              run.metrics = out.metrics;
+                              run.t = out.series.column("t_s");
+                              run.y = out.series.column("y_um");
+                            });
 
   AblateResult res;
   for (std::size_t fi = 0; fi < r.frequencies_Hz.size(); ++fi) {

@@ -243,6 +243,15 @@ PartResults empty_results(const ClaimPlan& p) {
   return r;
 }
 
+ClaimPlan with_lanes(ClaimPlan p, bool lanes) {
+  for (auto* v : {&p.sweeps_10Hz, &p.sweeps_dynamic})
+    for (SweepRequest& s : *v) s.lanes = lanes;
+  p.ablate_request.lanes = lanes;
+  p.params_request.lanes = lanes;
+  p.lanes = lanes;
+  return p;
+}
+
 std::string unit_name(const Unit& u) {
   switch (u.kind) {
     case UnitKind::Full:
@@ -292,6 +301,7 @@ void run_unit_body(const ClaimPlan& p, const Unit& u, const Model& m, PartResult
       ReproduceOptions o;
       o.threads = 1;
       o.quick = p.quick;
+      o.lanes = p.lanes;
       o.claims = &p.claims;
       out.full_claims = run_reproduce(m, o).claims;
       break;

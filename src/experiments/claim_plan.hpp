@@ -48,6 +48,7 @@ struct ClaimPlan {
   ClaimsData claims;   // the claims to score (not-applicable ones included: scored n/a)
   StudyRequests grid;  // the full study's requests (the extractors check conditions on them)
   bool full = false;   // a kind the planner does not know: run the whole study
+  bool lanes = true;   // the grids' runs in SIMD lanes (with_lanes)
   std::vector<SweepRequest> sweeps_10Hz, sweeps_dynamic;  // one per (current, frequency)
   bool frf = false, track = false, ablate = false, params = false;
   FrfRequest frf_request;
@@ -65,6 +66,9 @@ struct ClaimPlan {
 // The plan for `claims` (every one of them is scored), `metrics` and `functions`.
 ClaimPlan plan_claims(const ClaimsData& claims, bool quick, std::vector<MetricQuantity> metrics,
                       std::vector<FunctionQuantity> functions);
+// The plan with its grids' runs in SIMD lanes (where the model allows) or not: the sweeps',
+// the ablation's and the 20-150 degC runs' `lanes`.
+ClaimPlan with_lanes(ClaimPlan p, bool lanes);
 
 struct PartResults {
   std::vector<SweepResult> sweeps_10Hz, sweeps_dynamic;

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <utility>
 
+#include "experiments/lockstep.hpp"
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/experiment_fields.hpp"
@@ -52,14 +53,15 @@ struct Run {
   std::string error;
 };
 
-Run run_drive(const Model& m, const CompensateRequest& r, double T, double x) {
+// The run of drive x at temperature T (run: simulate(), or a lane of the lock-step batch).
+Run run_drive(const detail::RunFn& run, const CompensateRequest& r, double T, double x) {
   SimulationSettings s;
   s.temperature_C = T;
   s.waveform = drive(r, x);
   s.periods = r.periods;
   s.dt_s = r.dt_s;
   s.record_every = 1;
-  const Result res = simulate(m, s);
+  const Result res = run(s);
   Run out;
   out.metrics = res.metrics;
   out.diverged = res.diverged;
@@ -116,14 +118,14 @@ void validate_request(const Model& m, const CompensateRequest& r) {
 // The drive x in (0, x_hi] whose stroke at temperature T is the target (a root of
 // stroke(x) - target: bracketed from the reference drive, solved by TOMS 748), or x_hi when
 // even that falls short.
-CompensatePoint solve_point(const Model& m, const CompensateRequest& r, double T, double target,
-                            double x_ref, double x_hi) {
+CompensatePoint solve_point(const detail::RunFn& run_fn, const CompensateRequest& r, double T,
+                            double target, double x_ref, double x_hi) {
   CompensatePoint p;
   p.temperature_C = T;
   int evals = 0;
   auto stroke = [&](double x) {
     ++evals;
-    const Run run = run_drive(m, r, p.temperature_C, x);
+    const Run run = run_drive(run_fn, r, p.temperature_C, x);
     if (run.diverged) throw DivergenceError(run.error);
     return run.metrics;
   };
@@ -215,7 +217,13 @@ CompensateResult run_compensate(const Model& m, const CompensateRequest& r,
   validate_request(m, r);
   CompensateResult res;
   const auto wall0 = std::chrono::steady_clock::now();
-  const Run ref = run_drive(m, r, r.reference_temperature_C, reference_drive(r));
+  Run ref;  // the reference run takes the path of the searches' runs (lanes or simulate())
+  detail::lockstep_searches(m, 1, 1, r.lanes,
+                            [&](std::size_t, const detail::RunFn& run) {
+                              ref =
+                                  run_drive(run, r, r.reference_temperature_C, reference_drive(r));
+                            },
+                            {});
   if (ref.diverged) throw DivergenceError("compensate: the reference drive diverged: " + ref.error);
   res.reference = ref.metrics;
   res.target_stroke_um = r.target_stroke_um > 0.0 ? r.target_stroke_um : ref.metrics.stroke_um;
@@ -228,10 +236,11 @@ CompensateResult run_compensate(const Model& m, const CompensateRequest& r,
   res.threads = resolve_thread_count(r.threads, r.temperatures_C.size());
   const double x_hi = max_drive(r);
   const double x_ref = reference_drive(r);
-  detail::parallel_for(
-      r.temperatures_C.size(), res.threads,
-      [&](std::size_t i) {
-        res.points[i] = solve_point(m, r, r.temperatures_C[i], res.target_stroke_um, x_ref, x_hi);
+  // One search per temperature; in lanes, the searches' runs advance together (lockstep.hpp).
+  detail::lockstep_searches(
+      m, r.temperatures_C.size(), res.threads, r.lanes,
+      [&](std::size_t i, const detail::RunFn& run) {
+        res.points[i] = solve_point(run, r, r.temperatures_C[i], res.target_stroke_um, x_ref, x_hi);
       },
       progress);
   res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "experiments/lane_runs.hpp"
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/experiment_fields.hpp"
@@ -61,15 +62,19 @@ void check_request(const ParamsVsTemperatureRequest& r) {
   }
 }
 
-// One run: the metrics; at the Fig. 19 operating point (with_rods) also each rod's mean mu_r,
-// mean E_G and peak M over the metrics window.
-Run run_point(const Model& m, const ParamsVsTemperatureRequest& r, double T, double pp,
-              bool with_rods) {
+// One run's settings.
+SimulationSettings point_settings(const ParamsVsTemperatureRequest& r, double T, double pp) {
   SimulationSettings s;
   s.temperature_C = T;
   s.waveform = biased_sine(pp, r.frequency_Hz, r.current_min_A);
   s.periods = r.periods;
-  const Result out = simulate(m, s);
+  return s;
+}
+
+// One run's numbers: the metrics; at the Fig. 19 operating point (with_rods) also each rod's
+// mean mu_r, mean E_G and peak M over the metrics window.
+Run point_run(const Model& m, const ParamsVsTemperatureRequest& r, const Result& out,
+              bool with_rods) {
   Run run;
   run.diverged = out.diverged;
   run.error = out.error;
@@ -147,13 +152,13 @@ ParamsVsTemperatureResult run_params_vs_temperature(const Model& m,
   if (op == currents.size()) currents.push_back(r.current_pp_A);
   const std::size_t nc = currents.size(), n = r.temperatures_C.size() * nc;
 
+  std::vector<SimulationSettings> settings;
+  for (std::size_t i = 0; i < n; ++i)
+    settings.push_back(point_settings(r, r.temperatures_C[i / nc], currents[i % nc]));
   std::vector<Run> runs(n);
-  detail::parallel_for(n, resolve_thread_count(r.threads, n),
-                       [&](std::size_t i) {
-                         const std::size_t ti = i / nc, ci = i % nc;
-                         runs[i] = run_point(m, r, r.temperatures_C[ti], currents[ci], ci == op);
-                       },
-                       {});
+  detail::simulate_settings(
+      m, settings, resolve_thread_count(r.threads, n), r.lanes, false,
+      [&](std::size_t i, Result&& out) { runs[i] = point_run(m, r, out, i % nc == op); });
 
   ParamsVsTemperatureResult res;
   add_law_rows(m, r, conds, runs, nc, op, res);

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 
+#include "experiments/lane_runs.hpp"
 #include "gmasim/errors.hpp"
 
 namespace gmasim {
@@ -17,6 +18,39 @@ double Claim::rel_diff() const {
   if (!applicable || !std::isfinite(paper) || !std::isfinite(ours) || paper == 0.0)
     return std::numeric_limits<double>::quiet_NaN();
   return (ours - paper) / std::fabs(paper);
+}
+
+TimeSeries hysteresis_loops(const Model& m, int threads, bool lanes) {
+  TimeSeries loops;
+  loops.names = {"temperature_C", "current_A", "y_um", "B_T"};
+  loops.columns.assign(4, {});
+  std::vector<SimulationSettings> runs;
+  for (double T : {20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 100.0, 150.0}) {
+    SimulationSettings s;
+    s.temperature_C = T;
+    s.waveform = biased_sine(8.0, 10.0);
+    s.periods = 2;
+    runs.push_back(s);
+  }
+  std::vector<Result> results(runs.size());
+  detail::simulate_settings(m, runs, resolve_thread_count(threads, runs.size()), lanes, false,
+                            [&](std::size_t i, Result&& res) { results[i] = std::move(res); });
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const Result& res = results[i];
+    if (res.diverged || !res.has_metrics) continue;
+    const auto& t = res.series.column("t_s");
+    const auto& I = res.series.column("current_A");
+    const auto& y = res.series.column("y_um");
+    const auto& B = res.series.column("B_T");
+    for (std::size_t k = 0; k < t.size(); k += 20) {
+      if (t[k] < res.metrics.window_start_s - 1e-12) continue;
+      loops.columns[0].push_back(runs[i].temperature_C);
+      loops.columns[1].push_back(I[k]);
+      loops.columns[2].push_back(y[k]);
+      loops.columns[3].push_back(B[k]);
+    }
+  }
+  return loops;
 }
 
 ReproduceResult run_reproduce(const Model& m, const ReproduceOptions& o,
@@ -37,11 +71,13 @@ ReproduceResult run_reproduce(const Model& m, const ReproduceOptions& o,
   };
   SweepRequest& s10 = r.sweep_10Hz_request;
   s10.threads = o.threads;
+  s10.lanes = o.lanes;
   if (o.quick) s10.temperatures_C = {20, 40, 70};
   r.sweep_10Hz = run_sweep(m, s10);
   next();
   SweepRequest& sd = r.sweep_dynamic_request;
   sd.threads = o.threads;
+  sd.lanes = o.lanes;
   sd.temperatures_C =
       o.quick ? std::vector<double>{20, 70} : std::vector<double>{20, 30, 40, 50, 60, 70};
   sd.currents_pp_A = {6, 8};
@@ -57,34 +93,16 @@ ReproduceResult run_reproduce(const Model& m, const ReproduceOptions& o,
   if (o.quick) tr.temperatures_C = {20, 40, 70};
   r.track = run_track(m, tr);
   next();
+  r.ablate_request.lanes = o.lanes;
   r.ablate = run_ablate(m, r.ablate_request);
   next();
   ParamsVsTemperatureRequest& pr = r.params_request;
   if (o.quick) pr.temperatures_C = {20, 70, 150};
+  pr.lanes = o.lanes;
   r.params = run_params_vs_temperature(m, pr);
   next();
   r.thermal = thermal_expansion_coefficient(m);
-  r.loops.names = {"temperature_C", "current_A", "y_um", "B_T"};
-  r.loops.columns.assign(4, {});
-  for (double T : {20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 100.0, 150.0}) {
-    SimulationSettings s;
-    s.temperature_C = T;
-    s.waveform = biased_sine(8.0, 10.0);
-    s.periods = 2;
-    const Result res = simulate(m, s);
-    if (res.diverged || !res.has_metrics) continue;
-    const auto& t = res.series.column("t_s");
-    const auto& I = res.series.column("current_A");
-    const auto& y = res.series.column("y_um");
-    const auto& B = res.series.column("B_T");
-    for (std::size_t k = 0; k < t.size(); k += 20) {
-      if (t[k] < res.metrics.window_start_s - 1e-12) continue;
-      r.loops.columns[0].push_back(T);
-      r.loops.columns[1].push_back(I[k]);
-      r.loops.columns[2].push_back(y[k]);
-      r.loops.columns[3].push_back(B[k]);
-    }
-  }
+  r.loops = hysteresis_loops(m, o.threads, o.lanes);
   r.claims = score_claims(r, o.claims ? *o.claims : builtin_claims());
   mark_fitted(r.claims, m.spec);
   r.trends = trend_checks(r.claims);

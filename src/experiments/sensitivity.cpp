@@ -353,8 +353,9 @@ SensitivityResult run_sensitivity(const Model& m, const SensitivityRequest& r,
   SensitivityResult res;
   res.parameters = resolve_parameters(m.spec, r.parameters);
   Selection sel = select_quantities(r);
-  const detail::ClaimPlan plan =
-      detail::plan_claims(sel.claims, r.quick, std::move(sel.metrics), std::move(sel.functions));
+  const detail::ClaimPlan plan = detail::with_lanes(
+      detail::plan_claims(sel.claims, r.quick, std::move(sel.metrics), std::move(sel.functions)),
+      r.lanes);
   const Evaluations ev = build_models(m, res.parameters, r.step_large, r.step_small);
   // One work list: unit-major (the most expensive units first), evaluation-minor.
   std::vector<detail::PartResults> parts(ev.models.size(), detail::empty_results(plan));

@@ -5,15 +5,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <mutex>
 #include <span>
 
+#include "experiments/lane_runs.hpp"
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/model/validate.hpp"
-#include "gmasim/simulate/lanes.hpp"
 
 namespace gmasim {
 namespace {
@@ -141,31 +140,9 @@ SweepResult run_sweep(const Model& m, const SweepRequest& r, const ProgressFn& p
     if (run.has_metrics) p.metrics = run.metrics;
   };
   const auto wall0 = std::chrono::steady_clock::now();
-  if (r.lanes && lanes_supported(m)) {
-    // One block of points per thread, each advancing in SIMD lanes (a lane's numbers do not
-    // depend on the other lanes, so neither on the blocks nor on the thread count).
-    const std::size_t blocks = static_cast<std::size_t>(res.threads);
-    const std::size_t per = (jobs.size() + blocks - 1) / blocks;
-    std::mutex mu;  // the progress callback, once per point, serialised
-    std::size_t done = 0;
-    detail::parallel_for(
-        blocks, res.threads,
-        [&](std::size_t b) {
-          const std::size_t i0 = std::min(jobs.size(), b * per),
-                            i1 = std::min(jobs.size(), i0 + per);
-          const std::vector<Result> runs = simulate_lanes(
-              m, std::span<const SimulationSettings>(settings.data() + i0, i1 - i0), true);
-          for (std::size_t i = i0; i < i1; ++i) store(i, runs[i - i0]);
-          if (!progress) return;
-          const std::lock_guard<std::mutex> lock(mu);
-          for (std::size_t i = i0; i < i1; ++i) progress(++done, jobs.size());
-        },
-        nullptr);
-  } else {
-    detail::parallel_for(
-        jobs.size(), res.threads, [&](std::size_t i) { store(i, simulate(m, settings[i])); },
-        progress);
-  }
+  // In SIMD lanes, one block of points per thread (lane_runs.hpp); the sweep keeps only the
+  // metrics.
+  detail::simulate_settings(m, settings, res.threads, r.lanes, true, store, progress);
   res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
   add_changes(r, ref_in_grid, grid, slots);

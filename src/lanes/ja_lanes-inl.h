@@ -127,6 +127,7 @@ HWY_INLINE V<D> ja_irreversible_update(D d, V<D> Mirr0, V<D> Man0, V<D> Man1, V<
 template <class D>
 struct JaLaneConstants {
   V<D> MsT, a, alpha, c, k;
+  V<D> inv_a;  // 1/a, once per step (the scalar law's 1.0 / a_A_per_m)
 };
 
 // What a move depends on at its start only (jiles_atherton.hpp, ja_move_start): H_e0 and
@@ -139,8 +140,57 @@ template <class D>
 HWY_INLINE JaLaneStart<D> ja_move_start(D d, V<D> H0, V<D> M0, const JaLaneConstants<D>& p) {
   const V<D> He0 = hn::Add(H0, hn::Mul(p.alpha, M0));
   V<D> L, dL;
-  langevin_pair(d, hn::Mul(He0, hn::Div(C(d, 1.0), p.a)), L, dL);
+  langevin_pair(d, hn::Mul(He0, p.inv_a), L, dL);
   return {He0, hn::Mul(p.MsT, L)};
+}
+
+// One evaluation of eq. (9) at the end field H1 and a magnetisation iterate M1 (jiles_atherton.hpp,
+// ja_evaluate): M_irr1, F(M1) = (1-c) M_irr1 + c M_an(H1 + alpha M1) and chi_e = dF/dH_e.
+template <class D>
+struct JaLaneEvaluation {
+  V<D> Mirr1, M, chi_e;
+};
+template <class D>
+HWY_INLINE JaLaneEvaluation<D> ja_evaluate(D d, const JaLaneStart<D>& st, V<D> H1, V<D> M1,
+                                           const JaLaneConstants<D>& p, V<D> Mirr0, V<D> inv_a) {
+  const V<D> He1 = hn::Add(H1, hn::Mul(p.alpha, M1));
+  V<D> L1, dL1;
+  langevin_pair(d, hn::Mul(He1, inv_a), L1, dL1);
+  const V<D> Man1 = hn::Mul(p.MsT, L1);
+  const V<D> dMan = hn::Mul(hn::Mul(p.MsT, inv_a), dL1);
+  V<D> dMirr;
+  const V<D> Mirr1 =
+      ja_irreversible_update(d, Mirr0, st.Man0, Man1, dMan, hn::Sub(He1, st.He0), p.k, dMirr);
+  const V<D> one_c = hn::Sub(C(d, 1.0), p.c);
+  return {Mirr1, hn::Add(hn::Mul(one_c, Mirr1), hn::Mul(p.c, Man1)),
+          hn::Add(hn::Mul(one_c, dMirr), hn::Mul(p.c, dMan))};
+}
+
+// Eq. (9) solved at H1 by Newton's method in the lanes of `todo` (jiles_atherton.hpp,
+// ja_step_from for H1 != H0): from M_guess, steps -g / max(1 - alpha chi_e, 0.2), each lane
+// stopping where |g| <= 1e-12 M_s^T or at the 60th evaluation with that evaluation's M_irr1,
+// M and chi_e. The lanes outside todo keep e's values. Out of line: the rare path, so that
+// joint_trial's common one inlines into the Newton loop.
+template <class D>
+HWY_NOINLINE void ja_solve(D d, Mk<D> todo, const JaLaneStart<D>& st, V<D> H1, V<D> M_guess,
+                           const JaLaneConstants<D>& p, V<D> Mirr0, V<D> inv_a,
+                           JaLaneEvaluation<D>& e) {
+  const V<D> tol = hn::Mul(C(d, 1e-12), p.MsT);
+  V<D> M1 = M_guess;
+  Mk<D> left = todo;
+  for (int it = 0; it < 60 && !hn::AllFalse(d, left); ++it) {
+    const JaLaneEvaluation<D> ev = ja_evaluate(d, st, H1, M1, p, Mirr0, inv_a);
+    const V<D> g = hn::Sub(M1, ev.M);
+    const Mk<D> stop =
+        hn::And(left, it == 59 ? hn::FirstN(d, hn::Lanes(d)) : hn::Le(hn::Abs(g), tol));
+    e.Mirr1 = hn::IfThenElse(stop, ev.Mirr1, e.Mirr1);
+    e.M = hn::IfThenElse(stop, ev.M, e.M);
+    e.chi_e = hn::IfThenElse(stop, ev.chi_e, e.chi_e);
+    left = hn::AndNot(stop, left);
+    V<D> dg = hn::Sub(C(d, 1.0), hn::Mul(p.alpha, ev.chi_e));
+    dg = hn::IfThenElse(hn::Lt(dg, C(d, 0.2)), C(d, 0.2), dg);  // alpha > 0: damp the step
+    M1 = hn::IfThenElse(left, hn::Sub(M1, hn::Div(g, dg)), M1);
+  }
 }
 
 // The law's lane entry (gmasim/magnetisation/jiles_atherton.hpp, JilesAthertonLaw): the
@@ -148,23 +198,26 @@ HWY_INLINE JaLaneStart<D> ja_move_start(D d, V<D> H0, V<D> M0, const JaLaneConst
 // (kMirr). A joint trial is one evaluation of eq. (9) at (H1, M_iter) (physics::ja_evaluate,
 // no inner solve): M = F(M_iter), M_irr, the slope dM/dH and 1/mu_r (ja_slope_terms), the
 // law's Newton step M_next = M_iter - g / (1 - alpha chi_e) and whether |g| <= 1e-12 M_s^T.
+// In the lanes where |g| > 1e-5 M_s^T (a poor guess) eq. (9) is solved at H1 (ja_solve, the
+// scalar law's ja_step_from) from the Newton-corrected guess M_iter - g / max(1 - alpha chi_e,
+// 0.2); there M_iter := M, g := 0 and the slope terms come from that solution's chi_e.
 struct JilesAthertonLanes {
   template <class D>
   using Start = JaLaneStart<D>;
   template <class D>
   struct Trial {
     V<D> M, dM_dH, Mirr, inv_mu_r, M_next;
-    Mk<D> converged;
+    Mk<D> converged, solved;  // solved: eq. (9) solved fully (the safeguard)
   };
   template <class D>
   static Start<D> begin_move(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> M0) {
     return ja_move_start(d, H0, M0, p);
   }
   template <class D>
-  static Trial<D> joint_trial(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> Mirr0, V<D> M0,
-                              const Start<D>& st, V<D> H1, V<D> M_iter) {
+  static HWY_INLINE Trial<D> joint_trial(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> Mirr0,
+                                         V<D> M0, const Start<D>& st, V<D> H1, V<D> M_iter) {
     Trial<D> t;
-    const V<D> inv_a = hn::Div(C(d, 1.0), p.a);
+    const V<D> inv_a = p.inv_a;
     const Mk<D> same = hn::Eq(H1, H0);  // ja_step_from's H1 == H0: nothing moves
     V<D> chi_same = hn::Zero(d);
     if (!hn::AllFalse(d, same)) {
@@ -172,23 +225,22 @@ struct JilesAthertonLanes {
       langevin_pair(d, hn::Mul(hn::Add(H0, hn::Mul(p.alpha, M0)), inv_a), L0, dL0);
       chi_same = hn::Mul(hn::Mul(hn::Mul(p.c, p.MsT), inv_a), dL0);
     }
-    // ja_evaluate
-    const V<D> He1 = hn::Add(H1, hn::Mul(p.alpha, M_iter));
-    V<D> L1, dL1;
-    langevin_pair(d, hn::Mul(He1, inv_a), L1, dL1);
-    const V<D> Man1 = hn::Mul(p.MsT, L1);
-    const V<D> dMan = hn::Mul(hn::Mul(p.MsT, inv_a), dL1);
-    V<D> dMirr;
-    const V<D> Mirr1 =
-        ja_irreversible_update(d, Mirr0, st.Man0, Man1, dMan, hn::Sub(He1, st.He0), p.k, dMirr);
-    const V<D> one_c = hn::Sub(C(d, 1.0), p.c);
-    const V<D> F = hn::Add(hn::Mul(one_c, Mirr1), hn::Mul(p.c, Man1));
-    const V<D> chi =
-        hn::IfThenElse(same, chi_same, hn::Add(hn::Mul(one_c, dMirr), hn::Mul(p.c, dMan)));
-    t.Mirr = hn::IfThenElse(same, Mirr0, Mirr1);
-    t.M = hn::IfThenElse(same, M0, F);
+    JaLaneEvaluation<D> e = ja_evaluate(d, st, H1, M_iter, p, Mirr0, inv_a);
+    V<D> g = hn::Sub(M_iter, e.M);
+    const Mk<D> far = hn::AndNot(same, hn::Gt(hn::Abs(g), hn::Mul(C(d, 1e-5), p.MsT)));
+    t.solved = far;
+    if (!hn::AllFalse(d, far)) {  // far from eq. (9): solve it there
+      V<D> dg = hn::Sub(C(d, 1.0), hn::Mul(p.alpha, e.chi_e));
+      dg = hn::IfThenElse(hn::Lt(dg, C(d, 0.2)), C(d, 0.2), dg);
+      ja_solve(d, far, st, H1, hn::Sub(M_iter, hn::Div(g, dg)), p, Mirr0, inv_a, e);
+      M_iter = hn::IfThenElse(far, e.M, M_iter);
+      g = hn::IfThenElse(far, hn::Zero(d), g);
+    }
+    const V<D> chi = hn::IfThenElse(same, chi_same, e.chi_e);
+    t.Mirr = hn::IfThenElse(same, Mirr0, e.Mirr1);
+    t.M = hn::IfThenElse(same, M0, e.M);
     M_iter = hn::IfThenElse(same, M0, M_iter);
-    const V<D> g = hn::IfThenElse(same, hn::Zero(d), hn::Sub(M_iter, F));
+    g = hn::IfThenElse(same, hn::Zero(d), g);
     // ja_slope_terms: d = 1 - alpha chi_e, one division
     const V<D> dd = hn::Sub(C(d, 1.0), hn::Mul(p.alpha, chi)), dc = hn::Add(dd, chi);
     const V<D> inv = hn::Div(C(d, 1.0), hn::Mul(dd, dc));

@@ -123,6 +123,8 @@ struct LaneData {
   Structure st;
   std::size_t n = 0, npad = 0;
   std::vector<double> g, r, cm;  // global, rod and circuit fields, each npad long
+  // How many joint trials of a live lane solved eq. (9) fully (the law's safeguard, ja_solve).
+  std::size_t full_solves = 0;
   // The old state of one step (the kernel keeps a failing lane where it was).
   double* rod(int field, int i) {
     return r.data() +

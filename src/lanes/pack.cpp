@@ -228,6 +228,7 @@ void LaneBatch::rest_increment(std::span<const double> current_A, std::span<cons
 }
 
 bool LaneBatch::diverged(std::size_t lane) const { return d_->glob(lanes::kFail)[lane] != 0.0; }
+std::size_t LaneBatch::full_solves() const { return d_->full_solves; }
 
 void LaneBatch::unpack(std::size_t j, State& s) const {
   using namespace lanes;

@@ -61,14 +61,14 @@ struct RodStates {
 // D = diag(1/R), F the rods' MMFs and u = I psi_coil + pm psi_pm:  v = B^T u - S D F,
 // (D^-1 + S) z' = v (L D L^T, no square roots), z = z' + D F,
 // phi_r = ((B^T u - S z)_r + F_r) / R_r. ok is false where a pivot is not positive or z is
-// not finite.
+// not finite. One division per pivot (its reciprocal), as rod_solve.
 template <class D>
 HWY_INLINE Mk<D> circuit_solve(const Chunk<D>& c, const V<D>* R, const V<D>* mmf, V<D> I, V<D> pm,
                                V<D>* phi) {
   const D d = c.d;
   const int n = c.n;
   V<D> S[kMaxRods][kMaxRods], A[kMaxRods][kMaxRods], DF[kMaxRods], Btu[kMaxRods], x[kMaxRods],
-      piv[kMaxRods];
+      piv[kMaxRods], inv_piv[kMaxRods];
   for (int a = 0; a < n; ++a) {
     DF[a] = hn::Div(mmf[a], R[a]);
     Btu[a] = hn::Add(hn::Mul(I, hn::LoadU(d, c.L.bt_coil(a) + c.j)),
@@ -86,16 +86,17 @@ HWY_INLINE Mk<D> circuit_solve(const Chunk<D>& c, const V<D>* R, const V<D>* mmf
     for (int p = 0; p < j; ++p) dd = hn::Sub(dd, hn::Mul(hn::Mul(A[j][p], A[j][p]), piv[p]));
     ok = hn::And(ok, hn::Gt(dd, hn::Zero(d)));
     piv[j] = dd;
+    inv_piv[j] = hn::Div(C(d, 1.0), dd);  // one division per pivot
     for (int i = j + 1; i < n; ++i) {
       V<D> a = S[i][j];
       for (int p = 0; p < j; ++p) a = hn::Sub(a, hn::Mul(hn::Mul(A[i][p], A[j][p]), piv[p]));
-      A[i][j] = hn::Div(a, dd);
+      A[i][j] = hn::Mul(a, inv_piv[j]);
     }
   }
   for (int i = 0; i < n; ++i)
     for (int p = 0; p < i; ++p) x[i] = hn::Sub(x[i], hn::Mul(A[i][p], x[p]));
   for (int i = n - 1; i >= 0; --i) {
-    x[i] = hn::Div(x[i], piv[i]);
+    x[i] = hn::Mul(x[i], inv_piv[i]);
     for (int p = i + 1; p < n; ++p) x[i] = hn::Sub(x[i], hn::Mul(A[p][i], x[p]));
   }
   for (int a = 0; a < n; ++a) {
@@ -112,12 +113,16 @@ HWY_INLINE Mk<D> circuit_solve(const Chunk<D>& c, const V<D>* R, const V<D>* mmf
 
 template <class D>
 HWY_INLINE JaLaneConstants<D> ja_constants(const Chunk<D>& c, int i) {
-  return {c.rod(kMsTMag, i), c.rod(kJaA, i), c.rod(kJaAlpha, i), c.rod(kJaC, i), c.rod(kJaK, i)};
+  const V<D> a = c.rod(kJaA, i);
+  return {c.rod(kMsTMag, i),      a, c.rod(kJaAlpha, i), c.rod(kJaC, i), c.rod(kJaK, i),
+          hn::Div(C(c.d, 1.0), a)};
 }
 
-// A lane that has stopped keeps the trial of the iterate it stopped at; the others take t.
-template <class M, class T>
-HWY_INLINE void take_trial(M done, const T& t, T& tr) {
+// A lane that has stopped keeps the trial of the iterate it stopped at; the others take t
+// (and count its full solves of the law, LaneData::full_solves).
+template <class D, class M, class T>
+HWY_INLINE void take_trial(D d, M done, const T& t, T& tr, std::size_t& full_solves) {
+  if (!hn::AllFalse(d, t.solved)) full_solves += hn::CountTrue(d, hn::AndNot(done, t.solved));
   tr.M = hn::IfThenElse(done, tr.M, t.M);
   tr.dM_dH = hn::IfThenElse(done, tr.dM_dH, t.dM_dH);
   tr.Mirr = hn::IfThenElse(done, tr.Mirr, t.Mirr);
@@ -153,8 +158,10 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
   constexpr double kMu0 = physics::kMu0;
   V<D> g[kMaxRods], e0[kMaxRods], inv_mud[kMaxRods], l_A[kMaxRods], inv_A[kMaxRods];
   typename Law::template Start<D> start[kMaxRods];
+  JaLaneConstants<D> ja[kMaxRods];
   for (int i = 0; i < n; ++i) {
-    start[i] = Law::begin_move(d, ja_constants(c, i), s.f[kH][i], s.f[kM][i]);
+    ja[i] = ja_constants(c, i);
+    start[i] = Law::begin_move(d, ja[i], s.f[kH][i], s.f[kM][i]);
     mg.B0[i] = hn::Mul(C(d, kMu0), hn::Add(s.f[kH][i], s.f[kM][i]));
     l_A[i] = hn::Div(c.rod(kLength, i), c.rod(kArea, i));
     inv_A[i] = hn::Div(C(d, 1.0), c.rod(kArea, i));
@@ -173,10 +180,10 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
   for (int it = 0; !hn::AllTrue(d, done); ++it) {
     V<D> R[kMaxRods], mmf[kMaxRods], phi[kMaxRods];
     for (int i = 0; i < n; ++i) {
-      const auto t = Law::joint_trial(d, ja_constants(c, i), s.f[kH][i], s.f[kMirr][i], s.f[kM][i],
-                                      start[i], mg.H[i], mg.Mg[i]);
+      const auto t = Law::joint_trial(d, ja[i], s.f[kH][i], s.f[kMirr][i], s.f[kM][i], start[i],
+                                      mg.H[i], mg.Mg[i]);
       auto& tr = mg.trial[i];
-      take_trial(done, t, tr);
+      take_trial(d, done, t, tr, c.L.full_solves);
       mg.Bs[i] = hn::Mul(C(d, kMu0), hn::Add(mg.H[i], tr.M_next));
       inv_mud[i] = hn::Mul(tr.inv_mu_r, C(d, 1.0 / kMu0));
       R[i] = hn::Add(hn::Mul(l_A[i], hn::Add(inv_mud[i], g[i])), c.rod(kRs, i));

@@ -36,6 +36,9 @@ struct CompensateRequest {
   double tolerance_um = 1e-3;   // |stroke - target| of a solved point
   double dt_s = 0.0;            // 0: the automatic rule
   int threads = 0;
+  // The searches of the temperatures run in lock step, their runs advancing together in SIMD
+  // lanes (gmasim/simulate/lanes.hpp) where the model allows; false: one simulate() per run.
+  bool lanes = true;
 };
 
 struct CompensatePoint {

@@ -287,6 +287,9 @@ struct AblateRequest {
   double periods = 3.0;
   double current_min_A = -3.0;
   int threads = 0;
+  // The runs advance together in SIMD lanes (gmasim/simulate/lanes.hpp) where the model allows;
+  // false: one simulate() per run (the reference the lanes are compared with).
+  bool lanes = true;
 };
 
 struct AblationRow {
@@ -325,6 +328,8 @@ struct ParamsVsTemperatureRequest {
   double periods = 3.0;
   double current_min_A = -3.0;
   int threads = 0;
+  // The runs advance together in SIMD lanes where the model allows (AblateRequest::lanes).
+  bool lanes = true;
 };
 
 struct ParamsVsTemperatureRow {

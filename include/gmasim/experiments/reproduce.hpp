@@ -36,6 +36,9 @@ struct Claim {
 struct ReproduceOptions {
   int threads = 0;
   bool quick = false;  // smaller grids (tests)
+  // The grids' runs (sweeps, ablation, 20-150 degC runs, loops) advance in SIMD lanes where the
+  // model allows (gmasim/simulate/lanes.hpp); false: one simulate() per run.
+  bool lanes = true;
   // The claims to score; nullptr: the built-in data/claims.toml. Not owned.
   const ClaimsData* claims = nullptr;
 };
@@ -77,6 +80,11 @@ struct ReproduceResult {
   std::string model_readings;      // the options in force, e.g. "eq10: mean_field, kelvin"
   std::vector<TrendCheck> trends;  // the sign of each trend across current (trend_checks)
 };
+
+// The study's hysteresis loops (ReproduceResult::loops): y(I) and B(I) over the last of 2
+// periods of an 8 A, 10 Hz biased sine at 20, 30, 40, 50, 60, 70, 100 and 150 degC, every 20th
+// step; the runs in SIMD lanes where `lanes` and the model allow (ReproduceOptions::lanes).
+TimeSeries hysteresis_loops(const Model& m, int threads = 0, bool lanes = true);
 
 ReproduceResult run_reproduce(const Model& m, const ReproduceOptions& o,
                               const ProgressFn& progress = {});

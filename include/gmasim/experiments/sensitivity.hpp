@@ -109,6 +109,10 @@ struct SensitivityRequest : SensitivitySettings {
   // Keep only the quantities with these names (claim ids, metric or function names); empty:
   // all. An unknown name is an InputError.
   std::vector<std::string> only;
+  // The units' grids (sweeps, 20-150 degC runs, ablation) advance in SIMD lanes where the model
+  // allows (gmasim/simulate/lanes.hpp); false: one simulate() per run. The metric runs book the
+  // energy ledgers, which the lanes do not carry: they run simulate() either way.
+  bool lanes = true;
 };
 
 // "All numeric parameters of the model that a user would vary": every number of the spec,

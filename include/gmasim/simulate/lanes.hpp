@@ -57,6 +57,10 @@ class LaneBatch {
   // Whether the lane stopped, and why: the DivergenceError text step() or run_loop() would
   // have thrown (time, rod, quantity, value). A stopped lane keeps its last good state.
   bool diverged(std::size_t lane) const;
+  // How many of the live lanes' law evaluations (per rod and Newton iterate, summed over the
+  // steps so far) solved eq. (9) fully: the Jiles-Atherton law's safeguard where the joint
+  // Newton iterate is far from eq. (9) (|g| > 1e-5 M_s^T), as the scalar law's joint_trial does.
+  std::size_t full_solves() const;
   std::string error(std::size_t lane) const;
   // The lane's state as step() leaves it, into s (sized by make_state for the lane's model:
   // no allocation).
