@@ -255,8 +255,16 @@ void fill_curve(FrfCurve& cv, const SmallSignalModel& lin, const cd* stepped,
 }  // namespace
 
 LinearFrfMarkers linear_frf_markers(const SmallSignalModel& lin, double f_min_Hz, double f_max_Hz) {
-  const std::vector<double> fd = log_grid(f_min_Hz, f_max_Hz, 4000);
-  std::vector<double> md(fd.size());
+  // The grid of the last band asked for on this thread (identify asks for the same band in
+  // every evaluation: 4000 std::pow saved each time), and the magnitudes' storage.
+  thread_local double band[2] = {0.0, 0.0};
+  thread_local std::vector<double> fd, md;
+  if (fd.empty() || band[0] != f_min_Hz || band[1] != f_max_Hz) {
+    fd = log_grid(f_min_Hz, f_max_Hz, 4000);
+    band[0] = f_min_Hz;
+    band[1] = f_max_Hz;
+  }
+  md.resize(fd.size());
   for (std::size_t k = 0; k < fd.size(); ++k) md[k] = std::abs(lin.response(fd[k]));
   return {find_resonance_Hz(fd, md), find_bandwidth_3dB_Hz(fd, md)};
 }
