@@ -18,6 +18,7 @@
 #include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/model/validate.hpp"
 #include "gmasim/physics/magnetic.hpp"
+#include "gmasim/simulate/lanes.hpp"
 #include "gmasim/simulate/run_loop.hpp"
 
 namespace gmasim {
@@ -158,26 +159,35 @@ double settling_time_s(const SmallSignalModel& lin) {
 // steps per period with dt <= 10 us (whole steps per period); settled for settling_time_s and
 // at least settle_periods periods (low frequencies need few periods, high frequencies many),
 // then the first harmonic of y over measure_periods whole periods.
-cd detail::stepped_sine_point(const Model& m, const Conditions& c, const State& bias,
-                              const SmallSignalModel& lin, const FrfRequest& r, double fr) {
+detail::SteppedSineGrid detail::stepped_sine_grid(const SmallSignalModel& lin, const FrfRequest& r,
+                                                  double fr) {
   const long per =
       steps_to_resolve(1.0 / (fr * kMaxDt_s), r.min_steps_per_period, "steps per period");
   const double dt = 1.0 / (fr * static_cast<double>(per));
   const long settle =
       steps_to_resolve(settling_time_s(lin) * fr, r.settle_periods, "settle periods");
   const long measure = r.measure_periods;
-  const StepGrid grid =
+  SteppedSineGrid sg;
+  sg.grid =
       StepGrid::uniform(0.0, dt, static_cast<double>(settle + measure) * static_cast<double>(per),
                         fmt::format("stepped-sine steps at {:g} Hz", fr));
+  sg.first = settle * per;
+  sg.measured = measure * per;
+  return sg;
+}
+
+cd detail::stepped_sine_point(const Model& m, const Conditions& c, const State& bias,
+                              const SmallSignalModel& lin, const FrfRequest& r, double fr) {
+  const SteppedSineGrid sg = stepped_sine_grid(lin, r, fr);
   const double w = kTwoPi * fr;
   std::vector<double> ts, ys, is;
-  ts.reserve(static_cast<std::size_t>(measure * per));
+  ts.reserve(static_cast<std::size_t>(sg.measured));
   ys.reserve(ts.capacity());
   is.reserve(ts.capacity());
-  const long first = settle * per;  // samples first+1 .. total: whole periods
+  const long first = sg.first;  // samples first+1 .. total: whole periods
   State s = bias;
   run_loop(
-      m, c, s, grid, [&](double t) { return r.bias_A + r.amplitude_A * std::sin(w * t); },
+      m, c, s, sg.grid, [&](double t) { return r.bias_A + r.amplitude_A * std::sin(w * t); },
       [&](const State& st, const StepPoint& p) {
         if (p.k <= first) return;
         ts.push_back(p.t_s);
@@ -301,7 +311,11 @@ FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progres
 
   // Stepped sine: one work item per (temperature, frequency).
   std::vector<cd> stepped(nT * nf);
-  if (r.stepped_sine) {
+  if (r.stepped_sine && r.lanes &&
+      lanes_supported(m)) {  // the points in SIMD lanes (frf_lanes.cpp)
+    stepped = detail::stepped_sine_points_lanes(m, conds, bias, lin, r, f,
+                                                resolve_thread_count(r.threads, nT * nf), progress);
+  } else if (r.stepped_sine) {
     const std::size_t n = nT * nf;
     detail::parallel_for(
         n, resolve_thread_count(r.threads, n),
