@@ -18,6 +18,7 @@
 #include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/model/validate.hpp"
 #include "gmasim/physics/magnetic.hpp"
+#include "gmasim/simulate/lanes.hpp"
 #include "gmasim/simulate/run_loop.hpp"
 
 namespace gmasim {
@@ -158,26 +159,35 @@ double settling_time_s(const SmallSignalModel& lin) {
 // steps per period with dt <= 10 us (whole steps per period); settled for settling_time_s and
 // at least settle_periods periods (low frequencies need few periods, high frequencies many),
 // then the first harmonic of y over measure_periods whole periods.
-cd detail::stepped_sine_point(const Model& m, const Conditions& c, const State& bias,
-                              const SmallSignalModel& lin, const FrfRequest& r, double fr) {
+detail::SteppedSineGrid detail::stepped_sine_grid(const SmallSignalModel& lin, const FrfRequest& r,
+                                                  double fr) {
   const long per =
       steps_to_resolve(1.0 / (fr * kMaxDt_s), r.min_steps_per_period, "steps per period");
   const double dt = 1.0 / (fr * static_cast<double>(per));
   const long settle =
       steps_to_resolve(settling_time_s(lin) * fr, r.settle_periods, "settle periods");
   const long measure = r.measure_periods;
-  const StepGrid grid =
+  SteppedSineGrid sg;
+  sg.grid =
       StepGrid::uniform(0.0, dt, static_cast<double>(settle + measure) * static_cast<double>(per),
                         fmt::format("stepped-sine steps at {:g} Hz", fr));
+  sg.first = settle * per;
+  sg.measured = measure * per;
+  return sg;
+}
+
+cd detail::stepped_sine_point(const Model& m, const Conditions& c, const State& bias,
+                              const SmallSignalModel& lin, const FrfRequest& r, double fr) {
+  const SteppedSineGrid sg = stepped_sine_grid(lin, r, fr);
   const double w = kTwoPi * fr;
   std::vector<double> ts, ys, is;
-  ts.reserve(static_cast<std::size_t>(measure * per));
+  ts.reserve(static_cast<std::size_t>(sg.measured));
   ys.reserve(ts.capacity());
   is.reserve(ts.capacity());
-  const long first = settle * per;  // samples first+1 .. total: whole periods
+  const long first = sg.first;  // samples first+1 .. total: whole periods
   State s = bias;
   run_loop(
-      m, c, s, grid, [&](double t) { return r.bias_A + r.amplitude_A * std::sin(w * t); },
+      m, c, s, sg.grid, [&](double t) { return r.bias_A + r.amplitude_A * std::sin(w * t); },
       [&](const State& st, const StepPoint& p) {
         if (p.k <= first) return;
         ts.push_back(p.t_s);
@@ -255,8 +265,16 @@ void fill_curve(FrfCurve& cv, const SmallSignalModel& lin, const cd* stepped,
 }  // namespace
 
 LinearFrfMarkers linear_frf_markers(const SmallSignalModel& lin, double f_min_Hz, double f_max_Hz) {
-  const std::vector<double> fd = log_grid(f_min_Hz, f_max_Hz, 4000);
-  std::vector<double> md(fd.size());
+  // The grid of the last band asked for on this thread (identify asks for the same band in
+  // every evaluation: 4000 std::pow saved each time), and the magnitudes' storage.
+  thread_local double band[2] = {0.0, 0.0};
+  thread_local std::vector<double> fd, md;
+  if (fd.empty() || band[0] != f_min_Hz || band[1] != f_max_Hz) {
+    fd = log_grid(f_min_Hz, f_max_Hz, 4000);
+    band[0] = f_min_Hz;
+    band[1] = f_max_Hz;
+  }
+  md.resize(fd.size());
   for (std::size_t k = 0; k < fd.size(); ++k) md[k] = std::abs(lin.response(fd[k]));
   return {find_resonance_Hz(fd, md), find_bandwidth_3dB_Hz(fd, md)};
 }
@@ -293,7 +311,11 @@ FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progres
 
   // Stepped sine: one work item per (temperature, frequency).
   std::vector<cd> stepped(nT * nf);
-  if (r.stepped_sine) {
+  if (r.stepped_sine && r.lanes &&
+      lanes_supported(m)) {  // the points in SIMD lanes (frf_lanes.cpp)
+    stepped = detail::stepped_sine_points_lanes(m, conds, bias, lin, r, f,
+                                                resolve_thread_count(r.threads, nT * nf), progress);
+  } else if (r.stepped_sine) {
     const std::size_t n = nT * nf;
     detail::parallel_for(
         n, resolve_thread_count(r.threads, n),

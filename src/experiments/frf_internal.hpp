@@ -7,13 +7,32 @@
 #include <vector>
 
 #include "gmasim/experiments/experiments.hpp"
+#include "gmasim/simulate/run_loop.hpp"
 
 namespace gmasim::detail {
+
+// The time grid of the stepped-sine point at fr Hz: >= r.min_steps_per_period steps per period
+// with dt <= 10 us, settled for settling_time_s(lin) and >= r.settle_periods periods, then
+// r.measure_periods periods measured (steps first+1 .. grid.steps, `measured` of them).
+struct SteppedSineGrid {
+  StepGrid grid;
+  long first = 0, measured = 0;
+};
+SteppedSineGrid stepped_sine_grid(const SmallSignalModel& lin, const FrfRequest& r, double fr);
 
 // One stepped-sine point at fr Hz from the settled bias state (frf.cpp).
 std::complex<double> stepped_sine_point(const Model& m, const Conditions& c, const State& bias,
                                         const SmallSignalModel& lin, const FrfRequest& r,
                                         double fr);
+
+// stepped_sine_point for every (temperature ti, frequency fi) of the grid, index ti * f.size()
+// + fi, the points advancing together in SIMD lanes (frf_lanes.cpp; lanes_supported(m)):
+// sorted by length, `lanes_width()` at a time, the batches over `threads` threads. Equal to the
+// scalar points to the lanes' rounding; throws the DivergenceError of a diverged point.
+std::vector<std::complex<double>> stepped_sine_points_lanes(
+    const Model& m, const std::vector<Conditions>& conds, const std::vector<State>& bias,
+    const std::vector<SmallSignalModel>& lin, const FrfRequest& r, const std::vector<double>& f,
+    int threads, const ProgressFn& progress);
 
 // A stepped-sine curve: frequencies (ascending) and Y/I [m/A].
 struct SteppedCurve {

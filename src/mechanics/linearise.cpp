@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <vector>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/magnetisation/laws.hpp"
@@ -14,6 +15,7 @@
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
+#include "mechanics/small_lu.hpp"
 
 namespace gmasim {
 namespace {
@@ -203,44 +205,64 @@ SmallSignalModel linearise(const Model& m, const Conditions& c, const State& s) 
   return L;
 }
 
-std::complex<double> SmallSignalModel::response(double f_Hz) const {
-  const auto N = static_cast<Eigen::Index>(n);
-  const cd sj(0.0, kTwoPi * f_Hz);
-  Eigen::MatrixXcd A = Eigen::MatrixXcd::Identity(N, N);
-  Eigen::VectorXcd b(N);
-  Eigen::VectorXcd dM(N);
-  if (consistent) {  // port equations of the rods (see the struct), solved for dH
-    for (Eigen::Index i = 0; i < N; ++i) {
-      const auto ui = static_cast<std::size_t>(i);
-      b(i) = port_b_At_per_A[ui];
-      for (Eigen::Index j = 0; j < N; ++j) {
-        const auto uj = static_cast<std::size_t>(j);
-        A(i, j) = port_S_per_H[ui * static_cast<std::size_t>(n) + uj] * area_m2[uj] * kMu0 *
-                  (1.0 + chi[uj]);
-      }
-      A(i, i) += length_m[ui] * (1.0 + kappa_s_m_per_H[ui] * sj * kMu0 * (1.0 + chi[ui]));
+namespace {
+
+// dM of the response at s = sj: the rods' port equations solved for dH (consistent), or the
+// circuit's lagged gains solved for dM, into the n-vector x. The n x n system goes into a
+// (column-major) and x, then small_lu_solve (Eigen's bits without its heap) for n <=
+// kSmallLuMax, Eigen's PartialPivLU beyond.
+void response_dM(const SmallSignalModel& L, cd sj, cd* a, cd* x) {
+  const auto n = static_cast<std::size_t>(L.n);
+  auto A = [&](std::size_t i, std::size_t j) -> cd& { return a[j * n + i]; };
+  for (std::size_t j = 0; j < n; ++j)
+    for (std::size_t i = 0; i < n; ++i) A(i, j) = i == j ? cd(1.0) : cd(0.0);
+  if (L.consistent) {  // port equations of the rods (see the struct), solved for dH
+    for (std::size_t i = 0; i < n; ++i) {
+      x[i] = L.port_b_At_per_A[i];
+      for (std::size_t j = 0; j < n; ++j)
+        A(i, j) = L.port_S_per_H[i * n + j] * L.area_m2[j] * kMu0 * (1.0 + L.chi[j]);
+      A(i, i) += L.length_m[i] * (1.0 + L.kappa_s_m_per_H[i] * sj * kMu0 * (1.0 + L.chi[i]));
     }
-    const Eigen::VectorXcd dH = A.partialPivLu().solve(b);
-    for (Eigen::Index i = 0; i < N; ++i) dM(i) = chi[static_cast<std::size_t>(i)] * dH(i);
   } else {
-    for (Eigen::Index i = 0; i < N; ++i) {
-      const auto ui = static_cast<std::size_t>(i);
-      const cd lag_chi = chi[ui] / (1.0 + tau_s[ui] * sj);  // dM_i / dHc_i
-      b(i) = lag_chi * g_A_per_m_per_A[ui];
-      for (Eigen::Index j = 0; j < N; ++j)
-        A(i, j) -= lag_chi * G[ui * static_cast<std::size_t>(n) + static_cast<std::size_t>(j)];
+    for (std::size_t i = 0; i < n; ++i) {
+      const cd lag_chi = L.chi[i] / (1.0 + L.tau_s[i] * sj);  // dM_i / dHc_i
+      x[i] = lag_chi * L.g_A_per_m_per_A[i];
+      for (std::size_t j = 0; j < n; ++j) A(i, j) -= lag_chi * L.G[i * n + j];
     }
-    dM = A.partialPivLu().solve(b);
   }
+  if (L.n <= mechanics_detail::kSmallLuMax) {
+    mechanics_detail::small_lu_solve(a, x, L.n);
+  } else {
+    const auto N = static_cast<Eigen::Index>(n);
+    const Eigen::VectorXcd r = Eigen::Map<Eigen::MatrixXcd>(a, N, N).partialPivLu().solve(
+        Eigen::Map<Eigen::VectorXcd>(x, N));
+    for (std::size_t i = 0; i < n; ++i) x[i] = r(static_cast<Eigen::Index>(i));
+  }
+  if (L.consistent)
+    for (std::size_t i = 0; i < n; ++i) x[i] = L.chi[i] * x[i];  // dM = chi dH
+}
+
+}  // namespace
+
+std::complex<double> SmallSignalModel::response(double f_Hz) const {
+  const auto un = static_cast<std::size_t>(n);
+  const cd sj(0.0, kTwoPi * f_Hz);
+  constexpr std::size_t kMax = mechanics_detail::kSmallLuMax;
+  cd a_small[kMax * kMax], x_small[kMax];
+  std::vector<cd> a_big, x_big;  // only for more than kSmallLuMax rods
+  if (un > kMax) {
+    a_big.resize(un * un);
+    x_big.resize(un);
+  }
+  cd* const dM = un > kMax ? x_big.data() : x_small;
+  response_dM(*this, sj, un > kMax ? a_big.data() : a_small, dM);
   cd Y = 0.0, Q = 0.0;
-  for (Eigen::Index i = 0; i < N; ++i) {
-    const auto ui = static_cast<std::size_t>(i);
+  for (std::size_t i = 0; i < un; ++i) {
     cd dF = 0.0;
-    for (Eigen::Index j = 0; j < N; ++j)
-      dF += D_N_per_A_per_m[ui * static_cast<std::size_t>(n) + static_cast<std::size_t>(j)] * dM(j);
-    const cd X = dF / (mass_kg[ui] * sj * sj + damping_N_s_per_m[ui] * sj + stiffness_N_per_m[ui]);
+    for (std::size_t j = 0; j < un; ++j) dF += D_N_per_A_per_m[i * un + j] * dM[j];
+    const cd X = dF / (mass_kg[i] * sj * sj + damping_N_s_per_m[i] * sj + stiffness_N_per_m[i]);
     Y += X;
-    if (sensor_mount) Q += recoil_per_x[ui] * X;
+    if (sensor_mount) Q += recoil_per_x[i] * X;
   }
   // The probe's deflection u = Q s^2 / (s^2 + (c/m) s + k/m) (model.hpp, SensorMountModel).
   if (sensor_mount)

@@ -57,10 +57,13 @@ double hysteresis_width(const std::vector<double>& current_A, const std::vector<
     if (current_A[i] < current_A[imin]) imin = i;
     if (current_A[i] > current_A[imax]) imax = i;
   }
-  Branch rise, fall;
+  // The branches' storage is kept per thread: identify evaluates seven loops per candidate.
+  thread_local Branch rise, fall;
   auto collect = [&](Branch& b, std::size_t from, std::size_t to, bool rising) {
     // walk cyclically from `from` to `to` within [begin, end)
     const std::size_t n = end - begin;
+    b.I.clear();
+    b.y.clear();
     std::size_t k = from;
     for (std::size_t cnt = 0; cnt <= n; ++cnt) {
       b.I.push_back(current_A[k]);
@@ -130,32 +133,52 @@ double peak_to_peak(std::span<const double> v) {
 
 namespace {
 
+constexpr int kRefine = 8;  // refined points per sample interval
+
+// The cubic Hermite basis at s = j / kRefine, j < kRefine: h00, h10, h01, h11.
+struct HermiteBasis {
+  double h00[kRefine], h10[kRefine], h01[kRefine], h11[kRefine];
+};
+
+const HermiteBasis& hermite_basis() {
+  static const HermiteBasis hb = [] {
+    HermiteBasis b{};
+    for (int j = 0; j < kRefine; ++j) {
+      const double s = static_cast<double>(j) / kRefine, s2 = s * s, s3 = s2 * s;
+      b.h00[j] = 2 * s3 - 3 * s2 + 1;
+      b.h10[j] = s3 - 2 * s2 + s;
+      b.h01[j] = -2 * s3 + 3 * s2;
+      b.h11[j] = s3 - s2;
+    }
+    return b;
+  }();
+  return hb;
+}
+
 // Rows [b, e) of v (and the row e that closes a periodic window, when recorded) refined by
-// `factor` points per sample interval with the cubic Hermite interpolant whose slopes are the
-// centred differences (Catmull-Rom; third order in the sample spacing). The metrics of a
-// window are then taken from the refined samples, so that the sampling of the extremes and
-// the linear interpolation of the loop's branches add an error of third order in the step,
-// below the integrator's second order (docs/model.md, "Time step").
-std::vector<double> refine_window(const std::vector<double>& t, const std::vector<double>& v,
-                                  std::size_t b, std::size_t e, int factor) {
+// kRefine points per sample interval with the cubic Hermite interpolant whose slopes are the
+// centred differences (Catmull-Rom; third order in the sample spacing), into out (cleared
+// first). The metrics of a window are then taken from the refined samples, so that the
+// sampling of the extremes and the linear interpolation of the loop's branches add an error of
+// third order in the step, below the integrator's second order (docs/model.md, "Time step").
+void refine_window(const std::vector<double>& t, const std::vector<double>& v, std::size_t b,
+                   std::size_t e, std::vector<double>& out) {
   const std::size_t last = std::min(e, t.size() - 1);  // the closing row, if any
   auto slope = [&](std::size_t k) {
     const std::size_t lo = k > 0 ? k - 1 : k, hi = k + 1 < t.size() ? k + 1 : k;
     return (v[hi] - v[lo]) / (t[hi] - t[lo]);
   };
-  std::vector<double> out;
-  out.reserve((last - b) * static_cast<std::size_t>(factor) + 1);
+  const HermiteBasis& hb = hermite_basis();
+  out.clear();
+  double slope_k = last > b ? slope(b) : 0.0;
   for (std::size_t k = b; k < last; ++k) {
-    const double h = t[k + 1] - t[k];
-    const double m0 = slope(k) * h, m1 = slope(k + 1) * h;
-    for (int j = 0; j < factor; ++j) {
-      const double s = static_cast<double>(j) / factor, s2 = s * s, s3 = s2 * s;
-      out.push_back((2 * s3 - 3 * s2 + 1) * v[k] + (s3 - 2 * s2 + s) * m0 +
-                    (-2 * s3 + 3 * s2) * v[k + 1] + (s3 - s2) * m1);
-    }
+    const double h = t[k + 1] - t[k], slope_k1 = slope(k + 1);
+    const double m0 = slope_k * h, m1 = slope_k1 * h;
+    for (int j = 0; j < kRefine; ++j)
+      out.push_back(hb.h00[j] * v[k] + hb.h10[j] * m0 + hb.h01[j] * v[k + 1] + hb.h11[j] * m1);
+    slope_k = slope_k1;
   }
   if (last < e) out.push_back(v[last]);  // no closing row: keep the last sample
-  return out;
 }
 
 }  // namespace
@@ -163,10 +186,10 @@ std::vector<double> refine_window(const std::vector<double>& t, const std::vecto
 LoopMetrics loop_metrics(const std::vector<double>& t, const std::vector<double>& current_A,
                          const std::vector<double>& y_um, const std::vector<double>& B_T,
                          std::size_t b, std::size_t e) {
-  constexpr int kRefine = 8;
-  const auto I = refine_window(t, current_A, b, e, kRefine);
-  const auto y = refine_window(t, y_um, b, e, kRefine);
-  const auto B = refine_window(t, B_T, b, e, kRefine);
+  thread_local std::vector<double> I, y, B;  // refined; per thread (identify: 7 per candidate)
+  refine_window(t, current_A, b, e, I);
+  refine_window(t, y_um, b, e, y);
+  refine_window(t, B_T, b, e, B);
   return {peak_to_peak(y), hysteresis_width(I, y, 0, y.size()), peak_to_peak(B)};
 }
 

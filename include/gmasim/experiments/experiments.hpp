@@ -90,6 +90,10 @@ struct FrfRequest {
   bool stepped_sine = true, small_signal = true;
   BiasState bias_state = BiasState::Anhysteretic;
   int threads = 0;  // stepped-sine frequencies run in parallel
+  // The stepped-sine grid's points advance together in SIMD lanes (gmasim/simulate/lanes.hpp)
+  // where the model allows; false: one scalar run per point (the reference the lanes are
+  // compared with).
+  bool lanes = true;
   // Stepped sine: golden-section evaluations in ln f around the largest |Y/I| of the grid (the
   // peak refined between its grid neighbours, the points merged into the curve); 0: off.
   int peak_refinements = 12;
