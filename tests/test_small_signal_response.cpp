@@ -1,5 +1,5 @@
 // SmallSignalModel::response (src/mechanics/linearise.cpp) solves its n x n system with
-// small_lu_solve, a heap-free copy of Eigen's partial-pivoting LU: the frequency response must
+// Eigen's PartialPivLU on max-size (stack) matrices, without heap: the frequency response must
 // be what Eigen's PartialPivLU<MatrixXcd> gives, bit for bit (the identify objective's
 // first-resonance target reads the peak of 4000 of them, so one flipped bit changes the search's
 // path). The reference below is the response as it was written with Eigen.

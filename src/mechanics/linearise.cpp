@@ -15,7 +15,6 @@
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
-#include "mechanics/small_lu.hpp"
 
 namespace gmasim {
 namespace {
@@ -207,10 +206,15 @@ SmallSignalModel linearise(const Model& m, const Conditions& c, const State& s) 
 
 namespace {
 
+constexpr int kSmallRods = 8;
+using SmallMatrix =
+    Eigen::Matrix<cd, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kSmallRods, kSmallRods>;
+using SmallVector = Eigen::Matrix<cd, Eigen::Dynamic, 1, Eigen::ColMajor, kSmallRods, 1>;
+
 // dM of the response at s = sj: the rods' port equations solved for dH (consistent), or the
 // circuit's lagged gains solved for dM, into the n-vector x. The n x n system goes into a
-// (column-major) and x, then small_lu_solve (Eigen's bits without its heap) for n <=
-// kSmallLuMax, Eigen's PartialPivLU beyond.
+// (column-major) and x, then Eigen's PartialPivLU: on max-size (stack) matrices up to
+// kSmallRods rods, on heap matrices beyond.
 void response_dM(const SmallSignalModel& L, cd sj, cd* a, cd* x) {
   const auto n = static_cast<std::size_t>(L.n);
   auto A = [&](std::size_t i, std::size_t j) -> cd& { return a[j * n + i]; };
@@ -230,10 +234,12 @@ void response_dM(const SmallSignalModel& L, cd sj, cd* a, cd* x) {
       for (std::size_t j = 0; j < n; ++j) A(i, j) -= lag_chi * L.G[i * n + j];
     }
   }
-  if (L.n <= mechanics_detail::kSmallLuMax) {
-    mechanics_detail::small_lu_solve(a, x, L.n);
+  const auto N = static_cast<Eigen::Index>(n);
+  if (L.n <= kSmallRods) {  // Eigen on stack storage: no heap in the markers' 4000 solves
+    const SmallVector r = Eigen::PartialPivLU<SmallMatrix>(Eigen::Map<SmallMatrix>(a, N, N))
+                              .solve(Eigen::Map<SmallVector>(x, N));
+    for (std::size_t i = 0; i < n; ++i) x[i] = r(static_cast<Eigen::Index>(i));
   } else {
-    const auto N = static_cast<Eigen::Index>(n);
     const Eigen::VectorXcd r = Eigen::Map<Eigen::MatrixXcd>(a, N, N).partialPivLu().solve(
         Eigen::Map<Eigen::VectorXcd>(x, N));
     for (std::size_t i = 0; i < n; ++i) x[i] = r(static_cast<Eigen::Index>(i));
@@ -247,9 +253,9 @@ void response_dM(const SmallSignalModel& L, cd sj, cd* a, cd* x) {
 std::complex<double> SmallSignalModel::response(double f_Hz) const {
   const auto un = static_cast<std::size_t>(n);
   const cd sj(0.0, kTwoPi * f_Hz);
-  constexpr std::size_t kMax = mechanics_detail::kSmallLuMax;
+  constexpr std::size_t kMax = kSmallRods;
   cd a_small[kMax * kMax], x_small[kMax];
-  std::vector<cd> a_big, x_big;  // only for more than kSmallLuMax rods
+  std::vector<cd> a_big, x_big;  // only for more than kSmallRods rods
   if (un > kMax) {
     a_big.resize(un * un);
     x_big.resize(un);
