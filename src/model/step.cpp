@@ -71,8 +71,8 @@ void advance_sensor_mount(const SensorMountModel& o, double q0_m, double q1_m, d
 // density B1), the eddy field of eq. (7) (trapezoid; at rest H_c = H), the histories of the
 // first guess and the slope mu_r = 1 + dM/dH.
 template <class Law>
-void commit_rod(const RodConditions& rc, RodState& r, const typename Law::Trial& trial, double H1,
-                double B0, double B1, bool quasi_static, double h_s) {
+void commit_rod(const RodConditions& rc, RodState& r, const typename Law::JointTrial& trial,
+                double H1, double B0, double B1, bool quasi_static, double h_s) {
   r.M_prev2_A_per_m = r.M_prev_A_per_m;
   r.M_prev_A_per_m = r.M_A_per_m;
   Law::commit_trial(rc, r, trial);
@@ -108,9 +108,10 @@ template <class Law>
 void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, double current_A,
                                 double pm_scale, double h_s, bool quasi_static, double t1) {
   const std::size_t n = s.rods.size();
-  std::array<double, 8> H{}, Mg{}, inv_mud{}, B0{}, e0{}, g{}, Bs{}, l_A{}, inv_A{};
-  std::array<typename Law::MoveStart, 8> start{};
-  std::array<typename Law::JointTrial, 8> trial{};
+  // Written for rods 0..n-1 before they are read (no zero fill: the hot path).
+  std::array<double, 8> H, Mg, inv_mud, B0, e0, g, Bs, l_A, inv_A;
+  std::array<typename Law::MoveStart, 8> start;
+  std::array<typename Law::JointTrial, 8> trial;
   for (std::size_t i = 0; i < n; ++i) {
     const auto& r = s.rods[i];
     const auto& rc = c.rods[i];
@@ -121,6 +122,7 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
     if (quasi_static) {
       H[i] = r.H_A_per_m;
       Mg[i] = r.M_A_per_m;
+      e0[i] = g[i] = 0.0;  // no eddy term at rest
     } else {
       e0[i] = r.Hc_A_per_m - r.H_A_per_m;
       g[i] = 2.0 * rc.eddy_geometry_s_m_per_H / h_s;
