@@ -87,6 +87,20 @@ void commit_rod(const RodConditions& rc, RodState& r, const typename Law::JointT
   r.phi_Wb = B1 * rc.area_m2;
 }
 
+// After a full (undamped) correction the iterate solves the circuit linearised at the last
+// iterate exactly: the rods' branches and the network are linear in (H, M, phi), and M* is on
+// the law's tangent. The next correction is then the circuit's response to the laws' own steps
+// M_next - M* alone (law_steps: the sum of their sizes): at fixed flux a rod's field moves by
+// -(M_next - M*) / mu_r, and the passive network's response adds at most as much, so
+// |dH| <= 2 law_steps. Where every law holds and that bound is within a quarter of every rod's
+// field tolerance, the iterate has converged without the confirming solve (one solve a step).
+inline bool next_correction_within_tolerance(std::size_t n, double law_steps,
+                                             const std::array<double, 8>& H) {
+  for (std::size_t i = 0; i < n; ++i)
+    if (!(2.0 * law_steps <= 0.25 * (1e-7 + 1e-11 * std::fabs(H[i])))) return false;
+  return true;
+}
+
 // Consistent magnetic state (docs/model.md, "Magnetic state"). At the end of the step every
 // rod i satisfies, with its own JA state (eq. 9) and the circuit (eq. 23):
 //   phi_i = A_i B_i,  B_i = mu0 (H_i + M_i(H_i)),  U_i = l_i H_c,i + R_s,i phi_i  (eq. 7, first
@@ -108,8 +122,7 @@ template <class Law>
 void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, double current_A,
                                 double pm_scale, double h_s, bool quasi_static, double t1) {
   const std::size_t n = s.rods.size();
-  // Written for rods 0..n-1 before they are read (no zero fill: the hot path).
-  std::array<double, 8> H, Mg, inv_mud, B0, e0, g, Bs, l_A, inv_A;
+  std::array<double, 8> H, Mg, inv_mud, B0, e0, g, Bs, l_A, inv_A;  // set before read (no fill)
   std::array<typename Law::MoveStart, 8> start;
   std::array<typename Law::JointTrial, 8> trial;
   for (std::size_t i = 0; i < n; ++i) {
@@ -145,19 +158,8 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
       s.circuit.rod_extra_mmf[i] =
           -rc.length_m * (H[i] - Bs[i] * inv_mud[i] - g[i] * B0[i] - e0[i]);
     }
-    // After a full (undamped) correction the iterate solves the circuit linearised at the last
-    // iterate exactly: the rods' branches and the network are linear in (H, M, phi), and M* is
-    // on the law's tangent. The next correction is then the circuit's response to the laws' own
-    // steps M_next - M* alone: at fixed flux a rod's field moves by -(M_next - M*) / mu_r, and
-    // the passive network's response adds at most as much, so |dH| <= 2 sum |M_next - M*|.
-    // Where every law holds and that bound is within a quarter of every rod's field tolerance,
-    // the iterate has converged without the confirming solve (one solve a step, not two).
-    if (it >= 1 && it <= 8 && laws_hold) {
-      bool confirmed = true;
-      for (std::size_t i = 0; i < n; ++i)
-        confirmed = confirmed && 2.0 * law_steps <= 0.25 * (1e-7 + 1e-11 * std::fabs(H[i]));
-      if (confirmed) break;
-    }
+    if (it >= 1 && it <= 8 && laws_hold && next_correction_within_tolerance(n, law_steps, H))
+      break;  // the iterate has converged without the confirming solve
     ++s.newton_solves;
     if (!solve_circuit(m.circuit, s.rod_reluctance, current_A, pm_scale, s.circuit,
                        s.energy.enabled))
