@@ -236,14 +236,14 @@ double potential_drop(const CircuitBranch& br, const Eigen::VectorXd& psi) {
 // in fixed storage, unrolled for K = 1..4 rods (the hot path of the consistent state's Newton
 // solve), K = 0 for any k <= 8. Allocation-free. False if a pivot is not positive.
 template <int K>
-bool rod_solve(const CircuitMatrices& L, const double* R, const double* mmf, double current_A,
-               double pm_scale, int k_any, NodalBuffers& ws) {
+bool rod_solve(const CircuitMatrices& L, const double* R, const double* inv_R, const double* mmf,
+               double current_A, double pm_scale, int k_any, NodalBuffers& ws) {
   const int k = K > 0 ? K : k_any;
   // Written before read (no zero fill: hot path).
   double A[64], DF[8], Btu[8], x[8], piv[8], inv_piv[8];
   const double* S = L.S8.data();
   for (int r = 0; r < k; ++r) {
-    DF[r] = mmf[r] / R[r];
+    DF[r] = mmf[r] * inv_R[r];
     Btu[r] = current_A * L.bt_coil8[r] + pm_scale * L.bt_pm8[r];
   }
   for (int r = 0; r < k; ++r) {
@@ -293,35 +293,41 @@ bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_
   const CircuitMatrices& L = *c.matrices;
   NodalBuffers& nb = *ws.nodal.get();
   const int k = static_cast<int>(c.rod_branch.size());
-  std::array<double, 8> mmf{};
-  for (int r = 0; r < k; ++r)
+  std::array<double, 8> mmf, inv_R;  // written for r < k before they are read
+  const double* R = rod_reluctance_per_H.data();
+  for (int r = 0; r < k; ++r) {
     mmf[static_cast<std::size_t>(r)] =
         branch_mmf(c.branches[static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)])],
                    current_A, pm_scale, ws);
-  const double* R = rod_reluctance_per_H.data();
+    inv_R[static_cast<std::size_t>(r)] = 1.0 / R[r];  // one division per rod branch and solve
+  }
   bool ok = false;
   switch (k) {
     case 1:
-      ok = rod_solve<1>(L, R, mmf.data(), current_A, pm_scale, k, nb);
+      ok = rod_solve<1>(L, R, inv_R.data(), mmf.data(), current_A, pm_scale, k, nb);
       break;
     case 2:
-      ok = rod_solve<2>(L, R, mmf.data(), current_A, pm_scale, k, nb);
+      ok = rod_solve<2>(L, R, inv_R.data(), mmf.data(), current_A, pm_scale, k, nb);
       break;
     case 3:
-      ok = rod_solve<3>(L, R, mmf.data(), current_A, pm_scale, k, nb);
+      ok = rod_solve<3>(L, R, inv_R.data(), mmf.data(), current_A, pm_scale, k, nb);
       break;
     case 4:
-      ok = rod_solve<4>(L, R, mmf.data(), current_A, pm_scale, k, nb);
+      ok = rod_solve<4>(L, R, inv_R.data(), mmf.data(), current_A, pm_scale, k, nb);
       break;
     default:
-      ok = rod_solve<0>(L, R, mmf.data(), current_A, pm_scale, k, nb);
+      ok = rod_solve<0>(L, R, inv_R.data(), mmf.data(), current_A, pm_scale, k, nb);
   }
   if (!ok) return false;
   // The rod fluxes from the k x k solve, phi_r = (drop_r + F_r) / R_r (the same numbers
   // whether or not the other branches are wanted); the others from the node potentials.
-  for (int r = 0; r < k; ++r)
-    set_flux(c, static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)]),
-             rod_reluctance_per_H, current_A, pm_scale, nb.v(r), ws);
+  for (int r = 0; r < k; ++r) {
+    const auto ur = static_cast<std::size_t>(r);
+    const auto b = static_cast<std::size_t>(c.rod_branch[ur]);
+    ws.reluctance[b] = R[r];
+    ws.mmf[b] = mmf[ur];
+    ws.phi[b] = (nb.v(r) + mmf[ur]) * inv_R[ur];
+  }
   if (!all_branches) return true;
   nb.rhs.noalias() = current_A * L.psi_coil + pm_scale * L.psi_pm;
   nb.rhs.noalias() -= L.W * nb.z;

@@ -36,8 +36,11 @@ struct JilesAthertonLaw {
   struct Trial {
     double M, dM_dH, Mirr;
   };
+  // The move starts where the law's last evaluation left the Langevin function, when it is
+  // near (RodState::an_x; physics::ja_move_start_near): the step's start is the last end.
   static MoveStart begin_move(const RodConditions& rc, const RodState& r) {
-    return physics::ja_move_start(r.H_A_per_m, r.M_A_per_m, rc.MsT_mag, rc.ja);
+    return physics::ja_move_start_near(r.H_A_per_m, r.M_A_per_m, rc.MsT_mag, rc.ja, r.an_x,
+                                       {r.an_L, r.an_dL});
   }
   static Trial trial_from(const RodConditions& rc, const RodState& r, const MoveStart& st,
                           double H1, double M_guess) {
@@ -58,6 +61,8 @@ struct JilesAthertonLaw {
   // ja_step_from from the Newton-corrected guess, as before the joint solve: M_next = M.
   struct JointTrial : Trial {
     double inv_mu_r, M_next;
+    double an_x;                   // where the law was evaluated (H_e / a)
+    physics::LangevinValue an_lv;  // L and L' there
     bool converged;
   };
   static void joint_trial(const RodConditions& rc, const RodState& r, const MoveStart& st,
@@ -68,9 +73,13 @@ struct JilesAthertonLaw {
       physics::ja_step_from(r.H_A_per_m, st, H1, rc.MsT_mag, rc.ja, r.Mirr_A_per_m, r.M_A_per_m,
                             M_iter, t.Mirr, t.M, chi_e);
       M_iter = t.M;
+      t.an_x = r.an_x;  // nothing evaluated: the rod's own point stays
+      t.an_lv = {r.an_L, r.an_dL};
     } else {
-      const physics::JaEvaluation e = physics::ja_evaluate(st, H1, M_iter, rc.MsT_mag, rc.ja,
-                                                           r.Mirr_A_per_m, 1.0 / rc.ja.a_A_per_m);
+      const physics::JaEvaluation e =
+          physics::ja_evaluate(st, H1, M_iter, rc.MsT_mag, rc.ja, r.Mirr_A_per_m, st.inv_a);
+      t.an_x = e.x1;
+      t.an_lv = e.lv;
       t.Mirr = e.Mirr1;
       t.M = e.M;
       chi_e = e.chi_e;
@@ -92,6 +101,12 @@ struct JilesAthertonLaw {
   static void commit_trial(const RodConditions&, RodState& r, const Trial& t) {
     r.Mirr_A_per_m = t.Mirr;
     r.M_A_per_m = t.M;
+  }
+  static void commit_trial(const RodConditions& rc, RodState& r, const JointTrial& t) {
+    commit_trial(rc, r, static_cast<const Trial&>(t));
+    r.an_x = t.an_x;
+    r.an_L = t.an_lv.L;
+    r.an_dL = t.an_lv.dL;
   }
 
   // The same move, committed: r's M_irr and M at H1 (r.H_A_per_m is the caller's to set).

@@ -1,29 +1,60 @@
-// The mechanics module (docs/layers.md, "The mechanics module"): the update of one oscillator
-// row of eq. (15) over a time step, which step() calls for every rod. The chain's modes and
-// the small-signal linearisation are in gmasim/mechanics/mechanics.hpp.
+// The mechanics module (docs/layers.md, "The mechanics module"): the update of
+// one oscillator row of eq. (15) over a time step, which step() calls for every
+// rod. The chain's modes and the small-signal linearisation are in
+// gmasim/mechanics/mechanics.hpp.
 #pragma once
 
 #include <cmath>
 
 namespace gmasim::physics {
 
-// Exact update of one diagonal row of eq. (15),  m x'' + c x' + k x = F(t),  over a step
-// h with F linear from F0 to F1 (first-order hold) and m, c, k frozen over the step.
-// The homogeneous part is propagated with its closed-form solution (under-, critically
-// or over-damped), the ramp by its particular solution, so the update is exact for
-// piecewise-linear forcing and unconditionally stable: the step is not limited by the
-// 7-20 kHz mechanical modes. Updates x [m] and v [m/s].
-inline void oscillator_step(double m, double c, double k, double F0, double F1, double h, double& x,
-                            double& v) {
-  const double g = (F1 - F0) / h;  // force rate [N/s]
-  // Particular solution x_p(s) = (F0 + g s)/k - g c / k^2, v_p = g / k.
-  const double xp0 = (F0 - g * c / k) / k;
-  const double vp = g / k;
-  const double e0 = x - xp0;
-  const double ed0 = v - vp;
+// The transition matrix of the free row, m e'' + c e' + k e = 0, over a step h:
+// with A h = [[0, h], [-k h / m, -c h / m]] (trace tau = -c h / m, determinant
+// delta = k h^2 / m), exp(A h) = f0 I + f1 A h. N = A h - tau/2 I has N^2 = u
+// I, u = tau^2/4 - delta = -(w_d h)^2, so exp(N) = C I + S N with C = sum u^j /
+// (2j)! (cos w_d h) and S = sum u^j / (2j+1)! (sin(w_d h) / (w_d h); cosh and
+// sinh where u > 0, over-damped), and
+//   f1 = e^(tau/2) S,   f0 = e^(tau/2) (C - tau/2 S).
+// Where |u| <= 1/4 (w_d h <= 1/2: at least 12 steps per period) C and S are
+// summed to u^7 (truncation below 1e-18; Estrin's scheme), e^(tau/2) likewise
+// to (tau/2)^7 where |tau/2| <= 1/64 (below 1e-19) and by std::exp beyond: no
+// sincos or square root, every damping alike. valid = false beyond |u| = 1/4:
+// the closed form.
+struct OscillatorPropagator {
+  double f0, f1;
+  bool valid;
+};
+// c0 + c1 x + ... + c7 x^7 by Estrin's scheme (short dependency chains).
+inline double polynomial7(double x, const double (&c)[8]) {
+  const double x2 = x * x, x4 = x2 * x2;
+  return (c[0] + c[1] * x) + x2 * (c[2] + c[3] * x) +
+         x4 * ((c[4] + c[5] * x) + x2 * (c[6] + c[7] * x));
+}
+inline OscillatorPropagator oscillator_propagator(double tau, double delta) {
+  const double half_tau = 0.5 * tau;
+  const double u = half_tau * half_tau - delta;
+  if (!(std::fabs(u) <= 0.25)) return {0.0, 0.0, false};
+  constexpr double kCos[8] = {1.0,         1.0 / 2,       1.0 / 24,          1.0 / 720,
+                              1.0 / 40320, 1.0 / 3628800, 1.0 / 479001600.0, 1.0 / 87178291200.0};
+  constexpr double kSinc[8] = {
+      1.0,          1.0 / 6,          1.0 / 120,          1.0 / 5040,
+      1.0 / 362880, 1.0 / 39916800.0, 1.0 / 6227020800.0, 1.0 / 1307674368000.0};
+  constexpr double kExp[8] = {1.0,      1.0,       1.0 / 2,   1.0 / 6,
+                              1.0 / 24, 1.0 / 120, 1.0 / 720, 1.0 / 5040};
+  const double C = polynomial7(u, kCos), S = polynomial7(u, kSinc);
+  const double E =
+      std::fabs(half_tau) <= 1.0 / 64 ? polynomial7(half_tau, kExp) : std::exp(half_tau);
+  return {E * (C - half_tau * S), E * S, true};
+}
+
+// The closed form of the free row over h (under-, critically or over-damped)
+// from (e0, e0'): where the series of oscillator_propagator does not apply
+// (long steps).
+[[gnu::noinline]] inline void oscillator_free_closed_form(double m, double c, double k, double h,
+                                                          double e0, double ed0, double &e1,
+                                                          double &ed1) {
   const double wn = std::sqrt(k / m);
   const double zeta = c / (2.0 * std::sqrt(k * m));
-  double e1 = 0.0, ed1 = 0.0;
   if (zeta < 1.0 - 1e-9) {
     const double wd = wn * std::sqrt(1.0 - zeta * zeta);
     const double decay = std::exp(-zeta * wn * h);
@@ -44,7 +75,36 @@ inline void oscillator_step(double m, double c, double k, double F0, double F1, 
     e1 = (e0 + B * h) * E;
     ed1 = (B - wn * (e0 + B * h)) * E;
   }
-  const double xp1 = (F1 - g * c / k) / k;
+}
+
+// Exact update of one diagonal row of eq. (15),  m x'' + c x' + k x = F(t),
+// over a step h with F linear from F0 to F1 (first-order hold) and m, c, k
+// frozen over the step. The homogeneous part is propagated with its closed-form
+// solution (under-, critically or over-damped; by its series where the step is
+// short against the row's period: oscillator_propagator), the ramp by its
+// particular solution, so the update is exact for piecewise-linear forcing and
+// unconditionally stable: the step is not limited by the 7-20 kHz mechanical
+// modes. Updates x [m] and v [m/s].
+inline void oscillator_step(double m, double c, double k, double F0, double F1, double h, double &x,
+                            double &v) {
+  const double g = (F1 - F0) / h;  // force rate [N/s]
+  // Particular solution x_p(s) = (F0 + g s)/k - g c / k^2, v_p = g / k.
+  const double inv_k = 1.0 / k;
+  const double xp0 = (F0 - g * c * inv_k) * inv_k;
+  const double vp = g * inv_k;
+  const double e0 = x - xp0;
+  const double ed0 = v - vp;
+  double e1 = 0.0, ed1 = 0.0;
+  const double inv_m = 1.0 / m;
+  const double c_m = c * inv_m, k_m = k * inv_m;
+  const OscillatorPropagator pr = oscillator_propagator(-c_m * h, k_m * h * h);
+  if (pr.valid) [[likely]] {
+    e1 = pr.f0 * e0 + pr.f1 * h * ed0;
+    ed1 = pr.f0 * ed0 - pr.f1 * h * (k_m * e0 + c_m * ed0);
+  } else {
+    oscillator_free_closed_form(m, c, k, h, e0, ed0, e1, ed1);
+  }
+  const double xp1 = (F1 - g * c * inv_k) * inv_k;
   x = xp1 + e1;
   v = vp + ed1;
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <limits>
 #include <map>
 #include <string>
 #include <utility>
@@ -362,6 +363,10 @@ struct RodState {
                                // the law's first guess); stage 2
   double M_prev2_A_per_m = 0;  // M two steps earlier (consistent state: the law's first guess)
   double F_N = 0;              // force at the end of the last step (eq. 14); stage 3
+  // The Langevin function of eq. (9) where the consistent state's last law evaluation left it:
+  // x = H_e / a, L(x), L'(x) (the next move's start M_an from them when near:
+  // physics::ja_move_start_near); NaN: none. Stage 2, consistent state, Jiles-Atherton only.
+  double an_x = std::numeric_limits<double>::quiet_NaN(), an_L = 0, an_dL = 0;
   // reported
   double mu_r = 1;    // eq. (3) at the extrapolated M, stage 1 (printed); the JA differential
                       // permeability 1 + dM/dH, stage 2 (consistent)

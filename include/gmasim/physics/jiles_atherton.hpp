@@ -9,7 +9,8 @@
 namespace gmasim::physics {
 
 // Langevin function L(x) = coth x - 1/x and its derivative L'(x) = 1/x^2 - 1/sinh^2 x,
-// from one exponential; Taylor series for |x| < 0.1 (truncation below 1e-16 relative).
+// from one exponential and one division (1/(x (1 - e)) gives 1/x and 1/(1 - e)); Taylor
+// series for |x| < 0.1 (truncation below 1e-16 relative).
 struct LangevinValue {
   double L, dL;
 };
@@ -22,12 +23,17 @@ inline LangevinValue langevin_pair(double x) {
             1.0 / 3.0 -
                 x2 * (1.0 / 15.0 - x2 * (2.0 / 189.0 - x2 * (1.0 / 675.0 - x2 * (2.0 / 10395.0))))};
   }
-  const double inv_x = 1.0 / x;
-  if (ax > 40.0) return {(x > 0 ? 1.0 : -1.0) - inv_x, inv_x * inv_x};
+  if (ax > 40.0) {
+    const double inv_x = 1.0 / x;
+    return {(x > 0 ? 1.0 : -1.0) - inv_x, inv_x * inv_x};
+  }
   const double e = std::exp(-2.0 * ax);  // coth|x| = (1+e)/(1-e)
   const double one_minus_e = 1.0 - e;
-  const double coth_abs = (1.0 + e) / one_minus_e;
-  const double inv_sinh2 = 4.0 * e / (one_minus_e * one_minus_e);
+  const double q = 1.0 / (x * one_minus_e);
+  const double inv_x = one_minus_e * q;
+  const double inv_1me = x * q;  // 1 / (1 - e)
+  const double coth_abs = (1.0 + e) * inv_1me;
+  const double inv_sinh2 = 4.0 * e * inv_1me * inv_1me;
   return {(x > 0 ? coth_abs : -coth_abs) - inv_x, inv_x * inv_x - inv_sinh2};
 }
 inline double langevin(double x) { return langevin_pair(x).L; }
@@ -130,9 +136,10 @@ inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, dou
     u0 = Mirr0;
   }
   const double r = s / k_A_per_m;
-  const LagWeights w = lag_weights(r);
-  // d/dHe1 through M_an1 (weight 1 - q) and through r = s/k (dq/dr = (E - q)/r).
-  const double dq_dr = r > 1e-12 ? (w.E - w.q) / r : -0.5;
+  // d/dHe1 through M_an1 (weight 1 - q) and through r = s/k (dq/dr = (E - q)/r): one
+  // reciprocal of r for q and dq/dr (lag_weights_and_slope).
+  const LagWeightsSlope w = lag_weights_and_slope(r);
+  const double dq_dr = w.dq_dr;
   dMirr_dHe1 =
       (1.0 - w.q) * dMan1 + ds_dHe1 / k_A_per_m * (-(Mirr0 - u0) * w.E - (Man1 - u0) * dq_dr);
   return Man1 + (Mirr0 - u0) * w.E - (Man1 - u0) * w.q;
@@ -150,11 +157,28 @@ inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, dou
 // At H1 == H0 nothing moves: M_irr1 = M_irr0, M1 = M0 and chi_e is the reversible c dM_an/dH_e.
 struct JaMoveStart {
   double He0, Man0;
+  double inv_a;  // 1 / a^T, for the move's evaluations (ja_evaluate)
 };
 inline JaMoveStart ja_move_start(double H0, double M0, double MsT_A_per_m,
                                  const JaCoefficients& p) {
   const double He0 = H0 + p.alpha * M0;
-  return {He0, MsT_A_per_m * langevin(He0 * (1.0 / p.a_A_per_m))};
+  const double inv_a = 1.0 / p.a_A_per_m;
+  return {He0, MsT_A_per_m * langevin(He0 * inv_a), inv_a};
+}
+// ja_move_start with the Langevin function known at a nearby x_at = H_e / a (L and L' there,
+// lv; the last evaluation of the law, where the last step ended): where |H_e0 / a - x_at| <=
+// 1e-7, M_an(H_e0) = M_s^T (L(x_at) + L'(x_at) (x0 - x_at)), whose truncation (|L''| <= 0.5:
+// below 3e-15 M_s^T) is far below eq. (9)'s tolerance; otherwise ja_move_start. x_at NaN:
+// nothing known. (The consistent state commits its last iterate, so a step starts within
+// about alpha 1e-12 M_s^T / a of it: one exponential less per rod and step.)
+inline JaMoveStart ja_move_start_near(double H0, double M0, double MsT_A_per_m,
+                                      const JaCoefficients& p, double x_at,
+                                      const LangevinValue& lv) {
+  const double He0 = H0 + p.alpha * M0;
+  const double inv_a = 1.0 / p.a_A_per_m;
+  const double x0 = He0 * inv_a;
+  if (std::fabs(x0 - x_at) <= 1e-7) return {He0, MsT_A_per_m * (lv.L + lv.dL * (x0 - x_at)), inv_a};
+  return {He0, MsT_A_per_m * langevin(x0), inv_a};
 }
 // One evaluation of eq. (9) at the end field H1 and a magnetisation iterate M1 (inv_a = 1/a):
 // M_irr1 from ja_irreversible_update, the magnetisation the law gives there,
@@ -164,6 +188,8 @@ inline JaMoveStart ja_move_start(double H0, double M0, double MsT_A_per_m,
 // takes one per circuit solve).
 struct JaEvaluation {
   double Mirr1, M, chi_e;
+  double x1;         // H_e1 / a, where the Langevin function was evaluated
+  LangevinValue lv;  // L and L' at x1
 };
 inline JaEvaluation ja_evaluate(const JaMoveStart& st, double H1, double M1, double MsT_A_per_m,
                                 const JaCoefficients& p, double Mirr0, double inv_a) {
@@ -174,7 +200,8 @@ inline JaEvaluation ja_evaluate(const JaMoveStart& st, double H1, double M1, dou
   double dMirr = 0.0;
   const double Mirr1 =
       ja_irreversible_update(Mirr0, st.Man0, Man1, dMan, He1 - st.He0, p.k_A_per_m, dMirr);
-  return {Mirr1, (1.0 - p.c) * Mirr1 + p.c * Man1, (1.0 - p.c) * dMirr + p.c * dMan};
+  return {Mirr1, (1.0 - p.c) * Mirr1 + p.c * Man1, (1.0 - p.c) * dMirr + p.c * dMan, He1 * inv_a,
+          lv};
 }
 // The tolerance on g = M1 - F(M1) at which eq. (9) counts as solved [A/m]: 1e-12 M_s^T.
 inline double ja_magnetisation_tolerance(double MsT_A_per_m) { return 1e-12 * MsT_A_per_m; }

@@ -142,6 +142,23 @@ inline LagWeights lag_weights(double r) {
   return {E, (1.0 - E) / r};
 }
 
+// lag_weights with dq/dr = (E - q) / r beside them (ja_irreversible_update), from one
+// reciprocal of r; dq/dr = -1/2 at r <= 1e-12.
+struct LagWeightsSlope {
+  double E, q, dq_dr;
+};
+inline LagWeightsSlope lag_weights_and_slope(double r) {
+  const double E = std::exp(-r);
+  if (r < 1e-2) {
+    const double q =
+        1.0 - r * (1.0 / 2 - r * (1.0 / 6 - r * (1.0 / 24 - r * (1.0 / 120 - r * (1.0 / 720)))));
+    return {E, q, r > 1e-12 ? (E - q) / r : -0.5};
+  }
+  const double inv_r = 1.0 / r;
+  const double q = (1.0 - E) * inv_r;
+  return {E, q, (E - q) * inv_r};
+}
+
 // Exact update of the first-order lag  tau dH/dt = u(t) - H  over one step h with u
 // linear from u0 to u1 (first-order hold):
 //   H1 = u1 + (H0 - u0) E - (u1 - u0) q,   E = exp(-h/tau), q = (1 - E) tau/h.
