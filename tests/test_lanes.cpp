@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "alloc_counter.hpp"
+#include "builtin_models.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/identify/identify.hpp"
@@ -23,12 +24,9 @@
 
 namespace {
 
-using namespace gmasim;
+using gmasim_test::mdma;
 
-const Model& builtin() {
-  static const Model m = load_model("");
-  return m;
-}
+using namespace gmasim;
 
 // n simulations at rest: temperatures 20..75 degC, 10 Hz biased sines of 4..10 A.
 struct Runs {
@@ -37,16 +35,16 @@ struct Runs {
   std::vector<double> pp;
   explicit Runs(std::size_t n) {
     for (std::size_t i = 0; i < n; ++i) {
-      c.push_back(make_conditions(builtin(), 20.0 + 5.0 * static_cast<double>(i)));
+      c.push_back(make_conditions(mdma(), 20.0 + 5.0 * static_cast<double>(i)));
       pp.push_back(4.0 + 0.5 * static_cast<double>(i % 13));
-      s.push_back(make_state(builtin(), c.back(), 0.0));
+      s.push_back(make_state(mdma(), c.back(), 0.0));
     }
   }
   double current(std::size_t i, double t) const {
     return 0.5 * pp[i] * (1.0 - std::cos(2.0 * 3.141592653589793 * 10.0 * t));
   }
   LaneBatch batch() const {
-    std::vector<const Model*> m(c.size(), &builtin());
+    std::vector<const Model*> m(c.size(), &mdma());
     std::vector<const Conditions*> cp;
     std::vector<const State*> sp;
     for (std::size_t i = 0; i < c.size(); ++i) {
@@ -191,7 +189,7 @@ TEST(Lanes, FollowTheScalarStep) {
     for (std::size_t i = 0; i < n; ++i) {
       cur[i] = runs.current(i, t);
       t1[i] = t;
-      step(builtin(), runs.c[i], scalar[i], {cur[i], kDt});
+      step(mdma(), runs.c[i], scalar[i], {cur[i], kDt});
       scalar[i].t_s = t;
     }
     b.step(cur, dt, t1);
@@ -251,7 +249,7 @@ TEST(Lanes, DivergenceIsPerLane) {
   try {
     for (long k = 1; k <= 200; ++k) {
       const double t = static_cast<double>(k) * kDt;
-      step(builtin(), runs.c[2], s, {runs.current(2, t), kDt});
+      step(mdma(), runs.c[2], s, {runs.current(2, t), kDt});
       s.t_s = t;
     }
   } catch (const DivergenceError& err) {
@@ -322,7 +320,7 @@ TEST(Lanes, RecordIsTheUnpackedStatesRow) {
 // the lanes do not mirror yet); tolerance 5e-9. The ramp's increment allocates nothing.
 TEST(Lanes, MakeStatesMatchMakeState) {
   const Runs runs(9);
-  std::vector<const Model*> m(9, &builtin());
+  std::vector<const Model*> m(9, &mdma());
   std::vector<const Conditions*> c;
   std::vector<double> I0;
   for (std::size_t i = 0; i < 9; ++i) {
@@ -332,7 +330,7 @@ TEST(Lanes, MakeStatesMatchMakeState) {
   const std::vector<State> got = make_states(m, c, I0);
   double worst = 0.0;
   for (std::size_t i = 0; i < 9; ++i) {
-    const State ref = make_state(builtin(), runs.c[i], I0[i]);
+    const State ref = make_state(mdma(), runs.c[i], I0[i]);
     auto rel = [&](double x, double r, double scale) {
       const double e = std::fabs(x - r) / scale;
       worst = std::max(worst, e);
@@ -383,10 +381,10 @@ TEST(Lanes, SimulateLanesMatchesSimulate) {
       s.periods = 1;
       set.push_back(s);
     }
-  const std::vector<Result> got = simulate_lanes(builtin(), set);
+  const std::vector<Result> got = simulate_lanes(mdma(), set);
   ASSERT_EQ(got.size(), set.size());
   for (std::size_t i = 0; i < set.size(); ++i) {
-    const Result ref = simulate(builtin(), set[i]);
+    const Result ref = simulate(mdma(), set[i]);
     ASSERT_FALSE(got[i].diverged) << got[i].error;
     ASSERT_TRUE(got[i].has_metrics);
     EXPECT_EQ(got[i].series.rows(), ref.series.rows());
@@ -407,7 +405,7 @@ TEST(Lanes, ObjectiveResidualsMatchTheScalarRuns) {
   req.noise_pct = 0.0;
   req.flux_noise_pct = 0.0;
   req.objective.steps_per_period = 100;
-  const MeasurementSet data = synthesize_measurements(builtin(), req);
+  const MeasurementSet data = synthesize_measurements(mdma(), req);
   const FitSpec fit = load_fit_spec("rod1.ja.k0_A_per_m:1500:6000:log,material.chi_m:8:50:log");
   ObjectiveSettings s;
   s.steps_per_period = 100;
