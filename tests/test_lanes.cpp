@@ -121,9 +121,8 @@ TEST(Lanes, EachLaneEqualsTheWidthOneInstance) {
 // The fallback targets (SSE4: 2 lanes, and the portable EMU128 the baseline build compiles)
 // give each lane the width-1 numbers too, and the same run as the best target to the
 // rounding of FMA-based vs separate multiply-add in Highway's exp/cos (observed 4.8e-13,
-// tolerance 1e-10). The CI's sanitizer build compiles AVX2 and EMU128 only (CMakeLists.txt,
-// HWY_DISABLED_TARGETS): there the fallback tried is EMU128 (HWY_SCALAR with GCC < 12.3,
-// whose EMU128 Highway marks broken) against AVX2.
+// tolerance 1e-10). The CI's sanitizer build compiles AVX2, SSE4 and the scalar baseline only
+// (CMakeLists.txt, HWY_DISABLED_TARGETS): there the fallback tried is SSE4 against AVX2.
 TEST(Lanes, FallbackTargetsAgree) {
   const Runs runs(5);
   auto run = [&](LaneBatch& b, std::vector<double>& last) {
