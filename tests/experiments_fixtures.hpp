@@ -1,9 +1,11 @@
 // Shared pieces of the experiment tests (test_experiments.cpp, test_frf.cpp, test_track.cpp,
-// test_experiments_cli.cpp): the two readings of the built-in model and an InputError probe.
+// test_experiments_cli.cpp): the two readings of the built-in model (builtin_models.hpp) and an
+// InputError probe.
 #pragma once
 
 #include <string>
 
+#include "builtin_models.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io/io.hpp"
 #include "gmasim/model/model.hpp"
@@ -11,17 +13,8 @@
 
 namespace gmasim_experiments_test {
 
-inline const gmasim::Model& mdma() {
-  static const gmasim::Model m = gmasim::load_model("");
-  return m;
-}
-
-// The paper-as-printed reading (models/mdma_printed.toml): eq. 2, 3, 7, 10, 11 as printed.
-inline const gmasim::Model& mdma_printed() {
-  static const gmasim::Model m =
-      gmasim::load_model(std::string(GMASIM_SOURCE_DIR) + "/models/mdma_printed.toml");
-  return m;
-}
+using gmasim_test::mdma;
+using gmasim_test::mdma_printed;
 
 inline constexpr double kTwoPi = 2.0 * gmasim::physics::kPi;
 

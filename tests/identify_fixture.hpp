@@ -27,7 +27,7 @@ inline gmasim::ModelSpec printed_spec() {
 }
 
 // The printed reading, compiled once.
-inline const gmasim::Model& mdma() {
+inline const gmasim::Model& printed_fixture() {
   static const gmasim::Model m = gmasim::compile(printed_spec());
   return m;
 }

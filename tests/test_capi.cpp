@@ -36,7 +36,7 @@ struct SimDeleter {
 using ModelHandle = std::unique_ptr<gmasim_model, ModelDeleter>;
 using SimHandle = std::unique_ptr<gmasim_sim, SimDeleter>;
 
-ModelHandle builtin() {
+ModelHandle builtin_handle() {
   gmasim_model* m = nullptr;
   EXPECT_EQ(gmasim_model_load(nullptr, &m), GMASIM_OK) << gmasim_last_error();
   return ModelHandle(m);
@@ -65,7 +65,7 @@ TEST(CApi, VersionAndStatusNames) {
 }
 
 TEST(CApi, SimStepAllocatesNothing) {
-  ModelHandle m = builtin();
+  ModelHandle m = builtin_handle();
   SimHandle s = make_sim(m.get(), 70.0, 1e-5, -3.0);
   const gmasim::Waveform w = gmasim::biased_sine(8.0, 200.0);
   ASSERT_EQ(gmasim_sim_step(s.get(), w.current_at(1e-5)), GMASIM_OK);  // warm-up
@@ -100,7 +100,7 @@ TEST(CApi, SteppingIsBitIdenticalToGmasimStep) {
   const gmasim::Conditions c = gmasim::make_conditions(model, T);
   gmasim::State st = gmasim::make_state(model, c, w.current_at(0.0));
 
-  ModelHandle m = builtin();
+  ModelHandle m = builtin_handle();
   SimHandle s = make_sim(m.get(), T, dt, w.current_at(0.0));
   ASSERT_EQ(y_of(s.get()), st.y_m);
   int mismatches = 0;
@@ -126,7 +126,7 @@ TEST(CApi, SteppingIsBitIdenticalToGmasimStep) {
 }
 
 TEST(CApi, GettersReportTheState) {
-  ModelHandle m = builtin();
+  ModelHandle m = builtin_handle();
   int rods = 0;
   ASSERT_EQ(gmasim_model_rod_count(m.get(), &rods), GMASIM_OK);
   ASSERT_EQ(rods, 3);
@@ -185,7 +185,7 @@ TEST(CApi, GettersReportTheState) {
 }
 
 TEST(CApi, ResetAndTemperatureChange) {
-  ModelHandle m = builtin();
+  ModelHandle m = builtin_handle();
   SimHandle s = make_sim(m.get(), 20.0, 1e-5, 0.0);
   std::vector<double> first, second;
   for (int k = 1; k <= 300; ++k) {
@@ -240,7 +240,7 @@ TEST(CApi, NullHandlesAndPointersAreArgumentErrors) {
   EXPECT_EQ(s, nullptr);  // *out is cleared on failure
   EXPECT_THAT(gmasim_last_error(), HasSubstr("model is NULL"));
 
-  ModelHandle m = builtin();
+  ModelHandle m = builtin_handle();
   SimHandle sim = make_sim(m.get(), 20.0, 1e-5, 0.0);
   EXPECT_EQ(gmasim_sim_y_m(sim.get(), nullptr), GMASIM_E_ARGUMENT);
   EXPECT_THAT(gmasim_sim_last_error(sim.get()), HasSubstr("gmasim_sim_y_m: out is NULL"));
@@ -302,7 +302,7 @@ TEST(CApi, FreedAndUnknownHandlesAreErrorCodes) {
 }
 
 TEST(CApi, BadNumbersAreRefusedAndLeaveTheSimUntouched) {
-  ModelHandle m = builtin();
+  ModelHandle m = builtin_handle();
   SimHandle s = make_sim(m.get(), 20.0, 1e-5, 0.0);
   ASSERT_EQ(gmasim_sim_step(s.get(), 1.0), GMASIM_OK);
   gmasim_outputs before, after;
@@ -359,7 +359,7 @@ TEST(CApi, BadModelsNameTheFile) {
   // The built-in text loads the same model as the built-in path.
   ASSERT_EQ(gmasim_model_load_string(gmasim::kBuiltinModelToml, "mdma.toml", &m), GMASIM_OK);
   ModelHandle from_text(m);
-  ModelHandle from_path = builtin();
+  ModelHandle from_path = builtin_handle();
   SimHandle a = make_sim(from_text.get(), 60.0, 1e-5, 2.0);
   SimHandle b = make_sim(from_path.get(), 60.0, 1e-5, 2.0);
   for (int k = 0; k < 100; ++k) {

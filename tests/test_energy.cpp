@@ -14,6 +14,7 @@
 #include <map>
 #include <string>
 
+#include "builtin_models.hpp"
 #include "gmasim/io/io.hpp"
 #include "gmasim/model/energy.hpp"
 #include "gmasim/model/model.hpp"
@@ -25,10 +26,7 @@ using namespace gmasim;
 
 namespace {
 
-const Model& mdma() {
-  static const Model m = load_model("");
-  return m;
-}
+using gmasim_test::mdma;
 
 // The automatic step of a periodic run (docs/model.md, "Time step"): T/2000, at most 10 us.
 int steps_per_period(double f_Hz) {

@@ -22,7 +22,7 @@ using namespace gmasim_experiments_test;
 namespace {
 
 // The sine reference's deviation and derivatives at t (as the tracking loop previews it).
-std::array<double, 4> sine(double A_um, double f_Hz, double t) {
+std::array<double, 4> target_sine(double A_um, double f_Hz, double t) {
   const double w = kTwoPi * f_Hz, s = A_um * std::sin(w * t), c = A_um * std::cos(w * t);
   return {s, w * c, -w * w * s, -w * w * w * c};
 }
@@ -66,7 +66,7 @@ TEST(Feedforward, QuasiStaticInverseReproducesTheTargetsOnTheHysteresisLoop) {
   State s = make_state(m, c, set.bias_A);
   double worst = 0.0, i_min = 1e9, i_max = -1e9;
   for (int k = 0; k < 400; ++k) {  // two periods of a 20 um sine, 200 samples each
-    const double I = ff.current_A(sine(20.0, 1.0, k / 200.0));
+    const double I = ff.current_A(target_sine(20.0, 1.0, k / 200.0));
     quasi_static_step(m, c, s, I);
     worst = std::max(worst, std::fabs(s.y_m * 1e6 - ff.last_target_um()));
     i_min = std::min(i_min, I);
@@ -91,7 +91,7 @@ TEST(Feedforward, CurrentStaysWithinTheDriveLimits) {
   InverseFeedforward ff(m, 20.0, set);
   double i_min = 1e9, i_max = -1e9;
   for (int k = 0; k < 2000; ++k) {
-    const double I = ff.current_A(sine(40.0, 100.0, k * 1e-4));
+    const double I = ff.current_A(target_sine(40.0, 100.0, k * 1e-4));
     i_min = std::min(i_min, I);
     i_max = std::max(i_max, I);
   }
@@ -127,11 +127,11 @@ TEST(Feedforward, PerfectPlantTrackingErrorFalls) {
 // One sample of the feed-forward allocates nothing.
 TEST(Feedforward, SampleIsAllocationFree) {
   InverseFeedforward ff(mdma(), 20.0, {});
-  (void)ff.current_A(sine(20.0, 100.0, 0.0));
+  (void)ff.current_A(target_sine(20.0, 100.0, 0.0));
   gmasim_test::g_allocations = 0;
   gmasim_test::g_counting = true;
   double sum = 0.0;
-  for (int k = 1; k < 200; ++k) sum += ff.current_A(sine(20.0, 100.0, k * 1e-4));
+  for (int k = 1; k < 200; ++k) sum += ff.current_A(target_sine(20.0, 100.0, k * 1e-4));
   gmasim_test::g_counting = false;
   EXPECT_EQ(gmasim_test::g_allocations.load(), 0);
   EXPECT_TRUE(std::isfinite(sum));

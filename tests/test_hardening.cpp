@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "builtin_models.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/identify/identify.hpp"
@@ -32,10 +33,7 @@ using namespace gmasim;
 
 namespace {
 
-const Model& builtin() {
-  static const Model m = compile(builtin_model_spec());
-  return m;
-}
+using gmasim_test::mdma;
 
 Model builtin_with(const std::string& key, double value) {
   ModelSpec spec = builtin_model_spec();
@@ -86,7 +84,7 @@ TEST(Hardening, Item1OutputsNeverOverwriteInputs) {
 // At the smallest step the state is held at constant current (the limit keeps a factor 1e8
 // from where it is not, near 1e-24 s); a shorter step is refused everywhere.
 TEST(Hardening, Item2SmallestStepHoldsTheStateAndShorterIsRefused) {
-  auto m = std::make_shared<const Model>(builtin());
+  auto m = std::make_shared<const Model>(mdma());
   for (double I : {0.0, 5.0}) {
     Stepper st(m, 20.0, kMinStepDt_s, I);
     const double y0 = st.y_m();
@@ -121,12 +119,12 @@ TEST(Hardening, Item3GuardEndsPhysicallyImpossibleRuns) {
               HasSubstr("beyond the compressive strength of Terfenol-D"));
   // The guard never fires on the built-in model where it is valid: 20-150 degC, 6-12 A p-p,
   // 10-400 Hz (the grid of `model check`).
-  const MagneticStateCheck k = check_magnetic_state(builtin());
+  const MagneticStateCheck k = check_magnetic_state(mdma());
   EXPECT_EQ(k.divergence, "");
 }
 
 TEST(Hardening, Item3ModelWarningsNameTheValue) {
-  EXPECT_TRUE(model_warnings(builtin()).empty());
+  EXPECT_TRUE(model_warnings(mdma()).empty());
   for (const char* f : {"mdma_printed.toml", "single_rod.toml"})
     EXPECT_TRUE(model_warnings(load_model(std::string(GMASIM_SOURCE_DIR) + "/models/" + f)).empty())
         << f;
@@ -149,7 +147,7 @@ TEST(Hardening, Item4ThreadCountsAreChecked) {
   r.frequencies_Hz = {100};
   r.periods = 1;
   r.threads = -1;
-  EXPECT_THAT(input_error([&] { (void)run_sweep(builtin(), r); }),
+  EXPECT_THAT(input_error([&] { (void)run_sweep(mdma(), r); }),
               HasSubstr("threads = -1 (--threads): must be 0 (all cores) or in [1, 1024]"));
   IdentifyOptions o;
   o.population = 100000000;
@@ -202,11 +200,11 @@ TEST(Hardening, Item5ConcurrentSetsStayWholeAndStaleTemporariesGo) {
 TEST(Hardening, Item6SynthesizeRefusesWhatIdentifyRefuses) {
   SyntheticRequest r;
   r.objective.steps_per_period = 3;
-  EXPECT_THAT(input_error([&] { (void)synthesize_measurements(builtin(), r); }),
+  EXPECT_THAT(input_error([&] { (void)synthesize_measurements(mdma(), r); }),
               HasSubstr("steps per period 3 (--steps-per-period): must be >= 8"));
   r.objective.steps_per_period = 100;
   r.currents_pp_A = {0.0};
-  EXPECT_THAT(input_error([&] { (void)synthesize_measurements(builtin(), r); }),
+  EXPECT_THAT(input_error([&] { (void)synthesize_measurements(mdma(), r); }),
               HasSubstr("current peak-to-peak 0 A (--currents): must be in (0, 2000] A"));
 }
 
@@ -223,22 +221,22 @@ TEST(Hardening, Item7MemoryIsEstimatedBeforeTheRun) {
 
 // ---- item 8 -------------------------------------------------------------------------------
 TEST(Hardening, Item8ComputableAndValidatedRanges) {
-  const auto c = computable_range(builtin());
+  const auto c = computable_range(mdma());
   ASSERT_TRUE(c.has_value());
   EXPECT_LT(c->min_C, -50.0);
   EXPECT_GT(c->max_C, 150.0);  // above the validated range (observed 202.8 degC: eq. 3's stress
   EXPECT_LT(c->max_C, 300.0);  // terms exceed 1/chi_m in rod 3 beyond it)
-  (void)make_conditions(builtin(), c->max_C);  // the printed bounds are computable
-  (void)make_conditions(builtin(), c->min_C);
-  const std::string msg = input_error([] { (void)make_conditions(builtin(), 300.0); });
+  (void)make_conditions(mdma(), c->max_C);  // the printed bounds are computable
+  (void)make_conditions(mdma(), c->min_C);
+  const std::string msg = input_error([] { (void)make_conditions(mdma(), 300.0); });
   EXPECT_THAT(msg, HasSubstr("temperature 300 degC: outside the range where models/mdma.toml "
                              "(built-in) can be computed, " +
                              range_text(*c)));
-  const TemperatureRange v = validated_range(builtin());
+  const TemperatureRange v = validated_range(mdma());
   EXPECT_EQ(v.min_C, 20.0);
   EXPECT_EQ(v.max_C, 150.0);
-  EXPECT_FALSE(temperature_warning(builtin(), 100.0).has_value());
-  EXPECT_THAT(temperature_warning(builtin(), 250.0).value_or(""),
+  EXPECT_FALSE(temperature_warning(mdma(), 100.0).has_value());
+  EXPECT_THAT(temperature_warning(mdma(), 250.0).value_or(""),
               HasSubstr("temperature 250 degC: outside the range where models/mdma.toml "
                         "(built-in) was validated, [20, 150] degC"));
   const Model narrow = builtin_with("validity.validated_max_C", 70.0);

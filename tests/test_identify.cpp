@@ -28,7 +28,7 @@ using namespace gmasim;
 using gmasim_test::ci_objective;
 using gmasim_test::ci_request;
 using gmasim_test::input_error;
-using gmasim_test::mdma;
+using gmasim_test::printed_fixture;
 using gmasim_test::printed_spec;
 using gmasim_test::printed_text;
 using gmasim_test::TempDir;
@@ -116,7 +116,7 @@ const std::map<std::string, double> kTruth = {{"rod1.ja.k0_A_per_m", 3032.0},
 
 // ---- objective ------------------------------------------------------------------------
 TEST(Objective, ExactModelGivesZeroErrorAndUnitMappingRoundTrips) {
-  const MeasurementSet set = synthesize_measurements(mdma(), ci_request(0.0, 1));
+  const MeasurementSet set = synthesize_measurements(printed_fixture(), ci_request(0.0, 1));
   ASSERT_EQ(set.items.size(), 12u);
   FitSpec fit = eight_parameters();
   for (auto& p : fit.parameters) p.has_start = false;  // start at the model values (truth)
@@ -143,7 +143,7 @@ TEST(Objective, WeightsAndFluxEnterTheWeightedRms) {
   r.temperatures_C = {20};
   r.currents_pp_A = {8};
   r.frequencies_Hz = {10};
-  MeasurementSet set = synthesize_measurements(mdma(), r);
+  MeasurementSet set = synthesize_measurements(printed_fixture(), r);
   // Scale the measured displacement by 1.02: every residual is 2 % of y, whatever u.
   for (double& y : set.items[0].response) y *= 1.02;
   const FitSpec fit = load_fit_spec("material.chi_m:10:30");
@@ -235,7 +235,7 @@ TEST(Identify, ScalarTargetsAloneCalibrateAParameter) {
   ss.waveform = biased_sine(8.0, 10.0);
   ss.periods = 2;
   ss.dt_s = 0.1 / 200;
-  const Result ref = simulate(mdma(), ss);
+  const Result ref = simulate(printed_fixture(), ss);
   ASSERT_TRUE(ref.has_metrics);
   FitSpec fit = parse_fit_spec(fmt::format(R"(
 [[parameter]]
@@ -273,7 +273,7 @@ weight = 1e-6
 
 // ---- synthetic validation ---------------------------------------------------------------
 TEST(Identify, NoiseFreeDataRecoverTheTruthExactly) {
-  const MeasurementSet set = synthesize_measurements(mdma(), ci_request(0.0, 1));
+  const MeasurementSet set = synthesize_measurements(printed_fixture(), ci_request(0.0, 1));
   const IdentifyResult r = identify(printed_spec(), set, eight_parameters(), ci_options());
   EXPECT_LT(r.rms_pct, 1e-5);
   for (const auto& p : r.parameters) EXPECT_NEAR(p.value / kTruth.at(p.name), 1.0, 1e-4) << p.name;
@@ -285,7 +285,7 @@ TEST(Identify, SyntheticTwelveConditionsRecoverEightParameters) {
   // 95 % intervals, so a determined parameter falls outside now and then (seed 1: k_j at
   // 2.2 sigma) -- the test pins one seed; examples/identify_synthetic runs more.
   const auto t0 = std::chrono::steady_clock::now();
-  const MeasurementSet set = synthesize_measurements(mdma(), ci_request(1.0, 2));
+  const MeasurementSet set = synthesize_measurements(printed_fixture(), ci_request(1.0, 2));
   const IdentifyResult r = identify(printed_spec(), set, eight_parameters(), ci_options());
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_LE(r.rms_pct, 1.5);
@@ -343,7 +343,7 @@ TEST(Identify, CheckpointRoundTripAndResumeNeverWorse) {
   SyntheticRequest rq = ci_request(1.0, 4);
   rq.temperatures_C = {20, 70};
   rq.currents_pp_A = {8};
-  const MeasurementSet set = synthesize_measurements(mdma(), rq);
+  const MeasurementSet set = synthesize_measurements(printed_fixture(), rq);
   const FitSpec fit = load_fit_spec("rod1.ja.k0_A_per_m:1500:6000:log,material.chi_m:8:50:log");
   IdentifyOptions o = ci_options();
   o.refine = false;
@@ -380,7 +380,7 @@ TEST(Identify, StopFlagEndsCleanlyWithTheBestSoFar) {
   SyntheticRequest rq = ci_request(1.0, 4);
   rq.temperatures_C = {20};
   rq.frequencies_Hz = {100};
-  const MeasurementSet set = synthesize_measurements(mdma(), rq);
+  const MeasurementSet set = synthesize_measurements(printed_fixture(), rq);
   const FitSpec fit = load_fit_spec("material.chi_m:8:50:log");
   std::atomic<bool> stop{true};  // as if SIGINT came during the first population
   IdentifyOptions o = ci_options();

@@ -16,7 +16,7 @@ using ::testing::HasSubstr;
 using namespace gmasim;
 using gmasim_test::ci_request;
 using gmasim_test::input_error;
-using gmasim_test::mdma;
+using gmasim_test::printed_fixture;
 using gmasim_test::printed_spec;
 using gmasim_test::TempDir;
 
@@ -169,7 +169,7 @@ TEST(Measurements, WrittenSetReadsBackBitForBit) {
   r.temperatures_C = {20, 70};
   r.currents_pp_A = {8};
   r.frequencies_Hz = {100};
-  const MeasurementSet set = synthesize_measurements(mdma(), r);
+  const MeasurementSet set = synthesize_measurements(printed_fixture(), r);
   write_measurement_set(set, d.path().string());
   const MeasurementSet back = load_manifest((d.path() / "manifest.toml").string());
   ASSERT_EQ(back.items.size(), 2u);

@@ -25,6 +25,9 @@ using gmasim_test::TempDir;
 
 namespace {
 
+using gmasim_test::max_abs_diff;
+using gmasim_test::range;
+
 const ModelSpec& single_rod() {
   static const ModelSpec s =
       load_model_spec(std::string(GMASIM_SOURCE_DIR) + "/models/single_rod.toml");
@@ -65,17 +68,6 @@ Measurement butterfly(double A, int n) {
       m.response.push_back(0.0);
     }
   return m;
-}
-
-double range(const std::vector<double>& v) {
-  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
-  return *hi - *lo;
-}
-
-double max_abs_diff(const std::vector<double>& a, const std::vector<double>& b) {
-  double d = 0.0;
-  for (std::size_t i = 0; i < a.size(); ++i) d = std::max(d, std::fabs(a[i] - b[i]));
-  return d;
 }
 
 FitSpec fit_of(std::vector<FitParameter> p) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "alloc_counter.hpp"
+#include "builtin_models.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/identify/identify.hpp"
 #include "gmasim/io/io.hpp"
@@ -25,10 +26,10 @@ using gmasim_test::TempDir;
 
 namespace {
 
-const Model& builtin() {
-  static const Model m = compile(builtin_model_spec());
-  return m;
-}
+using gmasim_test::max_abs_diff;
+using gmasim_test::range;
+
+using gmasim_test::mdma;
 
 // A biased sine as a measured current table: `periods` periods of n samples at f (0: as a
 // quasi-static record, t = sample index).
@@ -49,23 +50,11 @@ Measurement sine_record(double pp, double min_A, double f, int n, double periods
   return m;
 }
 
-double max_abs_diff(const std::vector<double>& a, const std::vector<double>& b,
-                    std::size_t from = 0) {
-  double d = 0.0;
-  for (std::size_t i = from; i < a.size(); ++i) d = std::max(d, std::fabs(a[i] - b[i]));
-  return d;
-}
-
-double range(const std::vector<double>& v) {
-  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
-  return *hi - *lo;
-}
-
 }  // namespace
 
 // ---- quasi_static_step ----------------------------------------------------------------
 TEST(Records, QuasiStaticStepAllocatesNothingAndRestsAtFOverK) {
-  const Model& m = builtin();
+  const Model& m = mdma();
   const Conditions c = make_conditions(m, 70.0);
   State s = make_state(m, c, -3.0);
   quasi_static_step(m, c, s, -2.99);  // warm-up
@@ -95,7 +84,7 @@ TEST(Records, QuasiStaticStepAllocatesNothingAndRestsAtFOverK) {
 // The quasi-static record is the limit of a slow timed one: a 0.05 Hz biased sine run with
 // dynamic steps (eddy lag ~1e-4 s, mechanics at kHz) gives the same loop.
 TEST(Records, QuasiStaticRecordIsTheSlowLimitOfATimedRecord) {
-  const Model& m = builtin();
+  const Model& m = mdma();
   ObjectiveSettings s;
   s.steps_per_period = 4000;
   Measurement qs = sine_record(8.0, -3.0, 0.0, 200, 2.0, true);
@@ -116,7 +105,7 @@ TEST(Records, QuasiStaticRecordIsTheSlowLimitOfATimedRecord) {
 // The increment rule converges: the error against a 16x finer run falls about linearly as
 // the number of increments doubles (eq. 9 with a first-order hold).
 TEST(Records, QuasiStaticIncrementsConverge) {
-  const Model& m = builtin();
+  const Model& m = mdma();
   const Measurement qs = sine_record(8.0, -3.0, 0.0, 50, 2.0, true);
   auto run = [&](double inc) {
     ObjectiveSettings s;
@@ -148,7 +137,7 @@ TEST(Records, QuasiStaticIncrementsConverge) {
 // A field record made of the applied field H_c that a current record produced, stepped on
 // the same grid, reproduces that run: the driver finds back the current at every step.
 TEST(Records, FieldDriveReproducesTheCurrentDriveItWasMeasuredFrom) {
-  const Model& m = builtin();
+  const Model& m = mdma();
   const Conditions c = make_conditions(m, 20.0);
   const int n = 400;  // samples = steps: dt = 1/(f n)
   Measurement cur = sine_record(8.0, 0.0, 10.0, n, 1.5, false);
@@ -208,7 +197,7 @@ TEST(Records, FieldOutOfReachIsADivergenceNamingTheRod) {
 // ---- pre-cycling ------------------------------------------------------------------------
 // One period pre-cycled once is the second period of a two-period record.
 TEST(Records, PrecycledRecordIsTheSteadyLoop) {
-  const Model& m = builtin();
+  const Model& m = mdma();
   ObjectiveSettings s;
   s.steps_per_period = 400;
   Measurement two = sine_record(8.0, -3.0, 10.0, 200, 2.0, false);
@@ -279,7 +268,7 @@ TEST(Records, CsvRoundTripOfEveryNewKey) {
   r.offset = OffsetMode::FirstSample;
   r.precycles = 2;
   r.samples_per_period = 40;
-  MeasurementSet set = synthesize_measurements(builtin(), r);
+  MeasurementSet set = synthesize_measurements(mdma(), r);
   set.items[0].condition.flux_offset = OffsetMode::Fitted;
   const std::string path = dir.write("rec.csv", measurement_csv(set.items[0]));
   const Measurement back = load_measurement_csv(path);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "alloc_counter.hpp"
+#include "builtin_models.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/identify/identify.hpp"
@@ -23,12 +24,9 @@
 
 namespace {
 
-using namespace gmasim;
+using gmasim_test::mdma;
 
-const Model& builtin() {
-  static const Model m = load_model("");
-  return m;
-}
+using namespace gmasim;
 
 // n simulations at rest: temperatures 20..75 degC, 10 Hz biased sines of 4..10 A.
 struct Runs {
@@ -37,16 +35,16 @@ struct Runs {
   std::vector<double> pp;
   explicit Runs(std::size_t n) {
     for (std::size_t i = 0; i < n; ++i) {
-      c.push_back(make_conditions(builtin(), 20.0 + 5.0 * static_cast<double>(i)));
+      c.push_back(make_conditions(mdma(), 20.0 + 5.0 * static_cast<double>(i)));
       pp.push_back(4.0 + 0.5 * static_cast<double>(i % 13));
-      s.push_back(make_state(builtin(), c.back(), 0.0));
+      s.push_back(make_state(mdma(), c.back(), 0.0));
     }
   }
   double current(std::size_t i, double t) const {
     return 0.5 * pp[i] * (1.0 - std::cos(2.0 * 3.141592653589793 * 10.0 * t));
   }
   LaneBatch batch() const {
-    std::vector<const Model*> m(c.size(), &builtin());
+    std::vector<const Model*> m(c.size(), &mdma());
     std::vector<const Conditions*> cp;
     std::vector<const State*> sp;
     for (std::size_t i = 0; i < c.size(); ++i) {
@@ -123,7 +121,8 @@ TEST(Lanes, EachLaneEqualsTheWidthOneInstance) {
 // The fallback targets (SSE4: 2 lanes, and the portable EMU128 the baseline build compiles)
 // give each lane the width-1 numbers too, and the same run as the best target to the
 // rounding of FMA-based vs separate multiply-add in Highway's exp/cos (observed 4.8e-13,
-// tolerance 1e-10).
+// tolerance 1e-10). The CI's sanitizer build compiles AVX2, SSE4 and the scalar baseline only
+// (CMakeLists.txt, HWY_DISABLED_TARGETS): there the fallback tried is SSE4 against AVX2.
 TEST(Lanes, FallbackTargetsAgree) {
   const Runs runs(5);
   auto run = [&](LaneBatch& b, std::vector<double>& last) {
@@ -191,7 +190,7 @@ TEST(Lanes, FollowTheScalarStep) {
     for (std::size_t i = 0; i < n; ++i) {
       cur[i] = runs.current(i, t);
       t1[i] = t;
-      step(builtin(), runs.c[i], scalar[i], {cur[i], kDt});
+      step(mdma(), runs.c[i], scalar[i], {cur[i], kDt});
       scalar[i].t_s = t;
     }
     b.step(cur, dt, t1);
@@ -310,7 +309,7 @@ TEST(Lanes, DivergenceIsPerLane) {
   try {
     for (long k = 1; k <= 200; ++k) {
       const double t = static_cast<double>(k) * kDt;
-      step(builtin(), runs.c[2], s, {runs.current(2, t), kDt});
+      step(mdma(), runs.c[2], s, {runs.current(2, t), kDt});
       s.t_s = t;
     }
   } catch (const DivergenceError& err) {
@@ -381,7 +380,7 @@ TEST(Lanes, RecordIsTheUnpackedStatesRow) {
 // tolerance 6e-13. The ramp's increment allocates nothing.
 TEST(Lanes, MakeStatesMatchMakeState) {
   const Runs runs(9);
-  std::vector<const Model*> m(9, &builtin());
+  std::vector<const Model*> m(9, &mdma());
   std::vector<const Conditions*> c;
   std::vector<double> I0;
   for (std::size_t i = 0; i < 9; ++i) {
@@ -391,7 +390,7 @@ TEST(Lanes, MakeStatesMatchMakeState) {
   const std::vector<State> got = make_states(m, c, I0);
   double worst = 0.0;
   for (std::size_t i = 0; i < 9; ++i) {
-    const State ref = make_state(builtin(), runs.c[i], I0[i]);
+    const State ref = make_state(mdma(), runs.c[i], I0[i]);
     auto rel = [&](double x, double r, double scale) {
       const double e = std::fabs(x - r) / scale;
       worst = std::max(worst, e);
@@ -442,10 +441,10 @@ TEST(Lanes, SimulateLanesMatchesSimulate) {
       s.periods = 1;
       set.push_back(s);
     }
-  const std::vector<Result> got = simulate_lanes(builtin(), set);
+  const std::vector<Result> got = simulate_lanes(mdma(), set);
   ASSERT_EQ(got.size(), set.size());
   for (std::size_t i = 0; i < set.size(); ++i) {
-    const Result ref = simulate(builtin(), set[i]);
+    const Result ref = simulate(mdma(), set[i]);
     ASSERT_FALSE(got[i].diverged) << got[i].error;
     ASSERT_TRUE(got[i].has_metrics);
     EXPECT_EQ(got[i].series.rows(), ref.series.rows());
@@ -466,7 +465,7 @@ TEST(Lanes, ObjectiveResidualsMatchTheScalarRuns) {
   req.noise_pct = 0.0;
   req.flux_noise_pct = 0.0;
   req.objective.steps_per_period = 100;
-  const MeasurementSet data = synthesize_measurements(builtin(), req);
+  const MeasurementSet data = synthesize_measurements(mdma(), req);
   const FitSpec fit = load_fit_spec("rod1.ja.k0_A_per_m:1500:6000:log,material.chi_m:8:50:log");
   ObjectiveSettings s;
   s.steps_per_period = 100;

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "alloc_counter.hpp"
+#include "builtin_models.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io/io.hpp"
 #include "gmasim/model/model.hpp"
@@ -25,16 +26,8 @@ using ::testing::HasSubstr;
 
 namespace {
 
-const Model& mdma() {
-  static const Model m = load_model("");
-  return m;
-}
-
-// The paper-as-printed reading (models/mdma_printed.toml): eq. 2, 3, 7, 10, 11 as printed.
-const Model& mdma_printed() {
-  static const Model m = load_model(std::string(GMASIM_SOURCE_DIR) + "/models/mdma_printed.toml");
-  return m;
-}
+using gmasim_test::mdma;
+using gmasim_test::mdma_printed;
 
 // A random operating point of the circuit: three rod reluctances, log-uniform in
 // 10^5..10^9.5 1/H, and a coil current in the paper's range -3..9 A.
@@ -57,7 +50,7 @@ int branch(const Model& m, const std::string& name) {
   return 0;
 }
 
-SimulationSettings sine(double pp_A, double f_Hz, double T_C, double periods = 3) {
+SimulationSettings sine_run(double pp_A, double f_Hz, double T_C, double periods = 3) {
   SimulationSettings s;
   s.temperature_C = T_C;
   s.waveform = biased_sine(pp_A, f_Hz);
@@ -261,7 +254,7 @@ TEST(Model, QuasiStaticStrokeIsLambdaTimesLengthForStiffRods) {
 TEST(Numerics, HalvingDtChangesStrokeAndHysteresisByLessThan0p1Percent) {
   const Model& m = mdma();
   for (double f : {10.0, 400.0}) {
-    SimulationSettings s = sine(8.0, f, 70.0);
+    SimulationSettings s = sine_run(8.0, f, 70.0);
     const Result a = simulate(m, s);
     s.dt_s = a.dt_s / 2;
     const Result b = simulate(m, s);
@@ -284,7 +277,7 @@ TEST(Numerics, ExactStepAgreesWithAFineExplicitRk4Reference) {
   // The production step (exact eddy/JA/oscillator updates, auto dt = 1.25 us at 400 Hz)
   // against a plain RK4 of the same ODE at 1 us: observed stroke difference 6.9e-5.
   const Model& m = mdma_printed();
-  const SimulationSettings s = sine(8.0, 400.0, 70.0);
+  const SimulationSettings s = sine_run(8.0, 400.0, 70.0);
   const Result a = simulate(m, s);
   const Conditions c = make_conditions(m, 70.0);
   State st = make_state(m, c, s.waveform.current_at(0.0));
@@ -306,7 +299,7 @@ TEST(Numerics, ExactStepAgreesWithAFineExplicitRk4Reference) {
 
 TEST(Numerics, RunsAreBitForBitDeterministic) {
   const Model& m = mdma();
-  const SimulationSettings s = sine(10.0, 100.0, 45.0, 2);
+  const SimulationSettings s = sine_run(10.0, 100.0, 45.0, 2);
   const Result a = simulate(m, s), b = simulate(m, s);
   ASSERT_EQ(a.series.columns.size(), b.series.columns.size());
   for (std::size_t c = 0; c < a.series.columns.size(); ++c) {

@@ -21,7 +21,7 @@ using namespace gmasim::physics;
 
 namespace {
 
-const PreisachDistribution& dist() {
+const PreisachDistribution& reference_dist() {
   static const PreisachDistribution d = preisach_distribution(0.5, 1.2);
   return d;
 }
@@ -86,7 +86,7 @@ double up_measure_by_count(const PreisachDistribution& d, const std::vector<doub
 // steps of the staircase about the line h_u = x shrink with 1 - r), and the stack the law
 // holds after its own (coarser) demagnetisation counts the same hysterons up as the grid.
 TEST(PreisachAnhysteretic, ClosedFormIsTheLimitOfTheAcDemagnetisation) {
-  const PreisachDistribution& d = dist();
+  const PreisachDistribution& d = reference_dist();
   const double r_law = preisach_anhysteretic_ratio(d);
   EXPECT_GT(r_law, 0.9);
   for (double x : {-1.7, -0.4, 0.6, 1.5}) {

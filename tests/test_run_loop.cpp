@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "alloc_counter.hpp"
+#include "builtin_models.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io/io.hpp"
 #include "gmasim/model/model.hpp"
@@ -24,10 +25,7 @@ using ::testing::HasSubstr;
 
 namespace {
 
-const Model& mdma() {
-  static const Model m = load_model("");
-  return m;
-}
+using gmasim_test::mdma;
 
 // What the recorders below keep of every step: its time and the state's outputs.
 struct Trace {

@@ -1,11 +1,13 @@
-// Helpers shared by the test files: a temporary directory per test and the message of an
-// expected InputError.
+// Helpers shared by the test files: a temporary directory per test, the message of an
+// expected InputError, and the spread and largest difference of sampled values.
 #pragma once
 
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstddef>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -64,6 +66,20 @@ inline std::string input_error(const std::function<void()>& f) {
   }
   ADD_FAILURE() << "no InputError thrown";
   return "";
+}
+
+// The spread of v: largest minus smallest value.
+inline double range(const std::vector<double>& v) {
+  const auto [lo, hi] = std::minmax_element(v.begin(), v.end());
+  return *hi - *lo;
+}
+
+// The largest |a[i] - b[i]| over i >= from (b at least as long as a).
+inline double max_abs_diff(const std::vector<double>& a, const std::vector<double>& b,
+                           std::size_t from = 0) {
+  double d = 0.0;
+  for (std::size_t i = from; i < a.size(); ++i) d = std::max(d, std::fabs(a[i] - b[i]));
+  return d;
 }
 
 }  // namespace gmasim_test
