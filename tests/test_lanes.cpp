@@ -242,7 +242,7 @@ TEST(Lanes, SafeguardSolvesEq9WhereTheScalarLawDoes) {
     for (std::size_t i = 0; i < n; ++i) {
       cur[i] = current(i, t);
       t1[i] = t;
-      step(builtin(), runs.c[i], scalar[i], {cur[i], kDt});
+      step(mdma(), runs.c[i], scalar[i], {cur[i], kDt});
       scalar[i].t_s = t;
     }
     a.step(cur, dt, t1);
