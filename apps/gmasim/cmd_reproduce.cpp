@@ -49,11 +49,15 @@ class StageProgress {
   }
   StageProgress(const StageProgress&) = delete;
   StageProgress& operator=(const StageProgress&) = delete;
-  ProgressFn fn() {
-    return [this](std::size_t done, std::size_t total) {
+  // Model k of `models` (the study's model, then each --compare): its stages count after the
+  // earlier models', so the heartbeat keeps going, and counting, through the compared models.
+  ProgressFn fn(std::size_t k = 0, std::size_t models = 1) {
+    return [this, k, models](std::size_t done, std::size_t total) {
       const std::lock_guard<std::mutex> lock(mutex_);
-      done_ = done;
-      total_ = total;
+      done_ = k * total + done;
+      total_ = models * total;
+      done = done_;
+      total = total_;
       if (!tty_) return;
       fmt::print(stderr, "\rreproduce: stage {}/{}", done, total);
       if (done == total) fmt::print(stderr, "\n");
@@ -107,18 +111,20 @@ int run_reproduce_cmd(const ReproduceArgs& a) {
   if (!a.doc.empty()) outputs.push_back({a.doc, "--doc"});
   require_outputs_distinct(inputs, outputs);
   ensure_output_dir(a.out);
+  const std::size_t models = 1 + a.compare.size();
   ReproduceResult r;
+  std::vector<ComparedModel> compared;
   {
     StageProgress progress;
-    r = run_reproduce(model, o, progress.fn());
-  }
-  write_reproduce_outputs(model, r, a.out, a.no_figures ? std::string() : a.python,
-                          python_package_path());
-  std::vector<ComparedModel> compared;
-  for (const auto& path : a.compare) {
-    const Model other = load_model(path);
-    const ReproduceResult o2 = run_reproduce(other, o);
-    compared.push_back({std::filesystem::path(path).stem().string(), o2.model_readings, o2.claims});
+    r = run_reproduce(model, o, progress.fn(0, models));
+    write_reproduce_outputs(model, r, a.out, a.no_figures ? std::string() : a.python,
+                            python_package_path());
+    for (std::size_t k = 0; k < a.compare.size(); ++k) {
+      const Model other = load_model(a.compare[k]);
+      const ReproduceResult o2 = run_reproduce(other, o, progress.fn(k + 1, models));
+      compared.push_back(
+          {std::filesystem::path(a.compare[k]).stem().string(), o2.model_readings, o2.claims});
+    }
   }
   if (!a.doc.empty()) write_reproduction_doc(r, compared, a.doc, a.out, notes);
   const ClaimCount n = count_claims(r.claims);
