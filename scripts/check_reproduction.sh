@@ -4,9 +4,12 @@
 # identical to the committed file apart from the wall-time sentence. Exit 0 if identical;
 # 1 with the diff otherwise. Used by ctest (reproduction_doc_unchanged) and by refactors
 # that must keep every result bit-identical (issue 10).
-# Usage: scripts/check_reproduction.sh [path to gmasim]   (default build/ci/bin/gmasim)
+# Usage: scripts/check_reproduction.sh [--write] [path to gmasim]   (default build/ci/bin/gmasim)
+#   --write: rewrite docs/reproduction.md and its figures instead (scripts/regenerate.sh)
 set -euo pipefail
 SRC="$(cd "$(dirname "$0")/.." && pwd)"
+WRITE=0
+if [ "${1:-}" = --write ]; then WRITE=1; shift; fi
 B="${1:-$SRC/build/ci/bin/gmasim}"
 T="$(mktemp -d)"
 trap 'rm -rf "$T"' EXIT
@@ -17,9 +20,12 @@ for r in printed__kelvin__compression_negative printed__kelvin__compression_posi
          mean_field__room_referenced__compression_negative mean_field__room_referenced__compression_positive; do
   CMP+=("calibration/models/$r.toml")
 done
+DOC="$T/doc/reproduction.md"
+[ "$WRITE" = 1 ] && DOC=docs/reproduction.md
 mkdir -p "$T/doc"
-"$B" reproduce --out "$T/out" --doc "$T/doc/reproduction.md" --doc-notes docs/failing_claims.md \
+"$B" reproduce --out "$T/out" --doc "$DOC" --doc-notes docs/failing_claims.md \
   --compare "${CMP[@]}" >"$T/log" 2>&1 || { cat "$T/log"; exit 1; }
+if [ "$WRITE" = 1 ]; then echo "wrote docs/reproduction.md"; exit 0; fi
 strip() { sed -E 's/The whole study took [0-9.]+ s/The whole study took N s/' "$1"; }
 if diff <(strip docs/reproduction.md) <(strip "$T/doc/reproduction.md"); then
   echo "docs/reproduction.md: identical (apart from the wall time)"
