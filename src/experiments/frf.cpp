@@ -27,8 +27,6 @@ namespace {
 using namespace physics;
 using cd = std::complex<double>;
 
-constexpr double kTwoPi = 2.0 * kPi;
-
 double unwrap_deg(double prev, double now) {
   while (now - prev > 180.0) now -= 360.0;
   while (now - prev < -180.0) now += 360.0;
@@ -50,13 +48,9 @@ std::vector<double> log_grid(double f0, double f1, int n) {
 std::complex<double> first_harmonic_ratio(const std::vector<double>& t_s,
                                           const std::vector<double>& y,
                                           const std::vector<double>& i, double f_Hz) {
-  cd Y = 0.0, I = 0.0;
-  for (std::size_t k = 0; k < t_s.size(); ++k) {
-    const cd e = std::polar(1.0, -kTwoPi * f_Hz * t_s[k]);
-    Y += y[k] * e;
-    I += i[k] * e;
-  }
-  return Y / I;
+  detail::FirstHarmonicSums sums;
+  for (std::size_t k = 0; k < t_s.size(); ++k) sums.add(t_s[k], f_Hz, y[k], i[k]);
+  return sums.ratio();
 }
 
 double find_resonance_Hz(const std::vector<double>& f, const std::vector<double>& mag) {
@@ -179,7 +173,6 @@ detail::SteppedSineGrid detail::stepped_sine_grid(const SmallSignalModel& lin, c
 cd detail::stepped_sine_point(const Model& m, const Conditions& c, const State& bias,
                               const SmallSignalModel& lin, const FrfRequest& r, double fr) {
   const SteppedSineGrid sg = stepped_sine_grid(lin, r, fr);
-  const double w = kTwoPi * fr;
   std::vector<double> ts, ys, is;
   ts.reserve(static_cast<std::size_t>(sg.measured));
   ys.reserve(ts.capacity());
@@ -187,7 +180,7 @@ cd detail::stepped_sine_point(const Model& m, const Conditions& c, const State& 
   const long first = sg.first;  // samples first+1 .. total: whole periods
   State s = bias;
   run_loop(
-      m, c, s, sg.grid, [&](double t) { return r.bias_A + r.amplitude_A * std::sin(w * t); },
+      m, c, s, sg.grid, [&](double t) { return stepped_sine_current_A(r, fr, t); },
       [&](const State& st, const StepPoint& p) {
         if (p.k <= first) return;
         ts.push_back(p.t_s);

@@ -3,10 +3,12 @@
 // choice of the markers). docs/experiments.md, "Frequency response".
 #pragma once
 
+#include <cmath>
 #include <complex>
 #include <vector>
 
 #include "gmasim/experiments/experiments.hpp"
+#include "gmasim/physics/magnetic.hpp"
 #include "gmasim/simulate/run_loop.hpp"
 
 namespace gmasim::detail {
@@ -19,6 +21,23 @@ struct SteppedSineGrid {
   long first = 0, measured = 0;
 };
 SteppedSineGrid stepped_sine_grid(const SmallSignalModel& lin, const FrfRequest& r, double fr);
+
+// A stepped-sine point's drive at t_s: the bias plus the amplitude's sine at f_Hz [A].
+inline double stepped_sine_current_A(const FrfRequest& r, double f_Hz, double t_s) {
+  return r.bias_A + r.amplitude_A * std::sin(2.0 * physics::kPi * f_Hz * t_s);
+}
+
+// first_harmonic_ratio's sums, one sample at a time (the scalar point sums its recorded
+// samples, the lanes each lane's as it steps): y's and i's Fourier coefficient at f_Hz.
+struct FirstHarmonicSums {
+  std::complex<double> Y = 0.0, I = 0.0;
+  void add(double t_s, double f_Hz, double y, double i) {
+    const std::complex<double> e = std::polar(1.0, -2.0 * physics::kPi * f_Hz * t_s);
+    Y += y * e;
+    I += i * e;
+  }
+  std::complex<double> ratio() const { return Y / I; }
+};
 
 // One stepped-sine point at fr Hz from the settled bias state (frf.cpp).
 std::complex<double> stepped_sine_point(const Model& m, const Conditions& c, const State& bias,

@@ -1,8 +1,8 @@
 // The stepped-sine points of gmasim frf in SIMD lanes (frf_internal.hpp,
 // stepped_sine_points_lanes): each point runs in its own lane what stepped_sine_point runs with
 // run_loop -- the same grid (stepped_sine_grid), drive, and first harmonic over the measured
-// periods (first_harmonic_ratio's sums, accumulated step by step). The points are sorted by
-// their step count so that the lanes of a batch end close together; a lane that has ended
+// periods (first_harmonic_ratio's FirstHarmonicSums, accumulated step by step). The points are
+// sorted by their step count so that the lanes of a batch end close together; a lane that has ended
 // idles at its last time until the batch's longest point ends.
 #include <algorithm>
 #include <cmath>
@@ -13,7 +13,6 @@
 #include "experiments/frf_internal.hpp"
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
-#include "gmasim/physics/magnetic.hpp"
 #include "gmasim/simulate/lanes.hpp"
 
 namespace gmasim::detail {
@@ -44,26 +43,24 @@ void run_batch(const Model& m, const std::vector<Conditions>& conds, const std::
   LaneBatch batch(models, cs, ss);
   for (std::size_t k = 0; k < n; ++k) batch.set_time(k, pts[k].sg.grid.t0_s);
   std::vector<double> current(n), dt(n), t1(n);
-  std::vector<cd> Y(n, 0.0), I(n, 0.0);
+  std::vector<FirstHarmonicSums> sums(n);
   for (long q = 1; q <= longest; ++q) {
     for (std::size_t k = 0; k < n; ++k) {  // the Uniform clock; an ended lane idles
       const StepGrid& g = pts[k].sg.grid;
       const long kk = std::min(q, g.steps);
       t1[k] = g.t0_s + static_cast<double>(kk) * g.dt_s;
       dt[k] = g.dt_s;
-      current[k] = r.bias_A + r.amplitude_A * std::sin(2.0 * physics::kPi * pts[k].f_Hz * t1[k]);
+      current[k] = stepped_sine_current_A(r, pts[k].f_Hz, t1[k]);
     }
     batch.step(current, dt, t1);
     for (std::size_t k = 0; k < n; ++k) {
       if (q > pts[k].sg.grid.steps) continue;
       if (batch.diverged(k)) throw DivergenceError(batch.error(k));
       if (q <= pts[k].sg.first) continue;
-      const cd e = std::polar(1.0, -2.0 * physics::kPi * pts[k].f_Hz * t1[k]);
-      Y[k] += (batch.y_m(k) - pts[k].y0_m) * e;
-      I[k] += (current[k] - r.bias_A) * e;
+      sums[k].add(t1[k], pts[k].f_Hz, batch.y_m(k) - pts[k].y0_m, current[k] - r.bias_A);
     }
   }
-  for (std::size_t k = 0; k < n; ++k) out[pts[k].index] = Y[k] / I[k];
+  for (std::size_t k = 0; k < n; ++k) out[pts[k].index] = sums[k].ratio();
 }
 
 }  // namespace
