@@ -54,7 +54,7 @@ void check_request(const Model& m, const AblateRequest& r) {
   }
 }
 
-struct Run {  // only what the comparison needs (a full Result holds every column)
+struct AblationRun {  // only what the comparison needs (a full Result holds every column)
   std::vector<double> t, y;
   Metrics metrics;
   bool diverged = false;
@@ -62,7 +62,8 @@ struct Run {  // only what the comparison needs (a full Result holds every colum
 };
 
 // The deviation of a frozen run from the full one over the full run's metrics window.
-AblationRow compare(const Run& full, const Run& fr, const std::string& law, double f) {
+AblationRow compare(const AblationRun& full, const AblationRun& fr, const std::string& law,
+                    double f) {
   AblationRow row;
   row.law = law;
   row.frequency_Hz = f;
@@ -112,10 +113,10 @@ AblateResult run_ablate(const Model& m, const AblateRequest& r) {
     s.periods = r.periods;
     if (li > 0) s.freeze = laws[li - 1].freeze;
   }
-  std::vector<Run> runs(n);
+  std::vector<AblationRun> runs(n);
   detail::simulate_settings(m, settings, resolve_thread_count(r.threads, n), r.lanes, false,
                             [&](std::size_t i, Result&& out) {
-                              Run& run = runs[i];
+                              AblationRun& run = runs[i];
                               run.diverged = out.diverged;
                               run.error = out.error;
                               run.metrics = out.metrics;
@@ -125,7 +126,7 @@ AblateResult run_ablate(const Model& m, const AblateRequest& r) {
 
   AblateResult res;
   for (std::size_t fi = 0; fi < r.frequencies_Hz.size(); ++fi) {
-    const Run& full = runs[fi * per_f];
+    const AblationRun& full = runs[fi * per_f];
     if (full.diverged)
       throw DivergenceError(0.0, "", "full model at the ablation point", 0.0, full.error);
     res.full.push_back(full.metrics);

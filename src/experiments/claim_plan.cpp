@@ -13,13 +13,12 @@
 #include <limits>
 #include <string_view>
 
+#include "common/numbers.hpp"
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 
 namespace gmasim::detail {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 bool same(double a, double b) { return std::fabs(a - b) < 1e-9; }  // as the extractors compare
 

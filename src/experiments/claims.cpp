@@ -12,12 +12,11 @@
 #include <string_view>
 #include <utility>
 
+#include "common/numbers.hpp"
 #include "gmasim/experiments/reproduce.hpp"
 
 namespace gmasim {
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 bool same(double a, double b) { return std::fabs(a - b) < 1e-9; }
 

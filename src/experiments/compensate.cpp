@@ -47,14 +47,14 @@ double reference_drive(const CompensateRequest& r) {
   return r.adjust == CompensationAdjust::Scale ? 1.0 : r.reference_current_pp_A;
 }
 
-struct Run {
+struct DriveRun {
   Metrics metrics;
   bool diverged = false;
   std::string error;
 };
 
 // The run of drive x at temperature T (run: simulate(), or a lane of the lock-step batch).
-Run run_drive(const detail::RunFn& run, const CompensateRequest& r, double T, double x) {
+DriveRun run_drive(const detail::RunFn& run, const CompensateRequest& r, double T, double x) {
   SimulationSettings s;
   s.temperature_C = T;
   s.waveform = drive(r, x);
@@ -62,7 +62,7 @@ Run run_drive(const detail::RunFn& run, const CompensateRequest& r, double T, do
   s.dt_s = r.dt_s;
   s.record_every = 1;
   const Result res = run(s);
-  Run out;
+  DriveRun out;
   out.metrics = res.metrics;
   out.diverged = res.diverged;
   out.error = res.error;
@@ -125,7 +125,7 @@ CompensatePoint solve_point(const detail::RunFn& run_fn, const CompensateRequest
   int evals = 0;
   auto stroke = [&](double x) {
     ++evals;
-    const Run run = run_drive(run_fn, r, p.temperature_C, x);
+    const DriveRun run = run_drive(run_fn, r, p.temperature_C, x);
     if (run.diverged) throw DivergenceError(run.error);
     return run.metrics;
   };
@@ -217,7 +217,7 @@ CompensateResult run_compensate(const Model& m, const CompensateRequest& r,
   validate_request(m, r);
   CompensateResult res;
   const auto wall0 = std::chrono::steady_clock::now();
-  Run ref;  // the reference run takes the path of the searches' runs (lanes or simulate())
+  DriveRun ref;  // the reference run takes the path of the searches' runs (lanes or simulate())
   detail::lockstep_searches(m, 1, 1, r.lanes,
                             [&](std::size_t, const detail::RunFn& run) {
                               ref =

@@ -9,13 +9,13 @@
 #include <limits>
 #include <numeric>
 
+#include "common/numbers.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/sensitivity.hpp"
 
 namespace gmasim {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Singular values of the column-normalised Jacobian below this fraction of the largest are
 // raised to it for the covariance (identify's pseudo-inverse cuts eigenvalues of J^T J at

@@ -19,7 +19,7 @@ struct RodStats {
   double mu_r_mean = 0, M_peak = 0, E_mean_GPa = 0;
 };
 
-struct Run {
+struct PointRun {
   Metrics metrics;
   bool diverged = false;
   std::string error;
@@ -73,9 +73,9 @@ SimulationSettings point_settings(const ParamsVsTemperatureRequest& r, double T,
 
 // One run's numbers: the metrics; at the Fig. 19 operating point (with_rods) also each rod's
 // mean mu_r, mean E_G and peak M over the metrics window.
-Run point_run(const Model& m, const ParamsVsTemperatureRequest& r, const Result& out,
-              bool with_rods) {
-  Run run;
+PointRun point_run(const Model& m, const ParamsVsTemperatureRequest& r, const Result& out,
+                   bool with_rods) {
+  PointRun run;
   run.diverged = out.diverged;
   run.error = out.error;
   run.metrics = out.metrics;
@@ -99,11 +99,11 @@ Run point_run(const Model& m, const ParamsVsTemperatureRequest& r, const Result&
 // The Fig. 19 rows: per temperature and rod the laws and the run's means, with their changes
 // against the first temperature.
 void add_law_rows(const Model& m, const ParamsVsTemperatureRequest& r,
-                  const std::vector<Conditions>& conds, const std::vector<Run>& runs,
+                  const std::vector<Conditions>& conds, const std::vector<PointRun>& runs,
                   std::size_t nc, std::size_t op, ParamsVsTemperatureResult& res) {
   const double nan = std::nan("");
   for (std::size_t ti = 0; ti < r.temperatures_C.size(); ++ti) {
-    const Run& run = runs[ti * nc + op];
+    const PointRun& run = runs[ti * nc + op];
     const Conditions& c = conds[ti];
     for (std::size_t k = 0; k < m.rods.size(); ++k) {
       ParamsVsTemperatureRow row;
@@ -155,7 +155,7 @@ ParamsVsTemperatureResult run_params_vs_temperature(const Model& m,
   std::vector<SimulationSettings> settings;
   for (std::size_t i = 0; i < n; ++i)
     settings.push_back(point_settings(r, r.temperatures_C[i / nc], currents[i % nc]));
-  std::vector<Run> runs(n);
+  std::vector<PointRun> runs(n);
   detail::simulate_settings(
       m, settings, resolve_thread_count(r.threads, n), r.lanes, false,
       [&](std::size_t i, Result&& out) { runs[i] = point_run(m, r, out, i % nc == op); });
@@ -164,9 +164,9 @@ ParamsVsTemperatureResult run_params_vs_temperature(const Model& m,
   add_law_rows(m, r, conds, runs, nc, op, res);
   const double nan = std::nan("");
   for (std::size_t ci = 0; ci < r.retention_currents_pp_A.size(); ++ci) {
-    const Run& first = runs[ci];
+    const PointRun& first = runs[ci];
     for (std::size_t ti = 0; ti < r.temperatures_C.size(); ++ti) {
-      const Run& run = runs[ti * nc + ci];
+      const PointRun& run = runs[ti * nc + ci];
       RetentionRow row;
       row.current_pp_A = currents[ci];
       row.temperature_C = r.temperatures_C[ti];

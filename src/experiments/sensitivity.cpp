@@ -11,6 +11,7 @@
 #include <limits>
 #include <optional>
 
+#include "common/numbers.hpp"
 #include "experiments/claim_plan.hpp"
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
@@ -20,7 +21,6 @@
 namespace gmasim {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // The stencil of each parameter, in evaluation order after the base point: -h_large,
 // +h_large, -h_small, +h_small.
 constexpr int kStencil = 4;

@@ -29,7 +29,7 @@ void check_list(const std::vector<double>& v, const char* what, const char* unit
         fmt::format("{} {} values: too many (limit {:g})", v.size(), what, kMaxListValues));
 }
 
-struct Job {
+struct SweepJob {
   double T, pp, f;
 };
 
@@ -105,7 +105,7 @@ SweepResult run_sweep(const Model& m, const SweepRequest& r, const ProgressFn& p
   check_request(m, r);
   fields::check_request_fields(r);  // the table's rules (gmasim/experiments/experiment_fields.hpp)
   // The work list: the grid, then the reference temperature if it is not in the grid.
-  std::vector<Job> jobs;
+  std::vector<SweepJob> jobs;
   for (double T : r.temperatures_C)
     for (double pp : r.currents_pp_A)
       for (double f : r.frequencies_Hz) jobs.push_back({T, pp, f});
@@ -122,7 +122,7 @@ SweepResult run_sweep(const Model& m, const SweepRequest& r, const ProgressFn& p
   std::vector<SweepPoint> slots(jobs.size());
   std::vector<SimulationSettings> settings(jobs.size());
   for (std::size_t i = 0; i < jobs.size(); ++i) {
-    const Job& j = jobs[i];
+    const SweepJob& j = jobs[i];
     SimulationSettings& s = settings[i];
     s.temperature_C = j.T;
     s.waveform = biased_sine(j.pp, j.f, r.current_min_A);

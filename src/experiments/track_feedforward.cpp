@@ -36,13 +36,13 @@ double median(std::vector<double> v) {
   return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-struct Job {
+struct FeedforwardJob {
   std::size_t T, A, f, mismatch, controller;  // indices into the request's lists
 };
 
 // RMS(pid) / RMS(c) over the mismatches of each grid point, for every controller c but pid.
 std::vector<FeedforwardRatio> ratios(const FeedforwardEvaluationRequest& r,
-                                     const std::vector<Job>& jobs,
+                                     const std::vector<FeedforwardJob>& jobs,
                                      const std::vector<FeedforwardRun>& runs) {
   std::map<std::tuple<std::size_t, std::size_t, std::size_t, std::size_t>, double> pid;
   for (std::size_t i = 0; i < jobs.size(); ++i)
@@ -50,7 +50,7 @@ std::vector<FeedforwardRatio> ratios(const FeedforwardEvaluationRequest& r,
       pid[{jobs[i].T, jobs[i].A, jobs[i].f, jobs[i].mismatch}] = runs[i].point.error_rms_um;
   std::map<std::tuple<std::size_t, std::size_t, std::size_t, std::size_t>, std::vector<double>> by;
   for (std::size_t i = 0; i < jobs.size(); ++i) {
-    const Job& j = jobs[i];
+    const FeedforwardJob& j = jobs[i];
     if (runs[i].controller == TrackController::Pid) continue;
     const auto it = pid.find({j.T, j.A, j.f, j.mismatch});
     auto& v = by[{j.T, j.A, j.f, j.controller}];
@@ -192,7 +192,7 @@ FeedforwardEvaluation run_feedforward_evaluation(const Model& m,
     for (double T : tr.temperatures_C)
       res.inverses.push_back(fit_linear_inverse(m, make_conditions(m, T), tr.bias_A, inv.band_Hz));
 
-  std::vector<Job> jobs;
+  std::vector<FeedforwardJob> jobs;
   for (std::size_t T = 0; T < tr.temperatures_C.size(); ++T)
     for (std::size_t A = 0; A < tr.amplitudes_um.size(); ++A)
       for (std::size_t f = 0; f < tr.frequencies_Hz.size(); ++f)
@@ -203,7 +203,7 @@ FeedforwardEvaluation run_feedforward_evaluation(const Model& m,
   detail::parallel_for(
       jobs.size(), res.threads,
       [&](std::size_t i) {
-        const Job& j = jobs[i];
+        const FeedforwardJob& j = jobs[i];
         const double T = tr.temperatures_C[j.T];
         std::optional<InverseFeedforward> ff;
         if (req[j.controller].inverse.enabled) ff.emplace(m, T, inv, &res.inverses[j.T]);

@@ -23,6 +23,7 @@
 
 #include "gmasim/errors.hpp"
 #include "gmasim/io/io.hpp"
+#include "identify/internal.hpp"
 #include "identify/islands.hpp"
 #include "internal.hpp"
 
@@ -189,10 +190,6 @@ void verify_restored(const Checkpoint& c, const pagmo::problem& prob, const Iden
 }
 
 using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
 
 // One rank's global search: its archipelago, the seeds of its islands, and the outcome so
 // far. run() is run_ga().

@@ -18,10 +18,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double seconds_since(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
-
 // The options no other part checks before the search needs them.
 void check_options(const IdentifyOptions& o) {
   if (o.algorithm != "sga" && o.algorithm != "de" && o.algorithm != "sade" &&

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <functional>
 #include <string>
 #include <vector>
@@ -11,6 +12,11 @@
 #include "identify/communicator.hpp"
 
 namespace gmasim::identify_detail {
+
+// Wall-clock seconds since t (the report's timings).
+inline double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
 
 // Evaluates residual vectors at a batch of points: point i on rank i % R, and on each rank
 // over `threads` worker threads. Every rank gets every result, bit-identical.

@@ -22,8 +22,6 @@ namespace {
 using namespace physics;
 using cd = std::complex<double>;
 
-constexpr double kTwoPi = 2.0 * kPi;
-
 // The eq. (3) permeability of rod i at magnetisation M (rod_laws.hpp, as step() evaluates it).
 double mu_at(const Model& m, std::size_t i, const RodConditions& rc, double M) {
   return rod_permeability(rc, m.material.chi_m, M, 0.0, m.rods[i].name);

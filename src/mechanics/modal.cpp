@@ -8,9 +8,7 @@
 #include "gmasim/physics/magnetic.hpp"
 
 namespace gmasim {
-namespace {
-constexpr double kTwoPi = 2.0 * physics::kPi;
-}  // namespace
+using physics::kTwoPi;
 
 std::vector<Mode> mechanical_modes(const Model& m, const Conditions& c, const State& s) {
   (void)m;

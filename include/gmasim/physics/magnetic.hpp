@@ -9,6 +9,7 @@ namespace gmasim::physics {
 
 inline constexpr double kMu0 = 1.25663706212e-6;  // vacuum permeability [H/m]
 inline constexpr double kPi = 3.14159265358979323846;
+inline constexpr double kTwoPi = 2.0 * kPi;
 inline constexpr double kZeroCelsiusInK = 273.15;
 
 // Eq. (1): temperature-dependent bias MMF of the permanent magnets [A-turns].

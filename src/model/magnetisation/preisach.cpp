@@ -32,14 +32,14 @@ double& in_preisach(Model& m, std::size_t i) {
 using G = Group;
 using R = Rule;
 
-const GroupDef kGroup[] = {
+const GroupDef kPreisachGroup[] = {
     {G::RodPreisach, "<rod>.preisach", TableRule::Required,
      "The rod's Preisach constants at T_ref (options.magnetisation_law = \"preisach\"; "
      "docs/model.md, \"The Preisach law\")",
      MagnetisationLaw::Preisach},
 };
 
-const ParamDef kRows[] = {
+const ParamDef kPreisachRows[] = {
     {G::RodPreisach, "Hc0_A_per_m", "A/m", R::Positive,
      "median coercive field H_c0 of the hysterons at T_ref (log-normal distribution)",
      LAND(in_preisach, PreisachReference, Hc0_A_per_m)},
@@ -66,7 +66,7 @@ const ParamDef kRows[] = {
 }  // namespace
 
 const LawTables& preisach_tables() {
-  static const LawTables t{kGroup, kRows};
+  static const LawTables t{kPreisachGroup, kPreisachRows};
   return t;
 }
 
