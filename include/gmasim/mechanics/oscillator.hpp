@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+#include "gmasim/physics/series.hpp"
+
 namespace gmasim::physics {
 
 // The transition matrix of the free row, m e'' + c e' + k e = 0, over a step h:
@@ -24,12 +26,6 @@ struct OscillatorPropagator {
   double f0, f1;
   bool valid;
 };
-// c0 + c1 x + ... + c7 x^7 by Estrin's scheme (short dependency chains).
-inline double polynomial7(double x, const double (&c)[8]) {
-  const double x2 = x * x, x4 = x2 * x2;
-  return (c[0] + c[1] * x) + x2 * (c[2] + c[3] * x) +
-         x4 * ((c[4] + c[5] * x) + x2 * (c[6] + c[7] * x));
-}
 inline OscillatorPropagator oscillator_propagator(double tau, double delta) {
   const double half_tau = 0.5 * tau;
   const double u = half_tau * half_tau - delta;
@@ -39,11 +35,9 @@ inline OscillatorPropagator oscillator_propagator(double tau, double delta) {
   constexpr double kSinc[8] = {
       1.0,          1.0 / 6,          1.0 / 120,          1.0 / 5040,
       1.0 / 362880, 1.0 / 39916800.0, 1.0 / 6227020800.0, 1.0 / 1307674368000.0};
-  constexpr double kExp[8] = {1.0,      1.0,       1.0 / 2,   1.0 / 6,
-                              1.0 / 24, 1.0 / 120, 1.0 / 720, 1.0 / 5040};
   const double C = polynomial7(u, kCos), S = polynomial7(u, kSinc);
   const double E =
-      std::fabs(half_tau) <= 1.0 / 64 ? polynomial7(half_tau, kExp) : std::exp(half_tau);
+      std::fabs(half_tau) <= 1.0 / 64 ? exp_series7(half_tau) : std::exp(half_tau);
   return {E * (C - half_tau * S), E * S, true};
 }
 

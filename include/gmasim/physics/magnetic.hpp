@@ -5,6 +5,8 @@
 
 #include <cmath>
 
+#include "gmasim/physics/series.hpp"
+
 namespace gmasim::physics {
 
 inline constexpr double kMu0 = 1.25663706212e-6;  // vacuum permeability [H/m]
@@ -147,8 +149,7 @@ inline LagWeights lag_weights(double r) {
 struct LagWeightsSlope {
   double E, q, dq_dr;
 };
-inline LagWeightsSlope lag_weights_and_slope(double r) {
-  const double E = std::exp(-r);
+inline LagWeightsSlope lag_weights_and_slope_from(double r, double E) {
   if (r < 1e-2) {
     const double q =
         1.0 - r * (1.0 / 2 - r * (1.0 / 6 - r * (1.0 / 24 - r * (1.0 / 120 - r * (1.0 / 720)))));
@@ -157,6 +158,13 @@ inline LagWeightsSlope lag_weights_and_slope(double r) {
   const double inv_r = 1.0 / r;
   const double q = (1.0 - E) * inv_r;
   return {E, q, (E - q) * inv_r};
+}
+inline LagWeightsSlope lag_weights_and_slope(double r) {
+  return lag_weights_and_slope_from(r, std::exp(-r));
+}
+// The same with exp(-r) from a known exponential nearby (p, physics::exp_near); p becomes -r's.
+inline LagWeightsSlope lag_weights_and_slope_near(double r, ExpPoint& p) {
+  return lag_weights_and_slope_from(r, exp_near(-r, p));
 }
 
 // Exact update of the first-order lag  tau dH/dt = u(t) - H  over one step h with u
