@@ -43,7 +43,8 @@ struct JilesAthertonLaw {
   // The move starts where the law's last evaluation left the Langevin function, when it is
   // near (RodState::an_x; physics::ja_move_start_near): the step's start is the last end.
   static MoveStart begin_move(const RodConditions& rc, const RodState& r) {
-    return {physics::ja_move_start_near(r.H_A_per_m, r.M_A_per_m, rc.MsT_mag, rc.ja, r.an_x,
+    return {physics::ja_move_start_near(r.H_A_per_m, r.M_A_per_m, rc.MsT_mag, rc.ja,
+                                        rc.ja_inv_a_m_per_A, rc.ja_inv_k_m_per_A, r.an_x,
                                         {r.an_L, r.an_dL})};
   }
   static Trial trial_from(const RodConditions& rc, const RodState& r, const MoveStart& st,

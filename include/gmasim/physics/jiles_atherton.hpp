@@ -190,13 +190,12 @@ inline JaMoveStart ja_move_start(double H0, double M0, double MsT_A_per_m,
 // below 3e-15 M_s^T) is far below eq. (9)'s tolerance; otherwise ja_move_start. x_at NaN:
 // nothing known. (The consistent state commits its last iterate, so a step starts within
 // about alpha 1e-12 M_s^T / a of it: one exponential less per rod and step.)
+// inv_a = 1/a and inv_k = 1/k, divided once with the coefficients (RodConditions).
 inline JaMoveStart ja_move_start_near(double H0, double M0, double MsT_A_per_m,
-                                      const JaCoefficients& p, double x_at,
-                                      const LangevinValue& lv) {
+                                      const JaCoefficients& p, double inv_a, double inv_k,
+                                      double x_at, const LangevinValue& lv) {
   const double He0 = H0 + p.alpha * M0;
-  const double inv_a = 1.0 / p.a_A_per_m;
   const double x0 = He0 * inv_a;
-  const double inv_k = 1.0 / p.k_A_per_m;
   if (std::fabs(x0 - x_at) <= 1e-7)
     return {He0, MsT_A_per_m * (lv.L + lv.dL * (x0 - x_at)), inv_a, inv_k};
   return {He0, MsT_A_per_m * langevin(x0), inv_a, inv_k};

@@ -117,10 +117,11 @@ inline double eddy_time_constant(double mu_H_per_m, double r_outer_m, double r_i
 //   H_c = H + kappa dB/dt,   kappa = (r1^2 - r2^2)/(4 k_j rho)   [s m/H]
 // (kappa = eddy_time_constant(1, ...); for a linear material dB = mu dH this is eq. 7's
 // H(s) = H_c(s)/(1 + tau s) with tau = mu kappa). Trapezoidal average over a step h:
-//   (H_c0 + H_c1)/2 = (H0 + H1)/2 + kappa (B1 - B0)/h.
+//   (H_c0 + H_c1)/2 = (H0 + H1)/2 + kappa (B1 - B0)/h,
+// given g = 2 kappa / h [A/(m T)].
 inline double eddy_static_field_trapezoid(double H0, double H1, double Hc0, double B0_T,
-                                          double B1_T, double kappa_s_m_per_H, double h_s) {
-  return H1 + 2.0 * kappa_s_m_per_H * (B1_T - B0_T) / h_s - (Hc0 - H0);
+                                          double B1_T, double g_A_per_m_T) {
+  return H1 + g_A_per_m_T * (B1_T - B0_T) - (Hc0 - H0);
 }
 
 // Eq. (8): temperature-dependent resistivity of Terfenol-D [ohm m].

@@ -38,4 +38,11 @@ inline double exp_near(double y, ExpPoint& p) {
   return p.e;
 }
 
+// e^y where the last call with this p may have had the same y (a step's fixed decay over a run
+// at one time step): p's value when y == p.y, std::exp(y) otherwise, bit for bit either way.
+inline double exp_cached(double y, ExpPoint& p) {
+  if (!(y == p.y)) p = {y, std::exp(y)};
+  return p.e;
+}
+
 }  // namespace gmasim::physics
