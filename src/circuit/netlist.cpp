@@ -304,8 +304,7 @@ bool rod_solve3(const CircuitMatrices& L, const double* R, const double* inv_R, 
   const double a20 = S[16], a21 = S[17], a22 = S[18] + R[2];
   const double c00 = a11 * a22 - a21 * a21, c01 = a20 * a21 - a10 * a22,
                c02 = a10 * a21 - a20 * a11;
-  const double c11 = a00 * a22 - a20 * a20, c12 = a10 * a20 - a00 * a21,
-               m2 = a00 * a11 - a10 * a10;
+  const double c11 = a00 * a22 - a20 * a20, c12 = a10 * a20 - a00 * a21, m2 = a00 * a11 - a10 * a10;
   const double det = a00 * c00 + a10 * c01 + a20 * c02;
   if (!(a00 > 0.0 && m2 > 0.0 && det > 0.0)) return false;
   const double inv_det = 1.0 / det;

@@ -77,8 +77,8 @@ void commit_rod(const RodConditions& rc, RodState& r, const typename Law::JointT
   r.M_prev2_A_per_m = r.M_prev_A_per_m;
   r.M_prev_A_per_m = r.M_A_per_m;
   Law::commit_trial(rc, r, trial);
-  r.Hc_A_per_m = quasi_static ? H1
-                              : eddy_static_field_trapezoid(r.H_A_per_m, H1, r.Hc_A_per_m, B0, B1, g);
+  r.Hc_A_per_m =
+      quasi_static ? H1 : eddy_static_field_trapezoid(r.H_A_per_m, H1, r.Hc_A_per_m, B0, B1, g);
   r.H_prev2_A_per_m = r.H_prev_A_per_m;
   r.H_prev_A_per_m = r.H_A_per_m;
   r.H_A_per_m = H1;
@@ -122,7 +122,7 @@ template <class Law>
 void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, double current_A,
                                 double pm_scale, double h_s, bool quasi_static, double t1) {
   const std::size_t n = s.rods.size();
-  std::array<double, 8> H, Mg, inv_mud, B0, e0, g, Bs, l_A, inv_A;  // set before read (no fill)
+  std::array<double, 8> H, Mg, inv_mud, B0, e0, g, Bs;  // set before read (no fill)
   std::array<typename Law::MoveStart, 8> start;
   std::array<typename Law::JointTrial, 8> trial;
   const double two_over_h = 2.0 / h_s;
@@ -131,8 +131,6 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
     const auto& rc = c.rods[i];
     start[i] = Law::begin_move(rc, r);
     B0[i] = flux_density(r.H_A_per_m, r.M_A_per_m);
-    l_A[i] = rc.length_over_area_per_m;
-    inv_A[i] = rc.inv_area_per_m2;
     if (quasi_static) {
       H[i] = r.H_A_per_m;
       Mg[i] = r.M_A_per_m;
@@ -155,7 +153,8 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
       law_steps += std::fabs(trial[i].M_next - Mg[i]);
       Bs[i] = flux_density(H[i], trial[i].M_next);
       inv_mud[i] = trial[i].inv_mu_r * (1.0 / kMu0);
-      s.rod_reluctance[i] = l_A[i] * (inv_mud[i] + g[i]) + rc.series_reluctance_per_H;
+      s.rod_reluctance[i] =
+          rc.length_over_area_per_m * (inv_mud[i] + g[i]) + rc.series_reluctance_per_H;
       s.circuit.rod_extra_mmf[i] =
           -rc.length_m * (H[i] - Bs[i] * inv_mud[i] - g[i] * B0[i] - e0[i]);
     }
@@ -171,7 +170,7 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
     std::array<double, 8> dH;  // written for rods 0..n-1 below
     for (std::size_t i = 0; i < n; ++i) {
       const double phi = s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
-      dH[i] = (phi * inv_A[i] - Bs[i]) * inv_mud[i];
+      dH[i] = (phi * c.rods[i].inv_area_per_m2 - Bs[i]) * inv_mud[i];
       // The rod's Newton step: its field's and its law's (A/m both); NaN propagates.
       const double dM = std::fabs(trial[i].M_next - Mg[i]);
       const double step = dM <= std::fabs(dH[i]) ? std::fabs(dH[i]) : dM;

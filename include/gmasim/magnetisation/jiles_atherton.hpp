@@ -81,8 +81,8 @@ struct JilesAthertonLaw {
       t.an_x = r.an_x;  // nothing evaluated: the rod's own point stays
       t.an_lv = {r.an_L, r.an_dL};
     } else {
-      const physics::JaEvaluation e =
-          physics::ja_evaluate(st, H1, M_iter, rc.MsT_mag, rc.ja, r.Mirr_A_per_m, st.inv_a, st.near);
+      const physics::JaEvaluation e = physics::ja_evaluate(st, H1, M_iter, rc.MsT_mag, rc.ja,
+                                                           r.Mirr_A_per_m, st.inv_a, st.near);
       t.an_x = e.x1;
       t.an_lv = e.lv;
       t.Mirr = e.Mirr1;

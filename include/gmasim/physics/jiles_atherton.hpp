@@ -27,8 +27,8 @@ inline LangevinValue langevin_pair_from_exp(double x, double e) {
 }
 inline LangevinValue langevin_series(double x) {
   const double x2 = x * x;
-  return {x * (1.0 / 3.0 - x2 * (1.0 / 45.0 - x2 * (2.0 / 945.0 -
-                                                    x2 * (1.0 / 4725.0 - x2 * (2.0 / 93555.0))))),
+  return {x * (1.0 / 3.0 -
+               x2 * (1.0 / 45.0 - x2 * (2.0 / 945.0 - x2 * (1.0 / 4725.0 - x2 * (2.0 / 93555.0))))),
           1.0 / 3.0 -
               x2 * (1.0 / 15.0 - x2 * (2.0 / 189.0 - x2 * (1.0 / 675.0 - x2 * (2.0 / 10395.0))))};
 }
@@ -137,8 +137,7 @@ inline double ja_irreversible_slope(double H_A_per_m, double M_A_per_m, double M
 // inv_k = 1/k (JaMoveStart: one division per move, not two per evaluation). exp(-r) from the
 // known exponential `lag` where it is near (physics::exp_near); lag becomes this one's.
 inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, double dMan1,
-                                     double dHe, double inv_k, double& dMirr_dHe1,
-                                     ExpPoint& lag) {
+                                     double dHe, double inv_k, double& dMirr_dHe1, ExpPoint& lag) {
   dMirr_dHe1 = 0.0;
   if (dHe == 0.0) return Mirr0;
   const double delta = dHe > 0.0 ? 1.0 : -1.0;
@@ -158,8 +157,7 @@ inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, dou
   // reciprocal of r for q and dq/dr (lag_weights_and_slope).
   const LagWeightsSlope w = lag_weights_and_slope_near(r, lag);
   const double dq_dr = w.dq_dr;
-  dMirr_dHe1 =
-      (1.0 - w.q) * dMan1 + ds_dHe1 * inv_k * (-(Mirr0 - u0) * w.E - (Man1 - u0) * dq_dr);
+  dMirr_dHe1 = (1.0 - w.q) * dMan1 + ds_dHe1 * inv_k * (-(Mirr0 - u0) * w.E - (Man1 - u0) * dq_dr);
   return Man1 + (Mirr0 - u0) * w.E - (Man1 - u0) * w.q;
 }
 
@@ -225,8 +223,8 @@ inline JaEvaluation ja_evaluate(const JaMoveStart& st, double H1, double M1, dou
   const double Man1 = MsT_A_per_m * lv.L;
   const double dMan = MsT_A_per_m * inv_a * lv.dL;
   double dMirr = 0.0;
-  const double Mirr1 = ja_irreversible_update(Mirr0, st.Man0, Man1, dMan, He1 - st.He0, st.inv_k,
-                                              dMirr, near.lag);
+  const double Mirr1 =
+      ja_irreversible_update(Mirr0, st.Man0, Man1, dMan, He1 - st.He0, st.inv_k, dMirr, near.lag);
   return {Mirr1, (1.0 - p.c) * Mirr1 + p.c * Man1, (1.0 - p.c) * dMirr + p.c * dMan, He1 * inv_a,
           lv};
 }
