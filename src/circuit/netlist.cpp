@@ -233,8 +233,9 @@ double potential_drop(const CircuitBranch& br, const Eigen::VectorXd& psi) {
 //   v = B^T u - S D F,  (D^-1 + S) z' = v,  z = z' + D F,  B^T psi = B^T u - S z.
 // Leaves z in ws.z and the rod potential drops B^T psi in ws.v. The matrix D^-1 + S has the
 // same (dense, k x k) structure every step; it is factorised as L D L^T without square roots
-// in fixed storage, unrolled for K = 1..4 rods (the hot path of the consistent state's Newton
-// solve), K = 0 for any k <= 8. Allocation-free. False if a pivot is not positive.
+// in fixed storage, unrolled for K = 1, 2, 4 rods (the hot path of the consistent state's Newton
+// solve; three rods: rod_solve3), K = 0 for any k <= 8. Allocation-free. False if a pivot is not
+// positive.
 template <int K>
 bool rod_solve(const CircuitMatrices& L, const double* R, const double* inv_R, const double* mmf,
                double current_A, double pm_scale, int k_any, NodalBuffers& ws) {
@@ -284,6 +285,42 @@ bool rod_solve(const CircuitMatrices& L, const double* R, const double* inv_R, c
   return true;
 }
 
+// rod_solve for three rods (the built-in actuator), straight-line: D^-1 + S = A is solved by its
+// adjugate, z' = adj(A) v / det A, one division. The pivot test of the L D L^T form is
+// Sylvester's criterion on the leading minors (d_1 = a00, d_2 = m2 / a00, d_3 = det / m2 all
+// > 0). Allocation-free. False if a leading minor is not positive or z is not finite.
+bool rod_solve3(const CircuitMatrices& L, const double* R, const double* inv_R, const double* mmf,
+                double current_A, double pm_scale, NodalBuffers& ws) {
+  const double* S = L.S8.data();  // rows 0, 1, 2 at S, S + 8, S + 16
+  const double DF0 = mmf[0] * inv_R[0], DF1 = mmf[1] * inv_R[1], DF2 = mmf[2] * inv_R[2];
+  const double Btu0 = current_A * L.bt_coil8[0] + pm_scale * L.bt_pm8[0];
+  const double Btu1 = current_A * L.bt_coil8[1] + pm_scale * L.bt_pm8[1];
+  const double Btu2 = current_A * L.bt_coil8[2] + pm_scale * L.bt_pm8[2];
+  const double x0 = Btu0 - (S[0] * DF0 + S[1] * DF1 + S[2] * DF2);
+  const double x1 = Btu1 - (S[8] * DF0 + S[9] * DF1 + S[10] * DF2);
+  const double x2 = Btu2 - (S[16] * DF0 + S[17] * DF1 + S[18] * DF2);
+  // A = S + diag(R), its lower triangle (as the L D L^T form reads it).
+  const double a00 = S[0] + R[0], a10 = S[8], a11 = S[9] + R[1];
+  const double a20 = S[16], a21 = S[17], a22 = S[18] + R[2];
+  const double c00 = a11 * a22 - a21 * a21, c01 = a20 * a21 - a10 * a22,
+               c02 = a10 * a21 - a20 * a11;
+  const double c11 = a00 * a22 - a20 * a20, c12 = a10 * a20 - a00 * a21, m2 = a00 * a11 - a10 * a10;
+  const double det = a00 * c00 + a10 * c01 + a20 * c02;
+  if (!(a00 > 0.0 && m2 > 0.0 && det > 0.0)) return false;
+  const double inv_det = 1.0 / det;
+  const double z0 = (c00 * x0 + c01 * x1 + c02 * x2) * inv_det + DF0;
+  const double z1 = (c01 * x0 + c11 * x1 + c12 * x2) * inv_det + DF1;
+  const double z2 = (c02 * x0 + c12 * x1 + m2 * x2) * inv_det + DF2;
+  if (!(std::isfinite(z0) && std::isfinite(z1) && std::isfinite(z2))) return false;
+  ws.z(0) = z0;
+  ws.z(1) = z1;
+  ws.z(2) = z2;
+  ws.v(0) = Btu0 - (S[0] * z0 + S[1] * z1 + S[2] * z2);
+  ws.v(1) = Btu1 - (S[8] * z0 + S[9] * z1 + S[10] * z2);
+  ws.v(2) = Btu2 - (S[16] * z0 + S[17] * z1 + S[18] * z2);
+  return true;
+}
+
 }  // namespace
 
 bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_H, double current_A,
@@ -310,7 +347,7 @@ bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_
       ok = rod_solve<2>(L, R, inv_R.data(), mmf.data(), current_A, pm_scale, k, nb);
       break;
     case 3:
-      ok = rod_solve<3>(L, R, inv_R.data(), mmf.data(), current_A, pm_scale, k, nb);
+      ok = rod_solve3(L, R, inv_R.data(), mmf.data(), current_A, pm_scale, nb);
       break;
     case 4:
       ok = rod_solve<4>(L, R, inv_R.data(), mmf.data(), current_A, pm_scale, k, nb);

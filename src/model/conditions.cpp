@@ -221,6 +221,12 @@ Conditions conditions_at(const Model& m, double temperature_C, const Freeze& fz)
     rod_geometry(m, m.rods[i], d, rc);
     rod_material(m, m.rods[i], c, d, rc);
     rod_chain(m, i, c, rc);
+    rc.inv_area_per_m2 = 1.0 / rc.area_m2;
+    rc.length_over_area_per_m = rc.length_m / rc.area_m2;
+    rc.area_over_length_m = rc.area_m2 / rc.length_m;
+    rc.inv_MsT_E_m_per_A = 1.0 / rc.MsT_E;
+    rc.inv_Ms_strain_m_per_A = 1.0 / rc.Ms_strain_A_per_m;
+    rc.inv_mass_osc_per_kg = 1.0 / rc.mass_osc_kg;
     c.rods.push_back(rc);
   }
   return c;

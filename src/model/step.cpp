@@ -45,7 +45,7 @@ void finish_outputs(const Model& m, const Conditions& c, State& s) {
   }
   s.B_T = phi / area;
   for (std::size_t i = 0; i < s.rods.size(); ++i)
-    s.rods[i].B_T = s.rods[i].phi_Wb / c.rods[i].area_m2;
+    s.rods[i].B_T = s.rods[i].phi_Wb * c.rods[i].inv_area_per_m2;
 }
 
 // The housing's recoil q = p / M (model.hpp, SensorMountModel): p = sum (m/2 + m_lr) x.
@@ -62,23 +62,23 @@ void advance_sensor_mount(const SensorMountModel& o, double q0_m, double q1_m, d
                           State& s) {
   const double qdot = (q1_m - q0_m) / h_s;
   const double c = o.damping_N_s_per_m, k = o.stiffness_N_per_m;
-  oscillator_step(o.mass_kg, c, k, c * qdot + k * q0_m, c * qdot + k * q1_m, h_s, s.z_m,
-                  s.z_v_m_per_s);
+  oscillator_step(o.mass_kg, 1.0 / o.mass_kg, c, k, c * qdot + k * q0_m, c * qdot + k * q1_m, h_s,
+                  s.z_m, s.z_v_m_per_s, s.mount_decay);
   s.q_m = q1_m;
 }
 
 // The consistent state's end of step for one rod: the law's last Newton trial at H1 (its flux
 // density B1), the eddy field of eq. (7) (trapezoid; at rest H_c = H), the histories of the
 // first guess and the slope mu_r = 1 + dM/dH.
+// g = 2 kappa / h (eddy_static_field_trapezoid).
 template <class Law>
 void commit_rod(const RodConditions& rc, RodState& r, const typename Law::JointTrial& trial,
-                double H1, double B0, double B1, bool quasi_static, double h_s) {
+                double H1, double B0, double B1, bool quasi_static, double g) {
   r.M_prev2_A_per_m = r.M_prev_A_per_m;
   r.M_prev_A_per_m = r.M_A_per_m;
   Law::commit_trial(rc, r, trial);
-  r.Hc_A_per_m = quasi_static ? H1
-                              : eddy_static_field_trapezoid(r.H_A_per_m, H1, r.Hc_A_per_m, B0, B1,
-                                                            rc.eddy_geometry_s_m_per_H, h_s);
+  r.Hc_A_per_m =
+      quasi_static ? H1 : eddy_static_field_trapezoid(r.H_A_per_m, H1, r.Hc_A_per_m, B0, B1, g);
   r.H_prev2_A_per_m = r.H_prev_A_per_m;
   r.H_prev_A_per_m = r.H_A_per_m;
   r.H_A_per_m = H1;
@@ -122,23 +122,22 @@ template <class Law>
 void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, double current_A,
                                 double pm_scale, double h_s, bool quasi_static, double t1) {
   const std::size_t n = s.rods.size();
-  std::array<double, 8> H, Mg, inv_mud, B0, e0, g, Bs, l_A, inv_A;  // set before read (no fill)
+  std::array<double, 8> H, Mg, inv_mud, B0, e0, g, Bs;  // set before read (no fill)
   std::array<typename Law::MoveStart, 8> start;
   std::array<typename Law::JointTrial, 8> trial;
+  const double two_over_h = 2.0 / h_s;
   for (std::size_t i = 0; i < n; ++i) {
     const auto& r = s.rods[i];
     const auto& rc = c.rods[i];
     start[i] = Law::begin_move(rc, r);
     B0[i] = flux_density(r.H_A_per_m, r.M_A_per_m);
-    l_A[i] = rc.length_m / rc.area_m2;
-    inv_A[i] = 1.0 / rc.area_m2;
     if (quasi_static) {
       H[i] = r.H_A_per_m;
       Mg[i] = r.M_A_per_m;
       e0[i] = g[i] = 0.0;  // no eddy term at rest
     } else {
       e0[i] = r.Hc_A_per_m - r.H_A_per_m;
-      g[i] = 2.0 * rc.eddy_geometry_s_m_per_H / h_s;
+      g[i] = rc.eddy_geometry_s_m_per_H * two_over_h;
       H[i] = 3.0 * (r.H_A_per_m - r.H_prev_A_per_m) + r.H_prev2_A_per_m;
       Mg[i] = 3.0 * (r.M_A_per_m - r.M_prev_A_per_m) + r.M_prev2_A_per_m;
     }
@@ -154,7 +153,8 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
       law_steps += std::fabs(trial[i].M_next - Mg[i]);
       Bs[i] = flux_density(H[i], trial[i].M_next);
       inv_mud[i] = trial[i].inv_mu_r * (1.0 / kMu0);
-      s.rod_reluctance[i] = l_A[i] * (inv_mud[i] + g[i]) + rc.series_reluctance_per_H;
+      s.rod_reluctance[i] =
+          rc.length_over_area_per_m * (inv_mud[i] + g[i]) + rc.series_reluctance_per_H;
       s.circuit.rod_extra_mmf[i] =
           -rc.length_m * (H[i] - Bs[i] * inv_mud[i] - g[i] * B0[i] - e0[i]);
     }
@@ -170,7 +170,7 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
     std::array<double, 8> dH;  // written for rods 0..n-1 below
     for (std::size_t i = 0; i < n; ++i) {
       const double phi = s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
-      dH[i] = (phi * inv_A[i] - Bs[i]) * inv_mud[i];
+      dH[i] = (phi * c.rods[i].inv_area_per_m2 - Bs[i]) * inv_mud[i];
       // The rod's Newton step: its field's and its law's (A/m both); NaN propagates.
       const double dM = std::fabs(trial[i].M_next - Mg[i]);
       const double step = dM <= std::fabs(dH[i]) ? std::fabs(dH[i]) : dM;
@@ -196,7 +196,7 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
   }
   for (std::size_t i = 0; i < n; ++i) {  // commit the end-of-step state: the last iterate
     commit_rod<Law>(c.rods[i], s.rods[i], trial[i], H[i], B0[i], flux_density(H[i], trial[i].M),
-                    quasi_static, h_s);
+                    quasi_static, g[i]);
     s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])] = s.rods[i].phi_Wb;
   }
 }
@@ -413,14 +413,16 @@ void stage_strain(const Model& m, const Conditions& c, State& s, StepScratch& w)
 // Guard: |x| <= 1 m.
 void stage_mechanics(const Model& m, const Conditions& c, State& s, const StepInput& in,
                      const StepScratch& w) {
+  std::array<double, 8> inv_k_rod;  // each rod's compliance, once (written for 0..n-1)
+  for (std::size_t i = 0; i < s.rods.size(); ++i) inv_k_rod[i] = 1.0 / s.rods[i].k_rod_N_per_m;
   for (std::size_t i = 0; i < s.rods.size(); ++i) {
     const auto& rc = c.rods[i];
     auto& r = s.rods[i];
-    r.k_load_N_per_m = load_stiffness(rc, s);
+    r.k_load_N_per_m = load_stiffness_from_compliances(rc, inv_k_rod.data());
     const double K = 0.5 * (w.K0_N_per_m[i] + r.k_rod_N_per_m + r.k_load_N_per_m);
     r.K_osc_N_per_m = K;
-    oscillator_step(rc.mass_osc_kg, rc.damping_osc_N_s_per_m, K, w.F0_N[i], r.F_N, in.dt_s, r.x_m,
-                    r.v_m_per_s);
+    oscillator_step(rc.mass_osc_kg, rc.inv_mass_osc_per_kg, rc.damping_osc_N_s_per_m, K, w.F0_N[i],
+                    r.F_N, in.dt_s, r.x_m, r.v_m_per_s, r.osc_decay);
     check(r.x_m, w.t1_s, m.rods[i].name, "x [m]", 1.0);
   }
   if (m.sensor_mount.enabled) {

@@ -31,16 +31,21 @@ struct JilesAthertonLaw {
   // The consistent state's Newton solve tries several end fields H1 of one move: begin_move
   // fixes what depends on the move's start only (H_e0 and M_an(H_e0)), trial_from returns M, the
   // slope dM/dH and the state the move would leave at H1, and commit_trial commits that trial
-  // as it is (the last Newton iterate; no second evaluation of the law).
-  using MoveStart = physics::JaMoveStart;
+  // as it is (the last Newton iterate; no second evaluation of the law). The move also carries
+  // its last evaluation's exponentials: the next iterate is near and derives its own from them
+  // (physics::JaExpPoints, exp_near).
+  struct MoveStart : physics::JaMoveStart {
+    physics::JaExpPoints near{};
+  };
   struct Trial {
     double M, dM_dH, Mirr;
   };
   // The move starts where the law's last evaluation left the Langevin function, when it is
   // near (RodState::an_x; physics::ja_move_start_near): the step's start is the last end.
   static MoveStart begin_move(const RodConditions& rc, const RodState& r) {
-    return physics::ja_move_start_near(r.H_A_per_m, r.M_A_per_m, rc.MsT_mag, rc.ja, r.an_x,
-                                       {r.an_L, r.an_dL});
+    return {physics::ja_move_start_near(r.H_A_per_m, r.M_A_per_m, rc.MsT_mag, rc.ja,
+                                        rc.ja_inv_a_m_per_A, rc.ja_inv_k_m_per_A, r.an_x,
+                                        {r.an_L, r.an_dL})};
   }
   static Trial trial_from(const RodConditions& rc, const RodState& r, const MoveStart& st,
                           double H1, double M_guess) {
@@ -65,8 +70,8 @@ struct JilesAthertonLaw {
     physics::LangevinValue an_lv;  // L and L' there
     bool converged;
   };
-  static void joint_trial(const RodConditions& rc, const RodState& r, const MoveStart& st,
-                          double H1, double M_iter, JointTrial& t) {
+  static void joint_trial(const RodConditions& rc, const RodState& r, MoveStart& st, double H1,
+                          double M_iter, JointTrial& t) {
     double chi_e = 0.0;
     double g = 0.0;
     if (H1 == r.H_A_per_m) {
@@ -76,8 +81,8 @@ struct JilesAthertonLaw {
       t.an_x = r.an_x;  // nothing evaluated: the rod's own point stays
       t.an_lv = {r.an_L, r.an_dL};
     } else {
-      const physics::JaEvaluation e =
-          physics::ja_evaluate(st, H1, M_iter, rc.MsT_mag, rc.ja, r.Mirr_A_per_m, st.inv_a);
+      const physics::JaEvaluation e = physics::ja_evaluate(st, H1, M_iter, rc.MsT_mag, rc.ja,
+                                                           r.Mirr_A_per_m, st.inv_a, st.near);
       t.an_x = e.x1;
       t.an_lv = e.lv;
       t.Mirr = e.Mirr1;

@@ -6,6 +6,8 @@
 
 #include <cmath>
 
+#include "gmasim/physics/series.hpp"
+
 namespace gmasim::physics {
 
 // The transition matrix of the free row, m e'' + c e' + k e = 0, over a step h:
@@ -24,13 +26,8 @@ struct OscillatorPropagator {
   double f0, f1;
   bool valid;
 };
-// c0 + c1 x + ... + c7 x^7 by Estrin's scheme (short dependency chains).
-inline double polynomial7(double x, const double (&c)[8]) {
-  const double x2 = x * x, x4 = x2 * x2;
-  return (c[0] + c[1] * x) + x2 * (c[2] + c[3] * x) +
-         x4 * ((c[4] + c[5] * x) + x2 * (c[6] + c[7] * x));
-}
-inline OscillatorPropagator oscillator_propagator(double tau, double delta) {
+// decay: the last e^(tau/2) taken by std::exp (physics::exp_cached; a run's step repeats it).
+inline OscillatorPropagator oscillator_propagator(double tau, double delta, ExpPoint &decay) {
   const double half_tau = 0.5 * tau;
   const double u = half_tau * half_tau - delta;
   if (!(std::fabs(u) <= 0.25)) return {0.0, 0.0, false};
@@ -39,12 +36,14 @@ inline OscillatorPropagator oscillator_propagator(double tau, double delta) {
   constexpr double kSinc[8] = {
       1.0,          1.0 / 6,          1.0 / 120,          1.0 / 5040,
       1.0 / 362880, 1.0 / 39916800.0, 1.0 / 6227020800.0, 1.0 / 1307674368000.0};
-  constexpr double kExp[8] = {1.0,      1.0,       1.0 / 2,   1.0 / 6,
-                              1.0 / 24, 1.0 / 120, 1.0 / 720, 1.0 / 5040};
   const double C = polynomial7(u, kCos), S = polynomial7(u, kSinc);
   const double E =
-      std::fabs(half_tau) <= 1.0 / 64 ? polynomial7(half_tau, kExp) : std::exp(half_tau);
+      std::fabs(half_tau) <= 1.0 / 64 ? exp_series7(half_tau) : exp_cached(half_tau, decay);
   return {E * (C - half_tau * S), E * S, true};
+}
+inline OscillatorPropagator oscillator_propagator(double tau, double delta) {
+  ExpPoint none = kNoExpPoint;
+  return oscillator_propagator(tau, delta, none);
 }
 
 // The closed form of the free row over h (under-, critically or over-damped)
@@ -85,8 +84,9 @@ inline OscillatorPropagator oscillator_propagator(double tau, double delta) {
 // particular solution, so the update is exact for piecewise-linear forcing and
 // unconditionally stable: the step is not limited by the 7-20 kHz mechanical
 // modes. Updates x [m] and v [m/s].
-inline void oscillator_step(double m, double c, double k, double F0, double F1, double h, double &x,
-                            double &v) {
+// inv_m = 1/m; decay: oscillator_propagator's (the row's last e^(tau/2)).
+inline void oscillator_step(double m, double inv_m, double c, double k, double F0, double F1,
+                            double h, double &x, double &v, ExpPoint &decay) {
   const double g = (F1 - F0) / h;  // force rate [N/s]
   // Particular solution x_p(s) = (F0 + g s)/k - g c / k^2, v_p = g / k.
   const double inv_k = 1.0 / k;
@@ -95,9 +95,8 @@ inline void oscillator_step(double m, double c, double k, double F0, double F1, 
   const double e0 = x - xp0;
   const double ed0 = v - vp;
   double e1 = 0.0, ed1 = 0.0;
-  const double inv_m = 1.0 / m;
   const double c_m = c * inv_m, k_m = k * inv_m;
-  const OscillatorPropagator pr = oscillator_propagator(-c_m * h, k_m * h * h);
+  const OscillatorPropagator pr = oscillator_propagator(-c_m * h, k_m * h * h, decay);
   if (pr.valid) [[likely]] {
     e1 = pr.f0 * e0 + pr.f1 * h * ed0;
     ed1 = pr.f0 * ed0 - pr.f1 * h * (k_m * e0 + c_m * ed0);
@@ -107,6 +106,12 @@ inline void oscillator_step(double m, double c, double k, double F0, double F1, 
   const double xp1 = (F1 - g * c * inv_k) * inv_k;
   x = xp1 + e1;
   v = vp + ed1;
+}
+
+inline void oscillator_step(double m, double c, double k, double F0, double F1, double h, double &x,
+                            double &v) {
+  ExpPoint none = kNoExpPoint;
+  oscillator_step(m, 1.0 / m, c, k, F0, F1, h, x, v, none);
 }
 
 }  // namespace gmasim::physics

@@ -313,6 +313,16 @@ struct RodConditions {
   double fixed_compliance_m_per_N;  // sum of 1/k of the chain's non-rod members (eq. 18)
   std::array<int, 8> chain_rods;    // rods inside this rod's load chain (eq. 18)
   int chain_rod_count;
+  // Reciprocals and ratios of the fields above that every step uses, divided once here
+  // (make_conditions sets them with the fields they come from; the step multiplies).
+  double inv_area_per_m2;         // 1 / A^T
+  double length_over_area_per_m;  // l^T / A^T (eq. 2)
+  double area_over_length_m;      // A^T / l^T (eq. 17)
+  double inv_MsT_E_m_per_A;       // 1 / MsT_E (eq. 13)
+  double inv_Ms_strain_m_per_A;   // 1 / Ms_strain_A_per_m (eq. 11)
+  double inv_mass_osc_per_kg;     // 1 / mass_osc_kg (eq. 15)
+  double ja_inv_a_m_per_A;        // 1 / ja.a_A_per_m (eq. 9; Jiles-Atherton law only)
+  double ja_inv_k_m_per_A;        // 1 / ja.k_A_per_m (eq. 9; Jiles-Atherton law only)
 };
 
 struct Conditions {
@@ -380,6 +390,9 @@ struct RodState {
   double K_osc_N_per_m = 0;  // the oscillator's stiffness over the last step (eq. 16 at mid-step);
                              // stage 3 (make_state: at rest)
   RodEnergy energy;          // the ledgers' running sums (gmasim/model/energy.hpp); end of step()
+  // The oscillator's last e^(tau/2) by std::exp (physics::oscillator_propagator): the next step
+  // at the same dt reuses it. Stage 3.
+  physics::ExpPoint osc_decay = physics::kNoExpPoint;
 };
 
 struct State {
@@ -391,6 +404,7 @@ struct State {
   // Sensor mount (if any): q = p / M, the housing's recoil -x_h; z follows q through the bracket
   // (m z'' + c (z' - q') + k (z - q) = 0), so the probe's deflection is u = q - z; stage 3.
   double q_m = 0, z_m = 0, z_v_m_per_s = 0;
+  physics::ExpPoint mount_decay = physics::kNoExpPoint;  // the mount's, as RodState::osc_decay
   double B_T = 0;  // flux density seen by the induction coil (sensor branches); end of step()
   std::vector<RodState> rods;
   CircuitWorkspace circuit;  // stage 1: the rod branches' fluxes phi (eq. 23), the consistent

@@ -40,13 +40,14 @@ inline double rod_static_field(const Model& m, std::size_t i, const RodCondition
 }
 
 // Magnetostriction, Delta-E modulus and force of a rod at its present M (eq. 11-14, 17).
+// The reciprocals are RodConditions' (divided once); 1/E is eq. (13)'s bracket.
 inline void update_rod_mechanics(const Material& mat, const RodConditions& rc, RodState& r) {
-  r.E_Pa = physics::delta_e_modulus(r.M_A_per_m / rc.MsT_E, rc.dE);  // eq. (13)
-  r.lambda =
-      physics::magnetostriction(r.M_A_per_m / rc.Ms_strain_A_per_m, mat.lambda_s, rc.sigma_p_Pa,
-                                r.E_Pa);                                        // eq. (11)-(12)
-  r.F_N = physics::rod_force(r.lambda, r.E_Pa, rc.area_m2);                     // eq. (14)
-  r.k_rod_N_per_m = physics::axial_stiffness(r.E_Pa, rc.area_m2, rc.length_m);  // eq. (17)
+  const double inv_E = physics::delta_e_compliance(r.M_A_per_m * rc.inv_MsT_E_m_per_A, rc.dE);
+  r.E_Pa = 1.0 / inv_E;  // eq. (13)
+  r.lambda = physics::magnetostriction(r.M_A_per_m * rc.inv_Ms_strain_m_per_A, mat.lambda_s,
+                                       rc.sigma_p_Pa, r.E_Pa, inv_E);  // eq. (11)-(12)
+  r.F_N = physics::rod_force(r.lambda, r.E_Pa, rc.area_m2);            // eq. (14)
+  r.k_rod_N_per_m = r.E_Pa * rc.area_over_length_m;                    // eq. (17): E A / l
 }
 
 // Load stiffness of a rod (eq. 18): its fixed members plus the rods in its chain, whose
@@ -56,6 +57,13 @@ double load_stiffness(const RodConditions& rc, KRod k_rod) {
   double inv_k = rc.fixed_compliance_m_per_N;
   for (int j = 0; j < rc.chain_rod_count; ++j)
     inv_k += 1.0 / k_rod(rc.chain_rods[static_cast<std::size_t>(j)]);
+  return 1.0 / inv_k;
+}
+// The same from the rods' compliances 1/k_rod (inv_k_rod[j], divided once per rod and step).
+inline double load_stiffness_from_compliances(const RodConditions& rc, const double* inv_k_rod) {
+  double inv_k = rc.fixed_compliance_m_per_N;
+  for (int j = 0; j < rc.chain_rod_count; ++j)
+    inv_k += inv_k_rod[rc.chain_rods[static_cast<std::size_t>(j)]];
   return 1.0 / inv_k;
 }
 inline double load_stiffness(const RodConditions& rc, const State& s) {

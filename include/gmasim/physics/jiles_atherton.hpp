@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "gmasim/physics/magnetic.hpp"
+#include "gmasim/physics/series.hpp"
 
 namespace gmasim::physics {
 
@@ -14,20 +15,8 @@ namespace gmasim::physics {
 struct LangevinValue {
   double L, dL;
 };
-inline LangevinValue langevin_pair(double x) {
-  const double ax = std::fabs(x);
-  if (ax < 0.1) {
-    const double x2 = x * x;
-    return {x * (1.0 / 3.0 - x2 * (1.0 / 45.0 - x2 * (2.0 / 945.0 -
-                                                      x2 * (1.0 / 4725.0 - x2 * (2.0 / 93555.0))))),
-            1.0 / 3.0 -
-                x2 * (1.0 / 15.0 - x2 * (2.0 / 189.0 - x2 * (1.0 / 675.0 - x2 * (2.0 / 10395.0))))};
-  }
-  if (ax > 40.0) {
-    const double inv_x = 1.0 / x;
-    return {(x > 0 ? 1.0 : -1.0) - inv_x, inv_x * inv_x};
-  }
-  const double e = std::exp(-2.0 * ax);  // coth|x| = (1+e)/(1-e)
+// The closed form for 0.1 <= |x| <= 40 from e = exp(-2|x|) (coth|x| = (1+e)/(1-e)).
+inline LangevinValue langevin_pair_from_exp(double x, double e) {
   const double one_minus_e = 1.0 - e;
   const double q = 1.0 / (x * one_minus_e);
   const double inv_x = one_minus_e * q;
@@ -35,6 +24,32 @@ inline LangevinValue langevin_pair(double x) {
   const double coth_abs = (1.0 + e) * inv_1me;
   const double inv_sinh2 = 4.0 * e * inv_1me * inv_1me;
   return {(x > 0 ? coth_abs : -coth_abs) - inv_x, inv_x * inv_x - inv_sinh2};
+}
+inline LangevinValue langevin_series(double x) {
+  const double x2 = x * x;
+  return {x * (1.0 / 3.0 -
+               x2 * (1.0 / 45.0 - x2 * (2.0 / 945.0 - x2 * (1.0 / 4725.0 - x2 * (2.0 / 93555.0))))),
+          1.0 / 3.0 -
+              x2 * (1.0 / 15.0 - x2 * (2.0 / 189.0 - x2 * (1.0 / 675.0 - x2 * (2.0 / 10395.0))))};
+}
+inline LangevinValue langevin_asymptote(double x) {
+  const double inv_x = 1.0 / x;
+  return {(x > 0 ? 1.0 : -1.0) - inv_x, inv_x * inv_x};
+}
+inline LangevinValue langevin_pair(double x) {
+  const double ax = std::fabs(x);
+  if (ax < 0.1) return langevin_series(x);
+  if (ax > 40.0) return langevin_asymptote(x);
+  return langevin_pair_from_exp(x, std::exp(-2.0 * ax));
+}
+// langevin_pair with its exponential exp(-2|x|) from a known one nearby (p, physics::exp_near: a
+// few units in the last place from langevin_pair). p becomes the point of this evaluation where
+// the closed form was used (and stays as it was otherwise).
+inline LangevinValue langevin_pair_near(double x, ExpPoint& p) {
+  const double ax = std::fabs(x);
+  if (ax < 0.1) return langevin_series(x);
+  if (ax > 40.0) return langevin_asymptote(x);
+  return langevin_pair_from_exp(x, exp_near(-2.0 * ax, p));
 }
 inline double langevin(double x) { return langevin_pair(x).L; }
 inline double langevin_derivative(double x) { return langevin_pair(x).dL; }
@@ -119,8 +134,10 @@ inline double ja_irreversible_slope(double H_A_per_m, double M_A_per_m, double M
 // (M_an - M_irr) delta <= 0, holds M_irr until M_an crosses it.
 // Returns M_irr at the end of the step and, in dMirr_dHe1, its derivative with respect to
 // the end field H_e1 given dMan1 = dM_an/dH_e there (for Newton's method in ja_step).
+// inv_k = 1/k (JaMoveStart: one division per move, not two per evaluation). exp(-r) from the
+// known exponential `lag` where it is near (physics::exp_near); lag becomes this one's.
 inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, double dMan1,
-                                     double dHe, double k_A_per_m, double& dMirr_dHe1) {
+                                     double dHe, double inv_k, double& dMirr_dHe1, ExpPoint& lag) {
   dMirr_dHe1 = 0.0;
   if (dHe == 0.0) return Mirr0;
   const double delta = dHe > 0.0 ? 1.0 : -1.0;
@@ -135,13 +152,12 @@ inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, dou
     s *= frac;
     u0 = Mirr0;
   }
-  const double r = s / k_A_per_m;
+  const double r = s * inv_k;
   // d/dHe1 through M_an1 (weight 1 - q) and through r = s/k (dq/dr = (E - q)/r): one
   // reciprocal of r for q and dq/dr (lag_weights_and_slope).
-  const LagWeightsSlope w = lag_weights_and_slope(r);
+  const LagWeightsSlope w = lag_weights_and_slope_near(r, lag);
   const double dq_dr = w.dq_dr;
-  dMirr_dHe1 =
-      (1.0 - w.q) * dMan1 + ds_dHe1 / k_A_per_m * (-(Mirr0 - u0) * w.E - (Man1 - u0) * dq_dr);
+  dMirr_dHe1 = (1.0 - w.q) * dMan1 + ds_dHe1 * inv_k * (-(Mirr0 - u0) * w.E - (Man1 - u0) * dq_dr);
   return Man1 + (Mirr0 - u0) * w.E - (Man1 - u0) * w.q;
 }
 
@@ -158,12 +174,13 @@ inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, dou
 struct JaMoveStart {
   double He0, Man0;
   double inv_a;  // 1 / a^T, for the move's evaluations (ja_evaluate)
+  double inv_k;  // 1 / k^T, likewise (ja_irreversible_update)
 };
 inline JaMoveStart ja_move_start(double H0, double M0, double MsT_A_per_m,
                                  const JaCoefficients& p) {
   const double He0 = H0 + p.alpha * M0;
   const double inv_a = 1.0 / p.a_A_per_m;
-  return {He0, MsT_A_per_m * langevin(He0 * inv_a), inv_a};
+  return {He0, MsT_A_per_m * langevin(He0 * inv_a), inv_a, 1.0 / p.k_A_per_m};
 }
 // ja_move_start with the Langevin function known at a nearby x_at = H_e / a (L and L' there,
 // lv; the last evaluation of the law, where the last step ended): where |H_e0 / a - x_at| <=
@@ -171,37 +188,50 @@ inline JaMoveStart ja_move_start(double H0, double M0, double MsT_A_per_m,
 // below 3e-15 M_s^T) is far below eq. (9)'s tolerance; otherwise ja_move_start. x_at NaN:
 // nothing known. (The consistent state commits its last iterate, so a step starts within
 // about alpha 1e-12 M_s^T / a of it: one exponential less per rod and step.)
+// inv_a = 1/a and inv_k = 1/k, divided once with the coefficients (RodConditions).
 inline JaMoveStart ja_move_start_near(double H0, double M0, double MsT_A_per_m,
-                                      const JaCoefficients& p, double x_at,
-                                      const LangevinValue& lv) {
+                                      const JaCoefficients& p, double inv_a, double inv_k,
+                                      double x_at, const LangevinValue& lv) {
   const double He0 = H0 + p.alpha * M0;
-  const double inv_a = 1.0 / p.a_A_per_m;
   const double x0 = He0 * inv_a;
-  if (std::fabs(x0 - x_at) <= 1e-7) return {He0, MsT_A_per_m * (lv.L + lv.dL * (x0 - x_at)), inv_a};
-  return {He0, MsT_A_per_m * langevin(x0), inv_a};
+  if (std::fabs(x0 - x_at) <= 1e-7)
+    return {He0, MsT_A_per_m * (lv.L + lv.dL * (x0 - x_at)), inv_a, inv_k};
+  return {He0, MsT_A_per_m * langevin(x0), inv_a, inv_k};
 }
+// The exponentials of an evaluation (exp(-2|x|) of the Langevin function, exp(-r) of the lag),
+// for the next evaluation of the same move nearby (a Newton solve's next iterate).
+struct JaExpPoints {
+  ExpPoint langevin = kNoExpPoint, lag = kNoExpPoint;
+};
 // One evaluation of eq. (9) at the end field H1 and a magnetisation iterate M1 (inv_a = 1/a):
 // M_irr1 from ja_irreversible_update, the magnetisation the law gives there,
 //   F(M1) = (1-c) M_irr1 + c M_an(H1 + alpha M1),
 // and chi_e = dF/dH_e. Eq. (9) holds where g = M1 - F(M1) = 0; its Newton step in M1 is
 // -g / (1 - alpha chi_e) (ja_step_from iterates it; the consistent state's joint Newton solve
-// takes one per circuit solve).
+// takes one per circuit solve). `near`: the exponentials of the move's last evaluation, when
+// known (JaExpPoints; updated to this one's).
 struct JaEvaluation {
   double Mirr1, M, chi_e;
   double x1;         // H_e1 / a, where the Langevin function was evaluated
   LangevinValue lv;  // L and L' at x1
 };
 inline JaEvaluation ja_evaluate(const JaMoveStart& st, double H1, double M1, double MsT_A_per_m,
-                                const JaCoefficients& p, double Mirr0, double inv_a) {
+                                const JaCoefficients& p, double Mirr0, double inv_a,
+                                JaExpPoints& near) {
   const double He1 = H1 + p.alpha * M1;
-  const LangevinValue lv = langevin_pair(He1 * inv_a);
+  const LangevinValue lv = langevin_pair_near(He1 * inv_a, near.langevin);
   const double Man1 = MsT_A_per_m * lv.L;
   const double dMan = MsT_A_per_m * inv_a * lv.dL;
   double dMirr = 0.0;
   const double Mirr1 =
-      ja_irreversible_update(Mirr0, st.Man0, Man1, dMan, He1 - st.He0, p.k_A_per_m, dMirr);
+      ja_irreversible_update(Mirr0, st.Man0, Man1, dMan, He1 - st.He0, st.inv_k, dMirr, near.lag);
   return {Mirr1, (1.0 - p.c) * Mirr1 + p.c * Man1, (1.0 - p.c) * dMirr + p.c * dMan, He1 * inv_a,
           lv};
+}
+inline JaEvaluation ja_evaluate(const JaMoveStart& st, double H1, double M1, double MsT_A_per_m,
+                                const JaCoefficients& p, double Mirr0, double inv_a) {
+  JaExpPoints none{};
+  return ja_evaluate(st, H1, M1, MsT_A_per_m, p, Mirr0, inv_a, none);
 }
 // The tolerance on g = M1 - F(M1) at which eq. (9) counts as solved [A/m]: 1e-12 M_s^T.
 inline double ja_magnetisation_tolerance(double MsT_A_per_m) { return 1e-12 * MsT_A_per_m; }

@@ -5,6 +5,8 @@
 
 #include <cmath>
 
+#include "gmasim/physics/series.hpp"
+
 namespace gmasim::physics {
 
 inline constexpr double kMu0 = 1.25663706212e-6;  // vacuum permeability [H/m]
@@ -116,10 +118,11 @@ inline double eddy_time_constant(double mu_H_per_m, double r_outer_m, double r_i
 //   H_c = H + kappa dB/dt,   kappa = (r1^2 - r2^2)/(4 k_j rho)   [s m/H]
 // (kappa = eddy_time_constant(1, ...); for a linear material dB = mu dH this is eq. 7's
 // H(s) = H_c(s)/(1 + tau s) with tau = mu kappa). Trapezoidal average over a step h:
-//   (H_c0 + H_c1)/2 = (H0 + H1)/2 + kappa (B1 - B0)/h.
+//   (H_c0 + H_c1)/2 = (H0 + H1)/2 + kappa (B1 - B0)/h,
+// given g = 2 kappa / h [A/(m T)].
 inline double eddy_static_field_trapezoid(double H0, double H1, double Hc0, double B0_T,
-                                          double B1_T, double kappa_s_m_per_H, double h_s) {
-  return H1 + 2.0 * kappa_s_m_per_H * (B1_T - B0_T) / h_s - (Hc0 - H0);
+                                          double B1_T, double g_A_per_m_T) {
+  return H1 + g_A_per_m_T * (B1_T - B0_T) - (Hc0 - H0);
 }
 
 // Eq. (8): temperature-dependent resistivity of Terfenol-D [ohm m].
@@ -148,8 +151,7 @@ inline LagWeights lag_weights(double r) {
 struct LagWeightsSlope {
   double E, q, dq_dr;
 };
-inline LagWeightsSlope lag_weights_and_slope(double r) {
-  const double E = std::exp(-r);
+inline LagWeightsSlope lag_weights_and_slope_from(double r, double E) {
   if (r < 1e-2) {
     const double q =
         1.0 - r * (1.0 / 2 - r * (1.0 / 6 - r * (1.0 / 24 - r * (1.0 / 120 - r * (1.0 / 720)))));
@@ -158,6 +160,13 @@ inline LagWeightsSlope lag_weights_and_slope(double r) {
   const double inv_r = 1.0 / r;
   const double q = (1.0 - E) * inv_r;
   return {E, q, (E - q) * inv_r};
+}
+inline LagWeightsSlope lag_weights_and_slope(double r) {
+  return lag_weights_and_slope_from(r, std::exp(-r));
+}
+// The same with exp(-r) from a known exponential nearby (p, physics::exp_near); p becomes -r's.
+inline LagWeightsSlope lag_weights_and_slope_near(double r, ExpPoint& p) {
+  return lag_weights_and_slope_from(r, exp_near(-r, p));
 }
 
 // Exact update of the first-order lag  tau dH/dt = u(t) - H  over one step h with u

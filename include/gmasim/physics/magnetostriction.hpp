@@ -39,13 +39,18 @@ inline DeltaETerms delta_e_terms(double Es_Pa, double lambda_s, double sigma_Pa,
 //   1/E = 1/E_s + rot (1 - m^2) + coupling^2 m^2 / [mu0 Ms^2/chi_m sec^2(pi m/2) - S]
 // The last term is evaluated multiplied through by cos^2(pi m/2), so that m = 1 (where
 // sec^2 is infinite) gives E = E_s exactly.
-inline double delta_e_modulus(double m, const DeltaETerms& d) {
+// delta_e_compliance is 1/E, the bracket itself (the step multiplies by it where eq. 11-12 and
+// 17 divide by E).
+inline double delta_e_compliance(double m, const DeltaETerms& d) {
   const double c = std::cos(0.5 * kPi * m);
   const double c2 = c * c;
   const double m2 = m * m;
   const double third =
       d.coupling * d.coupling * m2 * c2 / (d.mu0_Ms2_over_chi_m_J_per_m3 - c2 * d.S_J_per_m3);
-  return 1.0 / (d.inverse_Es_per_Pa + d.rotation_compliance_per_Pa * (1.0 - m2) + third);
+  return d.inverse_Es_per_Pa + d.rotation_compliance_per_Pa * (1.0 - m2) + third;
+}
+inline double delta_e_modulus(double m, const DeltaETerms& d) {
+  return 1.0 / delta_e_compliance(m, d);
 }
 
 // Eq. (12): saturation and maximum magnetostrictive stress [Pa].
@@ -65,18 +70,29 @@ inline double tanh_absolute(double u) {
   return u < 0.0 ? -t : t;
 }
 
-inline double prestress_factor(double sigma_p_Pa, double sigma_s_Pa, double sigma_max_Pa) {
-  const double base = 1.0 + 0.5 * tanh_absolute(2.0 * sigma_p_Pa / sigma_s_Pa);
+// The factor at 2 sigma_p / sigma_s = two_sp_over_ss (given: the step forms it from 1/E).
+inline double prestress_factor_at(double two_sp_over_ss, double sigma_p_Pa, double sigma_s_Pa,
+                                  double sigma_max_Pa) {
+  const double base = 1.0 + 0.5 * tanh_absolute(two_sp_over_ss);
   if (sigma_p_Pa <= sigma_s_Pa) return base;
   return (1.0 - (sigma_p_Pa - sigma_s_Pa) / sigma_max_Pa) * base;
 }
+inline double prestress_factor(double sigma_p_Pa, double sigma_s_Pa, double sigma_max_Pa) {
+  return prestress_factor_at(2.0 * sigma_p_Pa / sigma_s_Pa, sigma_p_Pa, sigma_s_Pa, sigma_max_Pa);
+}
 
 // Eq. (11)-(12): magnetostrictive strain [-] with the stress thresholds of eq. (12)
-// taken at the current modulus E_G.
-inline double magnetostriction(double m, double lambda_s, double sigma_p_Pa, double E_Pa) {
-  const double f = prestress_factor(sigma_p_Pa, saturation_stress(lambda_s, E_Pa),
-                                    maximum_stress(lambda_s, E_Pa));
+// taken at the current modulus E_G; inv_E_per_Pa = 1/E_G (delta_e_compliance), so that
+// 2 sigma_p / sigma_s = (4 sigma_p / lambda_s) / E_G is a product.
+inline double magnetostriction(double m, double lambda_s, double sigma_p_Pa, double E_Pa,
+                               double inv_E_per_Pa) {
+  const double f =
+      prestress_factor_at(4.0 * sigma_p_Pa / lambda_s * inv_E_per_Pa, sigma_p_Pa,
+                          saturation_stress(lambda_s, E_Pa), maximum_stress(lambda_s, E_Pa));
   return f * lambda_s * m * m;
+}
+inline double magnetostriction(double m, double lambda_s, double sigma_p_Pa, double E_Pa) {
+  return magnetostriction(m, lambda_s, sigma_p_Pa, E_Pa, 1.0 / E_Pa);
 }
 
 // Eq. (14): magnetostrictive force of one rod [N].  F = lambda E A.

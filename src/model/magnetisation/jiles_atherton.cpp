@@ -90,6 +90,8 @@ void jiles_atherton_conditions(const Model& m, const RodModel& rod, double T_law
                                RodConditions& rc) {
   rc.ja = ja_at(m, rod.ja, T_law_C);  // eq. (10)
   if (m.options.magnetic_state == MagneticState::Consistent) rc.ja.alpha += rc.alpha_sigma;
+  rc.ja_inv_a_m_per_A = 1.0 / rc.ja.a_A_per_m;
+  rc.ja_inv_k_m_per_A = 1.0 / rc.ja.k_A_per_m;
   if (!(rc.ja.a_A_per_m > 0 && rc.ja.k_A_per_m > 0 && rc.ja.c >= 0 && rc.ja.c < 1 &&
         std::isfinite(rc.ja.alpha)))
     throw InputError(fmt::format(
