@@ -33,18 +33,18 @@ HWY_INLINE void mechanics(const Chunk<D>& c, RodStates<D>& s, V<D> h, V<D> t1, F
     s.f[kF][i] = hn::Mul(hn::Mul(s.f[kLambda][i], E), A);
     s.f[kKRod][i] = hn::Div(hn::Mul(E, A), c.rod(kLength, i));
   }
+  V<D> compliance[kMaxRods];  // 1 / k_rod, each rod's once (the chains share them)
+  for (int i = 0; i < n; ++i) compliance[i] = hn::Div(C(d, 1.0), s.f[kKRod][i]);
   for (int i = 0; i < n; ++i) {
     V<D> inv_k = c.rod(kFixedCompl, i);
     for (int k = 0; k < st.chain_count[static_cast<std::size_t>(i)]; ++k)
       inv_k = hn::Add(
-          inv_k,
-          hn::Div(C(d, 1.0),
-                  s.f[kKRod][st.chain[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)]]));
+          inv_k, compliance[st.chain[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)]]);
     s.f[kKLoad][i] = hn::Div(C(d, 1.0), inv_k);
     const V<D> K = hn::Mul(C(d, 0.5), hn::Add(hn::Add(K0[i], s.f[kKRod][i]), s.f[kKLoad][i]));
     s.f[kKOsc][i] = K;
-    oscillator_step(d, c.rod(kMassOsc, i), c.rod(kDampOsc, i), K, F0[i], s.f[kF][i], h, s.f[kX][i],
-                    s.f[kV][i]);
+    oscillator_step(d, c.rod(kMassOsc, i), c.rod(kInvMassOsc, i), c.rod(kDampOsc, i), K, F0[i],
+                    s.f[kF][i], h, s.f[kX][i], s.f[kV][i]);
     fails.check(d, s.f[kX][i], C(d, 1.0), kFailX, i, t1);
   }
 }
@@ -63,7 +63,7 @@ HWY_INLINE void mount_and_outputs(const Chunk<D>& c, RodStates<D>& s, V<D>* g, V
     const V<D> q0 = g[kQ];
     const V<D> qdot = hn::Div(hn::Sub(q1, q0), h);
     const V<D> cm = c.glob(kMountC), km = c.glob(kMountK);
-    oscillator_step(d, c.glob(kMountMass), cm, km, hn::Add(hn::Mul(cm, qdot), hn::Mul(km, q0)),
+    oscillator_step(d, c.glob(kMountMass), c.glob(kMountInvMass), cm, km, hn::Add(hn::Mul(cm, qdot), hn::Mul(km, q0)),
                     hn::Add(hn::Mul(cm, qdot), hn::Mul(km, q1)), h, g[kZ], g[kZv]);
     g[kQ] = q1;
     fails.check(d, g[kZ], C(d, 1.0), kFailZ, -1, t1);
