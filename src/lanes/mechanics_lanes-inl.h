@@ -58,43 +58,49 @@ HWY_INLINE V<D> polynomial7(D d, V<D> x, const double (&c)[8]) {
 }
 
 // The closed form of the free row m e'' + c e' + k e = 0 over h (oscillator.hpp,
-// oscillator_free_closed_form): under-, over- or critically damped per lane. Out of line: the
-// rare path (steps long against the row's period), so that oscillator_step's common one stays
-// small in the inlined kernel.
+// oscillator_free_closed_form): under-, over- or critically damped per lane, each regime
+// computed only where a lane is in it. Out of line: the rare path (steps long against the
+// row's period), so that oscillator_step's common one stays small in the inlined kernel.
 template <class D>
 HWY_NOINLINE void oscillator_closed_form(D d, V<D> m, V<D> c, V<D> k, V<D> h, V<D> e0, V<D> ed0,
                                          V<D>& e1, V<D>& ed1) {
   const V<D> wn = hn::Sqrt(hn::Div(k, m));
   const V<D> zeta = hn::Div(c, hn::Mul(C(d, 2.0), hn::Sqrt(hn::Mul(k, m))));
-  const V<D> zwn = hn::Mul(zeta, wn);
-  // under-damped
-  const V<D> wd = hn::Mul(wn, hn::Sqrt(hn::Sub(C(d, 1.0), hn::Mul(zeta, zeta))));
-  const V<D> decay = hn::Exp(d, hn::Mul(hn::Mul(hn::Neg(zeta), wn), h));
-  const V<D> cs = hn::Cos(d, hn::Mul(wd, h)), sn = hn::Sin(d, hn::Mul(wd, h));
-  const V<D> B = hn::Div(hn::Add(ed0, hn::Mul(zwn, e0)), wd);
-  const V<D> e1u = hn::Mul(decay, hn::Add(hn::Mul(e0, cs), hn::Mul(B, sn)));
-  const V<D> ed1u = hn::Mul(
-      decay,
-      hn::Sub(hn::Mul(ed0, cs),
-              hn::Mul(hn::Div(hn::Add(hn::Mul(hn::Mul(wn, wn), e0), hn::Mul(zwn, ed0)), wd), sn)));
-  // over-damped
-  const V<D> s = hn::Mul(wn, hn::Sqrt(hn::Sub(hn::Mul(zeta, zeta), C(d, 1.0))));
-  const V<D> nzwn = hn::Mul(hn::Neg(zeta), wn);
-  const V<D> r1 = hn::Add(nzwn, s), r2 = hn::Sub(nzwn, s);
-  const V<D> A1 = hn::Div(hn::Sub(ed0, hn::Mul(r2, e0)), hn::Sub(r1, r2));
-  const V<D> A2 = hn::Div(hn::Sub(hn::Mul(r1, e0), ed0), hn::Sub(r1, r2));
-  const V<D> E1 = hn::Exp(d, hn::Mul(r1, h)), E2 = hn::Exp(d, hn::Mul(r2, h));
-  const V<D> e1o = hn::Add(hn::Mul(A1, E1), hn::Mul(A2, E2));
-  const V<D> ed1o = hn::Add(hn::Mul(hn::Mul(A1, r1), E1), hn::Mul(hn::Mul(A2, r2), E2));
-  // critically damped
-  const V<D> Ec = hn::Exp(d, hn::Mul(hn::Neg(wn), h));
-  const V<D> Bc = hn::Add(ed0, hn::Mul(wn, e0));
-  const V<D> eBh = hn::Add(e0, hn::Mul(Bc, h));
-  const V<D> e1c = hn::Mul(eBh, Ec);
-  const V<D> ed1c = hn::Mul(hn::Sub(Bc, hn::Mul(wn, eBh)), Ec);
   const Mk<D> under = hn::Lt(zeta, C(d, 1.0 - 1e-9)), over = hn::Gt(zeta, C(d, 1.0 + 1e-9));
-  e1 = hn::IfThenElse(under, e1u, hn::IfThenElse(over, e1o, e1c));
-  ed1 = hn::IfThenElse(under, ed1u, hn::IfThenElse(over, ed1o, ed1c));
+  e1 = ed1 = hn::Zero(d);
+  if (!hn::AllFalse(d, under)) {
+    const V<D> zwn = hn::Mul(zeta, wn);
+    const V<D> wd = hn::Mul(wn, hn::Sqrt(hn::Sub(C(d, 1.0), hn::Mul(zeta, zeta))));
+    const V<D> decay = hn::Exp(d, hn::Mul(hn::Mul(hn::Neg(zeta), wn), h));
+    const V<D> cs = hn::Cos(d, hn::Mul(wd, h)), sn = hn::Sin(d, hn::Mul(wd, h));
+    const V<D> B = hn::Div(hn::Add(ed0, hn::Mul(zwn, e0)), wd);
+    e1 = hn::Mul(decay, hn::Add(hn::Mul(e0, cs), hn::Mul(B, sn)));
+    ed1 = hn::Mul(
+        decay,
+        hn::Sub(
+            hn::Mul(ed0, cs),
+            hn::Mul(hn::Div(hn::Add(hn::Mul(hn::Mul(wn, wn), e0), hn::Mul(zwn, ed0)), wd), sn)));
+    if (hn::AllTrue(d, under)) return;
+  }
+  if (!hn::AllFalse(d, over)) {
+    const V<D> s = hn::Mul(wn, hn::Sqrt(hn::Sub(hn::Mul(zeta, zeta), C(d, 1.0))));
+    const V<D> nzwn = hn::Mul(hn::Neg(zeta), wn);
+    const V<D> r1 = hn::Add(nzwn, s), r2 = hn::Sub(nzwn, s);
+    const V<D> A1 = hn::Div(hn::Sub(ed0, hn::Mul(r2, e0)), hn::Sub(r1, r2));
+    const V<D> A2 = hn::Div(hn::Sub(hn::Mul(r1, e0), ed0), hn::Sub(r1, r2));
+    const V<D> E1 = hn::Exp(d, hn::Mul(r1, h)), E2 = hn::Exp(d, hn::Mul(r2, h));
+    e1 = hn::IfThenElse(over, hn::Add(hn::Mul(A1, E1), hn::Mul(A2, E2)), e1);
+    ed1 = hn::IfThenElse(over, hn::Add(hn::Mul(hn::Mul(A1, r1), E1), hn::Mul(hn::Mul(A2, r2), E2)),
+                         ed1);
+  }
+  const Mk<D> critical = hn::Not(hn::Or(under, over));
+  if (!hn::AllFalse(d, critical)) {
+    const V<D> Ec = hn::Exp(d, hn::Mul(hn::Neg(wn), h));
+    const V<D> Bc = hn::Add(ed0, hn::Mul(wn, e0));
+    const V<D> eBh = hn::Add(e0, hn::Mul(Bc, h));
+    e1 = hn::IfThenElse(critical, hn::Mul(eBh, Ec), e1);
+    ed1 = hn::IfThenElse(critical, hn::Mul(hn::Sub(Bc, hn::Mul(wn, eBh)), Ec), ed1);
+  }
 }
 
 // Eq. (15), one diagonal row m x'' + c x' + k x = F(t) with F linear over the step, exact

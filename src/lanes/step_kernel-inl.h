@@ -115,8 +115,8 @@ HWY_INLINE Mk<D> circuit_solve(const Chunk<D>& c, const V<D>* R, const V<D>* mmf
 
 template <class D>
 HWY_INLINE JaLaneConstants<D> ja_constants(const Chunk<D>& c, int i) {
-  return {c.rod(kMsTMag, i),  c.rod(kJaA, i), c.rod(kJaAlpha, i),
-          c.rod(kJaC, i),     c.rod(kJaK, i), c.rod(kJaInvA, i)};
+  return {c.rod(kMsTMag, i), c.rod(kJaA, i), c.rod(kJaAlpha, i),
+          c.rod(kJaC, i),    c.rod(kJaK, i), c.rod(kJaInvA, i)};
 }
 
 // A lane that has stopped keeps the trial of the iterate it stopped at; the others take t
@@ -141,6 +141,39 @@ struct Magnetic {
   V<D> H[kMaxRods], Mg[kMaxRods], B0[kMaxRods], Bs[kMaxRods];
   typename Law::template Trial<D> trial[kMaxRods];
 };
+
+// model/step.cpp's next_correction_within_tolerance per lane: after an undamped correction the
+// next one is bounded by 2 law_steps (the sum of the laws' own steps |M_next - M*|); true where
+// that bound is within a quarter of every rod's field tolerance, 1e-7 A/m + 1e-11 |H|.
+template <class D>
+HWY_INLINE Mk<D> next_correction_within_tolerance(D d, int n, V<D> law_steps, const V<D>* H) {
+  const V<D> bound = hn::Mul(C(d, 2.0), law_steps);
+  Mk<D> within = hn::FirstN(d, hn::Lanes(d));
+  for (int i = 0; i < n; ++i)
+    within = hn::And(
+        within, hn::Le(bound, hn::Mul(C(d, 0.25),
+                                      hn::Add(C(d, 1e-7), hn::Mul(C(d, 1e-11), hn::Abs(H[i]))))));
+  return within;
+}
+
+// The lanes of an iterate that neither converged nor are done, where their largest step is not
+// finite or at the cap (60): accepted where it is within 1 mA/m, failed otherwise (kFailNewton,
+// named by the rod of that step). Returns the lanes that stop.
+template <class D>
+HWY_INLINE Mk<D> stopped(D d, int n, Mk<D> done, V<D> worst, V<D> worst_rod, int it, V<D> t1,
+                         Fails<D>& fails) {
+  const Mk<D> stop =
+      hn::AndNot(done, hn::Or(hn::Not(hn::IsFinite(worst)),
+                              it == 60 ? hn::FirstN(d, hn::Lanes(d)) : hn::FirstN(d, 0)));
+  const Mk<D> accept = hn::And(stop, hn::Le(worst, C(d, 1e-3)));  // 1 mA/m
+  const Mk<D> bad = hn::AndNot(accept, stop);
+  if (!hn::AllFalse(d, bad)) {
+    for (int i = 0; i < n; ++i)  // the rod of the largest step names the failure
+      fails.mark(d, hn::And(bad, hn::Eq(worst_rod, C(d, static_cast<double>(i)))), kFailNewton,
+                 worst, i, t1, hn::Zero(d));
+  }
+  return stop;
+}
 
 // Newton's method on the rods' fields and magnetisations jointly (model/step.cpp,
 // consistent_magnetic_update): the first guess extrapolated quadratically from the last three
@@ -205,13 +238,8 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
           hn::Add(hn::Add(hn::Mul(c.rod(kCoilTurns, i), I), hn::Mul(c.rod(kPmMmf, i), pm)), extra);
     }
     if (it >= 1 && it <= 8) {  // the iterate has converged without the confirming solve
-      Mk<D> skip = laws_hold;
-      const V<D> bound = hn::Mul(C(d, 2.0), law_steps);
-      for (int i = 0; i < n; ++i)
-        skip = hn::And(skip, hn::Le(bound, hn::Mul(C(d, 0.25), hn::Add(C(d, 1e-7),
-                                                                       hn::Mul(C(d, 1e-11),
-                                                                               hn::Abs(mg.H[i]))))));
-      done = hn::Or(done, skip);
+      done =
+          hn::Or(done, hn::And(laws_hold, next_correction_within_tolerance(d, n, law_steps, mg.H)));
       if (hn::AllTrue(d, done)) break;
     }
     c.L.lane_solves += hn::CountTrue(d, hn::Not(done));
@@ -234,17 +262,7 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
                           hn::Le(adH, hn::Add(C(d, 1e-7), hn::Mul(C(d, 1e-11), hn::Abs(mg.H[i])))));
     }
     done = hn::Or(done, converged);
-    const Mk<D> stop =
-        hn::AndNot(done, hn::Or(hn::Not(hn::IsFinite(worst)),
-                                it == 60 ? hn::FirstN(d, hn::Lanes(d)) : hn::FirstN(d, 0)));
-    const Mk<D> accept = hn::And(stop, hn::Le(worst, C(d, 1e-3)));  // 1 mA/m
-    const Mk<D> bad = hn::AndNot(accept, stop);
-    if (!hn::AllFalse(d, bad)) {
-      for (int i = 0; i < n; ++i)  // the rod of the largest step names the failure
-        fails.mark(d, hn::And(bad, hn::Eq(worst_rod, C(d, static_cast<double>(i)))), kFailNewton,
-                   worst, i, t1, hn::Zero(d));
-    }
-    done = hn::Or(done, stop);
+    done = hn::Or(done, stopped(d, n, done, worst, worst_rod, it, t1, fails));
     const V<D> damping = C(d, it < 8 ? 1.0 : 0.5);
     for (int i = 0; i < n; ++i) {  // the lanes still iterating: the next iterate
       const V<D> step = hn::Mul(damping, dH[i]);
