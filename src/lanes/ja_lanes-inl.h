@@ -35,6 +35,23 @@ HWY_INLINE V<D> C(D d, double x) {
 template <class D>
 HWY_INLINE void langevin_pair(D d, V<D> x, V<D>& L, V<D>& dL) {
   const V<D> ax = hn::Abs(x);
+  const V<D> e = hn::Exp(d, hn::Mul(C(d, -2.0), ax));  // coth|x| = (1 + e)/(1 - e)
+  const V<D> ome = hn::Sub(C(d, 1.0), e);
+  const V<D> q = hn::Div(C(d, 1.0), hn::Mul(x, ome));
+  const V<D> inv_x = hn::Mul(ome, q);
+  const V<D> inv_1me = hn::Mul(x, q);
+  const V<D> coth_abs = hn::Mul(hn::Add(C(d, 1.0), e), inv_1me);
+  const V<D> inv_sinh2 = hn::Mul(hn::Mul(hn::Mul(C(d, 4.0), e), inv_1me), inv_1me);
+  const V<D> inv_x2 = hn::Mul(inv_x, inv_x);
+  const Mk<D> pos = hn::Gt(x, hn::Zero(d));
+  const V<D> Lb = hn::Sub(hn::IfThenElse(pos, C(d, 1.0), C(d, -1.0)), inv_x);
+  const V<D> Lm = hn::Sub(hn::IfThenElse(pos, coth_abs, hn::Neg(coth_abs)), inv_x);
+  const V<D> dLm = hn::Sub(inv_x2, inv_sinh2);
+  const Mk<D> big = hn::Gt(ax, C(d, 40.0));
+  L = hn::IfThenElse(big, Lb, Lm);
+  dL = hn::IfThenElse(big, inv_x2, dLm);
+  const Mk<D> small = hn::Lt(ax, C(d, 0.1));
+  if (hn::AllFalse(d, small)) return;  // the series only where a lane needs it
   const V<D> x2 = hn::Mul(x, x);
   const V<D> Lt = hn::Mul(
       x,
@@ -55,21 +72,8 @@ HWY_INLINE void langevin_pair(D d, V<D> x, V<D>& L, V<D>& dL) {
                   hn::Mul(x2, hn::Sub(C(d, 2.0 / 189.0),
                                       hn::Mul(x2, hn::Sub(C(d, 1.0 / 675.0),
                                                           hn::Mul(x2, C(d, 2.0 / 10395.0)))))))));
-  const V<D> e = hn::Exp(d, hn::Mul(C(d, -2.0), ax));  // coth|x| = (1 + e)/(1 - e)
-  const V<D> ome = hn::Sub(C(d, 1.0), e);
-  const V<D> q = hn::Div(C(d, 1.0), hn::Mul(x, ome));
-  const V<D> inv_x = hn::Mul(ome, q);
-  const V<D> inv_1me = hn::Mul(x, q);
-  const V<D> coth_abs = hn::Mul(hn::Add(C(d, 1.0), e), inv_1me);
-  const V<D> inv_sinh2 = hn::Mul(hn::Mul(hn::Mul(C(d, 4.0), e), inv_1me), inv_1me);
-  const V<D> inv_x2 = hn::Mul(inv_x, inv_x);
-  const Mk<D> pos = hn::Gt(x, hn::Zero(d));
-  const V<D> Lb = hn::Sub(hn::IfThenElse(pos, C(d, 1.0), C(d, -1.0)), inv_x);
-  const V<D> Lm = hn::Sub(hn::IfThenElse(pos, coth_abs, hn::Neg(coth_abs)), inv_x);
-  const V<D> dLm = hn::Sub(inv_x2, inv_sinh2);
-  const Mk<D> small = hn::Lt(ax, C(d, 0.1)), big = hn::Gt(ax, C(d, 40.0));
-  L = hn::IfThenElse(small, Lt, hn::IfThenElse(big, Lb, Lm));
-  dL = hn::IfThenElse(small, dLt, hn::IfThenElse(big, inv_x2, dLm));
+  L = hn::IfThenElse(small, Lt, L);
+  dL = hn::IfThenElse(small, dLt, dL);
 }
 
 // exp(-r), q(r) = (1 - exp(-r))/r and dq/dr = (E - q)/r (magnetic.hpp, lag_weights_and_slope):

@@ -127,14 +127,18 @@ HWY_INLINE void oscillator_step(D d, V<D> m, V<D> inv_m, V<D> c, V<D> k, V<D> F0
   const V<D> c_m = hn::Mul(c, inv_m), k_m = hn::Mul(k, inv_m);
   const V<D> half_tau = hn::Mul(C(d, 0.5), hn::Mul(hn::Neg(c_m), h));
   const V<D> u = hn::Sub(hn::Mul(half_tau, half_tau), hn::Mul(hn::Mul(k_m, h), h));
-  const V<D> Cu = polynomial7(d, u, kCos), Su = polynomial7(d, u, kSinc);
-  const Mk<D> short_tau = hn::Le(hn::Abs(half_tau), C(d, 1.0 / 64));
-  V<D> E = polynomial7(d, half_tau, kExp);
-  if (!hn::AllTrue(d, short_tau)) E = hn::IfThenElse(short_tau, E, hn::Exp(d, half_tau));
-  const V<D> f0 = hn::Mul(E, hn::Sub(Cu, hn::Mul(half_tau, Su))), f1h = hn::Mul(hn::Mul(E, Su), h);
-  V<D> e1 = hn::Add(hn::Mul(f0, e0), hn::Mul(f1h, ed0));
-  V<D> ed1 = hn::Sub(hn::Mul(f0, ed0), hn::Mul(f1h, hn::Add(hn::Mul(k_m, e0), hn::Mul(c_m, ed0))));
   const Mk<D> series = hn::Le(hn::Abs(u), C(d, 0.25));
+  V<D> e1 = hn::Zero(d), ed1 = hn::Zero(d);
+  if (!hn::AllFalse(d, series)) {  // the propagator's series, where a lane's step is short
+    const V<D> Cu = polynomial7(d, u, kCos), Su = polynomial7(d, u, kSinc);
+    const Mk<D> short_tau = hn::Le(hn::Abs(half_tau), C(d, 1.0 / 64));
+    V<D> E = polynomial7(d, half_tau, kExp);
+    if (!hn::AllTrue(d, short_tau)) E = hn::IfThenElse(short_tau, E, hn::Exp(d, half_tau));
+    const V<D> f0 = hn::Mul(E, hn::Sub(Cu, hn::Mul(half_tau, Su)));
+    const V<D> f1h = hn::Mul(hn::Mul(E, Su), h);
+    e1 = hn::Add(hn::Mul(f0, e0), hn::Mul(f1h, ed0));
+    ed1 = hn::Sub(hn::Mul(f0, ed0), hn::Mul(f1h, hn::Add(hn::Mul(k_m, e0), hn::Mul(c_m, ed0))));
+  }
   if (!hn::AllTrue(d, series)) {
     V<D> e1c, ed1c;
     oscillator_closed_form(d, m, c, k, h, e0, ed0, e1c, ed1c);
