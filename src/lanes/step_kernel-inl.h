@@ -156,6 +156,15 @@ HWY_INLINE Mk<D> next_correction_within_tolerance(D d, int n, V<D> law_steps, co
   return within;
 }
 
+// One circuit solve of the vector, and the lanes (not padding) that need it (LaneData's
+// lane_solves, vector_solves).
+template <class D>
+HWY_INLINE void count_solve(const Chunk<D>& c, Mk<D> done) {
+  const std::size_t real = c.j < c.L.n ? c.L.n - c.j : 0;
+  c.L.lane_solves += hn::CountTrue(c.d, hn::AndNot(done, hn::FirstN(c.d, real)));
+  ++c.L.vector_solves;
+}
+
 // The lanes of an iterate that neither converged nor are done, where their largest step is not
 // finite or at the cap (60): accepted where it is within 1 mA/m, failed otherwise (kFailNewton,
 // named by the rod of that step). Returns the lanes that stop.
@@ -242,8 +251,7 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
           hn::Or(done, hn::And(laws_hold, next_correction_within_tolerance(d, n, law_steps, mg.H)));
       if (hn::AllTrue(d, done)) break;
     }
-    c.L.lane_solves += hn::CountTrue(d, hn::Not(done));
-    ++c.L.vector_solves;
+    count_solve(c, done);
     const Mk<D> ok = circuit_solve(c, R, mmf, I, pm, phi);
     fails.mark(d, hn::AndNot(done, hn::Not(ok)), kFailCircuit, hn::Zero(d), -1, t1, hn::Zero(d));
     done = hn::Or(done, fails.failed);
