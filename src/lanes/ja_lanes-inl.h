@@ -29,10 +29,29 @@ HWY_INLINE V<D> C(D d, double x) {
 }
 
 // Langevin function and slope (jiles_atherton.hpp, langevin_pair): L = coth x - 1/x,
-// L' = 1/x^2 - 1/sinh^2 x from one exponential, Taylor series for |x| < 0.1.
+// L' = 1/x^2 - 1/sinh^2 x from one exponential and one division (q = 1/(x (1 - e)) gives 1/x
+// and 1/(1 - e)), Taylor series for |x| < 0.1. Beyond |x| = 40, e < 2e-35 and 1 - e = 1: the
+// same q is 1/x, as the scalar's large-x branch divides.
 template <class D>
 HWY_INLINE void langevin_pair(D d, V<D> x, V<D>& L, V<D>& dL) {
   const V<D> ax = hn::Abs(x);
+  const V<D> e = hn::Exp(d, hn::Mul(C(d, -2.0), ax));  // coth|x| = (1 + e)/(1 - e)
+  const V<D> ome = hn::Sub(C(d, 1.0), e);
+  const V<D> q = hn::Div(C(d, 1.0), hn::Mul(x, ome));
+  const V<D> inv_x = hn::Mul(ome, q);
+  const V<D> inv_1me = hn::Mul(x, q);
+  const V<D> coth_abs = hn::Mul(hn::Add(C(d, 1.0), e), inv_1me);
+  const V<D> inv_sinh2 = hn::Mul(hn::Mul(hn::Mul(C(d, 4.0), e), inv_1me), inv_1me);
+  const V<D> inv_x2 = hn::Mul(inv_x, inv_x);
+  const Mk<D> pos = hn::Gt(x, hn::Zero(d));
+  const V<D> Lb = hn::Sub(hn::IfThenElse(pos, C(d, 1.0), C(d, -1.0)), inv_x);
+  const V<D> Lm = hn::Sub(hn::IfThenElse(pos, coth_abs, hn::Neg(coth_abs)), inv_x);
+  const V<D> dLm = hn::Sub(inv_x2, inv_sinh2);
+  const Mk<D> big = hn::Gt(ax, C(d, 40.0));
+  L = hn::IfThenElse(big, Lb, Lm);
+  dL = hn::IfThenElse(big, inv_x2, dLm);
+  const Mk<D> small = hn::Lt(ax, C(d, 0.1));
+  if (hn::AllFalse(d, small)) return;  // the series only where a lane needs it
   const V<D> x2 = hn::Mul(x, x);
   const V<D> Lt = hn::Mul(
       x,
@@ -53,24 +72,15 @@ HWY_INLINE void langevin_pair(D d, V<D> x, V<D>& L, V<D>& dL) {
                   hn::Mul(x2, hn::Sub(C(d, 2.0 / 189.0),
                                       hn::Mul(x2, hn::Sub(C(d, 1.0 / 675.0),
                                                           hn::Mul(x2, C(d, 2.0 / 10395.0)))))))));
-  const V<D> inv_x = hn::Div(C(d, 1.0), x);
-  const Mk<D> pos = hn::Gt(x, hn::Zero(d));
-  const V<D> Lb = hn::Sub(hn::IfThenElse(pos, C(d, 1.0), C(d, -1.0)), inv_x);
-  const V<D> inv_x2 = hn::Mul(inv_x, inv_x);
-  const V<D> e = hn::Exp(d, hn::Mul(C(d, -2.0), ax));
-  const V<D> ome = hn::Sub(C(d, 1.0), e);
-  const V<D> coth_abs = hn::Div(hn::Add(C(d, 1.0), e), ome);
-  const V<D> inv_sinh2 = hn::Div(hn::Mul(C(d, 4.0), e), hn::Mul(ome, ome));
-  const V<D> Lm = hn::Sub(hn::IfThenElse(pos, coth_abs, hn::Neg(coth_abs)), inv_x);
-  const V<D> dLm = hn::Sub(inv_x2, inv_sinh2);
-  const Mk<D> small = hn::Lt(ax, C(d, 0.1)), big = hn::Gt(ax, C(d, 40.0));
-  L = hn::IfThenElse(small, Lt, hn::IfThenElse(big, Lb, Lm));
-  dL = hn::IfThenElse(small, dLt, hn::IfThenElse(big, inv_x2, dLm));
+  L = hn::IfThenElse(small, Lt, L);
+  dL = hn::IfThenElse(small, dLt, dL);
 }
 
-// exp(-r) and q(r) = (1 - exp(-r))/r (magnetic.hpp, lag_weights), Taylor series for r < 1e-2.
+// exp(-r), q(r) = (1 - exp(-r))/r and dq/dr = (E - q)/r (magnetic.hpp, lag_weights_and_slope):
+// Taylor series for q at r < 1e-2 (where dq/dr divides by r, and is -1/2 at r <= 1e-12), one
+// reciprocal of r beyond; one division per lane either way.
 template <class D>
-HWY_INLINE void lag_weights(D d, V<D> r, V<D>& E, V<D>& q) {
+HWY_INLINE void lag_weights_and_slope(D d, V<D> r, V<D>& E, V<D>& q, V<D>& dq_dr) {
   E = hn::Exp(d, hn::Neg(r));
   const V<D> qt = hn::Sub(
       C(d, 1.0),
@@ -84,7 +94,12 @@ HWY_INLINE void lag_weights(D d, V<D> r, V<D>& E, V<D>& q) {
                          hn::Mul(r, hn::Sub(C(d, 1.0 / 24),
                                             hn::Mul(r, hn::Sub(C(d, 1.0 / 120),
                                                                hn::Mul(r, C(d, 1.0 / 720)))))))))));
-  q = hn::IfThenElse(hn::Lt(r, C(d, 1e-2)), qt, hn::Div(hn::Sub(C(d, 1.0), E), r));
+  const Mk<D> small = hn::Lt(r, C(d, 1e-2));
+  const V<D> quot = hn::Div(hn::IfThenElse(small, hn::Sub(E, qt), C(d, 1.0)), r);
+  const V<D> qm = hn::Mul(hn::Sub(C(d, 1.0), E), quot);  // quot = 1/r here
+  q = hn::IfThenElse(small, qt, qm);
+  dq_dr = hn::IfThenElse(small, hn::IfThenElse(hn::Gt(r, C(d, 1e-12)), quot, C(d, -0.5)),
+                         hn::Mul(hn::Sub(E, qm), quot));
 }
 
 // Eq. (9), second line, integrated over one step (jiles_atherton.hpp,
@@ -111,9 +126,8 @@ HWY_INLINE V<D> ja_irreversible_update(D d, V<D> Mirr0, V<D> Man0, V<D> Man1, V<
   }
   const V<D> u0 = hn::IfThenElse(cross, Mirr0, Man0);
   const V<D> r = hn::Div(s, k);
-  V<D> E, q;
-  lag_weights(d, r, E, q);
-  const V<D> dq_dr = hn::IfThenElse(hn::Gt(r, C(d, 1e-12)), hn::Div(hn::Sub(E, q), r), C(d, -0.5));
+  V<D> E, q, dq_dr;
+  lag_weights_and_slope(d, r, E, q, dq_dr);
   const V<D> a0 = hn::Sub(Mirr0, u0), a1 = hn::Sub(Man1, u0);
   const V<D> dm =
       hn::Add(hn::Mul(hn::Sub(C(d, 1.0), q), dMan1),
@@ -127,20 +141,31 @@ HWY_INLINE V<D> ja_irreversible_update(D d, V<D> Mirr0, V<D> Man0, V<D> Man1, V<
 template <class D>
 struct JaLaneConstants {
   V<D> MsT, a, alpha, c, k;
-  V<D> inv_a;  // 1/a, once per step (the scalar law's 1.0 / a_A_per_m)
+  V<D> inv_a;  // 1/a (the scalar law's 1.0 / a_A_per_m, packed once: LaneData kJaInvA)
 };
 
-// What a move depends on at its start only (jiles_atherton.hpp, ja_move_start): H_e0 and
-// M_an(H_e0), fixed while the consistent state's Newton solve tries several end fields.
+// What a move depends on at its start only (jiles_atherton.hpp, ja_move_start_near): H_e0 and
+// M_an(H_e0), fixed while the consistent state's Newton solve tries several end fields. Where
+// the law's last evaluation (x_at = H_e / a, L and L' there: the rod's kAnX, kAnL, kAnDL) is
+// within 1e-7 of x0 = H_e0 / a, M_an(H_e0) = M_s^T (L + L' (x0 - x_at)); elsewhere (x_at NaN:
+// nothing known) the Langevin function at x0, computed only where a lane needs it.
 template <class D>
 struct JaLaneStart {
   V<D> He0, Man0;
 };
 template <class D>
-HWY_INLINE JaLaneStart<D> ja_move_start(D d, V<D> H0, V<D> M0, const JaLaneConstants<D>& p) {
+HWY_INLINE JaLaneStart<D> ja_move_start(D d, V<D> H0, V<D> M0, const JaLaneConstants<D>& p,
+                                        V<D> x_at, V<D> L_at, V<D> dL_at) {
   const V<D> He0 = hn::Add(H0, hn::Mul(p.alpha, M0));
-  V<D> L, dL;
-  langevin_pair(d, hn::Mul(He0, p.inv_a), L, dL);
+  const V<D> x0 = hn::Mul(He0, p.inv_a);
+  const V<D> dx = hn::Sub(x0, x_at);
+  const Mk<D> near = hn::Le(hn::Abs(dx), C(d, 1e-7));
+  V<D> L = hn::Add(L_at, hn::Mul(dL_at, dx));
+  if (!hn::AllTrue(d, near)) {
+    V<D> Lx, dLx;
+    langevin_pair(d, x0, Lx, dLx);
+    L = hn::IfThenElse(near, L, Lx);
+  }
   return {He0, hn::Mul(p.MsT, L)};
 }
 
@@ -149,21 +174,27 @@ HWY_INLINE JaLaneStart<D> ja_move_start(D d, V<D> H0, V<D> M0, const JaLaneConst
 template <class D>
 struct JaLaneEvaluation {
   V<D> Mirr1, M, chi_e;
+  V<D> x1, L1, dL1;  // where the Langevin function was evaluated (H_e1 / a), L and L' there
 };
 template <class D>
 HWY_INLINE JaLaneEvaluation<D> ja_evaluate(D d, const JaLaneStart<D>& st, V<D> H1, V<D> M1,
                                            const JaLaneConstants<D>& p, V<D> Mirr0, V<D> inv_a) {
   const V<D> He1 = hn::Add(H1, hn::Mul(p.alpha, M1));
+  const V<D> x1 = hn::Mul(He1, inv_a);
   V<D> L1, dL1;
-  langevin_pair(d, hn::Mul(He1, inv_a), L1, dL1);
+  langevin_pair(d, x1, L1, dL1);
   const V<D> Man1 = hn::Mul(p.MsT, L1);
   const V<D> dMan = hn::Mul(hn::Mul(p.MsT, inv_a), dL1);
   V<D> dMirr;
   const V<D> Mirr1 =
       ja_irreversible_update(d, Mirr0, st.Man0, Man1, dMan, hn::Sub(He1, st.He0), p.k, dMirr);
   const V<D> one_c = hn::Sub(C(d, 1.0), p.c);
-  return {Mirr1, hn::Add(hn::Mul(one_c, Mirr1), hn::Mul(p.c, Man1)),
-          hn::Add(hn::Mul(one_c, dMirr), hn::Mul(p.c, dMan))};
+  return {Mirr1,
+          hn::Add(hn::Mul(one_c, Mirr1), hn::Mul(p.c, Man1)),
+          hn::Add(hn::Mul(one_c, dMirr), hn::Mul(p.c, dMan)),
+          x1,
+          L1,
+          dL1};
 }
 
 // Eq. (9) solved at H1 by Newton's method in the lanes of `todo` (jiles_atherton.hpp,
@@ -204,20 +235,27 @@ HWY_NOINLINE void ja_solve(D d, Mk<D> todo, const JaLaneStart<D>& st, V<D> H1, V
 struct JilesAthertonLanes {
   template <class D>
   using Start = JaLaneStart<D>;
+  // The rod's state at the step's start: H, M_irr, M and the law's last evaluation (RodState's
+  // an_x, an_L, an_dL).
+  template <class D>
+  struct Rod {
+    V<D> H, Mirr, M, an_x, an_L, an_dL;
+  };
   template <class D>
   struct Trial {
     V<D> M, dM_dH, Mirr, inv_mu_r, M_next;
+    V<D> an_x, an_L, an_dL;   // the evaluation the trial carries to the next step's start
     Mk<D> converged, solved;  // solved: eq. (9) solved fully (the safeguard)
   };
   template <class D>
-  static Start<D> begin_move(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> M0) {
-    return ja_move_start(d, H0, M0, p);
+  static Start<D> begin_move(D d, const JaLaneConstants<D>& p, const Rod<D>& r) {
+    return ja_move_start(d, r.H, r.M, p, r.an_x, r.an_L, r.an_dL);
   }
   template <class D>
-  static HWY_INLINE Trial<D> joint_trial(D d, const JaLaneConstants<D>& p, V<D> H0, V<D> Mirr0,
-                                         V<D> M0, const Start<D>& st, V<D> H1, V<D> M_iter) {
+  static HWY_INLINE Trial<D> joint_trial(D d, const JaLaneConstants<D>& p, const Rod<D>& r,
+                                         const Start<D>& st, V<D> H1, V<D> M_iter) {
     Trial<D> t;
-    const V<D> inv_a = p.inv_a;
+    const V<D> inv_a = p.inv_a, H0 = r.H, Mirr0 = r.Mirr, M0 = r.M;
     const Mk<D> same = hn::Eq(H1, H0);  // ja_step_from's H1 == H0: nothing moves
     V<D> chi_same = hn::Zero(d);
     if (!hn::AllFalse(d, same)) {
@@ -226,6 +264,11 @@ struct JilesAthertonLanes {
       chi_same = hn::Mul(hn::Mul(hn::Mul(p.c, p.MsT), inv_a), dL0);
     }
     JaLaneEvaluation<D> e = ja_evaluate(d, st, H1, M_iter, p, Mirr0, inv_a);
+    // the point carried to the next step: this evaluation's (not the safeguard's last), the
+    // rod's own where nothing moves (JilesAthertonLaw::joint_trial)
+    t.an_x = hn::IfThenElse(same, r.an_x, e.x1);
+    t.an_L = hn::IfThenElse(same, r.an_L, e.L1);
+    t.an_dL = hn::IfThenElse(same, r.an_dL, e.dL1);
     V<D> g = hn::Sub(M_iter, e.M);
     const Mk<D> far = hn::AndNot(same, hn::Gt(hn::Abs(g), hn::Mul(C(d, 1e-5), p.MsT)));
     t.solved = far;

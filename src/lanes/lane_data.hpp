@@ -37,6 +37,9 @@ enum RodField : int {
   kKLoad,
   kKOsc,
   kB,
+  kAnX,   // the law's last evaluation, H_e / a (RodState::an_x; NaN: none)
+  kAnL,   // L there (RodState::an_L)
+  kAnDL,  // L' there (RodState::an_dL)
   kRodStateCount,
   kLength = kRodStateCount,
   kArea,
@@ -63,6 +66,10 @@ enum RodField : int {
   kPmMmf,
   kStrainBound,
   kFluxMs,
+  kJaInvA,     // 1 / a (the scalar law's inv_a)
+  kLengthPerArea,  // l / A (the consistent step's l_A)
+  kInvArea,    // 1 / A
+  kInvMassOsc, // 1 / m of the rod's oscillator (oscillator_step's inv_m)
   kRodFieldCount
 };
 
@@ -85,6 +92,7 @@ enum GlobalField : int {
   kActMass,
   kLambdaS,
   kSensorArea,
+  kMountInvMass,  // 1 / m of the sensor mount's oscillator
   kFail,
   kFailValue,
   kFailRod,
@@ -125,6 +133,9 @@ struct LaneData {
   std::vector<double> g, r, cm;  // global, rod and circuit fields, each npad long
   // How many joint trials of a live lane solved eq. (9) fully (the law's safeguard, ja_solve).
   std::size_t full_solves = 0;
+  // The consistent state's circuit solves: per live lane that needed one (State::newton_solves
+  // summed over the lanes), and per vector of lanes (what the kernel ran).
+  std::size_t lane_solves = 0, vector_solves = 0;
   // The old state of one step (the kernel keeps a failing lane where it was).
   double* rod(int field, int i) {
     return r.data() +

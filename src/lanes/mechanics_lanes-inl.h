@@ -30,64 +30,122 @@ HWY_INLINE V<D> delta_e_modulus(D d, V<D> m, V<D> inv_Es, V<D> rot, V<D> couplin
 }
 
 // Eq. (11)-(12): lambda = f(sigma_p) lambda_s m^2 with the prestress factor f at the
-// thresholds sigma_s = lambda_s E / 2, sigma_max = 3 lambda_s E / 2 (magnetostriction.hpp).
+// thresholds sigma_s = lambda_s E / 2, sigma_max = 3 lambda_s E / 2 (magnetostriction.hpp,
+// prestress_factor), its tanh from one exponential (tanh_absolute).
 template <class D>
 HWY_INLINE V<D> magnetostriction(D d, V<D> m, V<D> lambda_s, V<D> sigma_p, V<D> E) {
   const V<D> ss = hn::Mul(hn::Mul(C(d, 0.5), lambda_s), E);
   const V<D> smax = hn::Mul(hn::Mul(C(d, 1.5), lambda_s), E);
-  const V<D> base =
-      hn::Add(C(d, 1.0), hn::Mul(C(d, 0.5), hn::Tanh(d, hn::Div(hn::Mul(C(d, 2.0), sigma_p), ss))));
+  const V<D> u = hn::Div(hn::Mul(C(d, 2.0), sigma_p), ss);
+  const V<D> e = hn::Exp(d, hn::Mul(C(d, -2.0), hn::Abs(u)));
+  const V<D> ta = hn::Div(hn::Sub(C(d, 1.0), e), hn::Add(C(d, 1.0), e));
+  const V<D> t = hn::IfThenElse(hn::Lt(u, hn::Zero(d)), hn::Neg(ta), ta);
+  const V<D> base = hn::Add(C(d, 1.0), hn::Mul(C(d, 0.5), t));
   const V<D> above = hn::Mul(hn::Sub(C(d, 1.0), hn::Div(hn::Sub(sigma_p, ss), smax)), base);
   const V<D> f = hn::IfThenElse(hn::Le(sigma_p, ss), base, above);
   return hn::Mul(hn::Mul(hn::Mul(f, lambda_s), m), m);
 }
 
-// Eq. (15), one diagonal row m x'' + c x' + k x = F(t) with F linear over the step, exact
-// (mechanics.hpp, oscillator_step): under-, over- or critically damped per lane.
+// c0 + c1 x + ... + c7 x^7 by Estrin's scheme (oscillator.hpp, polynomial7).
 template <class D>
-HWY_INLINE void oscillator_step(D d, V<D> m, V<D> c, V<D> k, V<D> F0, V<D> F1, V<D> h, V<D>& x,
-                                V<D>& v) {
-  const V<D> g = hn::Div(hn::Sub(F1, F0), h);
-  const V<D> gck = hn::Div(hn::Mul(g, c), k);
-  const V<D> xp0 = hn::Div(hn::Sub(F0, gck), k);
-  const V<D> vp = hn::Div(g, k);
-  const V<D> e0 = hn::Sub(x, xp0), ed0 = hn::Sub(v, vp);
+HWY_INLINE V<D> polynomial7(D d, V<D> x, const double (&c)[8]) {
+  const V<D> x2 = hn::Mul(x, x), x4 = hn::Mul(x2, x2);
+  const V<D> p01 = hn::Add(C(d, c[0]), hn::Mul(C(d, c[1]), x));
+  const V<D> p23 = hn::Add(C(d, c[2]), hn::Mul(C(d, c[3]), x));
+  const V<D> p45 = hn::Add(C(d, c[4]), hn::Mul(C(d, c[5]), x));
+  const V<D> p67 = hn::Add(C(d, c[6]), hn::Mul(C(d, c[7]), x));
+  return hn::Add(hn::Add(p01, hn::Mul(x2, p23)), hn::Mul(x4, hn::Add(p45, hn::Mul(x2, p67))));
+}
+
+// The closed form of the free row m e'' + c e' + k e = 0 over h (oscillator.hpp,
+// oscillator_free_closed_form): under-, over- or critically damped per lane, each regime
+// computed only where a lane is in it. Out of line: the rare path (steps long against the
+// row's period), so that oscillator_step's common one stays small in the inlined kernel.
+template <class D>
+HWY_NOINLINE void oscillator_closed_form(D d, V<D> m, V<D> c, V<D> k, V<D> h, V<D> e0, V<D> ed0,
+                                         V<D>& e1, V<D>& ed1) {
   const V<D> wn = hn::Sqrt(hn::Div(k, m));
   const V<D> zeta = hn::Div(c, hn::Mul(C(d, 2.0), hn::Sqrt(hn::Mul(k, m))));
-  const V<D> zwn = hn::Mul(zeta, wn);
-  // under-damped
-  const V<D> wd = hn::Mul(wn, hn::Sqrt(hn::Sub(C(d, 1.0), hn::Mul(zeta, zeta))));
-  const V<D> decay = hn::Exp(d, hn::Mul(hn::Mul(hn::Neg(zeta), wn), h));
-  const V<D> cs = hn::Cos(d, hn::Mul(wd, h)), sn = hn::Sin(d, hn::Mul(wd, h));
-  const V<D> B = hn::Div(hn::Add(ed0, hn::Mul(zwn, e0)), wd);
-  const V<D> e1u = hn::Mul(decay, hn::Add(hn::Mul(e0, cs), hn::Mul(B, sn)));
-  const V<D> ed1u = hn::Mul(
-      decay,
-      hn::Sub(hn::Mul(ed0, cs),
-              hn::Mul(hn::Div(hn::Add(hn::Mul(hn::Mul(wn, wn), e0), hn::Mul(zwn, ed0)), wd), sn)));
-  const Mk<D> under = hn::Lt(zeta, C(d, 1.0 - 1e-9));
-  V<D> e1 = e1u, ed1 = ed1u;
-  if (!hn::AllTrue(d, under)) {  // the other regimes only where a lane needs them
-    // over-damped
+  const Mk<D> under = hn::Lt(zeta, C(d, 1.0 - 1e-9)), over = hn::Gt(zeta, C(d, 1.0 + 1e-9));
+  e1 = ed1 = hn::Zero(d);
+  if (!hn::AllFalse(d, under)) {
+    const V<D> zwn = hn::Mul(zeta, wn);
+    const V<D> wd = hn::Mul(wn, hn::Sqrt(hn::Sub(C(d, 1.0), hn::Mul(zeta, zeta))));
+    const V<D> decay = hn::Exp(d, hn::Mul(hn::Mul(hn::Neg(zeta), wn), h));
+    const V<D> cs = hn::Cos(d, hn::Mul(wd, h)), sn = hn::Sin(d, hn::Mul(wd, h));
+    const V<D> B = hn::Div(hn::Add(ed0, hn::Mul(zwn, e0)), wd);
+    e1 = hn::Mul(decay, hn::Add(hn::Mul(e0, cs), hn::Mul(B, sn)));
+    ed1 = hn::Mul(
+        decay,
+        hn::Sub(
+            hn::Mul(ed0, cs),
+            hn::Mul(hn::Div(hn::Add(hn::Mul(hn::Mul(wn, wn), e0), hn::Mul(zwn, ed0)), wd), sn)));
+    if (hn::AllTrue(d, under)) return;
+  }
+  if (!hn::AllFalse(d, over)) {
     const V<D> s = hn::Mul(wn, hn::Sqrt(hn::Sub(hn::Mul(zeta, zeta), C(d, 1.0))));
     const V<D> nzwn = hn::Mul(hn::Neg(zeta), wn);
     const V<D> r1 = hn::Add(nzwn, s), r2 = hn::Sub(nzwn, s);
     const V<D> A1 = hn::Div(hn::Sub(ed0, hn::Mul(r2, e0)), hn::Sub(r1, r2));
     const V<D> A2 = hn::Div(hn::Sub(hn::Mul(r1, e0), ed0), hn::Sub(r1, r2));
     const V<D> E1 = hn::Exp(d, hn::Mul(r1, h)), E2 = hn::Exp(d, hn::Mul(r2, h));
-    const V<D> e1o = hn::Add(hn::Mul(A1, E1), hn::Mul(A2, E2));
-    const V<D> ed1o = hn::Add(hn::Mul(hn::Mul(A1, r1), E1), hn::Mul(hn::Mul(A2, r2), E2));
-    // critically damped
+    e1 = hn::IfThenElse(over, hn::Add(hn::Mul(A1, E1), hn::Mul(A2, E2)), e1);
+    ed1 = hn::IfThenElse(over, hn::Add(hn::Mul(hn::Mul(A1, r1), E1), hn::Mul(hn::Mul(A2, r2), E2)),
+                         ed1);
+  }
+  const Mk<D> critical = hn::Not(hn::Or(under, over));
+  if (!hn::AllFalse(d, critical)) {
     const V<D> Ec = hn::Exp(d, hn::Mul(hn::Neg(wn), h));
     const V<D> Bc = hn::Add(ed0, hn::Mul(wn, e0));
     const V<D> eBh = hn::Add(e0, hn::Mul(Bc, h));
-    const V<D> e1c = hn::Mul(eBh, Ec);
-    const V<D> ed1c = hn::Mul(hn::Sub(Bc, hn::Mul(wn, eBh)), Ec);
-    const Mk<D> over = hn::Gt(zeta, C(d, 1.0 + 1e-9));
-    e1 = hn::IfThenElse(under, e1u, hn::IfThenElse(over, e1o, e1c));
-    ed1 = hn::IfThenElse(under, ed1u, hn::IfThenElse(over, ed1o, ed1c));
+    e1 = hn::IfThenElse(critical, hn::Mul(eBh, Ec), e1);
+    ed1 = hn::IfThenElse(critical, hn::Mul(hn::Sub(Bc, hn::Mul(wn, eBh)), Ec), ed1);
   }
-  const V<D> xp1 = hn::Div(hn::Sub(F1, gck), k);
+}
+
+// Eq. (15), one diagonal row m x'' + c x' + k x = F(t) with F linear over the step, exact
+// (mechanics.hpp, oscillator_step; inv_m = 1/m): the free row by the series of its propagator
+// (oscillator_propagator: f0 = e^(tau/2) (C - tau/2 S), f1 = e^(tau/2) S, C and S summed in u =
+// tau^2/4 - delta, e^(tau/2) by its series where |tau/2| <= 1/64) where |u| <= 1/4, by the
+// closed form in the lanes beyond (oscillator_closed_form, only where a lane needs it).
+template <class D>
+HWY_INLINE void oscillator_step(D d, V<D> m, V<D> inv_m, V<D> c, V<D> k, V<D> F0, V<D> F1, V<D> h,
+                                V<D>& x, V<D>& v) {
+  constexpr double kCos[8] = {1.0,         1.0 / 2,       1.0 / 24,          1.0 / 720,
+                              1.0 / 40320, 1.0 / 3628800, 1.0 / 479001600.0, 1.0 / 87178291200.0};
+  constexpr double kSinc[8] = {
+      1.0,          1.0 / 6,          1.0 / 120,          1.0 / 5040,
+      1.0 / 362880, 1.0 / 39916800.0, 1.0 / 6227020800.0, 1.0 / 1307674368000.0};
+  constexpr double kExp[8] = {1.0,      1.0,       1.0 / 2,   1.0 / 6,
+                              1.0 / 24, 1.0 / 120, 1.0 / 720, 1.0 / 5040};
+  const V<D> g = hn::Div(hn::Sub(F1, F0), h);  // force rate [N/s]
+  const V<D> inv_k = hn::Div(C(d, 1.0), k);
+  const V<D> gck = hn::Mul(hn::Mul(g, c), inv_k);
+  const V<D> xp0 = hn::Mul(hn::Sub(F0, gck), inv_k);
+  const V<D> vp = hn::Mul(g, inv_k);
+  const V<D> e0 = hn::Sub(x, xp0), ed0 = hn::Sub(v, vp);
+  const V<D> c_m = hn::Mul(c, inv_m), k_m = hn::Mul(k, inv_m);
+  const V<D> half_tau = hn::Mul(C(d, 0.5), hn::Mul(hn::Neg(c_m), h));
+  const V<D> u = hn::Sub(hn::Mul(half_tau, half_tau), hn::Mul(hn::Mul(k_m, h), h));
+  const Mk<D> series = hn::Le(hn::Abs(u), C(d, 0.25));
+  V<D> e1 = hn::Zero(d), ed1 = hn::Zero(d);
+  if (!hn::AllFalse(d, series)) {  // the propagator's series, where a lane's step is short
+    const V<D> Cu = polynomial7(d, u, kCos), Su = polynomial7(d, u, kSinc);
+    const Mk<D> short_tau = hn::Le(hn::Abs(half_tau), C(d, 1.0 / 64));
+    V<D> E = polynomial7(d, half_tau, kExp);
+    if (!hn::AllTrue(d, short_tau)) E = hn::IfThenElse(short_tau, E, hn::Exp(d, half_tau));
+    const V<D> f0 = hn::Mul(E, hn::Sub(Cu, hn::Mul(half_tau, Su)));
+    const V<D> f1h = hn::Mul(hn::Mul(E, Su), h);
+    e1 = hn::Add(hn::Mul(f0, e0), hn::Mul(f1h, ed0));
+    ed1 = hn::Sub(hn::Mul(f0, ed0), hn::Mul(f1h, hn::Add(hn::Mul(k_m, e0), hn::Mul(c_m, ed0))));
+  }
+  if (!hn::AllTrue(d, series)) {
+    V<D> e1c, ed1c;
+    oscillator_closed_form(d, m, c, k, h, e0, ed0, e1c, ed1c);
+    e1 = hn::IfThenElse(series, e1, e1c);
+    ed1 = hn::IfThenElse(series, ed1, ed1c);
+  }
+  const V<D> xp1 = hn::Mul(hn::Sub(F1, gck), inv_k);
   x = hn::Add(xp1, e1);
   v = hn::Add(vp, ed1);
 }

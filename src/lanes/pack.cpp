@@ -80,8 +80,9 @@ void pack_globals(LaneData& L, std::size_t j, const Model& m, const Conditions& 
                             m.sensor_mount.damping_N_s_per_m,
                             m.sensor_mount.actuator_mass_kg,
                             m.material.lambda_s,
-                            sensor_area};
-  for (int f = 0; f <= kSensorArea; ++f) glob(f) = globals[f];
+                            sensor_area,
+                            m.sensor_mount.enabled ? 1.0 / m.sensor_mount.mass_kg : 0.0};
+  for (int f = 0; f <= kMountInvMass; ++f) glob(f) = globals[f];
   for (int f = kFail; f < kGlobalFieldCount; ++f) glob(f) = 0.0;
 }
 
@@ -118,7 +119,10 @@ void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, 
                                           r.k_rod_N_per_m,
                                           r.k_load_N_per_m,
                                           r.K_osc_N_per_m,
-                                          r.B_T};
+                                          r.B_T,
+                                          r.an_x,
+                                          r.an_L,
+                                          r.an_dL};
     for (int f = 0; f < kRodStateCount; ++f) rod(f, i) = state[f];
     const auto& br =
         m.circuit
@@ -149,7 +153,11 @@ void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, 
         br.coil_turns,
         br.pm_mmf_At,
         kStrainGuardFactor * m.material.lambda_s * q * q,
-        std::max(m.material.Ms_A_per_m, rc.MsT_mag)};
+        std::max(m.material.Ms_A_per_m, rc.MsT_mag),
+        1.0 / rc.ja.a_A_per_m,
+        rc.length_m / rc.area_m2,
+        1.0 / rc.area_m2,
+        1.0 / rc.mass_osc_kg};
     for (int f = kRodStateCount; f < kRodFieldCount; ++f) rod(f, i) = constants[f - kRodStateCount];
     for (int b = 0; b < n; ++b) L.S(i, b)[j] = lr.S8[static_cast<std::size_t>(8 * i + b)];
     L.bt_coil(i)[j] = lr.bt_coil8[i];
@@ -229,6 +237,8 @@ void LaneBatch::rest_increment(std::span<const double> current_A, std::span<cons
 
 bool LaneBatch::diverged(std::size_t lane) const { return d_->glob(lanes::kFail)[lane] != 0.0; }
 std::size_t LaneBatch::full_solves() const { return d_->full_solves; }
+std::size_t LaneBatch::newton_solves() const { return d_->lane_solves; }
+std::size_t LaneBatch::vector_solves() const { return d_->vector_solves; }
 
 void LaneBatch::unpack(std::size_t j, State& s) const {
   using namespace lanes;
@@ -254,7 +264,10 @@ void LaneBatch::unpack(std::size_t j, State& s) const {
                                             &r.k_rod_N_per_m,
                                             &r.k_load_N_per_m,
                                             &r.K_osc_N_per_m,
-                                            &r.B_T};
+                                            &r.B_T,
+                                            &r.an_x,
+                                            &r.an_L,
+                                            &r.an_dL};
     for (int f = 0; f < kRodStateCount; ++f) *fields[f] = L.rod(f, i)[j];
   }
   double* const globals[kGlobalStateCount] = {&s.t_s, &s.current_A, &s.y_m,         &s.y_stack_m,

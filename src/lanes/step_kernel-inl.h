@@ -61,16 +61,18 @@ struct RodStates {
 // D = diag(1/R), F the rods' MMFs and u = I psi_coil + pm psi_pm:  v = B^T u - S D F,
 // (D^-1 + S) z' = v (L D L^T, no square roots), z = z' + D F,
 // phi_r = ((B^T u - S z)_r + F_r) / R_r. ok is false where a pivot is not positive or z is
-// not finite. One division per pivot (its reciprocal), as rod_solve.
+// not finite. One division per pivot and per rod branch (their reciprocals), as rod_solve and
+// solve_circuit.
 template <class D>
 HWY_INLINE Mk<D> circuit_solve(const Chunk<D>& c, const V<D>* R, const V<D>* mmf, V<D> I, V<D> pm,
                                V<D>* phi) {
   const D d = c.d;
   const int n = c.n;
   V<D> S[kMaxRods][kMaxRods], A[kMaxRods][kMaxRods], DF[kMaxRods], Btu[kMaxRods], x[kMaxRods],
-      piv[kMaxRods], inv_piv[kMaxRods];
+      piv[kMaxRods], inv_piv[kMaxRods], inv_R[kMaxRods];
   for (int a = 0; a < n; ++a) {
-    DF[a] = hn::Div(mmf[a], R[a]);
+    inv_R[a] = hn::Div(C(d, 1.0), R[a]);
+    DF[a] = hn::Mul(mmf[a], inv_R[a]);
     Btu[a] = hn::Add(hn::Mul(I, hn::LoadU(d, c.L.bt_coil(a) + c.j)),
                      hn::Mul(pm, hn::LoadU(d, c.L.bt_pm(a) + c.j)));
     for (int b = 0; b < n; ++b) S[a][b] = hn::LoadU(d, c.L.S(a, b) + c.j);
@@ -106,16 +108,15 @@ HWY_INLINE Mk<D> circuit_solve(const Chunk<D>& c, const V<D>* R, const V<D>* mmf
   for (int a = 0; a < n; ++a) {
     V<D> sz = hn::Zero(d);
     for (int b = 0; b < n; ++b) sz = hn::Add(sz, hn::Mul(S[a][b], x[b]));
-    phi[a] = hn::Div(hn::Add(hn::Sub(Btu[a], sz), mmf[a]), R[a]);
+    phi[a] = hn::Mul(hn::Add(hn::Sub(Btu[a], sz), mmf[a]), inv_R[a]);
   }
   return ok;
 }
 
 template <class D>
 HWY_INLINE JaLaneConstants<D> ja_constants(const Chunk<D>& c, int i) {
-  const V<D> a = c.rod(kJaA, i);
-  return {c.rod(kMsTMag, i),      a, c.rod(kJaAlpha, i), c.rod(kJaC, i), c.rod(kJaK, i),
-          hn::Div(C(c.d, 1.0), a)};
+  return {c.rod(kMsTMag, i), c.rod(kJaA, i), c.rod(kJaAlpha, i),
+          c.rod(kJaC, i),    c.rod(kJaK, i), c.rod(kJaInvA, i)};
 }
 
 // A lane that has stopped keeps the trial of the iterate it stopped at; the others take t
@@ -128,6 +129,9 @@ HWY_INLINE void take_trial(D d, M done, const T& t, T& tr, std::size_t& full_sol
   tr.Mirr = hn::IfThenElse(done, tr.Mirr, t.Mirr);
   tr.inv_mu_r = hn::IfThenElse(done, tr.inv_mu_r, t.inv_mu_r);
   tr.M_next = hn::IfThenElse(done, tr.M_next, t.M_next);
+  tr.an_x = hn::IfThenElse(done, tr.an_x, t.an_x);
+  tr.an_L = hn::IfThenElse(done, tr.an_L, t.an_L);
+  tr.an_dL = hn::IfThenElse(done, tr.an_dL, t.an_dL);
   tr.converged = hn::Or(hn::And(done, tr.converged), hn::AndNot(done, t.converged));
 }
 
@@ -138,6 +142,48 @@ struct Magnetic {
   typename Law::template Trial<D> trial[kMaxRods];
 };
 
+// model/step.cpp's next_correction_within_tolerance per lane: after an undamped correction the
+// next one is bounded by 2 law_steps (the sum of the laws' own steps |M_next - M*|); true where
+// that bound is within a quarter of every rod's field tolerance, 1e-7 A/m + 1e-11 |H|.
+template <class D>
+HWY_INLINE Mk<D> next_correction_within_tolerance(D d, int n, V<D> law_steps, const V<D>* H) {
+  const V<D> bound = hn::Mul(C(d, 2.0), law_steps);
+  Mk<D> within = hn::FirstN(d, hn::Lanes(d));
+  for (int i = 0; i < n; ++i)
+    within = hn::And(
+        within, hn::Le(bound, hn::Mul(C(d, 0.25),
+                                      hn::Add(C(d, 1e-7), hn::Mul(C(d, 1e-11), hn::Abs(H[i]))))));
+  return within;
+}
+
+// One circuit solve of the vector, and the lanes (not padding) that need it (LaneData's
+// lane_solves, vector_solves).
+template <class D>
+HWY_INLINE void count_solve(const Chunk<D>& c, Mk<D> done) {
+  const std::size_t real = c.j < c.L.n ? c.L.n - c.j : 0;
+  c.L.lane_solves += hn::CountTrue(c.d, hn::AndNot(done, hn::FirstN(c.d, real)));
+  ++c.L.vector_solves;
+}
+
+// The lanes of an iterate that neither converged nor are done, where their largest step is not
+// finite or at the cap (60): accepted where it is within 1 mA/m, failed otherwise (kFailNewton,
+// named by the rod of that step). Returns the lanes that stop.
+template <class D>
+HWY_INLINE Mk<D> stopped(D d, int n, Mk<D> done, V<D> worst, V<D> worst_rod, int it, V<D> t1,
+                         Fails<D>& fails) {
+  const Mk<D> stop =
+      hn::AndNot(done, hn::Or(hn::Not(hn::IsFinite(worst)),
+                              it == 60 ? hn::FirstN(d, hn::Lanes(d)) : hn::FirstN(d, 0)));
+  const Mk<D> accept = hn::And(stop, hn::Le(worst, C(d, 1e-3)));  // 1 mA/m
+  const Mk<D> bad = hn::AndNot(accept, stop);
+  if (!hn::AllFalse(d, bad)) {
+    for (int i = 0; i < n; ++i)  // the rod of the largest step names the failure
+      fails.mark(d, hn::And(bad, hn::Eq(worst_rod, C(d, static_cast<double>(i)))), kFailNewton,
+                 worst, i, t1, hn::Zero(d));
+  }
+  return stop;
+}
+
 // Newton's method on the rods' fields and magnetisations jointly (model/step.cpp,
 // consistent_magnetic_update): the first guess extrapolated quadratically from the last three
 // steps (H = 3 (H_n - H_n-1) + H_n-2, M likewise); at each iterate (H*, M*) each rod's law
@@ -145,26 +191,29 @@ struct Magnetic {
 // step to M_next and linearised into a branch U = R_eff phi + U_off, the circuit solved, H* moved
 // to the field its flux implies and M* to M_next + dM/dH dH. Per lane: a lane whose field
 // corrections are all below 1e-7 A/m + 1e-11 |H| and whose laws all hold (|g| <= 1e-12 M_s^T)
-// keeps that iterate and its trial (the last evaluation is committed); the loop ends when every
-// lane has converged or failed, or at the cap (60), where a lane whose largest step (field or
-// law) is within 1 mA/m is accepted and the others fail (kFailNewton, the rod of that step).
-// quasi_static (make_state's ramp, consistent_magnetic_update's quasi_static): no eddy term,
-// the first guess at H_n and M_n.
+// keeps that iterate and its trial (the last evaluation is committed); so does a lane, after an
+// undamped correction (iterates 1-8), whose laws all hold and whose next correction is bounded
+// within a quarter of every rod's field tolerance (next_correction_within_tolerance) -- without
+// the confirming solve, which runs only while some lane of the vector still needs it. The loop
+// ends when every lane has converged or failed, or at the cap (60), where a lane whose largest
+// step (field or law) is within 1 mA/m is accepted and the others fail (kFailNewton, the rod of
+// that step). quasi_static (make_state's ramp, consistent_magnetic_update's quasi_static): no
+// eddy term, the first guess at H_n and M_n.
 template <class Law, class D>
 HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, V<D> pm, V<D> h,
                               V<D> t1, bool quasi_static, Magnetic<Law, D>& mg, Fails<D>& fails) {
   const D d = c.d;
   const int n = c.n;
   constexpr double kMu0 = physics::kMu0;
-  V<D> g[kMaxRods], e0[kMaxRods], inv_mud[kMaxRods], l_A[kMaxRods], inv_A[kMaxRods];
+  V<D> g[kMaxRods], e0[kMaxRods], inv_mud[kMaxRods];
   typename Law::template Start<D> start[kMaxRods];
+  typename Law::template Rod<D> rod[kMaxRods];
   JaLaneConstants<D> ja[kMaxRods];
   for (int i = 0; i < n; ++i) {
     ja[i] = ja_constants(c, i);
-    start[i] = Law::begin_move(d, ja[i], s.f[kH][i], s.f[kM][i]);
+    rod[i] = {s.f[kH][i], s.f[kMirr][i], s.f[kM][i], s.f[kAnX][i], s.f[kAnL][i], s.f[kAnDL][i]};
+    start[i] = Law::begin_move(d, ja[i], rod[i]);
     mg.B0[i] = hn::Mul(C(d, kMu0), hn::Add(s.f[kH][i], s.f[kM][i]));
-    l_A[i] = hn::Div(c.rod(kLength, i), c.rod(kArea, i));
-    inv_A[i] = hn::Div(C(d, 1.0), c.rod(kArea, i));
     if (quasi_static) {
       e0[i] = g[i] = hn::Zero(d);
       mg.H[i] = s.f[kH][i];
@@ -179,14 +228,17 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
   Mk<D> done = fails.failed;
   for (int it = 0; !hn::AllTrue(d, done); ++it) {
     V<D> R[kMaxRods], mmf[kMaxRods], phi[kMaxRods];
+    V<D> law_steps = hn::Zero(d);  // sum over the rods of |M_next - M*|
+    Mk<D> laws_hold = hn::FirstN(d, hn::Lanes(d));
     for (int i = 0; i < n; ++i) {
-      const auto t = Law::joint_trial(d, ja[i], s.f[kH][i], s.f[kMirr][i], s.f[kM][i], start[i],
-                                      mg.H[i], mg.Mg[i]);
+      const auto t = Law::joint_trial(d, ja[i], rod[i], start[i], mg.H[i], mg.Mg[i]);
       auto& tr = mg.trial[i];
       take_trial(d, done, t, tr, c.L.full_solves);
+      laws_hold = hn::And(laws_hold, tr.converged);
+      law_steps = hn::Add(law_steps, hn::Abs(hn::Sub(tr.M_next, mg.Mg[i])));
       mg.Bs[i] = hn::Mul(C(d, kMu0), hn::Add(mg.H[i], tr.M_next));
       inv_mud[i] = hn::Mul(tr.inv_mu_r, C(d, 1.0 / kMu0));
-      R[i] = hn::Add(hn::Mul(l_A[i], hn::Add(inv_mud[i], g[i])), c.rod(kRs, i));
+      R[i] = hn::Add(hn::Mul(c.rod(kLengthPerArea, i), hn::Add(inv_mud[i], g[i])), c.rod(kRs, i));
       const V<D> extra = hn::Mul(
           hn::Neg(c.rod(kLength, i)),
           hn::Sub(hn::Sub(hn::Sub(mg.H[i], hn::Mul(mg.Bs[i], inv_mud[i])), hn::Mul(g[i], mg.B0[i])),
@@ -194,13 +246,19 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
       mmf[i] =
           hn::Add(hn::Add(hn::Mul(c.rod(kCoilTurns, i), I), hn::Mul(c.rod(kPmMmf, i), pm)), extra);
     }
+    if (it >= 1 && it <= 8) {  // the iterate has converged without the confirming solve
+      done =
+          hn::Or(done, hn::And(laws_hold, next_correction_within_tolerance(d, n, law_steps, mg.H)));
+      if (hn::AllTrue(d, done)) break;
+    }
+    count_solve(c, done);
     const Mk<D> ok = circuit_solve(c, R, mmf, I, pm, phi);
     fails.mark(d, hn::AndNot(done, hn::Not(ok)), kFailCircuit, hn::Zero(d), -1, t1, hn::Zero(d));
     done = hn::Or(done, fails.failed);
     V<D> worst = hn::Zero(d), worst_rod = hn::Zero(d), dH[kMaxRods];
     Mk<D> converged = hn::FirstN(d, hn::Lanes(d));
     for (int i = 0; i < n; ++i) {
-      dH[i] = hn::Mul(hn::Sub(hn::Mul(phi[i], inv_A[i]), mg.Bs[i]), inv_mud[i]);
+      dH[i] = hn::Mul(hn::Sub(hn::Mul(phi[i], c.rod(kInvArea, i)), mg.Bs[i]), inv_mud[i]);
       const V<D> adH = hn::Abs(dH[i]);
       // the rod's Newton step: its field's and its law's; NaN propagates
       const V<D> dM = hn::Abs(hn::Sub(mg.trial[i].M_next, mg.Mg[i]));
@@ -212,17 +270,7 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
                           hn::Le(adH, hn::Add(C(d, 1e-7), hn::Mul(C(d, 1e-11), hn::Abs(mg.H[i])))));
     }
     done = hn::Or(done, converged);
-    const Mk<D> stop =
-        hn::AndNot(done, hn::Or(hn::Not(hn::IsFinite(worst)),
-                                it == 60 ? hn::FirstN(d, hn::Lanes(d)) : hn::FirstN(d, 0)));
-    const Mk<D> accept = hn::And(stop, hn::Le(worst, C(d, 1e-3)));  // 1 mA/m
-    const Mk<D> bad = hn::AndNot(accept, stop);
-    if (!hn::AllFalse(d, bad)) {
-      for (int i = 0; i < n; ++i)  // the rod of the largest step names the failure
-        fails.mark(d, hn::And(bad, hn::Eq(worst_rod, C(d, static_cast<double>(i)))), kFailNewton,
-                   worst, i, t1, hn::Zero(d));
-    }
-    done = hn::Or(done, stop);
+    done = hn::Or(done, stopped(d, n, done, worst, worst_rod, it, t1, fails));
     const V<D> damping = C(d, it < 8 ? 1.0 : 0.5);
     for (int i = 0; i < n; ++i) {  // the lanes still iterating: the next iterate
       const V<D> step = hn::Mul(damping, dH[i]);
@@ -261,6 +309,9 @@ HWY_INLINE void commit_fields(const Chunk<D>& c, RodStates<D>& s, V<D> h, bool q
     s.f[kMuR][i] = hn::Add(C(d, 1.0), tr.dM_dH);
     s.f[kTau][i] = hn::Mul(hn::Mul(C(d, kMu0), s.f[kMuR][i]), kappa);
     s.f[kPhi][i] = hn::Mul(B1, c.rod(kArea, i));
+    s.f[kAnX][i] = tr.an_x;
+    s.f[kAnL][i] = tr.an_L;
+    s.f[kAnDL][i] = tr.an_dL;
   }
 }
 

@@ -33,18 +33,18 @@ HWY_INLINE void mechanics(const Chunk<D>& c, RodStates<D>& s, V<D> h, V<D> t1, F
     s.f[kF][i] = hn::Mul(hn::Mul(s.f[kLambda][i], E), A);
     s.f[kKRod][i] = hn::Div(hn::Mul(E, A), c.rod(kLength, i));
   }
+  V<D> compliance[kMaxRods];  // 1 / k_rod, each rod's once (the chains share them)
+  for (int i = 0; i < n; ++i) compliance[i] = hn::Div(C(d, 1.0), s.f[kKRod][i]);
   for (int i = 0; i < n; ++i) {
     V<D> inv_k = c.rod(kFixedCompl, i);
     for (int k = 0; k < st.chain_count[static_cast<std::size_t>(i)]; ++k)
       inv_k = hn::Add(
-          inv_k,
-          hn::Div(C(d, 1.0),
-                  s.f[kKRod][st.chain[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)]]));
+          inv_k, compliance[st.chain[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)]]);
     s.f[kKLoad][i] = hn::Div(C(d, 1.0), inv_k);
     const V<D> K = hn::Mul(C(d, 0.5), hn::Add(hn::Add(K0[i], s.f[kKRod][i]), s.f[kKLoad][i]));
     s.f[kKOsc][i] = K;
-    oscillator_step(d, c.rod(kMassOsc, i), c.rod(kDampOsc, i), K, F0[i], s.f[kF][i], h, s.f[kX][i],
-                    s.f[kV][i]);
+    oscillator_step(d, c.rod(kMassOsc, i), c.rod(kInvMassOsc, i), c.rod(kDampOsc, i), K, F0[i],
+                    s.f[kF][i], h, s.f[kX][i], s.f[kV][i]);
     fails.check(d, s.f[kX][i], C(d, 1.0), kFailX, i, t1);
   }
 }
@@ -63,7 +63,8 @@ HWY_INLINE void mount_and_outputs(const Chunk<D>& c, RodStates<D>& s, V<D>* g, V
     const V<D> q0 = g[kQ];
     const V<D> qdot = hn::Div(hn::Sub(q1, q0), h);
     const V<D> cm = c.glob(kMountC), km = c.glob(kMountK);
-    oscillator_step(d, c.glob(kMountMass), cm, km, hn::Add(hn::Mul(cm, qdot), hn::Mul(km, q0)),
+    oscillator_step(d, c.glob(kMountMass), c.glob(kMountInvMass), cm, km,
+                    hn::Add(hn::Mul(cm, qdot), hn::Mul(km, q0)),
                     hn::Add(hn::Mul(cm, qdot), hn::Mul(km, q1)), h, g[kZ], g[kZv]);
     g[kQ] = q1;
     fails.check(d, g[kZ], C(d, 1.0), kFailZ, -1, t1);
@@ -122,12 +123,18 @@ HWY_INLINE void store_fails(const Chunk<D>& c, const Fails<D>& f) {
   hn::StoreU(f.bound, c.d, c.L.glob(kFailBound) + c.j);
 }
 
-// The rods' state of lanes [j, j + Lanes(d)), loaded field by field.
+// The rods' state of lanes [j, j + Lanes(d)), loaded field by field. A full step writes its
+// outputs (mu_r, E, lambda, tau, phi, K_osc, B) before it reads them: with outputs = false they
+// are not loaded (a lane that fails keeps them in memory: store_rods).
 template <class D>
-HWY_INLINE RodStates<D> load_rods(const Chunk<D>& c) {
+HWY_INLINE RodStates<D> load_rods(const Chunk<D>& c, bool outputs) {
   RodStates<D> s;
-  for (int f = 0; f < kRodStateCount; ++f)
+  for (int f = 0; f < kRodStateCount; ++f) {
+    if (!outputs &&
+        (f == kMuR || f == kE || f == kLambda || f == kTau || f == kPhi || f == kKOsc || f == kB))
+      continue;
     for (int i = 0; i < c.n; ++i) s.f[f][i] = c.rod(f, i);
+  }
   return s;
 }
 
@@ -143,7 +150,7 @@ HWY_INLINE void store_rods(const Chunk<D>& c, const RodStates<D>& s, Mk<D> keep)
 template <class D>
 HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in) {
   const Chunk<D> c{d, L, j, L.st.rods};
-  RodStates<D> s = load_rods(c);
+  RodStates<D> s = load_rods(c, false);
   V<D> g[kGlobalStateCount];
   for (int f = 0; f < kGlobalStateCount; ++f) g[f] = c.glob(f);
   Fails<D> fails = load_fails(c);
@@ -174,7 +181,7 @@ HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
 template <class D>
 HWY_INLINE void ramp_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in) {
   const Chunk<D> c{d, L, j, L.st.rods};
-  RodStates<D> s = load_rods(c);
+  RodStates<D> s = load_rods(c, true);
   Fails<D> fails = load_fails(c);
   const Mk<D> alive = hn::Not(fails.failed);
   const V<D> I = hn::LoadU(d, in.current_A + j), pm = hn::LoadU(d, in.pm_scale + j);

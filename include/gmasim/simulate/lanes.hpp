@@ -61,6 +61,11 @@ class LaneBatch {
   // steps so far) solved eq. (9) fully: the Jiles-Atherton law's safeguard where the joint
   // Newton iterate is far from eq. (9) (|g| > 1e-5 M_s^T), as the scalar law's joint_trial does.
   std::size_t full_solves() const;
+  // The consistent state's circuit solves so far: summed over the live lanes that needed one
+  // (as State::newton_solves counts them), and per vector of lanes the kernel ran (a vector
+  // solves while any of its lanes needs it).
+  std::size_t newton_solves() const;
+  std::size_t vector_solves() const;
   std::string error(std::size_t lane) const;
   // The lane's state as step() leaves it, into s (sized by make_state for the lane's model:
   // no allocation).
