@@ -62,7 +62,7 @@ SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings
       [&](const State& x, const StepPoint& p) { rec(x, p.k); });
   std::vector<double> t(rows);  // uniform: only the spacing matters to the refinement
   for (std::size_t k = 0; k < rows; ++k) t[k] = static_cast<double>(k);
-  const LoopMetrics L = loop_metrics(t, I, y, B, 0, rows - 1);
+  const LoopMetrics L = loop_metrics(t, I, y, B, 0, rows - 1, run.want);
   SineMetrics r;
   r.stroke_um = L.stroke_um;
   r.B_pp_T = L.B_pp_T;

@@ -8,6 +8,7 @@
 
 #include "gmasim/identify/identify.hpp"
 #include "gmasim/simulate/run_loop.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim::identify_detail {
 
@@ -28,10 +29,14 @@ class StartCache {
   std::deque<Entry> entries_;
 };
 
-// The biased sine of a stroke, hysteresis or B_pp target at one temperature.
+// The biased sine of a stroke, hysteresis or B_pp target at one temperature, and the loop
+// measures its targets read (the others are not computed: loop_metrics's want).
 struct SineRun {
   double T, pp, f, min;
-  bool operator==(const SineRun&) const = default;
+  LoopMetricsWanted want{false, false, false};
+  bool same_drive(const SineRun& o) const {
+    return T == o.T && pp == o.pp && f == o.f && min == o.min;
+  }
 };
 
 struct SineMetrics {
