@@ -335,6 +335,7 @@ Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const F
   double W = add_records(I, start_model);
   add_targets(I, start_model, W);
   check_run_lengths(I);
+  for (auto& run : I.sine_runs) run.drive_A = identify_detail::sine_drive(run, I.settings);
   lay_out_residuals(I, W);
   impl_ = std::move(impl);
 }

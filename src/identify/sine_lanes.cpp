@@ -71,7 +71,8 @@ std::vector<SineMetrics> run_sines_lanes(const Model& m, const std::vector<SineR
       const long kk = std::min(q, g.steps);
       t1[k] = g.t0_s + static_cast<double>(kk) * g.dt_s;
       dt[k] = g.dt_s;
-      current[k] = ls[k].w.current_at(t1[k]);
+      const std::vector<double>& drive = runs[k].drive_A;  // sine_drive: the same numbers
+      current[k] = drive.empty() ? ls[k].w.current_at(t1[k]) : drive[static_cast<std::size_t>(kk)];
     }
     batch.step(current, dt, t1);
     for (std::size_t k = 0; k < n; ++k) {
