@@ -201,13 +201,36 @@ double add_records(Objective::Impl& I, const Model& start_model) {
   return W;
 }
 
+// The loop measure a sine target of this kind reads (Objective::Impl::target_value).
+void add_wanted(LoopMetricsWanted& w, TargetKind kind) {
+  switch (kind) {
+    case TargetKind::StrokeUm:
+    case TargetKind::StrokeChangePct:
+    case TargetKind::RetentionPct:
+      w.stroke = true;
+      return;
+    case TargetKind::HysteresisUm:
+    case TargetKind::HysteresisChangePct:
+      w.hysteresis = true;
+      return;
+    case TargetKind::BppT:
+    case TargetKind::BppChangePct:
+      w.B_pp = true;
+      return;
+    default:
+      return;
+  }
+}
+
 // The targets and the runs they share; adds their weights to W.
 void add_targets(Objective::Impl& I, const Model& start_model, double& W) {
-  auto sine_index = [&](const SineRun& r) {
-    const auto it = std::find(I.sine_runs.begin(), I.sine_runs.end(), r);
-    if (it != I.sine_runs.end()) return static_cast<int>(it - I.sine_runs.begin());
-    I.sine_runs.push_back(r);
-    return static_cast<int>(I.sine_runs.size() - 1);
+  // The run of a drive (shared by the targets at it), wanting the loop measure of `kind`.
+  auto sine_index = [&](const SineRun& r, TargetKind kind) {
+    auto it = std::find_if(I.sine_runs.begin(), I.sine_runs.end(),
+                           [&](const SineRun& o) { return o.same_drive(r); });
+    if (it == I.sine_runs.end()) it = I.sine_runs.insert(it, r);
+    add_wanted(it->want, kind);
+    return static_cast<int>(it - I.sine_runs.begin());
   };
   for (const auto& t : I.fit.targets) {
     TargetData td;
@@ -226,13 +249,14 @@ void add_targets(Objective::Impl& I, const Model& start_model, double& W) {
       td.res_run = static_cast<int>(it - I.res_runs.begin());
       if (it == I.res_runs.end()) I.res_runs.push_back(rr);
     } else {
-      td.run = sine_index({t.temperature_C, t.current_pp_A, t.frequency_Hz, t.current_min_A});
+      td.run =
+          sine_index({t.temperature_C, t.current_pp_A, t.frequency_Hz, t.current_min_A}, t.kind);
       const bool change = t.kind == TargetKind::StrokeChangePct ||
                           t.kind == TargetKind::HysteresisChangePct ||
                           t.kind == TargetKind::BppChangePct || t.kind == TargetKind::RetentionPct;
       if (change) {
         td.ref_run = sine_index(
-            {t.reference_temperature_C, t.current_pp_A, t.frequency_Hz, t.current_min_A});
+            {t.reference_temperature_C, t.current_pp_A, t.frequency_Hz, t.current_min_A}, t.kind);
       }
     }
     W += t.weight;
@@ -311,6 +335,7 @@ Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const F
   double W = add_records(I, start_model);
   add_targets(I, start_model, W);
   check_run_lengths(I);
+  for (auto& run : I.sine_runs) run.drive_A = identify_detail::sine_drive(run, I.settings);
   lay_out_residuals(I, W);
   impl_ = std::move(impl);
 }

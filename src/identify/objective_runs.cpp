@@ -36,6 +36,17 @@ SineGrid sine_target_grid(const SineRun& run, const ObjectiveSettings& s) {
   return g;
 }
 
+std::vector<double> sine_drive(const SineRun& run, const ObjectiveSettings& s) {
+  const SineGrid g = sine_target_grid(run, s);
+  if (g.grid.steps > kMaxStoredDriveSteps) return {};
+  const Waveform w = biased_sine(run.pp, run.f, run.min);
+  std::vector<double> d(static_cast<std::size_t>(g.grid.steps) + 1);
+  for (long q = 0; q <= g.grid.steps; ++q)  // run_sines_lanes's times, t0 + q dt
+    d[static_cast<std::size_t>(q)] =
+        w.current_at(g.grid.t0_s + static_cast<double>(q) * g.grid.dt_s);
+  return d;
+}
+
 SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings& s,
                      std::vector<double>& I, std::vector<double>& y, std::vector<double>& B,
                      StartCache& starts) {
@@ -62,7 +73,7 @@ SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings
       [&](const State& x, const StepPoint& p) { rec(x, p.k); });
   std::vector<double> t(rows);  // uniform: only the spacing matters to the refinement
   for (std::size_t k = 0; k < rows; ++k) t[k] = static_cast<double>(k);
-  const LoopMetrics L = loop_metrics(t, I, y, B, 0, rows - 1);
+  const LoopMetrics L = loop_metrics(t, I, y, B, 0, rows - 1, run.want);
   SineMetrics r;
   r.stroke_um = L.stroke_um;
   r.B_pp_T = L.B_pp_T;

@@ -8,6 +8,7 @@
 
 #include "gmasim/identify/identify.hpp"
 #include "gmasim/simulate/run_loop.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim::identify_detail {
 
@@ -28,10 +29,17 @@ class StartCache {
   std::deque<Entry> entries_;
 };
 
-// The biased sine of a stroke, hysteresis or B_pp target at one temperature.
+// The biased sine of a stroke, hysteresis or B_pp target at one temperature, and the loop
+// measures its targets read (the others are not computed: loop_metrics's want).
 struct SineRun {
   double T, pp, f, min;
-  bool operator==(const SineRun&) const = default;
+  LoopMetricsWanted want{false, false, false};
+  // The drive current at the grid's times t0 + q dt, q = 0 .. steps (sine_drive): the same for
+  // every candidate, so the objective computes it once; empty: run_sines_lanes computes it.
+  std::vector<double> drive_A{};
+  bool same_drive(const SineRun& o) const {
+    return T == o.T && pp == o.pp && f == o.f && min == o.min;
+  }
 };
 
 struct SineMetrics {
@@ -45,6 +53,11 @@ struct SineGrid {
   long per_period = 0;
 };
 SineGrid sine_target_grid(const SineRun& run, const ObjectiveSettings& s);
+
+// The run's drive on its grid (SineRun::drive_A), or nothing when the run has more than
+// kMaxStoredDriveSteps steps (then each evaluation computes it as it goes).
+constexpr long kMaxStoredDriveSteps = 1000000;
+std::vector<double> sine_drive(const SineRun& run, const ObjectiveSettings& s);
 
 // Runs the sine from the cached start state; the metrics are those of its last period, whose
 // current, y [um] and B [T] are left in I, y, B (buffers reused across calls).

@@ -17,6 +17,7 @@ namespace {
 struct LaneSine {
   Waveform w;
   SineGrid g;
+  LoopMetricsWanted want;
   std::vector<double> I, y, B;  // the last period and its closing row
 };
 
@@ -24,7 +25,7 @@ SineMetrics metrics_of(const LaneSine& ls) {
   const std::size_t rows = ls.I.size();
   std::vector<double> t(rows);  // uniform: only the spacing matters to the refinement
   for (std::size_t k = 0; k < rows; ++k) t[k] = static_cast<double>(k);
-  const LoopMetrics L = loop_metrics(t, ls.I, ls.y, ls.B, 0, rows - 1);
+  const LoopMetrics L = loop_metrics(t, ls.I, ls.y, ls.B, 0, rows - 1, ls.want);
   SineMetrics r;
   r.stroke_um = L.stroke_um;
   r.B_pp_T = L.B_pp_T;
@@ -46,6 +47,7 @@ std::vector<SineMetrics> run_sines_lanes(const Model& m, const std::vector<SineR
     const SineRun& run = runs[k];
     ls[k].w = biased_sine(run.pp, run.f, run.min);
     ls[k].g = sine_target_grid(run, s);
+    ls[k].want = run.want;
     const auto& cs = starts.get(run.T, ls[k].w.current_at(0.0));
     conds[k] = &cs.first;
     states[k] = &cs.second;
@@ -69,7 +71,8 @@ std::vector<SineMetrics> run_sines_lanes(const Model& m, const std::vector<SineR
       const long kk = std::min(q, g.steps);
       t1[k] = g.t0_s + static_cast<double>(kk) * g.dt_s;
       dt[k] = g.dt_s;
-      current[k] = ls[k].w.current_at(t1[k]);
+      const std::vector<double>& drive = runs[k].drive_A;  // sine_drive: the same numbers
+      current[k] = drive.empty() ? ls[k].w.current_at(t1[k]) : drive[static_cast<std::size_t>(kk)];
     }
     batch.step(current, dt, t1);
     for (std::size_t k = 0; k < n; ++k) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <tuple>
 #include <utility>
 
@@ -52,24 +53,34 @@ double hysteresis_width(const std::vector<double>& current_A, const std::vector<
                         std::size_t begin, std::size_t end) {
   if (end <= begin + 2) return 0.0;
   // Split the period at its current extremes into the rising and the falling branch.
+  // The first sample of the smallest and of the largest current (the extremes kept in
+  // registers: a load through the running index per sample made this loop latency-bound).
   std::size_t imin = begin, imax = begin;
+  double cmin = current_A[begin], cmax = current_A[begin];
   for (std::size_t i = begin; i < end; ++i) {
-    if (current_A[i] < current_A[imin]) imin = i;
-    if (current_A[i] > current_A[imax]) imax = i;
+    const double c = current_A[i];
+    if (c < cmin) {
+      cmin = c;
+      imin = i;
+    }
+    if (c > cmax) {
+      cmax = c;
+      imax = i;
+    }
   }
   // The branches' storage is kept per thread: identify evaluates seven loops per candidate.
   thread_local Branch rise, fall;
   auto collect = [&](Branch& b, std::size_t from, std::size_t to, bool rising) {
     // walk cyclically from `from` to `to` within [begin, end)
     const std::size_t n = end - begin;
-    b.I.clear();
-    b.y.clear();
+    const std::size_t count = (to >= from ? to - from : to + n - from) + 1;  // from .. to
+    b.I.resize(count);
+    b.y.resize(count);
     std::size_t k = from;
-    for (std::size_t cnt = 0; cnt <= n; ++cnt) {
-      b.I.push_back(current_A[k]);
-      b.y.push_back(y[k]);
-      if (k == to) break;
-      k = (k + 1 - begin) % n + begin;
+    for (std::size_t cnt = 0; cnt < count; ++cnt) {
+      b.I[cnt] = current_A[k];
+      b.y[cnt] = y[k];
+      if (++k == end) k = begin;
     }
     if (!rising) {
       std::reverse(b.I.begin(), b.I.end());
@@ -169,28 +180,39 @@ void refine_window(const std::vector<double>& t, const std::vector<double>& v, s
     return (v[hi] - v[lo]) / (t[hi] - t[lo]);
   };
   const HermiteBasis& hb = hermite_basis();
-  out.clear();
+  const std::size_t intervals = last > b ? last - b : 0;
+  out.resize(intervals * kRefine + (last < e ? 1 : 0));  // written by index: no push_back
+  double* o = out.data();
   double slope_k = last > b ? slope(b) : 0.0;
-  for (std::size_t k = b; k < last; ++k) {
+  for (std::size_t k = b; k < last; ++k, o += kRefine) {
     const double h = t[k + 1] - t[k], slope_k1 = slope(k + 1);
-    const double m0 = slope_k * h, m1 = slope_k1 * h;
+    const double m0 = slope_k * h, m1 = slope_k1 * h, v0 = v[k], v1 = v[k + 1];
     for (int j = 0; j < kRefine; ++j)
-      out.push_back(hb.h00[j] * v[k] + hb.h10[j] * m0 + hb.h01[j] * v[k + 1] + hb.h11[j] * m1);
+      o[j] = hb.h00[j] * v0 + hb.h10[j] * m0 + hb.h01[j] * v1 + hb.h11[j] * m1;
     slope_k = slope_k1;
   }
-  if (last < e) out.push_back(v[last]);  // no closing row: keep the last sample
+  if (last < e) *o = v[last];  // no closing row: keep the last sample
 }
 
 }  // namespace
 
 LoopMetrics loop_metrics(const std::vector<double>& t, const std::vector<double>& current_A,
                          const std::vector<double>& y_um, const std::vector<double>& B_T,
-                         std::size_t b, std::size_t e) {
+                         std::size_t b, std::size_t e, LoopMetricsWanted want) {
   thread_local std::vector<double> I, y, B;  // refined; per thread (identify: 7 per candidate)
-  refine_window(t, current_A, b, e, I);
-  refine_window(t, y_um, b, e, y);
-  refine_window(t, B_T, b, e, B);
-  return {peak_to_peak(y), hysteresis_width(I, y, 0, y.size()), peak_to_peak(B)};
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  LoopMetrics L{nan, nan, nan};
+  if (want.stroke || want.hysteresis) refine_window(t, y_um, b, e, y);
+  if (want.stroke) L.stroke_um = peak_to_peak(y);
+  if (want.hysteresis) {
+    refine_window(t, current_A, b, e, I);
+    L.hysteresis_um = hysteresis_width(I, y, 0, y.size());
+  }
+  if (want.B_pp) {
+    refine_window(t, B_T, b, e, B);
+    L.B_pp_T = peak_to_peak(B);
+  }
+  return L;
 }
 
 Metrics compute_metrics(const TimeSeries& ts, double t0, double t1) {

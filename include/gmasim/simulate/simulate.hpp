@@ -203,9 +203,14 @@ Metrics compute_metrics(const TimeSeries& ts, double t0_s, double t1_s);
 struct LoopMetrics {
   double stroke_um = 0, hysteresis_um = 0, B_pp_T = 0;
 };
+// Which of them to compute: a measure not wanted is left NaN and costs nothing (identify's sine
+// targets need one or two of the three on most runs).
+struct LoopMetricsWanted {
+  bool stroke = true, hysteresis = true, B_pp = true;
+};
 LoopMetrics loop_metrics(const std::vector<double>& t_s, const std::vector<double>& current_A,
                          const std::vector<double>& y_um, const std::vector<double>& B_T,
-                         std::size_t b, std::size_t e);
+                         std::size_t b, std::size_t e, LoopMetricsWanted want = {});
 
 // max - min of v; 0 for an empty span. The one peak-to-peak of metrics, fits and records.
 double peak_to_peak(std::span<const double> v);
