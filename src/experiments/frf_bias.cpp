@@ -1,8 +1,11 @@
 // gmasim frf's bias point (Fig. 15): the actuator settled at a DC bias current, in the
 // anhysteretic state an AC shake-down leaves or on its virgin curve (settle_at_bias,
 // gmasim/experiments/experiments.hpp). docs/experiments.md, "Frequency response".
+#include "gmasim/experiments/frf_bias.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/experiments.hpp"
@@ -44,28 +47,39 @@ void anhysteretic_fixed_point(const Model& m, const Conditions& c, State& s, dou
   }
 }
 
+// Whether settle_at_bias ramps on the anhysteretic curves (the consistent reading) instead of
+// the virgin curve.
+bool anhysteretic_ramp(const Model& m, BiasState bias_state) {
+  return bias_state == BiasState::Anhysteretic &&
+         m.options.magnetic_state == MagneticState::Consistent;
+}
+
 template <class Law>
-State settle_law(const Model& m, const Conditions& c, double bias_A, BiasState bias_state) {
-  State s;
-  if (bias_state == BiasState::Anhysteretic &&
-      m.options.magnetic_state == MagneticState::Consistent) {
-    // The consistent reading: the quasi-static ramp of make_state with every rod's JA law
-    // reduced to its anhysteretic curve, M = M_an(H + alpha M) (c = 1, eq. 9), so that the
-    // circuit, the fields and the magnetisations are solved together (the fixed point above
-    // does not converge when a rod's series reluctance makes its branch nearly flux-driven).
-    // Then M_irr = M_an = M, where the full law of eq. (9) holds the same state (Preisach: the
-    // hysterons' coercive fields shrunk, then the AC-demagnetised state of the full law).
-    Conditions anh = c;
+Conditions ramp_conditions(const Model& m, const Conditions& c, BiasState bias_state) {
+  Conditions anh = c;
+  if (anhysteretic_ramp(m, bias_state))
     for (auto& rc : anh.rods) Law::reduce_to_anhysteretic(rc);
-    s = make_state(m, anh, bias_A);
+  return anh;
+}
+
+template <class Law>
+State settle_from(const Model& m, const Conditions& c, State s, double bias_A,
+                  BiasState bias_state) {
+  if (anhysteretic_ramp(m, bias_state)) {
+    // The consistent reading: s is the quasi-static ramp of make_state with every rod's JA law
+    // reduced to its anhysteretic curve, M = M_an(H + alpha M) (c = 1, eq. 9; ramp_conditions),
+    // so that the circuit, the fields and the magnetisations are solved together (the fixed
+    // point above does not converge when a rod's series reluctance makes its branch nearly
+    // flux-driven). Then M_irr = M_an = M, where the full law of eq. (9) holds the same state
+    // (Preisach: the hysterons' coercive fields shrunk, then the AC-demagnetised state of the
+    // full law).
     for (std::size_t i = 0; i < s.rods.size(); ++i) {
       auto& r = s.rods[i];
       (void)Law::hold_anhysteretic(c.rods[i], r, r.M_A_per_m);
       hold_history(r);
     }
-  } else {
-    s = make_state(m, c, bias_A);  // virgin curve, static equilibrium
-    if (bias_state == BiasState::Anhysteretic) anhysteretic_fixed_point<Law>(m, c, s, bias_A);
+  } else if (bias_state == BiasState::Anhysteretic) {  // s: the virgin curve, static equilibrium
+    anhysteretic_fixed_point<Law>(m, c, s, bias_A);
   }
   double tau_max = 0.0;
   for (const auto& r : s.rods) tau_max = std::max(tau_max, r.tau_s);
@@ -77,10 +91,22 @@ State settle_law(const Model& m, const Conditions& c, double bias_A, BiasState b
 
 }  // namespace
 
-State settle_at_bias(const Model& m, const Conditions& c, double bias_A, BiasState bias_state) {
+Conditions bias_ramp_conditions(const Model& m, const Conditions& c, BiasState bias_state) {
   return with_magnetisation_law(m.options.magnetisation_law, [&](auto law) {
-    return settle_law<decltype(law)>(m, c, bias_A, bias_state);
+    return ramp_conditions<decltype(law)>(m, c, bias_state);
   });
+}
+
+State settle_at_bias_from(const Model& m, const Conditions& c, State ramped, double bias_A,
+                          BiasState bias_state) {
+  return with_magnetisation_law(m.options.magnetisation_law, [&](auto law) {
+    return settle_from<decltype(law)>(m, c, std::move(ramped), bias_A, bias_state);
+  });
+}
+
+State settle_at_bias(const Model& m, const Conditions& c, double bias_A, BiasState bias_state) {
+  const Conditions ramp = bias_ramp_conditions(m, c, bias_state);
+  return settle_at_bias_from(m, c, make_state(m, ramp, bias_A), bias_A, bias_state);
 }
 
 }  // namespace gmasim

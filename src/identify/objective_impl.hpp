@@ -8,10 +8,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <string>
 #include <vector>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments/frf_bias.hpp"
 #include "gmasim/identify/identify.hpp"
 #include "gmasim/simulate/lanes.hpp"
 #include "identify/objective_runs.hpp"
@@ -133,7 +135,10 @@ struct Objective::Impl {
   // The simulations of the scalar targets. Throws InputError / DivergenceError.
   void target_runs(const Model& model, StartCache& starts, std::vector<SineMetrics>& sm,
                    std::vector<double>& res) const {
-    if (settings.lanes && sine_runs.size() > 1 && lanes_supported(model)) {
+    const bool lanes = settings.lanes && lanes_supported(model);
+    std::deque<identify_detail::BiasRamp> ramps;  // the frf targets' (lanes), per res_runs
+    if (lanes) ramps = make_ramps_in_lanes(model, starts);
+    if (lanes && sine_runs.size() > 1) {
       sm = identify_detail::run_sines_lanes(model, sine_runs, settings, starts);
     } else {
       std::vector<double> I, yy, BB;
@@ -143,7 +148,44 @@ struct Objective::Impl {
     }
     res.resize(res_runs.size());
     for (std::size_t k = 0; k < res_runs.size(); ++k)
-      res[k] = identify_detail::lowest_resonance_Hz(model, res_runs[k]);
+      res[k] = identify_detail::lowest_resonance_Hz(model, res_runs[k], starts,
+                                                    lanes ? &ramps[k] : nullptr);
+  }
+
+  // The (temperature, initial current) of every state at rest the targets start from: the sine
+  // runs' (their minimum) and the modulus and resonance targets' (their bias).
+  std::vector<std::pair<double, double>> target_starts() const {
+    std::vector<std::pair<double, double>> k;
+    for (const auto& run : sine_runs)
+      k.emplace_back(run.T, biased_sine(run.pp, run.f, run.min).current_at(0.0));
+    for (const auto& run : res_runs)
+      if (run.kind == TargetKind::ModulusGPa || run.kind == TargetKind::ResonanceHz)
+        k.emplace_back(run.T, run.bias);
+    return k;
+  }
+
+  // Every quasi-static ramp of the targets in one batch of lanes: the start states
+  // (target_starts, into the cache) and the frf targets' bias ramps, returned per res_runs
+  // (the other targets' entries unused).
+  std::deque<identify_detail::BiasRamp> make_ramps_in_lanes(const Model& model,
+                                                            StartCache& starts) const {
+    std::deque<identify_detail::BiasRamp> ramps(res_runs.size());
+    std::vector<const Conditions*> rc;
+    std::vector<double> I0;
+    std::vector<std::size_t> which;
+    const FrfRequest frf;
+    for (std::size_t k = 0; k < res_runs.size(); ++k) {
+      const ResonanceRun& run = res_runs[k];
+      if (run.kind != TargetKind::FrfPeakHz && run.kind != TargetKind::BandwidthHz) continue;
+      ramps[k].c = make_conditions(model, run.T);
+      ramps[k].ramp_c = bias_ramp_conditions(model, ramps[k].c, frf.bias_state);
+      rc.push_back(&ramps[k].ramp_c);
+      I0.push_back(run.bias);
+      which.push_back(k);
+    }
+    std::vector<State> st = starts.make_in_lanes(target_starts(), rc, I0);
+    for (std::size_t j = 0; j < which.size(); ++j) ramps[which[j]].ramped = std::move(st[j]);
+    return ramps;
   }
 
   bool residuals(const double* u, double* r, std::string* why = nullptr) const {

@@ -9,8 +9,11 @@
 #include <limits>
 
 #include "gmasim/experiments/experiments.hpp"
+#include "gmasim/experiments/frf_bias.hpp"
+#include "gmasim/mechanics/mechanics.hpp"
 #include "gmasim/model/validate.hpp"
 #include "gmasim/physics/magnetic.hpp"
+#include "gmasim/simulate/lanes.hpp"
 #include "identify/record_run.hpp"
 
 namespace gmasim {
@@ -23,6 +26,39 @@ const std::pair<Conditions, State>& StartCache::get(double T, double I0) {
   State st = make_state(m_, c, I0);
   entries_.push_back({T, I0, {std::move(c), std::move(st)}});
   return entries_.back().cs;
+}
+
+std::vector<State> StartCache::make_in_lanes(const std::vector<std::pair<double, double>>& T_I0,
+                                             const std::vector<const Conditions*>& extra_c,
+                                             const std::vector<double>& extra_I0) {
+  std::vector<std::pair<double, double>> todo;
+  for (const auto& k : T_I0) {
+    bool cached = std::find(todo.begin(), todo.end(), k) != todo.end();
+    for (const auto& e : entries_) cached = cached || (e.T == k.first && e.I0 == k.second);
+    if (!cached) todo.push_back(k);
+  }
+  const std::size_t n = todo.size(), ne = extra_c.size();
+  if (n + ne < 2) {  // one ramp: make_state, no lanes to share
+    std::vector<State> extra;
+    for (std::size_t k = 0; k < ne; ++k) extra.push_back(make_state(m_, *extra_c[k], extra_I0[k]));
+    return extra;
+  }
+  std::deque<Conditions> conds;  // stable addresses
+  std::vector<const Conditions*> cp;
+  std::vector<double> I0;
+  for (const auto& [T, I] : todo) {
+    conds.push_back(make_conditions(m_, T));
+    cp.push_back(&conds.back());
+    I0.push_back(I);
+  }
+  cp.insert(cp.end(), extra_c.begin(), extra_c.end());
+  I0.insert(I0.end(), extra_I0.begin(), extra_I0.end());
+  const std::vector<const Model*> models(n + ne, &m_);
+  std::vector<State> st = make_states(models, cp, I0);
+  for (std::size_t k = 0; k < n; ++k)
+    entries_.push_back({todo[k].first, todo[k].second, {std::move(conds[k]), std::move(st[k])}});
+  st.erase(st.begin(), st.begin() + static_cast<std::ptrdiff_t>(n));
+  return st;
 }
 
 SineGrid sine_target_grid(const SineRun& run, const ObjectiveSettings& s) {
@@ -81,21 +117,27 @@ SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings
   return r;
 }
 
-double lowest_resonance_Hz(const Model& m, const ResonanceRun& run) {
+double lowest_resonance_Hz(const Model& m, const ResonanceRun& run, StartCache& starts,
+                           const BiasRamp* ramp) {
   if (run.kind == TargetKind::ModulusGPa) {  // eq. (13) at rest, mean over the rods
-    const Conditions c = make_conditions(m, run.T);
-    const State st = make_state(m, c, run.bias);
+    const State& st = starts.get(run.T, run.bias).second;
     double E = 0.0;
     for (const auto& r : st.rods) E += r.E_Pa;
     return E / static_cast<double>(st.rods.size()) * 1e-9;
   }
   if (run.kind != TargetKind::ResonanceHz) {  // the small-signal frequency response (Fig. 15)
-    // run_frf's linearised markers without the rest of its curve (the same numbers).
-    const LinearFrfMarkers lm = linear_frf_markers(m, run.T, run.bias);
+    // run_frf's linearised markers without the rest of its curve (the same numbers; from the
+    // ramp made in lanes, to their rounding).
+    const FrfRequest r;
+    const LinearFrfMarkers lm =
+        ramp ? linear_frf_markers(
+                   linearise(m, ramp->c,
+                             settle_at_bias_from(m, ramp->c, ramp->ramped, run.bias, r.bias_state)),
+                   r.f_min_Hz, r.f_max_Hz)
+             : linear_frf_markers(m, run.T, run.bias);
     return run.kind == TargetKind::FrfPeakHz ? lm.first_resonance_Hz : lm.bandwidth_3dB_Hz;
   }
-  const Conditions c = make_conditions(m, run.T);
-  const State st = make_state(m, c, run.bias);
+  const auto& [c, st] = starts.get(run.T, run.bias);
   double f = std::numeric_limits<double>::infinity();
   for (int i = 0; i < m.rod_count(); ++i) {
     const double K = oscillator_stiffness(c, st, i);

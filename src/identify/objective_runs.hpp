@@ -19,6 +19,14 @@ class StartCache {
  public:
   explicit StartCache(const Model& m) : m_(m) {}
   const std::pair<Conditions, State>& get(double T, double I0);
+  // Makes the states of the (temperature, initial current) pairs not cached yet and the extra
+  // ramps (make_state of the model under extra_c[k] at extra_I0[k]) together, in SIMD lanes
+  // (make_states, gmasim/simulate/lanes.hpp; the model lanes_supported): equal to make_state to
+  // the lanes' rounding (~1e-14 relative), one ramp for all of them. Returns the extra states.
+  // Fewer than two ramps in all: make_state (the pairs are then left to get()).
+  std::vector<State> make_in_lanes(const std::vector<std::pair<double, double>>& T_I0,
+                                   const std::vector<const Conditions*>& extra_c,
+                                   const std::vector<double>& extra_I0);
 
  private:
   struct Entry {
@@ -78,8 +86,18 @@ struct ResonanceRun {
   TargetKind kind;  // ResonanceHz, FrfPeakHz, BandwidthHz or ModulusGPa (at rest, no sine)
   bool operator==(const ResonanceRun&) const = default;
 };
-// The value of a target computed at rest or from the small-signal response (no sine run).
-double lowest_resonance_Hz(const Model& m, const ResonanceRun& run);
+// The small-signal targets' bias point before its settling (settle_at_bias_from,
+// gmasim/experiments/frf_bias.hpp): the conditions at the target's temperature, those of the
+// ramp and the ramp's state, made with the start states in lanes (StartCache::make_in_lanes).
+struct BiasRamp {
+  Conditions c, ramp_c;
+  State ramped;
+};
+// The value of a target computed at rest or from the small-signal response (no sine run); the
+// states at rest (modulus, resonance) are the cached ones at (T, bias). ramp: the bias point's
+// ramp of a frf_peak_Hz or bandwidth_Hz target if made already (nullptr: settle_at_bias makes it).
+double lowest_resonance_Hz(const Model& m, const ResonanceRun& run, StartCache& starts,
+                           const BiasRamp* ramp = nullptr);
 
 // run_record() from the record's start state: the cached one, or for a record measured at its
 // own prestress (condition key prestress_MPa) the model with that preload (record_run.hpp,
