@@ -220,7 +220,7 @@ reason = "the sleeve length"
 )",
                                      "modulus.toml");
   ObjectiveSettings s = ci_objective();
-  s.lanes = false;  // make_state itself (lanes: Identify.TargetRampsInLanesMatchTheScalarRamps)
+  s.lanes = false;  // make_state itself (lanes: Lanes.TargetRunsAndRampsMatchTheScalarPath)
   const Objective obj(builtin_model_spec(), MeasurementSet{}, fit, s);
   const auto tf = obj.target_fits(obj.start_unit());
   ASSERT_EQ(tf.size(), 2u);
@@ -404,43 +404,4 @@ TEST(Identify, StopFlagEndsCleanlyWithTheBestSoFar) {
   EXPECT_EQ(r.generations_done, 0);
   EXPECT_LE(r.rms_pct, r.start_rms_pct);
   EXPECT_EQ(r.parameters.size(), 1u);
-}
-
-// The calibration's objective (calibration/consistent.toml) makes every quasi-static ramp of
-// its targets in one batch of SIMD lanes (the sine runs' start states, the modulus target's
-// state at rest and the first resonance's bias ramp: make_states) where lanes are on, and one
-// make_state per ramp where they are off. The targets that read nothing but a ramp (modulus:
-// E_G at rest; first resonance: the settled, linearised bias point) and every other target
-// agree to the lanes' rounding, at the start and away from it. Observed: relative difference
-// 1.1e-14 of the ramp-only targets, 1.9e-12 of any target (the sine runs' lanes too);
-// tolerances 10x.
-TEST(Identify, TargetRampsInLanesMatchTheScalarRamps) {
-  const std::string src = GMASIM_SOURCE_DIR;
-  const ModelSpec start = load_model_spec(src + "/calibration/start/consistent.toml");
-  const FitSpec fit = load_fit_spec(src + "/calibration/consistent.toml");
-  ObjectiveSettings s;
-  const Objective batched(start, MeasurementSet{}, fit, s);
-  s.lanes = false;
-  const Objective scalar(start, MeasurementSet{}, fit, s);
-  std::vector<double> u = batched.start_unit();
-  double worst_ramp = 0.0, worst = 0.0;
-  int ramp_targets = 0;
-  for (int point = 0; point < 2; ++point) {
-    if (point == 1)
-      for (std::size_t j = 0; j < u.size(); ++j) u[j] = 0.2 + 0.6 * static_cast<double>(j % 4) / 3;
-    const auto ta = batched.target_fits(u), tb = scalar.target_fits(u);
-    ASSERT_EQ(ta.size(), tb.size());
-    for (std::size_t i = 0; i < ta.size(); ++i) {
-      ASSERT_FALSE(ta[i].failed || tb[i].failed) << ta[i].label;
-      const double rel = std::fabs(ta[i].simulated / tb[i].simulated - 1.0);
-      const bool ramp_only = ta[i].kind == "modulus_GPa" || ta[i].kind == "frf_peak_Hz";
-      ramp_targets += ramp_only ? 1 : 0;
-      if (ramp_only) worst_ramp = std::max(worst_ramp, rel);
-      worst = std::max(worst, rel);
-      EXPECT_LT(rel, ramp_only ? 1.2e-13 : 2e-11) << "point " << point << ", " << ta[i].label;
-    }
-  }
-  EXPECT_EQ(ramp_targets, 4);  // the modulus and the first resonance at both points
-  std::printf("target ramps, lanes vs scalar: ramp-only targets %.3g, any target %.3g (relative)\n",
-              worst_ramp, worst);
 }
