@@ -15,6 +15,7 @@
 #include "gmasim/experiments/claims.hpp"
 #include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/experiments.hpp"
+#include "gmasim/experiments/frf_bias.hpp"
 #include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/model/validate.hpp"
 #include "gmasim/physics/magnetic.hpp"
@@ -272,11 +273,14 @@ LinearFrfMarkers linear_frf_markers(const SmallSignalModel& lin, double f_min_Hz
   return {find_resonance_Hz(fd, md), find_bandwidth_3dB_Hz(fd, md)};
 }
 
-LinearFrfMarkers linear_frf_markers(const Model& m, double T_C, double bias_A) {
+LinearFrfMarkers linear_frf_markers_at(const Model& m, const Conditions& c, const State& settled) {
   const FrfRequest r;
+  return linear_frf_markers(linearise(m, c, settled), r.f_min_Hz, r.f_max_Hz);
+}
+
+LinearFrfMarkers linear_frf_markers(const Model& m, double T_C, double bias_A) {
   const Conditions c = make_conditions(m, T_C);
-  const State bias = settle_at_bias(m, c, bias_A, r.bias_state);
-  return linear_frf_markers(linearise(m, c, bias), r.f_min_Hz, r.f_max_Hz);
+  return linear_frf_markers_at(m, c, settle_at_bias(m, c, bias_A, FrfRequest{}.bias_state));
 }
 
 FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progress) {

@@ -128,12 +128,10 @@ double lowest_resonance_Hz(const Model& m, const ResonanceRun& run, StartCache& 
   if (run.kind != TargetKind::ResonanceHz) {  // the small-signal frequency response (Fig. 15)
     // run_frf's linearised markers without the rest of its curve (the same numbers; from the
     // ramp made in lanes, to their rounding).
-    const FrfRequest r;
     const LinearFrfMarkers lm =
-        ramp ? linear_frf_markers(
-                   linearise(m, ramp->c,
-                             settle_at_bias_from(m, ramp->c, ramp->ramped, run.bias, r.bias_state)),
-                   r.f_min_Hz, r.f_max_Hz)
+        ramp ? linear_frf_markers_at(
+                   m, ramp->c,
+                   settle_at_bias_from(m, ramp->c, ramp->ramped, run.bias, FrfRequest{}.bias_state))
              : linear_frf_markers(m, run.T, run.bias);
     return run.kind == TargetKind::FrfPeakHz ? lm.first_resonance_Hz : lm.bandwidth_3dB_Hz;
   }

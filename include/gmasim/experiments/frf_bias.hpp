@@ -19,4 +19,8 @@ Conditions bias_ramp_conditions(const Model& m, const Conditions& c, BiasState b
 State settle_at_bias_from(const Model& m, const Conditions& c, State ramped, double bias_A,
                           BiasState bias_state);
 
+// run_frf's linearised markers over its default band at a settled bias state of conditions c
+// (linear_frf_markers(m, T, bias_A) with the state settle_at_bias gives there).
+LinearFrfMarkers linear_frf_markers_at(const Model& m, const Conditions& c, const State& settled);
+
 }  // namespace gmasim
