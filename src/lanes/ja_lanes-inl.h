@@ -76,7 +76,7 @@ HWY_INLINE void langevin_pair(D d, V<D> x, V<D>& L, V<D>& dL) {
   dL = hn::IfThenElse(small, dLt, dL);
 }
 
-// exp(-r), q(r) = (1 - exp(-r))/r and dq/dr = (E - q)/r (magnetic.hpp, lag_weights_and_slope):
+// exp(-r), q(r) = (1 - exp(-r))/r and dq/dr = (E - q)/r (magnetic.hpp, lag_weights_and_slope_from):
 // Taylor series for q at r < 1e-2 (where dq/dr divides by r, and is -1/2 at r <= 1e-12), one
 // reciprocal of r beyond; one division per lane either way.
 template <class D>

@@ -154,7 +154,7 @@ inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, dou
   }
   const double r = s * inv_k;
   // d/dHe1 through M_an1 (weight 1 - q) and through r = s/k (dq/dr = (E - q)/r): one
-  // reciprocal of r for q and dq/dr (lag_weights_and_slope).
+  // reciprocal of r for q and dq/dr (lag_weights_and_slope_from).
   const LagWeightsSlope w = lag_weights_and_slope_near(r, lag);
   const double dq_dr = w.dq_dr;
   dMirr_dHe1 = (1.0 - w.q) * dMan1 + ds_dHe1 * inv_k * (-(Mirr0 - u0) * w.E - (Man1 - u0) * dq_dr);

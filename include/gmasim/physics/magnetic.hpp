@@ -161,9 +161,6 @@ inline LagWeightsSlope lag_weights_and_slope_from(double r, double E) {
   const double q = (1.0 - E) * inv_r;
   return {E, q, (E - q) * inv_r};
 }
-inline LagWeightsSlope lag_weights_and_slope(double r) {
-  return lag_weights_and_slope_from(r, std::exp(-r));
-}
 // The same with exp(-r) from a known exponential nearby (p, physics::exp_near); p becomes -r's.
 inline LagWeightsSlope lag_weights_and_slope_near(double r, ExpPoint& p) {
   return lag_weights_and_slope_from(r, exp_near(-r, p));
