@@ -46,8 +46,8 @@ void expect_dense(const SmallSignalModel& L, double f0, double f1, const char* w
 TEST(FrfMarkers, EqualTheDenseGridsAtTheMdmaBiasPoints) {
   const Model& m = gmasim_experiments_test::mdma();
   int i = 0;
-  for (double T : {-20.0, 20.0, 70.0, 150.0})
-    for (double bias : {0.5, 1.0, 4.0}) {
+  for (double T : {20.0, 150.0})
+    for (double bias : {1.0, 4.0}) {
       const Conditions c = make_conditions(m, T);
       const SmallSignalModel L =
           linearise(m, c, settle_at_bias(m, c, bias, BiasState::Anhysteretic));
@@ -69,7 +69,7 @@ TEST(FrfMarkers, EqualTheDenseGridsWithSharpAndMovedResonances) {
   auto log_uniform = [&](double lo, double hi) {
     return lo * std::pow(hi / lo, std::uniform_real_distribution<double>(0.0, 1.0)(g));
   };
-  for (int trial = 0; trial < 50; ++trial) {
+  for (int trial = 0; trial < 24; ++trial) {
     SmallSignalModel L = L0;
     const double f_sm = log_uniform(500.0, 3000.0), zeta_sm = log_uniform(1e-3, 0.1);
     L.sm_stiffness_N_per_m = L.sm_mass_kg * std::pow(2.0 * M_PI * f_sm, 2);
