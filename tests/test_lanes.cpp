@@ -506,11 +506,12 @@ TEST(Lanes, ObjectiveResidualsMatchTheScalarRuns) {
 // seven biased-sine runs) with its runs in lanes against the scalar path (lanes = false): the
 // sine runs (identify/sine_lanes.cpp) and every quasi-static ramp of its targets in one batch
 // (the sine runs' start states, the modulus target's state at rest, the first resonance's bias
-// ramp: make_states) against one run_sine / make_state each, at the start and at a point away
-// from it. Observed: residuals (% of each target's scale) 9.7e-12 % apart, tolerance 1e-10 %;
-// the targets that read nothing but a ramp (modulus: E_G at rest; first resonance: the settled,
-// linearised bias point) 2.7e-15 to 1.1e-14 relative, tolerance 1.2e-13; any target 1.9e-12 to
-// 2.5e-12, tolerance 2e-11.
+// ramp: make_states; then the bias point's DC settling in the eighth lane beside the seven
+// sines) against one run_sine / make_state / settle_at_bias each, at the start and at a point
+// away from it. Observed: residuals (% of each target's scale) 9.5e-12 % apart, tolerance
+// 1e-10 %; the targets that read nothing but a ramp (modulus: E_G at rest; first resonance: the
+// settled, linearised bias point) 1.6e-15 to 1.1e-14 relative, tolerance 1.2e-13; any target
+// 1.9e-12 to 2.5e-12, tolerance 2e-11.
 TEST(Lanes, TargetRunsAndRampsMatchTheScalarPath) {
   const std::string src = GMASIM_SOURCE_DIR;
   const ModelSpec start = load_model_spec(src + "/calibration/start/consistent.toml");

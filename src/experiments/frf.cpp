@@ -34,13 +34,6 @@ double unwrap_deg(double prev, double now) {
   return now;
 }
 
-std::vector<double> log_grid(double f0, double f1, int n) {
-  std::vector<double> f(static_cast<std::size_t>(n));
-  for (int k = 0; k < n; ++k)
-    f[static_cast<std::size_t>(k)] = f0 * std::pow(f1 / f0, static_cast<double>(k) / (n - 1));
-  return f;
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
@@ -52,35 +45,6 @@ std::complex<double> first_harmonic_ratio(const std::vector<double>& t_s,
   detail::FirstHarmonicSums sums;
   for (std::size_t k = 0; k < t_s.size(); ++k) sums.add(t_s[k], f_Hz, y[k], i[k]);
   return sums.ratio();
-}
-
-double find_resonance_Hz(const std::vector<double>& f, const std::vector<double>& mag) {
-  if (mag.size() < 3) return 0.0;
-  double best = 0.0, f_best = 0.0;
-  for (std::size_t k = 1; k + 1 < mag.size(); ++k) {
-    if (mag[k] > mag[k - 1] && mag[k] >= mag[k + 1] && mag[k] > best) {
-      best = mag[k];
-      // Parabolic refinement in log f.
-      const double a = mag[k - 1], b = mag[k], cc = mag[k + 1];
-      const double den = a - 2 * b + cc;
-      const double off = den != 0.0 ? 0.5 * (a - cc) / den : 0.0;
-      const double lf = std::log(f[k]) + off * 0.5 * (std::log(f[k + 1]) - std::log(f[k - 1]));
-      f_best = std::exp(lf);
-    }
-  }
-  return f_best;
-}
-
-double find_bandwidth_3dB_Hz(const std::vector<double>& f, const std::vector<double>& mag) {
-  if (mag.size() < 2) return 0.0;
-  const double level = mag.front() / std::sqrt(2.0);
-  for (std::size_t k = 1; k < mag.size(); ++k) {
-    if (mag[k] < level) {
-      const double u = (mag[k - 1] - level) / (mag[k - 1] - mag[k]);
-      return std::exp(std::log(f[k - 1]) + u * (std::log(f[k]) - std::log(f[k - 1])));
-    }
-  }
-  return 0.0;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -249,7 +213,7 @@ void fill_curve(FrfCurve& cv, const SmallSignalModel& lin, const cd* stepped,
   // The same search beyond the band, up to twice the highest mode.
   double f_top = r.f_max_Hz;
   for (double fm : cv.mode_frequencies_Hz) f_top = std::max(f_top, 2.0 * fm);
-  const std::vector<double> fe = log_grid(r.f_min_Hz, f_top, 8000);
+  const std::vector<double> fe = detail::log_grid(r.f_min_Hz, f_top, 8000);
   std::vector<double> me(fe.size());
   for (std::size_t k = 0; k < fe.size(); ++k) me[k] = std::abs(lin.response(fe[k]));
   cv.linear_peak_extended_Hz = find_resonance_Hz(fe, me);
@@ -257,21 +221,6 @@ void fill_curve(FrfCurve& cv, const SmallSignalModel& lin, const cd* stepped,
 }
 
 }  // namespace
-
-LinearFrfMarkers linear_frf_markers(const SmallSignalModel& lin, double f_min_Hz, double f_max_Hz) {
-  // The grid of the last band asked for on this thread (identify asks for the same band in
-  // every evaluation: 4000 std::pow saved each time), and the magnitudes' storage.
-  thread_local double band[2] = {0.0, 0.0};
-  thread_local std::vector<double> fd, md;
-  if (fd.empty() || band[0] != f_min_Hz || band[1] != f_max_Hz) {
-    fd = log_grid(f_min_Hz, f_max_Hz, 4000);
-    band[0] = f_min_Hz;
-    band[1] = f_max_Hz;
-  }
-  md.resize(fd.size());
-  for (std::size_t k = 0; k < fd.size(); ++k) md[k] = std::abs(lin.response(fd[k]));
-  return {find_resonance_Hz(fd, md), find_bandwidth_3dB_Hz(fd, md)};
-}
 
 LinearFrfMarkers linear_frf_markers_at(const Model& m, const Conditions& c, const State& settled) {
   const FrfRequest r;
@@ -290,7 +239,7 @@ FrfResult run_frf(const Model& m, const FrfRequest& r, const ProgressFn& progres
   for (double T : r.temperatures_C) conds.push_back(make_conditions(m, T));
 
   const auto wall0 = std::chrono::steady_clock::now();
-  const std::vector<double> f = log_grid(r.f_min_Hz, r.f_max_Hz, r.points);
+  const std::vector<double> f = detail::log_grid(r.f_min_Hz, r.f_max_Hz, r.points);
   const std::size_t nT = r.temperatures_C.size(), nf = f.size();
 
   // Bias points, linearisations and modes (cheap; one per temperature).

@@ -62,9 +62,10 @@ Conditions ramp_conditions(const Model& m, const Conditions& c, BiasState bias_s
   return anh;
 }
 
+// settle_at_bias_from up to its DC settling: the state the settling starts from.
 template <class Law>
-State settle_from(const Model& m, const Conditions& c, State s, double bias_A,
-                  BiasState bias_state) {
+State settling_start(const Model& m, const Conditions& c, State s, double bias_A,
+                     BiasState bias_state) {
   if (anhysteretic_ramp(m, bias_state)) {
     // The consistent reading: s is the quasi-static ramp of make_state with every rod's JA law
     // reduced to its anhysteretic curve, M = M_an(H + alpha M) (c = 1, eq. 9; ramp_conditions),
@@ -81,11 +82,6 @@ State settle_from(const Model& m, const Conditions& c, State s, double bias_A,
   } else if (bias_state == BiasState::Anhysteretic) {  // s: the virgin curve, static equilibrium
     anhysteretic_fixed_point<Law>(m, c, s, bias_A);
   }
-  double tau_max = 0.0;
-  for (const auto& r : s.rods) tau_max = std::max(tau_max, r.tau_s);
-  // Let H (eddy lag), M and the oscillators come to rest at the bias.
-  run_dc(m, c, s, bias_A, std::max(20.0 * tau_max, 10e-3));
-  s.t_s = 0.0;
   return s;
 }
 
@@ -97,11 +93,26 @@ Conditions bias_ramp_conditions(const Model& m, const Conditions& c, BiasState b
   });
 }
 
-State settle_at_bias_from(const Model& m, const Conditions& c, State ramped, double bias_A,
+State bias_settling_start(const Model& m, const Conditions& c, State ramped, double bias_A,
                           BiasState bias_state) {
   return with_magnetisation_law(m.options.magnetisation_law, [&](auto law) {
-    return settle_from<decltype(law)>(m, c, std::move(ramped), bias_A, bias_state);
+    return settling_start<decltype(law)>(m, c, std::move(ramped), bias_A, bias_state);
   });
+}
+
+StepGrid bias_settling_grid(const State& start) {
+  // Let H (eddy lag), M and the oscillators come to rest at the bias.
+  double tau_max = 0.0;
+  for (const auto& r : start.rods) tau_max = std::max(tau_max, r.tau_s);
+  return StepGrid::covering(start.t_s, std::max(20.0 * tau_max, 10e-3), kSettleDt_s, "DC settling");
+}
+
+State settle_at_bias_from(const Model& m, const Conditions& c, State ramped, double bias_A,
+                          BiasState bias_state) {
+  State s = bias_settling_start(m, c, std::move(ramped), bias_A, bias_state);
+  run_loop(m, c, s, bias_settling_grid(s), HeldCurrent{bias_A});
+  s.t_s = 0.0;
+  return s;
 }
 
 State settle_at_bias(const Model& m, const Conditions& c, double bias_A, BiasState bias_state) {

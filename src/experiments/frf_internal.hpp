@@ -13,6 +13,9 @@
 
 namespace gmasim::detail {
 
+// n frequencies from f0 to f1, evenly spaced in log f (frf_markers.cpp).
+std::vector<double> log_grid(double f0, double f1, int n);
+
 // The time grid of the stepped-sine point at fr Hz: >= r.min_steps_per_period steps per period
 // with dt <= 10 us, settled for settling_time_s(lin) and >= r.settle_periods periods, then
 // r.measure_periods periods measured (steps first+1 .. grid.steps, `measured` of them).

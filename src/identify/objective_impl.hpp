@@ -138,8 +138,10 @@ struct Objective::Impl {
     const bool lanes = settings.lanes && lanes_supported(model);
     std::deque<identify_detail::BiasRamp> ramps;  // the frf targets' (lanes), per res_runs
     if (lanes) ramps = make_ramps_in_lanes(model, starts);
-    if (lanes && sine_runs.size() > 1) {
-      sm = identify_detail::run_sines_lanes(model, sine_runs, settings, starts);
+    if (lanes && sine_runs.size() > 1) {  // the frf targets' DC settling beside, if it fits
+      sm = identify_detail::run_sines_lanes(
+          model, sine_runs, settings, starts,
+          identify_detail::settlings_beside_sines(model, sine_runs, settings, res_runs, ramps));
     } else {
       std::vector<double> I, yy, BB;
       sm.resize(sine_runs.size());

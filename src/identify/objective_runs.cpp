@@ -128,11 +128,18 @@ double lowest_resonance_Hz(const Model& m, const ResonanceRun& run, StartCache& 
   if (run.kind != TargetKind::ResonanceHz) {  // the small-signal frequency response (Fig. 15)
     // run_frf's linearised markers without the rest of its curve (the same numbers; from the
     // ramp made in lanes, to their rounding).
-    const LinearFrfMarkers lm =
-        ramp ? linear_frf_markers_at(
-                   m, ramp->c,
-                   settle_at_bias_from(m, ramp->c, ramp->ramped, run.bias, FrfRequest{}.bias_state))
-             : linear_frf_markers(m, run.T, run.bias);
+    LinearFrfMarkers lm;
+    if (!ramp) {
+      lm = linear_frf_markers(m, run.T, run.bias);
+    } else if (ramp->settled) {
+      State settled = ramp->ramped;
+      settled.t_s = 0.0;  // as settle_at_bias_from leaves it
+      lm = linear_frf_markers_at(m, ramp->c, settled);
+    } else {
+      lm = linear_frf_markers_at(
+          m, ramp->c,
+          settle_at_bias_from(m, ramp->c, ramp->ramped, run.bias, FrfRequest{}.bias_state));
+    }
     return run.kind == TargetKind::FrfPeakHz ? lm.first_resonance_Hz : lm.bandwidth_3dB_Hz;
   }
   const auto& [c, st] = starts.get(run.T, run.bias);
@@ -143,6 +150,35 @@ double lowest_resonance_Hz(const Model& m, const ResonanceRun& run, StartCache& 
     f = std::min(f, std::sqrt(K / mass) / (2.0 * physics::kPi));
   }
   return f;
+}
+
+std::vector<HeldRun> settlings_beside_sines(const Model& m, const std::vector<SineRun>& sines,
+                                            const ObjectiveSettings& s,
+                                            const std::vector<ResonanceRun>& res_runs,
+                                            std::deque<BiasRamp>& ramps) {
+  long longest = 0;
+  for (const auto& run : sines) longest = std::max(longest, sine_target_grid(run, s).grid.steps);
+  const BiasState bias_state = FrfRequest{}.bias_state;
+  std::vector<std::size_t> which;
+  std::vector<State> start;
+  for (std::size_t k = 0; k < res_runs.size(); ++k) {
+    const ResonanceRun& run = res_runs[k];
+    if (run.kind != TargetKind::FrfPeakHz && run.kind != TargetKind::BandwidthHz) continue;
+    start.push_back(bias_settling_start(m, ramps[k].c, ramps[k].ramped, run.bias, bias_state));
+    if (bias_settling_grid(start.back()).steps > longest) return {};
+    which.push_back(k);
+  }
+  const auto W = static_cast<std::size_t>(lanes_width());
+  const std::size_t ns = sines.size(), nh = which.size();
+  if (nh == 0 || (ns + nh + W - 1) / W > (ns + W - 1) / W) return {};
+  std::vector<HeldRun> held;
+  for (std::size_t j = 0; j < nh; ++j) {
+    BiasRamp& r = ramps[which[j]];
+    r.ramped = std::move(start[j]);
+    r.settled = true;
+    held.push_back({&r.c, &r.ramped, res_runs[which[j]].bias, bias_settling_grid(r.ramped)});
+  }
+  return held;
 }
 
 void run_record_from_start(const Model& m, StartCache& starts, const Measurement& meas,

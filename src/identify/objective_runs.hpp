@@ -73,11 +73,23 @@ SineMetrics run_sine(const Model& m, const SineRun& run, const ObjectiveSettings
                      std::vector<double>& I, std::vector<double>& y, std::vector<double>& B,
                      StartCache& starts);
 
+// A DC run beside the sine runs in their lanes: the frf targets' bias settling
+// (settle_at_bias_from's run_loop, gmasim/experiments/frf_bias.hpp): the state s advanced in
+// place over grid at the held current I, under conditions c.
+struct HeldRun {
+  const Conditions* c = nullptr;
+  State* s = nullptr;
+  double I = 0;
+  StepGrid grid;
+};
+
 // run_sine for every run (all of one model), the runs advancing together in SIMD lanes
 // (gmasim/simulate/lanes.hpp; the model lanes_supported): the metrics in the order of runs.
-// Throws the DivergenceError of the first run (in that order) that diverges.
+// The held runs advance in lanes of the same batch, each state left as its last step leaves it.
+// Throws the DivergenceError of the first run (in that order, the sines first) that diverges.
 std::vector<SineMetrics> run_sines_lanes(const Model& m, const std::vector<SineRun>& runs,
-                                         const ObjectiveSettings& s, StartCache& starts);
+                                         const ObjectiveSettings& s, StartCache& starts,
+                                         const std::vector<HeldRun>& held = {});
 
 // A resonance_Hz (lowest eq. 15 oscillator frequency at the bias), frf_peak_Hz or
 // bandwidth_Hz (the small-signal frequency response of Fig. 15) target.
@@ -92,7 +104,21 @@ struct ResonanceRun {
 struct BiasRamp {
   Conditions c, ramp_c;
   State ramped;
+  // ramped has run its DC settling already (settlings_beside_sines): settle_at_bias_from's
+  // state but for its time.
+  bool settled = false;
 };
+
+// The frf targets' DC settlings (ramps[k] for res_runs[k] of kind frf_peak_Hz or bandwidth_Hz)
+// as held runs beside the sine runs, when they fit in the lanes the sines leave free (no more
+// vectors of lanes_width() lanes) and in their length (no more steps): each such ramp's state
+// set to bias_settling_start's in place and marked settled (run_sines_lanes then settles it).
+// Otherwise nothing (the settlings run scalar in lowest_resonance_Hz).
+std::vector<HeldRun> settlings_beside_sines(const Model& m, const std::vector<SineRun>& sines,
+                                            const ObjectiveSettings& s,
+                                            const std::vector<ResonanceRun>& res_runs,
+                                            std::deque<BiasRamp>& ramps);
+
 // The value of a target computed at rest or from the small-signal response (no sine run); the
 // states at rest (modulus, resonance) are the cached ones at (T, bias). ramp: the bias point's
 // ramp of a frf_peak_Hz or bandwidth_Hz target if made already (nullptr: settle_at_bias makes it).

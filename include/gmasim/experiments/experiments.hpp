@@ -162,8 +162,11 @@ double find_bandwidth_3dB_Hz(const std::vector<double>& f_Hz, const std::vector<
 
 // The linearisation's first resonance and -3 dB bandwidth [Hz], as run_frf() marks them on a
 // curve without the stepped sine: |Y(f)| on a 4000-point log grid over [f_min_Hz, f_max_Hz]
-// (find_resonance_Hz, find_bandwidth_3dB_Hz). run_frf's markers and linear_frf_markers() of
-// the same bias point are the same numbers.
+// (find_resonance_Hz, find_bandwidth_3dB_Hz), its points computed only where those rules can
+// pick one (a scan of every 8th point, 501 of them, then windows of 9 to 33 points around its
+// peaks, notches, first crossing and the oscillators' natural frequencies in the band;
+// src/experiments/frf_markers.cpp).
+// run_frf's markers and linear_frf_markers() of the same bias point are the same numbers.
 struct LinearFrfMarkers {
   double first_resonance_Hz = 0, bandwidth_3dB_Hz = 0;
 };
