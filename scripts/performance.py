@@ -153,12 +153,17 @@ def callgrind_step_instructions(exe: pathlib.Path, arg: int, work: pathlib.Path)
                          cwd=ROOT, capture_output=True, text=True)
     if res.returncode != 0 or not out.is_file():
         sys.exit(f"performance.py: callgrind of BM_FullModelStepCount/{arg} failed:\n{res.stderr[-400:]}")
-    total, calls, lines = None, 0, out.read_text().splitlines()
+    # Function names are compressed: "(id) name" the first time an id appears, "(id)" after it.
+    total, calls, names, lines = None, 0, {}, out.read_text().splitlines()
     for i, line in enumerate(lines):
         if line.startswith("summary:") or line.startswith("totals:"):
             total = int(line.split()[1])
-        if line.startswith("cfn=") and "gmasim::step(" in line and i + 1 < len(lines):
-            calls += int(lines[i + 1].split()[0].removeprefix("calls="))
+        if line.startswith(("fn=(", "cfn=(")):
+            fid, _, name = line.split("=", 1)[1].partition(" ")
+            name = names.setdefault(fid, name)
+            if (line.startswith("cfn=") and name.startswith("gmasim::step(") and i + 1 < len(lines)
+                    and lines[i + 1].startswith("calls=")):
+                calls += int(lines[i + 1].split()[0].removeprefix("calls="))
     if not total or calls <= 0:
         sys.exit(f"performance.py: no calls of step() in {out}")
     return total / calls, calls
