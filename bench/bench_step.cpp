@@ -24,6 +24,11 @@ void BM_FullModelStep(benchmark::State& bs) {
 }
 BENCHMARK(BM_FullModelStep)->Arg(0)->Arg(1);
 
+// The same steps, exactly 2000 of them (one 400 Hz period at the automatic dt of 1.25 us) from
+// make_state: a fixed amount of work, for counting the instructions of step() under callgrind
+// (scripts/performance.py --sections callgrind), where the timed loop's iteration count varies.
+BENCHMARK(BM_FullModelStep)->Name("BM_FullModelStepCount")->Arg(0)->Arg(1)->Iterations(2000);
+
 // The same step of the built-in model with the energy ledgers booked (gmasim/model/energy.hpp:
 // every branch of the circuit solved, each rod's dissipation along the step's path and its
 // oscillator's power by Gauss-Legendre), against BM_FullModelStep/0 (issue 18).

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """The tables of docs/performance.md, measured in one run on this machine (issue 22, item 5).
 
-    /usr/bin/python3 scripts/performance.py [--bin build/ci/bin] [--reps 3] [--quick]
+    /usr/bin/python3 scripts/performance.py [--bin build/ci/bin] [--reps 3] [--sections bench,numpy,scaling,growth,callgrind]
 
 Every figure is a ratio of two timings taken in the same run, interleaved (A B A B ...) and
 reduced to the median of --reps repetitions, because the machines are shared and noisy: the
@@ -15,6 +15,11 @@ absolute times are printed for reference only. Sections:
   4. MPI: `gmasim identify` on one process against 2 ranks (mpirun -np 2), the same islands.
   5. growth: rods (models/single_rod.toml, 1 rod, against models/mdma.toml, 3 rods), periods
      of a simulation, conditions (grid points) of a sweep.
+  6. callgrind (not in the default --sections): the instructions of step() per step, consistent
+     state (BM_FullModelStepCount/0) against the printed reading (/1), counted by valgrind's
+     callgrind over a fixed 2000 steps, and their ratio; beside it the ns per step of
+     BM_FullModelStep/0 and /1 from one run, interleaved (issue 22, item 1: /0 <= 500 ns and
+     /0 <= /1; the count decides where the shared machine's timings cannot).
 
 Standard library only (numpy for section 2, as bench/numpy_rk4_printed.py needs it).
 """
@@ -135,6 +140,62 @@ def numpy_section(bindir: pathlib.Path, reps: int) -> str:
                   "stroke numpy / gmasim (rel. diff.)"], rows)
 
 
+STEP_SYMBOL = "gmasim::step(*"  # callgrind collects inside step() only (--toggle-collect)
+
+
+def callgrind_step_instructions(exe: pathlib.Path, arg: int, work: pathlib.Path) -> tuple[float, int]:
+    """(instructions per step, steps) inside step() for BM_FullModelStepCount/<arg>: the
+    instructions callgrind collected while in step(), over the calls of step() it recorded."""
+    out = work / f"callgrind.{arg}.out"
+    res = subprocess.run(["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
+                          f"--toggle-collect={STEP_SYMBOL}", str(exe),
+                          f"--benchmark_filter=^BM_FullModelStepCount/{arg}/"],
+                         cwd=ROOT, capture_output=True, text=True)
+    if res.returncode != 0 or not out.is_file():
+        sys.exit(f"performance.py: callgrind of BM_FullModelStepCount/{arg} failed:\n{res.stderr[-400:]}")
+    # Function names are compressed: "(id) name" the first time an id appears, "(id)" after it.
+    total, calls, names, lines = None, 0, {}, out.read_text().splitlines()
+    for i, line in enumerate(lines):
+        if line.startswith("summary:") or line.startswith("totals:"):
+            total = int(line.split()[1])
+        if line.startswith(("fn=(", "cfn=(")):
+            fid, _, name = line.split("=", 1)[1].partition(" ")
+            name = names.setdefault(fid, name)
+            if (line.startswith("cfn=") and name.startswith("gmasim::step(") and i + 1 < len(lines)
+                    and lines[i + 1].startswith("calls=")):
+                calls += int(lines[i + 1].split()[0].removeprefix("calls="))
+    if not total or calls <= 0:
+        sys.exit(f"performance.py: no calls of step() in {out}")
+    return total / calls, calls
+
+
+def callgrind_section(bindir: pathlib.Path, reps: int, work: pathlib.Path) -> str:
+    exe = bindir / "gmasim_bench"
+    if not exe.is_file():
+        return f"(no {exe}: build the gmasim_bench target of a Release preset)"
+    if not shutil.which("valgrind"):
+        return "(no valgrind on PATH: apt-get install valgrind)"
+    ir = {arg: callgrind_step_instructions(exe, arg, work) for arg in (0, 1)}
+    run = subprocess.run([str(exe), "--benchmark_filter=^BM_FullModelStep/[01]$",
+                          "--benchmark_format=json", f"--benchmark_repetitions={max(reps, 2)}",
+                          "--benchmark_enable_random_interleaving=true"],
+                         cwd=ROOT, capture_output=True, text=True)
+    if run.returncode != 0:
+        return f"(gmasim_bench failed: {run.stderr.strip()[-400:]})"
+    ns: dict[str, list[float]] = {"0": [], "1": []}
+    for b in json.loads(run.stdout)["benchmarks"]:
+        if b.get("run_type") == "iteration" and b["time_unit"] == "ns":
+            ns[b["run_name"].rsplit("/", 1)[1]].append(b["cpu_time"])
+    med = {k: statistics.median(v) for k, v in ns.items() if v}
+    rows = [[f"/{a}", "consistent state (built-in)" if a == 0 else "printed reading",
+             f"{ir[a][0]:.0f}", f"{ir[a][1]}", f"{med.get(str(a), float('nan')):.0f}",
+             f"{min(ns[str(a)]):.0f}-{max(ns[str(a)]):.0f}" if ns[str(a)] else "-"] for a in (0, 1)]
+    rows.append(["/0 / /1", "", f"{ir[0][0] / ir[1][0]:.3f}", "",
+                 f"{med['0'] / med['1']:.3f}" if len(med) == 2 else "-", ""])
+    return table(["BM_FullModelStep", "step", "instructions per step (callgrind)", "steps counted",
+                  "median CPU ns per step (interleaved)", "range ns"], rows)
+
+
 def identify_cmd(gm: str, out: pathlib.Path, islands: int, threads: int) -> list[str]:
     return [gm, "identify", "--model", str(ROOT / "calibration/start/consistent.toml"),
             "--fit", str(ROOT / "calibration/consistent.toml"), "--out", str(out / "m.toml"),
@@ -205,17 +266,17 @@ def main() -> int:
     ap.add_argument("--bin", default=str(ROOT / "build/ci/bin"), help="directory of gmasim and gmasim_bench")
     ap.add_argument("--reps", type=int, default=3, help="repetitions per timing (median), >= 1")
     ap.add_argument("--sections", default="bench,numpy,scaling,growth",
-                    help="comma-separated subset of bench, numpy, scaling, growth")
+                    help="comma-separated subset of bench, numpy, scaling, growth, callgrind")
     a = ap.parse_args()
     if not 1 <= a.reps <= 50:
         sys.exit(f"performance.py: --reps {a.reps}: must be in [1, 50]")
     bindir = pathlib.Path(a.bin).resolve()
-    if not (bindir / "gmasim").is_file():
-        sys.exit(f"performance.py: no gmasim in {bindir} (--bin)")
     wanted = a.sections.split(",")
-    unknown = set(wanted) - {"bench", "numpy", "scaling", "growth"}
+    unknown = set(wanted) - {"bench", "numpy", "scaling", "growth", "callgrind"}
     if unknown:
         sys.exit(f"performance.py: --sections: unknown {sorted(unknown)}")
+    if set(wanted) & {"numpy", "scaling", "growth"} and not (bindir / "gmasim").is_file():
+        sys.exit(f"performance.py: no gmasim in {bindir} (--bin)")
     print(f"# performance.py: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f} at the start, "
           f"--reps {a.reps}\n")
     with tempfile.TemporaryDirectory(prefix="gmasim_performance_") as tmp:
@@ -223,7 +284,8 @@ def main() -> int:
         for name, fn in (("bench", lambda: bench_section(bindir, a.reps)),
                          ("numpy", lambda: numpy_section(bindir, a.reps)),
                          ("scaling", lambda: scaling_section(bindir, a.reps, work)),
-                         ("growth", lambda: growth_section(bindir, a.reps, work))):
+                         ("growth", lambda: growth_section(bindir, a.reps, work)),
+                         ("callgrind", lambda: callgrind_section(bindir, a.reps, work))):
             if name in wanted:
                 print(f"## {name}\n\n{fn()}\n", flush=True)
     print(f"# load average {os.getloadavg()[0]:.2f} at the end")

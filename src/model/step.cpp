@@ -101,6 +101,15 @@ inline bool next_correction_within_tolerance(std::size_t n, double law_steps,
   return true;
 }
 
+// A rod's branch U = R_eff phi + U_off linearised at the Newton iterate (H*, M_next) of
+// consistent_magnetic_update, with B* = mu0 (H* + M_next), inv_mud = 1/(mu0 mu_r) and the eddy
+// field's g = 2 kappa / h, B0 and e0 = H_c - H at the step's start: R_eff and the MMF -U_off.
+inline void linearise_rod_branch(const RodConditions& rc, double H, double Bs, double inv_mud,
+                                 double g, double B0, double e0, double& R_eff, double& mmf) {
+  R_eff = rc.length_over_area_per_m * (inv_mud + g) + rc.series_reluctance_per_H;
+  mmf = -rc.length_m * (H - Bs * inv_mud - g * B0 - e0);
+}
+
 // Consistent magnetic state (docs/model.md, "Magnetic state"). At the end of the step every
 // rod i satisfies, with its own JA state (eq. 9) and the circuit (eq. 23):
 //   phi_i = A_i B_i,  B_i = mu0 (H_i + M_i(H_i)),  U_i = l_i H_c,i + R_s,i phi_i  (eq. 7, first
@@ -147,19 +156,18 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
     bool laws_hold = true;
     double law_steps = 0.0;  // sum over the rods of |M_next - M*|, the laws' own Newton steps
     for (std::size_t i = 0; i < n; ++i) {
-      const auto& rc = c.rods[i];
-      Law::joint_trial(rc, s.rods[i], start[i], H[i], Mg[i], trial[i]);
+      Law::joint_trial(c.rods[i], s.rods[i], start[i], H[i], Mg[i], trial[i]);
       laws_hold = laws_hold && trial[i].converged;
       law_steps += std::fabs(trial[i].M_next - Mg[i]);
-      Bs[i] = flux_density(H[i], trial[i].M_next);
-      inv_mud[i] = trial[i].inv_mu_r * (1.0 / kMu0);
-      s.rod_reluctance[i] =
-          rc.length_over_area_per_m * (inv_mud[i] + g[i]) + rc.series_reluctance_per_H;
-      s.circuit.rod_extra_mmf[i] =
-          -rc.length_m * (H[i] - Bs[i] * inv_mud[i] - g[i] * B0[i] - e0[i]);
     }
     if (it >= 1 && it <= 8 && laws_hold && next_correction_within_tolerance(n, law_steps, H))
-      break;  // the iterate has converged without the confirming solve
+      break;  // the iterate has converged without the confirming solve (nor its linearisation)
+    for (std::size_t i = 0; i < n; ++i) {  // each rod's branch, linearised at the iterate
+      Bs[i] = flux_density(H[i], trial[i].M_next);
+      inv_mud[i] = trial[i].inv_mu_r * (1.0 / kMu0);
+      linearise_rod_branch(c.rods[i], H[i], Bs[i], inv_mud[i], g[i], B0[i], e0[i],
+                           s.rod_reluctance[i], s.circuit.rod_extra_mmf[i]);
+    }
     ++s.newton_solves;
     if (!solve_circuit(m.circuit, s.rod_reluctance, current_A, pm_scale, s.circuit,
                        s.energy.enabled))
@@ -396,12 +404,12 @@ void stage_magnetic(const Model& m, const Conditions& c, State& s, const StepInp
 
 // Stage 2: each rod's Delta-E modulus (eq. 13), magnetostriction (eq. 11-12), force (eq. 14)
 // and axial stiffness (eq. 17) at its new magnetisation; keeps the start's force and
-// stiffness (eq. 16) for stage 3.
+// stiffness (eq. 16) and the end's compliance 1/k_rod for stage 3.
 void stage_strain(const Model& m, const Conditions& c, State& s, StepScratch& w) {
   for (std::size_t i = 0; i < s.rods.size(); ++i) {
     w.F0_N[i] = s.rods[i].F_N;
     w.K0_N_per_m[i] = s.rods[i].k_rod_N_per_m + s.rods[i].k_load_N_per_m;
-    update_rod_mechanics(m.material, c.rods[i], s.rods[i]);
+    w.inv_k_rod[i] = update_rod_mechanics(m.material, c.rods[i], s.rods[i]);
   }
 }
 
@@ -413,12 +421,10 @@ void stage_strain(const Model& m, const Conditions& c, State& s, StepScratch& w)
 // Guard: |x| <= 1 m.
 void stage_mechanics(const Model& m, const Conditions& c, State& s, const StepInput& in,
                      const StepScratch& w) {
-  std::array<double, 8> inv_k_rod;  // each rod's compliance, once (written for 0..n-1)
-  for (std::size_t i = 0; i < s.rods.size(); ++i) inv_k_rod[i] = 1.0 / s.rods[i].k_rod_N_per_m;
   for (std::size_t i = 0; i < s.rods.size(); ++i) {
     const auto& rc = c.rods[i];
     auto& r = s.rods[i];
-    r.k_load_N_per_m = load_stiffness_from_compliances(rc, inv_k_rod.data());
+    r.k_load_N_per_m = load_stiffness_from_compliances(rc, w.inv_k_rod.data());
     const double K = 0.5 * (w.K0_N_per_m[i] + r.k_rod_N_per_m + r.k_load_N_per_m);
     r.K_osc_N_per_m = K;
     oscillator_step(rc.mass_osc_kg, rc.inv_mass_osc_per_kg, rc.damping_osc_N_s_per_m, K, w.F0_N[i],

@@ -33,9 +33,10 @@ struct JilesAthertonLaw {
   // slope dM/dH and the state the move would leave at H1, and commit_trial commits that trial
   // as it is (the last Newton iterate; no second evaluation of the law). The move also carries
   // its last evaluation's exponentials: the next iterate is near and derives its own from them
-  // (physics::JaExpPoints, exp_near).
+  // (physics::JaExpPoints, exp_near), from the anchors the rod's last step left (RodState::ja_exp)
+  // to the committed trial's, which keep them for the next step.
   struct MoveStart : physics::JaMoveStart {
-    physics::JaExpPoints near{};
+    physics::JaExpPoints near;
   };
   struct Trial {
     double M, dM_dH, Mirr;
@@ -45,7 +46,8 @@ struct JilesAthertonLaw {
   static MoveStart begin_move(const RodConditions& rc, const RodState& r) {
     return {physics::ja_move_start_near(r.H_A_per_m, r.M_A_per_m, rc.MsT_mag, rc.ja,
                                         rc.ja_inv_a_m_per_A, rc.ja_inv_k_m_per_A, r.an_x,
-                                        {r.an_L, r.an_dL})};
+                                        {r.an_L, r.an_dL}),
+            r.ja_exp};
   }
   static Trial trial_from(const RodConditions& rc, const RodState& r, const MoveStart& st,
                           double H1, double M_guess) {
@@ -66,14 +68,16 @@ struct JilesAthertonLaw {
   // ja_step_from from the Newton-corrected guess, as before the joint solve: M_next = M.
   struct JointTrial : Trial {
     double inv_mu_r, M_next;
-    double an_x;                   // where the law was evaluated (H_e / a)
-    physics::LangevinValue an_lv;  // L and L' there
+    double an_x;                       // where the law was evaluated (H_e / a)
+    physics::LangevinValue an_lv;      // L and L' there
+    const physics::JaExpPoints* near;  // the move's anchors (its MoveStart's, which outlives it)
     bool converged;
   };
   static void joint_trial(const RodConditions& rc, const RodState& r, MoveStart& st, double H1,
                           double M_iter, JointTrial& t) {
     double chi_e = 0.0;
     double g = 0.0;
+    t.near = &st.near;
     if (H1 == r.H_A_per_m) {
       physics::ja_step_from(r.H_A_per_m, st, H1, rc.MsT_mag, rc.ja, r.Mirr_A_per_m, r.M_A_per_m,
                             M_iter, t.Mirr, t.M, chi_e);
@@ -112,6 +116,7 @@ struct JilesAthertonLaw {
     r.an_x = t.an_x;
     r.an_L = t.an_lv.L;
     r.an_dL = t.an_lv.dL;
+    r.ja_exp = *t.near;
   }
 
   // The same move, committed: r's M_irr and M at H1 (r.H_A_per_m is the caller's to set).

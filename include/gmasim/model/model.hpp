@@ -377,6 +377,10 @@ struct RodState {
   // x = H_e / a, L(x), L'(x) (the next move's start M_an from them when near:
   // physics::ja_move_start_near); NaN: none. Stage 2, consistent state, Jiles-Atherton only.
   double an_x = std::numeric_limits<double>::quiet_NaN(), an_L = 0, an_dL = 0;
+  // The anchors of the law's exponentials (physics::JaExpPoints, exp_near) where the consistent
+  // state's evaluations left them: the next step's evaluations start from them. Stage 2,
+  // consistent state, Jiles-Atherton only; none (NaN) after make_state.
+  physics::JaExpPoints ja_exp{};
   // reported
   double mu_r = 1;    // eq. (3) at the extrapolated M, stage 1 (printed); the JA differential
                       // permeability 1 + dM/dH, stage 2 (consistent)
@@ -393,6 +397,9 @@ struct RodState {
   // The oscillator's last e^(tau/2) by std::exp (physics::oscillator_propagator): the next step
   // at the same dt reuses it. Stage 3.
   physics::ExpPoint osc_decay = physics::kNoExpPoint;
+  // The anchor of eq. (11)'s tanh exponential (physics::magnetostriction_near, exp_near) where
+  // the last evaluation left it. Stage 3 (update_rod_mechanics).
+  physics::ExpPoint prestress_exp = physics::kNoExpPoint;
 };
 
 struct State {

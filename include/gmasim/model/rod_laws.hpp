@@ -40,14 +40,17 @@ inline double rod_static_field(const Model& m, std::size_t i, const RodCondition
 }
 
 // Magnetostriction, Delta-E modulus and force of a rod at its present M (eq. 11-14, 17).
-// The reciprocals are RodConditions' (divided once); 1/E is eq. (13)'s bracket.
-inline void update_rod_mechanics(const Material& mat, const RodConditions& rc, RodState& r) {
+// The reciprocals are RodConditions' (divided once); 1/E is eq. (13)'s bracket. Returns the
+// rod's compliance 1/k_rod = (1/E) l / A (eq. 17), for the load stiffness of eq. (18).
+inline double update_rod_mechanics(const Material& mat, const RodConditions& rc, RodState& r) {
   const double inv_E = physics::delta_e_compliance(r.M_A_per_m * rc.inv_MsT_E_m_per_A, rc.dE);
   r.E_Pa = 1.0 / inv_E;  // eq. (13)
-  r.lambda = physics::magnetostriction(r.M_A_per_m * rc.inv_Ms_strain_m_per_A, mat.lambda_s,
-                                       rc.sigma_p_Pa, r.E_Pa, inv_E);  // eq. (11)-(12)
-  r.F_N = physics::rod_force(r.lambda, r.E_Pa, rc.area_m2);            // eq. (14)
-  r.k_rod_N_per_m = r.E_Pa * rc.area_over_length_m;                    // eq. (17): E A / l
+  r.lambda = physics::magnetostriction_near(r.M_A_per_m * rc.inv_Ms_strain_m_per_A, mat.lambda_s,
+                                            rc.sigma_p_Pa, r.E_Pa, inv_E,
+                                            r.prestress_exp);  // eq. (11)-(12)
+  r.F_N = physics::rod_force(r.lambda, r.E_Pa, rc.area_m2);    // eq. (14)
+  r.k_rod_N_per_m = r.E_Pa * rc.area_over_length_m;            // eq. (17): E A / l
+  return inv_E * rc.length_over_area_per_m;
 }
 
 // Load stiffness of a rod (eq. 18): its fixed members plus the rods in its chain, whose

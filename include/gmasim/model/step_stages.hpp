@@ -20,12 +20,15 @@
 namespace gmasim {
 
 // What a step carries from its start to its later stages.
+// The arrays are not cleared (a step's fixed cost): each stage writes rods 0..n-1 of what it
+// leaves before a later stage reads them, start only where the ledgers are enabled.
 struct StepScratch {
-  double t1_s = 0.0;                   // the end of the step
-  double current0_A = 0.0;             // the coil current at its start
-  std::array<StepStart, 8> start{};    // the ledgers' start values (stage_ledger_start)
-  std::array<double, 8> F0_N{};        // each rod's force at the start (stage_strain)
-  std::array<double, 8> K0_N_per_m{};  // each rod's stiffness k_rod + k_load at the start
+  double t1_s = 0.0;                 // the end of the step
+  double current0_A = 0.0;           // the coil current at its start
+  std::array<StepStart, 8> start;    // the ledgers' start values (stage_begin)
+  std::array<double, 8> F0_N;        // each rod's force at the start (stage_strain)
+  std::array<double, 8> K0_N_per_m;  // each rod's stiffness k_rod + k_load at the start
+  std::array<double, 8> inv_k_rod;   // each rod's compliance 1/k_rod at the end (stage_strain)
 };
 
 // Sets t1_s and current0_A (and, with the ledgers enabled, their start values).

@@ -42,9 +42,8 @@ inline LangevinValue langevin_pair(double x) {
   if (ax > 40.0) return langevin_asymptote(x);
   return langevin_pair_from_exp(x, std::exp(-2.0 * ax));
 }
-// langevin_pair with its exponential exp(-2|x|) from a known one nearby (p, physics::exp_near: a
-// few units in the last place from langevin_pair). p becomes the point of this evaluation where
-// the closed form was used (and stays as it was otherwise).
+// langevin_pair with its exponential exp(-2|x|) from an anchor nearby (p, physics::exp_near: a
+// few units in the last place from langevin_pair; p moves where it is not near).
 inline LangevinValue langevin_pair_near(double x, ExpPoint& p) {
   const double ax = std::fabs(x);
   if (ax < 0.1) return langevin_series(x);
@@ -135,7 +134,7 @@ inline double ja_irreversible_slope(double H_A_per_m, double M_A_per_m, double M
 // Returns M_irr at the end of the step and, in dMirr_dHe1, its derivative with respect to
 // the end field H_e1 given dMan1 = dM_an/dH_e there (for Newton's method in ja_step).
 // inv_k = 1/k (JaMoveStart: one division per move, not two per evaluation). exp(-r) from the
-// known exponential `lag` where it is near (physics::exp_near); lag becomes this one's.
+// anchor `lag` where it is near (physics::exp_near; lag moves where it is not).
 inline double ja_irreversible_update(double Mirr0, double Man0, double Man1, double dMan1,
                                      double dHe, double inv_k, double& dMirr_dHe1, ExpPoint& lag) {
   dMirr_dHe1 = 0.0;
@@ -198,8 +197,9 @@ inline JaMoveStart ja_move_start_near(double H0, double M0, double MsT_A_per_m,
     return {He0, MsT_A_per_m * (lv.L + lv.dL * (x0 - x_at)), inv_a, inv_k};
   return {He0, MsT_A_per_m * langevin(x0), inv_a, inv_k};
 }
-// The exponentials of an evaluation (exp(-2|x|) of the Langevin function, exp(-r) of the lag),
-// for the next evaluation of the same move nearby (a Newton solve's next iterate).
+// The anchors of an evaluation's exponentials (exp(-2|x|) of the Langevin function, exp(-r) of
+// the lag; physics::exp_near), for the next evaluations nearby: a Newton solve's next iterate and
+// the next step's (RodState::ja_exp).
 struct JaExpPoints {
   ExpPoint langevin = kNoExpPoint, lag = kNoExpPoint;
 };
@@ -208,8 +208,8 @@ struct JaExpPoints {
 //   F(M1) = (1-c) M_irr1 + c M_an(H1 + alpha M1),
 // and chi_e = dF/dH_e. Eq. (9) holds where g = M1 - F(M1) = 0; its Newton step in M1 is
 // -g / (1 - alpha chi_e) (ja_step_from iterates it; the consistent state's joint Newton solve
-// takes one per circuit solve). `near`: the exponentials of the move's last evaluation, when
-// known (JaExpPoints; updated to this one's).
+// takes one per circuit solve). `near`: the anchors of the exponentials (JaExpPoints; moved
+// where they are not near).
 struct JaEvaluation {
   double Mirr1, M, chi_e;
   double x1;         // H_e1 / a, where the Langevin function was evaluated

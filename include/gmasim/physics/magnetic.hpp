@@ -161,7 +161,7 @@ inline LagWeightsSlope lag_weights_and_slope_from(double r, double E) {
   const double q = (1.0 - E) * inv_r;
   return {E, q, (E - q) * inv_r};
 }
-// The same with exp(-r) from a known exponential nearby (p, physics::exp_near); p becomes -r's.
+// The same with exp(-r) from an anchor nearby (p, physics::exp_near; moved where it is not).
 inline LagWeightsSlope lag_weights_and_slope_near(double r, ExpPoint& p) {
   return lag_weights_and_slope_from(r, exp_near(-r, p));
 }

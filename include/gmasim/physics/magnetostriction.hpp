@@ -38,11 +38,11 @@ inline DeltaETerms delta_e_terms(double Es_Pa, double lambda_s, double sigma_Pa,
 // Eq. (13): Delta-E modulus E_G^{M,T,sigma} [Pa] at reduced magnetisation m = M/M_s^T.
 //   1/E = 1/E_s + rot (1 - m^2) + coupling^2 m^2 / [mu0 Ms^2/chi_m sec^2(pi m/2) - S]
 // The last term is evaluated multiplied through by cos^2(pi m/2), so that m = 1 (where
-// sec^2 is infinite) gives E = E_s exactly.
+// sec^2 is infinite) gives E = E_s exactly; cos(pi m/2) by its series (cos_half_pi).
 // delta_e_compliance is 1/E, the bracket itself (the step multiplies by it where eq. 11-12 and
 // 17 divide by E).
 inline double delta_e_compliance(double m, const DeltaETerms& d) {
-  const double c = std::cos(0.5 * kPi * m);
+  const double c = cos_half_pi(m);
   const double c2 = c * c;
   const double m2 = m * m;
   const double third =
@@ -64,18 +64,28 @@ inline double maximum_stress(double lambda_s, double E_Pa) { return 1.5 * lambda
 // tanh u from one exponential, sign(u) (1 - e^{-2|u|}) / (1 + e^{-2|u|}): its absolute error is
 // a few 1e-16 (not its relative error near u = 0), all eq. (11) needs beside 1 (std::tanh goes
 // through expm1, about three times the cost of exp).
-inline double tanh_absolute(double u) {
-  const double e = std::exp(-2.0 * std::fabs(u));
+inline double tanh_from_exp(double u, double e) {  // e = exp(-2|u|)
   const double t = (1.0 - e) / (1.0 + e);
   return u < 0.0 ? -t : t;
 }
+inline double tanh_absolute(double u) { return tanh_from_exp(u, std::exp(-2.0 * std::fabs(u))); }
+// The same with its exponential from an anchor nearby (p, exp_near: the step's last one).
+inline double tanh_absolute_near(double u, ExpPoint& p) {
+  return tanh_from_exp(u, exp_near(-2.0 * std::fabs(u), p));
+}
 
 // The factor at 2 sigma_p / sigma_s = two_sp_over_ss (given: the step forms it from 1/E).
-inline double prestress_factor_at(double two_sp_over_ss, double sigma_p_Pa, double sigma_s_Pa,
-                                  double sigma_max_Pa) {
-  const double base = 1.0 + 0.5 * tanh_absolute(two_sp_over_ss);
+// tanh_2sp_ss: tanh(2 sigma_p / sigma_s) (tanh_absolute).
+inline double prestress_factor_from_tanh(double tanh_2sp_ss, double sigma_p_Pa, double sigma_s_Pa,
+                                         double sigma_max_Pa) {
+  const double base = 1.0 + 0.5 * tanh_2sp_ss;
   if (sigma_p_Pa <= sigma_s_Pa) return base;
   return (1.0 - (sigma_p_Pa - sigma_s_Pa) / sigma_max_Pa) * base;
+}
+inline double prestress_factor_at(double two_sp_over_ss, double sigma_p_Pa, double sigma_s_Pa,
+                                  double sigma_max_Pa) {
+  return prestress_factor_from_tanh(tanh_absolute(two_sp_over_ss), sigma_p_Pa, sigma_s_Pa,
+                                    sigma_max_Pa);
 }
 inline double prestress_factor(double sigma_p_Pa, double sigma_s_Pa, double sigma_max_Pa) {
   return prestress_factor_at(2.0 * sigma_p_Pa / sigma_s_Pa, sigma_p_Pa, sigma_s_Pa, sigma_max_Pa);
@@ -84,6 +94,15 @@ inline double prestress_factor(double sigma_p_Pa, double sigma_s_Pa, double sigm
 // Eq. (11)-(12): magnetostrictive strain [-] with the stress thresholds of eq. (12)
 // taken at the current modulus E_G; inv_E_per_Pa = 1/E_G (delta_e_compliance), so that
 // 2 sigma_p / sigma_s = (4 sigma_p / lambda_s) / E_G is a product.
+// The step's: tanh's exponential from the anchor `near` (tanh_absolute_near; RodState::
+// prestress_exp), a few units in the last place from magnetostriction's.
+inline double magnetostriction_near(double m, double lambda_s, double sigma_p_Pa, double E_Pa,
+                                    double inv_E_per_Pa, ExpPoint& near) {
+  const double f = prestress_factor_from_tanh(
+      tanh_absolute_near(4.0 * sigma_p_Pa / lambda_s * inv_E_per_Pa, near), sigma_p_Pa,
+      saturation_stress(lambda_s, E_Pa), maximum_stress(lambda_s, E_Pa));
+  return f * lambda_s * m * m;
+}
 inline double magnetostriction(double m, double lambda_s, double sigma_p_Pa, double E_Pa,
                                double inv_E_per_Pa) {
   const double f =

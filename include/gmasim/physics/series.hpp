@@ -1,7 +1,8 @@
-// Short power series shared by the step's laws: a degree-7 polynomial by Estrin's scheme and
-// e^x from its Taylor series where |x| <= 1/64 (truncation below 1e-19 relative), and e^y from a
-// nearby known value e^{y_prev} (exp_near: one exponential less where a Newton solve evaluates
-// a law again close to its last point).
+// Short power series shared by the step's laws: a degree-7 polynomial by Estrin's scheme, e^x
+// from its Taylor series where |x| <= 1/64 (truncation below 1e-19 relative) or, to degree 10,
+// where |x| <= 1/8 (below 3e-18), and e^y from a known anchor value e^{y_a} (exp_near: one
+// exponential less where a law is evaluated again close to an earlier point, within a Newton
+// solve and from one step to the next).
 #pragma once
 
 #include <cmath>
@@ -22,20 +23,43 @@ inline double exp_series7(double x) {
   return polynomial7(x, kExp);
 }
 
+// e^x - 1 to (x^11 / 11!): below 3e-18 relative to e^x where |x| <= 1/8.
+inline double expm1_series10(double x) {
+  const double x2 = x * x, x4 = x2 * x2, x8 = x4 * x4;
+  return x * (((1.0 + x * (1.0 / 2)) + x2 * (1.0 / 6 + x * (1.0 / 24))) +
+              x4 * ((1.0 / 120 + x * (1.0 / 720)) + x2 * (1.0 / 5040 + x * (1.0 / 40320))) +
+              x8 * (1.0 / 362880 + x * (1.0 / 3628800)));
+}
+
+// cos(pi m / 2) for |m| <= 1 from its Taylor series in t = m^2 to t^10 (truncation below 2e-17,
+// absolute; rounding a few 1e-16 absolute, where std::cos(0.5 * pi * m) is itself 6e-17 off at
+// m = 1 through the rounding of pi/2): no range reduction. std::cos elsewhere.
+inline double cos_half_pi(double m) {
+  if (!(std::fabs(m) <= 1.0)) return std::cos(1.5707963267948966 * m);
+  const double t = m * m, t2 = t * t, t4 = t2 * t2, t8 = t4 * t4;
+  return ((1.0 - 1.2337005501361697 * t) + t2 * (0.25366950790104803 - 0.02086348076335296 * t)) +
+         t4 * ((0.0009192602748394266 - 2.5202042373060607e-05 * t) +
+               t2 * (4.710874778818172e-07 - 6.386603083791852e-09 * t)) +
+         t8 * ((6.565963114979473e-11 - 5.294400200734623e-13 * t) + t2 * 3.437739179098607e-15);
+}
+
 // A known exponential: e = e^y; y NaN: none.
 struct ExpPoint {
   double y, e;
 };
 inline constexpr ExpPoint kNoExpPoint{__builtin_nan(""), 0.0};
 
-// e^y from a known e^{y_prev} nearby (p): e^{y_prev} e^{y - y_prev} by exp_series7 where
-// |y - y_prev| <= 1/64 (a few units in the last place from std::exp(y)), std::exp(y) otherwise
-// or where nothing is known. p becomes the point (y, e^y).
-inline double exp_near(double y, ExpPoint& p) {
-  const double d = y - p.y;
-  p.e = std::fabs(d) <= 1.0 / 64 ? p.e * exp_series7(d) : std::exp(y);
-  p.y = y;
-  return p.e;
+// e^y from an anchor a = (y_a, e^{y_a}) that std::exp computed: e^{y_a} + e^{y_a} (e^d - 1),
+// d = y - y_a, by expm1_series10 where |d| <= 1/8; otherwise (or where a.y is NaN: no anchor)
+// std::exp(y), and a becomes (y, e^y). The anchor moves only there, so every value is one series
+// and two roundings away from a std::exp value (within 2 units in the last place of std::exp(y),
+// test Series.ExpNearIsWithinAFewUlp), however long the anchor is kept: over a Newton solve's
+// iterates and from step to step (RodState::ja_exp, prestress_exp).
+inline double exp_near(double y, ExpPoint& a) {
+  const double d = y - a.y;
+  if (std::fabs(d) <= 1.0 / 8) return a.e + a.e * expm1_series10(d);
+  a = {y, std::exp(y)};
+  return a.e;
 }
 
 // e^y where the last call with this p may have had the same y (a step's fixed decay over a run
