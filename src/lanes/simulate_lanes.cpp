@@ -1,6 +1,7 @@
 // simulate_lanes (gmasim/lanes.hpp): simulate() for many settings at once, the runs that
 // share a step count advancing together in a LaneBatch. Each lane's run is simulate()'s: the
 // same grid, rest state, records, checks, metrics and error texts (src/simulate/run.cpp).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -8,6 +9,7 @@
 
 #include "gmasim/errors.hpp"
 #include "gmasim/model/validity.hpp"
+#include "gmasim/physics/magnetic.hpp"
 #include "gmasim/simulate/lanes.hpp"
 #include "gmasim/simulate/run_loop.hpp"
 #include "simulate/record.hpp"
@@ -54,6 +56,29 @@ struct LaneRun {
   }
 };
 constexpr std::size_t kStagedRows = 64;
+
+// The lanes' drives at one time: Waveform::current_at of a biased sine (every lane of a group is
+// periodic), min + pp/2 (1 - cos 2 pi f t), the cosine taken once per distinct frequency (a
+// sweep's lanes share a few) -- the same operations, the same bits.
+struct Drives {
+  std::vector<double> freq, cosine;  // the distinct frequencies, their cos 2 pi f t
+  std::vector<std::size_t> of;       // lane -> its frequency's index
+  std::vector<const Waveform*> w;    // lane -> its waveform
+  void add(const Waveform& wf) {
+    std::size_t u = 0;
+    while (u < freq.size() && !(freq[u] == wf.frequency_Hz)) ++u;
+    if (u == freq.size()) freq.push_back(wf.frequency_Hz);
+    of.push_back(u);
+    w.push_back(&wf);
+  }
+  void at(double t, std::vector<double>& current) {
+    constexpr double two_pi = 2.0 * physics::kPi;
+    cosine.resize(freq.size());
+    for (std::size_t u = 0; u < freq.size(); ++u) cosine[u] = std::cos(two_pi * freq[u] * t);
+    for (std::size_t l = 0; l < w.size(); ++l)
+      current[l] = w[l]->min_A + 0.5 * w[l]->pp_A * (1.0 - cosine[of[l]]);
+  }
+};
 constexpr std::size_t kGlobalColumns = 6;  // run.cpp's make_columns: t_s .. y_stack_um
 
 // metrics_only: the rods' columns hold at most the rest state's row: none.
@@ -113,13 +138,13 @@ void run_group(const Model& m, std::span<const SimulationSettings> settings,
     for (std::size_t l = 0; l < n; ++l) runs[lane_of[l]].rows.resize(kStagedRows * width);
     std::vector<double> current(n), dt(n, p.dt_s), t1(n);
     std::size_t live = n;
+    Drives drives;
+    for (std::size_t l = 0; l < n; ++l) drives.add(settings[runs[lane_of[l]].setting].waveform);
 
     for (long k = 1; k <= p.steps && live > 0; ++k) {
       const double t = 0.0 + static_cast<double>(k) * p.dt_s;  // the Uniform clock
-      for (std::size_t l = 0; l < n; ++l) {
-        current[l] = settings[runs[lane_of[l]].setting].waveform.current_at(t);
-        t1[l] = t;
-      }
+      drives.at(t, current);
+      std::fill(t1.begin(), t1.end(), t);
       batch.step(current, dt, t1);
       for (std::size_t l = 0; l < n; ++l) {
         LaneRun& lr = runs[lane_of[l]];
