@@ -136,8 +136,8 @@ HWY_INLINE void langevin_pair(D d, V<D> x, V<D>& L, V<D>& dL, ExpLanes<D>* near 
 // reciprocal of r beyond; one division per lane either way.
 // With `near` (lag_weights_and_slope_near), exp(-r) by exp_near; the lanes of `update` take it.
 template <class D>
-HWY_INLINE void lag_weights_and_slope(D d, V<D> r, V<D>& E, V<D>& q, V<D>& dq_dr,
-                                      ExpLanes<D>* near, Mk<D> update) {
+HWY_INLINE void lag_weights_and_slope(D d, V<D> r, V<D>& E, V<D>& q, V<D>& dq_dr, ExpLanes<D>* near,
+                                      Mk<D> update) {
   E = near ? exp_near(d, hn::Neg(r), *near, update) : hn::Exp(d, hn::Neg(r));
   const V<D> qt = hn::Sub(
       C(d, 1.0),
@@ -165,8 +165,7 @@ HWY_INLINE void lag_weights_and_slope(D d, V<D> r, V<D>& E, V<D>& q, V<D>& dq_dr
 // inv_k = 1/k; exp(-r) from `near` where given (its lanes of `update` that move take it).
 template <class D>
 HWY_INLINE V<D> ja_irreversible_update(D d, V<D> Mirr0, V<D> Man0, V<D> Man1, V<D> dMan1, V<D> dHe,
-                                       V<D> inv_k, V<D>& dMirr, ExpLanes<D>* near,
-                                       Mk<D> update) {
+                                       V<D> inv_k, V<D>& dMirr, ExpLanes<D>* near, Mk<D> update) {
   const V<D> zero = hn::Zero(d);
   const V<D> delta = hn::IfThenElse(hn::Gt(dHe, zero), C(d, 1.0), C(d, -1.0));
   const V<D> d0 = hn::Mul(hn::Sub(Man0, Mirr0), delta);
@@ -242,8 +241,7 @@ struct JaLaneEvaluation {
 template <class D>
 HWY_INLINE JaLaneEvaluation<D> ja_evaluate(D d, const JaLaneStart<D>& st, V<D> H1, V<D> M1,
                                            const JaLaneConstants<D>& p, V<D> Mirr0, V<D> inv_a,
-                                           JaExpLanes<D>* near = nullptr,
-                                           Mk<D> update = Mk<D>()) {
+                                           JaExpLanes<D>* near = nullptr, Mk<D> update = Mk<D>()) {
   const V<D> He1 = hn::Add(H1, hn::Mul(p.alpha, M1));
   const V<D> x1 = hn::Mul(He1, inv_a);
   V<D> L1, dL1;
@@ -251,9 +249,8 @@ HWY_INLINE JaLaneEvaluation<D> ja_evaluate(D d, const JaLaneStart<D>& st, V<D> H
   const V<D> Man1 = hn::Mul(p.MsT, L1);
   const V<D> dMan = hn::Mul(hn::Mul(p.MsT, inv_a), dL1);
   V<D> dMirr;
-  const V<D> Mirr1 =
-      ja_irreversible_update(d, Mirr0, st.Man0, Man1, dMan, hn::Sub(He1, st.He0), p.inv_k, dMirr,
-                             near ? &near->lag : nullptr, update);
+  const V<D> Mirr1 = ja_irreversible_update(d, Mirr0, st.Man0, Man1, dMan, hn::Sub(He1, st.He0),
+                                            p.inv_k, dMirr, near ? &near->lag : nullptr, update);
   const V<D> one_c = hn::Sub(C(d, 1.0), p.c);
   return {Mirr1,
           hn::Add(hn::Mul(one_c, Mirr1), hn::Mul(p.c, Man1)),
@@ -329,7 +326,8 @@ struct JilesAthertonLanes {
       langevin_pair(d, hn::Mul(hn::Add(H0, hn::Mul(p.alpha, M0)), inv_a), L0, dL0);
       chi_same = hn::Mul(hn::Mul(hn::Mul(p.c, p.MsT), inv_a), dL0);
     }
-    JaLaneEvaluation<D> e = ja_evaluate(d, st, H1, M_iter, p, Mirr0, inv_a, &st.near, hn::Not(same));
+    JaLaneEvaluation<D> e =
+        ja_evaluate(d, st, H1, M_iter, p, Mirr0, inv_a, &st.near, hn::Not(same));
     // the point carried to the next step: this evaluation's (not the safeguard's last), the
     // rod's own where nothing moves (JilesAthertonLaw::joint_trial)
     t.an_x = hn::IfThenElse(same, r.an_x, e.x1);

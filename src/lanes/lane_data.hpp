@@ -66,15 +66,15 @@ enum RodField : int {
   kPmMmf,
   kStrainBound,
   kFluxMs,
-  kJaInvA,     // 1 / a (the scalar law's inv_a)
-  kLengthPerArea,  // l / A (the consistent step's l_A)
-  kInvArea,    // 1 / A
-  kInvMassOsc, // 1 / m of the rod's oscillator (oscillator_step's inv_m)
-  kJaInvK,         // 1 / k (JaMoveStart::inv_k)
-  kInvMsTE,        // 1 / M_s^T of eq. (13) (RodConditions::inv_MsT_E_m_per_A)
-  kInvMsStrain,    // 1 / M_s of eq. (11) (RodConditions::inv_Ms_strain_m_per_A)
-  kAreaOverLength, // A / l (eq. 17)
-  kFourSpOverLs,   // 4 sigma_p / lambda_s (eq. 11's 2 sigma_p / sigma_s times E)
+  kJaInvA,          // 1 / a (the scalar law's inv_a)
+  kLengthPerArea,   // l / A (the consistent step's l_A)
+  kInvArea,         // 1 / A
+  kInvMassOsc,      // 1 / m of the rod's oscillator (oscillator_step's inv_m)
+  kJaInvK,          // 1 / k (JaMoveStart::inv_k)
+  kInvMsTE,         // 1 / M_s^T of eq. (13) (RodConditions::inv_MsT_E_m_per_A)
+  kInvMsStrain,     // 1 / M_s of eq. (11) (RodConditions::inv_Ms_strain_m_per_A)
+  kAreaOverLength,  // A / l (eq. 17)
+  kFourSpOverLs,    // 4 sigma_p / lambda_s (eq. 11's 2 sigma_p / sigma_s times E)
   kRodFieldCount
 };
 

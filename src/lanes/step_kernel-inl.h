@@ -82,7 +82,9 @@ HWY_INLINE Mk<D> circuit_solve3(const Chunk<D>& c, const V<D>* R, const V<D>* mm
                                    hn::Mul(S(a, 2), DF[2])));
   const V<D> a00 = hn::Add(S(0, 0), R[0]), a10 = S(1, 0), a11 = hn::Add(S(1, 1), R[1]);
   const V<D> a20 = S(2, 0), a21 = S(2, 1), a22 = hn::Add(S(2, 2), R[2]);
-  auto minor = [&](V<D> p, V<D> q, V<D> r, V<D> s) { return hn::Sub(hn::Mul(p, q), hn::Mul(r, s)); };
+  auto minor = [&](V<D> p, V<D> q, V<D> r, V<D> s) {
+    return hn::Sub(hn::Mul(p, q), hn::Mul(r, s));
+  };
   const V<D> c00 = minor(a11, a22, a21, a21), c01 = minor(a20, a21, a10, a22);
   const V<D> c02 = minor(a10, a21, a20, a11), c11 = minor(a00, a22, a20, a20);
   const V<D> c12 = minor(a10, a20, a00, a21), m2 = minor(a00, a11, a10, a10);

@@ -31,8 +31,9 @@ HWY_INLINE void mechanics(const Chunk<D>& c, RodStates<D>& s, V<D> h, V<D> t1, F
                            c.rod(kCoupling, i), c.rod(kMu0Ms2, i), c.rod(kSdE, i));
     const V<D> E = hn::Div(C(d, 1.0), inv_E);
     s.f[kE][i] = E;
-    s.f[kLambda][i] = magnetostriction(d, hn::Mul(M, c.rod(kInvMsStrain, i)), lambda_s,
-                                       c.rod(kSigmaP, i), E, hn::Mul(c.rod(kFourSpOverLs, i), inv_E));
+    s.f[kLambda][i] =
+        magnetostriction(d, hn::Mul(M, c.rod(kInvMsStrain, i)), lambda_s, c.rod(kSigmaP, i), E,
+                         hn::Mul(c.rod(kFourSpOverLs, i), inv_E));
     s.f[kF][i] = hn::Mul(hn::Mul(s.f[kLambda][i], E), A);
     s.f[kKRod][i] = hn::Mul(E, c.rod(kAreaOverLength, i));
   }
