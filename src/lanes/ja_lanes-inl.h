@@ -263,8 +263,10 @@ HWY_INLINE JaLaneEvaluation<D> ja_evaluate(D d, const JaLaneStart<D>& st, V<D> H
 // Eq. (9) solved at H1 by Newton's method in the lanes of `todo` (jiles_atherton.hpp,
 // ja_step_from for H1 != H0): from M_guess, steps -g / max(1 - alpha chi_e, 0.2), each lane
 // stopping where |g| <= 1e-12 M_s^T or at the 60th evaluation with that evaluation's M_irr1,
-// M and chi_e. The lanes outside todo keep e's values. Out of line: the rare path, so that
-// joint_trial's common one inlines into the Newton loop.
+// M and chi_e. The lanes outside todo keep e's values. An iterate's exponentials come from the
+// last iterate's where they are near (exp_near; the scalar law takes std::exp: a few units in the
+// last place apart). Out of line: the rare path, so that joint_trial's common one inlines into
+// the Newton loop.
 template <class D>
 HWY_NOINLINE void ja_solve(D d, Mk<D> todo, const JaLaneStart<D>& st, V<D> H1, V<D> M_guess,
                            const JaLaneConstants<D>& p, V<D> Mirr0, V<D> inv_a,
@@ -272,8 +274,9 @@ HWY_NOINLINE void ja_solve(D d, Mk<D> todo, const JaLaneStart<D>& st, V<D> H1, V
   const V<D> tol = hn::Mul(C(d, 1e-12), p.MsT);
   V<D> M1 = M_guess;
   Mk<D> left = todo;
+  JaExpLanes<D> near = no_exp_points(d);  // each iterate's exponentials from the last one's
   for (int it = 0; it < 60 && !hn::AllFalse(d, left); ++it) {
-    const JaLaneEvaluation<D> ev = ja_evaluate(d, st, H1, M1, p, Mirr0, inv_a);
+    const JaLaneEvaluation<D> ev = ja_evaluate(d, st, H1, M1, p, Mirr0, inv_a, &near, left);
     const V<D> g = hn::Sub(M1, ev.M);
     const Mk<D> stop =
         hn::And(left, it == 59 ? hn::FirstN(d, hn::Lanes(d)) : hn::Le(hn::Abs(g), tol));

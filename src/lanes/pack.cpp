@@ -61,9 +61,13 @@ bool same_structure(const lanes::Structure& a, const lanes::Structure& b) {
 }
 
 // Lane j's State scalars and constants (the GlobalField numbers), its failure record cleared.
-void pack_globals(LaneData& L, std::size_t j, const Model& m, const Conditions& c, const State& s,
-                  double sensor_area) {
+void pack_globals(LaneData& L, std::size_t j, const Model& m, const Conditions& c, const State& s) {
   using namespace lanes;
+  double sensor_area = 0.0;
+  for (int b : m.flux_sensor_branches)
+    sensor_area +=
+        c.rods[static_cast<std::size_t>(m.circuit.branches[static_cast<std::size_t>(b)].rod)]
+            .area_m2;
   auto glob = [&](int f) -> double& { return L.glob(f)[j]; };
   const double globals[] = {s.t_s,
                             s.current_A,
@@ -92,11 +96,6 @@ void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, 
   using namespace lanes;
   auto rod = [&](int f, int i) -> double& { return L.rod(f, i)[j]; };
   const int n = m.rod_count();
-  double sensor_area = 0.0;
-  for (int b : m.flux_sensor_branches)
-    sensor_area +=
-        c.rods[static_cast<std::size_t>(m.circuit.branches[static_cast<std::size_t>(b)].rod)]
-            .area_m2;
   for (int i = 0; i < n; ++i) {
     const RodState& r = s.rods[static_cast<std::size_t>(i)];
     const RodConditions& rc = c.rods[static_cast<std::size_t>(i)];
@@ -168,7 +167,7 @@ void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, 
     L.bt_coil(i)[j] = lr.bt_coil8[i];
     L.bt_pm(i)[j] = lr.bt_pm8[i];
   }
-  pack_globals(L, j, m, c, s, sensor_area);
+  pack_globals(L, j, m, c, s);
 }
 
 }  // namespace

@@ -94,7 +94,30 @@ void finish(const SimulationSettings& s, const Plan& p, Result& r) {
   }
 }
 
-// The rest states (make_state), then the steps of the group in lanes.
+// The runs' settings (idx) and conditions, and their rest states: make_state's ramp for all of
+// them in lanes (make_states: equal to make_state to the lanes' rounding); none where a ramp
+// fails (then each run makes its own, make_state, and its error is the run's).
+std::vector<State> rest_states(const Model& m, std::span<const SimulationSettings> settings,
+                               const std::vector<std::size_t>& idx, std::vector<LaneRun>& runs) {
+  const std::vector<const Model*> models(runs.size(), &m);
+  std::vector<const Conditions*> conds;
+  std::vector<double> I0;
+  for (std::size_t q = 0; q < idx.size(); ++q) {
+    LaneRun& lr = runs[q];
+    const SimulationSettings& s = settings[idx[q]];
+    lr.setting = idx[q];
+    lr.c = make_conditions(m, s.temperature_C, s.freeze);
+    conds.push_back(&lr.c);
+    I0.push_back(s.waveform.current_at(0.0));
+  }
+  try {
+    return make_states(models, conds, I0);
+  } catch (const DivergenceError&) {
+    return {};
+  }
+}
+
+// The rest states (rest_states), then the steps of the group in lanes.
 void run_group(const Model& m, std::span<const SimulationSettings> settings,
                const std::vector<std::size_t>& idx, const Plan& p, bool metrics_only,
                std::vector<Result>& out) {
@@ -104,17 +127,16 @@ void run_group(const Model& m, std::span<const SimulationSettings> settings,
   std::vector<const Conditions*> conds;
   std::vector<const State*> states;
   std::vector<std::size_t> lane_of;  // lane -> run
+  std::vector<State> rest = rest_states(m, settings, idx, runs);
   for (std::size_t q = 0; q < idx.size(); ++q) {
     LaneRun& lr = runs[q];
     const SimulationSettings& s = settings[idx[q]];
     Result& r = out[idx[q]];
-    lr.setting = idx[q];
-    lr.c = make_conditions(m, s.temperature_C, s.freeze);
     r.dt_s = p.dt_s;
     r.thermal_expansion_start_um = r.thermal_expansion_um = lr.c.thermal_expansion_m * 1e6;
     make_columns(m, r.series, static_cast<std::size_t>(p.steps / s.record_every + 2));
     try {
-      lr.st = make_state(m, lr.c, s.waveform.current_at(0.0));
+      lr.st = rest.empty() ? make_state(m, lr.c, s.waveform.current_at(0.0)) : std::move(rest[q]);
       lr.st.energy.enabled = false;
       check_physical_validity(m, lr.c, lr.st, 0.0);
       if (metrics_only)

@@ -231,6 +231,25 @@ HWY_INLINE Mk<D> stopped(D d, int n, Mk<D> done, V<D> worst, V<D> worst_rod, int
   return stop;
 }
 
+// Rod i's flux density B0 at the step's start, its eddy terms e0 = H_c - H and g = 2 kappa / h
+// and the first guess (H, M) of newton_fields; quasi_static: no eddy term, the guess (H_n, M_n).
+template <class Law, class D>
+HWY_INLINE void first_guess(const Chunk<D>& c, const RodStates<D>& s, int i, V<D> two_over_h,
+                            bool quasi_static, Magnetic<Law, D>& mg, V<D>& e0) {
+  const D d = c.d;
+  mg.B0[i] = hn::Mul(C(d, physics::kMu0), hn::Add(s.f[kH][i], s.f[kM][i]));
+  if (quasi_static) {
+    e0 = mg.g[i] = hn::Zero(d);
+    mg.H[i] = s.f[kH][i];
+    mg.Mg[i] = s.f[kM][i];
+    return;
+  }
+  e0 = hn::Sub(s.f[kHc][i], s.f[kH][i]);
+  mg.g[i] = hn::Mul(c.rod(kKappa, i), two_over_h);
+  mg.H[i] = hn::Add(hn::Mul(C(d, 3.0), hn::Sub(s.f[kH][i], s.f[kHprev][i])), s.f[kHprev2][i]);
+  mg.Mg[i] = hn::Add(hn::Mul(C(d, 3.0), hn::Sub(s.f[kM][i], s.f[kMprev][i])), s.f[kMprev2][i]);
+}
+
 // Newton's method on the rods' fields and magnetisations jointly (model/step.cpp,
 // consistent_magnetic_update): the first guess extrapolated quadratically from the last three
 // steps (H = 3 (H_n - H_n-1) + H_n-2, M likewise); at each iterate (H*, M*) each rod's law
@@ -253,7 +272,7 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
   const int n = c.n;
   constexpr double kMu0 = physics::kMu0;
   V<D> e0[kMaxRods], inv_mud[kMaxRods];
-  V<D>* g = mg.g;
+  const V<D>* g = mg.g;
   const V<D> two_over_h = hn::Div(C(d, 2.0), h);
   typename Law::template Start<D> start[kMaxRods];
   typename Law::template Rod<D> rod[kMaxRods];
@@ -262,17 +281,7 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
     ja[i] = ja_constants(c, i);
     rod[i] = {s.f[kH][i], s.f[kMirr][i], s.f[kM][i], s.f[kAnX][i], s.f[kAnL][i], s.f[kAnDL][i]};
     start[i] = Law::begin_move(d, ja[i], rod[i]);
-    mg.B0[i] = hn::Mul(C(d, kMu0), hn::Add(s.f[kH][i], s.f[kM][i]));
-    if (quasi_static) {
-      e0[i] = g[i] = hn::Zero(d);
-      mg.H[i] = s.f[kH][i];
-      mg.Mg[i] = s.f[kM][i];
-      continue;
-    }
-    e0[i] = hn::Sub(s.f[kHc][i], s.f[kH][i]);
-    g[i] = hn::Mul(c.rod(kKappa, i), two_over_h);
-    mg.H[i] = hn::Add(hn::Mul(C(d, 3.0), hn::Sub(s.f[kH][i], s.f[kHprev][i])), s.f[kHprev2][i]);
-    mg.Mg[i] = hn::Add(hn::Mul(C(d, 3.0), hn::Sub(s.f[kM][i], s.f[kMprev][i])), s.f[kMprev2][i]);
+    first_guess(c, s, i, two_over_h, quasi_static, mg, e0[i]);
   }
   Mk<D> done = fails.failed;
   const Mk<D> real = hn::FirstN(d, c.j < c.L.n ? c.L.n - c.j : 0);
