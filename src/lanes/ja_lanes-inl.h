@@ -59,8 +59,13 @@ template <class D>
 HWY_INLINE V<D> exp_near(D d, V<D> y, ExpLanes<D>& p, Mk<D> update) {
   const V<D> dy = hn::Sub(y, p.y);
   const Mk<D> near = hn::Le(hn::Abs(dy), C(d, 1.0 / 64));  // false where y_prev is NaN
-  V<D> e = hn::Mul(p.e, exp_series7(d, dy));
-  if (!hn::AllTrue(d, near)) e = hn::IfThenElse(near, e, hn::Exp(d, y));
+  V<D> e;
+  if (hn::AllFalse(d, near))  // a move's first evaluation
+    e = hn::Exp(d, y);
+  else if (hn::AllTrue(d, near))
+    e = hn::Mul(p.e, exp_series7(d, dy));
+  else
+    e = hn::IfThenElse(near, hn::Mul(p.e, exp_series7(d, dy)), hn::Exp(d, y));
   p.y = hn::IfThenElse(update, y, p.y);
   p.e = hn::IfThenElse(update, e, p.e);
   return e;
@@ -263,10 +268,8 @@ HWY_INLINE JaLaneEvaluation<D> ja_evaluate(D d, const JaLaneStart<D>& st, V<D> H
 // Eq. (9) solved at H1 by Newton's method in the lanes of `todo` (jiles_atherton.hpp,
 // ja_step_from for H1 != H0): from M_guess, steps -g / max(1 - alpha chi_e, 0.2), each lane
 // stopping where |g| <= 1e-12 M_s^T or at the 60th evaluation with that evaluation's M_irr1,
-// M and chi_e. The lanes outside todo keep e's values. An iterate's exponentials come from the
-// last iterate's where they are near (exp_near; the scalar law takes std::exp: a few units in the
-// last place apart). Out of line: the rare path, so that joint_trial's common one inlines into
-// the Newton loop.
+// M and chi_e. The lanes outside todo keep e's values. Out of line: the rare path, so that
+// joint_trial's common one inlines into the Newton loop.
 template <class D>
 HWY_NOINLINE void ja_solve(D d, Mk<D> todo, const JaLaneStart<D>& st, V<D> H1, V<D> M_guess,
                            const JaLaneConstants<D>& p, V<D> Mirr0, V<D> inv_a,
@@ -274,9 +277,8 @@ HWY_NOINLINE void ja_solve(D d, Mk<D> todo, const JaLaneStart<D>& st, V<D> H1, V
   const V<D> tol = hn::Mul(C(d, 1e-12), p.MsT);
   V<D> M1 = M_guess;
   Mk<D> left = todo;
-  JaExpLanes<D> near = no_exp_points(d);  // each iterate's exponentials from the last one's
   for (int it = 0; it < 60 && !hn::AllFalse(d, left); ++it) {
-    const JaLaneEvaluation<D> ev = ja_evaluate(d, st, H1, M1, p, Mirr0, inv_a, &near, left);
+    const JaLaneEvaluation<D> ev = ja_evaluate(d, st, H1, M1, p, Mirr0, inv_a);
     const V<D> g = hn::Sub(M1, ev.M);
     const Mk<D> stop =
         hn::And(left, it == 59 ? hn::FirstN(d, hn::Lanes(d)) : hn::Le(hn::Abs(g), tol));
