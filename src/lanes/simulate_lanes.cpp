@@ -49,9 +49,15 @@ struct LaneRun {
   std::vector<double> rows;
   std::size_t staged = 0;
   // Appends the staged rows' first `columns` values (of `width`) to the series.
+  // Written by index into the grown column (no push_back per value: its end pointer was a chain).
   void flush(TimeSeries& ts, std::size_t width, std::size_t columns) {
-    for (std::size_t q = 0; q < columns; ++q)
-      for (std::size_t k = 0; k < staged; ++k) ts.columns[q].push_back(rows[k * width + q]);
+    for (std::size_t q = 0; q < columns; ++q) {
+      std::vector<double>& col = ts.columns[q];
+      const std::size_t at = col.size();
+      col.resize(at + staged);
+      double* o = col.data() + at;
+      for (std::size_t k = 0; k < staged; ++k) o[k] = rows[k * width + q];
+    }
     staged = 0;
   }
 };
