@@ -28,14 +28,74 @@ HWY_INLINE V<D> C(D d, double x) {
   return hn::Set(d, x);
 }
 
+// c0 + c1 x + ... + c7 x^7 by Estrin's scheme (series.hpp, polynomial7).
+template <class D>
+HWY_INLINE V<D> polynomial7(D d, V<D> x, const double (&c)[8]) {
+  const V<D> x2 = hn::Mul(x, x), x4 = hn::Mul(x2, x2);
+  const V<D> p01 = hn::Add(C(d, c[0]), hn::Mul(C(d, c[1]), x));
+  const V<D> p23 = hn::Add(C(d, c[2]), hn::Mul(C(d, c[3]), x));
+  const V<D> p45 = hn::Add(C(d, c[4]), hn::Mul(C(d, c[5]), x));
+  const V<D> p67 = hn::Add(C(d, c[6]), hn::Mul(C(d, c[7]), x));
+  return hn::Add(hn::Add(p01, hn::Mul(x2, p23)), hn::Mul(x4, hn::Add(p45, hn::Mul(x2, p67))));
+}
+
+// e^x to (x^8 / 8!) where |x| <= 1/64 (series.hpp, exp_series7).
+template <class D>
+HWY_INLINE V<D> exp_series7(D d, V<D> x) {
+  constexpr double kExp[8] = {1.0,      1.0,       1.0 / 2,   1.0 / 6,
+                              1.0 / 24, 1.0 / 120, 1.0 / 720, 1.0 / 5040};
+  return polynomial7(d, x, kExp);
+}
+
+// A known exponential per lane, e = e^y (series.hpp, ExpPoint; y NaN: none).
+template <class D>
+struct ExpLanes {
+  V<D> y, e;
+};
+// series.hpp's exp_near per lane: e^y from the known e^{y_prev} where |y - y_prev| <= 1/64
+// (e^{y_prev} exp_series7(y - y_prev)), hn::Exp elsewhere (computed only where a lane needs
+// it). The lanes of `update` take (y, e^y) as their point.
+template <class D>
+HWY_INLINE V<D> exp_near(D d, V<D> y, ExpLanes<D>& p, Mk<D> update) {
+  const V<D> dy = hn::Sub(y, p.y);
+  const Mk<D> near = hn::Le(hn::Abs(dy), C(d, 1.0 / 64));  // false where y_prev is NaN
+  V<D> e;
+  if (hn::AllFalse(d, near))  // a move's first evaluation
+    e = hn::Exp(d, y);
+  else if (hn::AllTrue(d, near))
+    e = hn::Mul(p.e, exp_series7(d, dy));
+  else
+    e = hn::IfThenElse(near, hn::Mul(p.e, exp_series7(d, dy)), hn::Exp(d, y));
+  p.y = hn::IfThenElse(update, y, p.y);
+  p.e = hn::IfThenElse(update, e, p.e);
+  return e;
+}
+// The exponentials of a law evaluation, for the next one nearby (jiles_atherton.hpp,
+// JaExpPoints): exp(-2|x|) of the Langevin function and exp(-r) of the lag.
+template <class D>
+struct JaExpLanes {
+  ExpLanes<D> langevin, lag;
+};
+template <class D>
+HWY_INLINE JaExpLanes<D> no_exp_points(D d) {
+  const V<D> nan = hn::Set(d, __builtin_nan("")), zero = hn::Zero(d);
+  return {{nan, zero}, {nan, zero}};
+}
+
 // Langevin function and slope (jiles_atherton.hpp, langevin_pair): L = coth x - 1/x,
 // L' = 1/x^2 - 1/sinh^2 x from one exponential and one division (q = 1/(x (1 - e)) gives 1/x
 // and 1/(1 - e)), Taylor series for |x| < 0.1. Beyond |x| = 40, e < 2e-35 and 1 - e = 1: the
 // same q is 1/x, as the scalar's large-x branch divides.
+// With `near` (langevin_pair_near), exp(-2|x|) by exp_near from its point; the lanes of `update`
+// where the closed form applies take this one's.
 template <class D>
-HWY_INLINE void langevin_pair(D d, V<D> x, V<D>& L, V<D>& dL) {
+HWY_INLINE void langevin_pair(D d, V<D> x, V<D>& L, V<D>& dL, ExpLanes<D>* near = nullptr,
+                              Mk<D> update = Mk<D>()) {
   const V<D> ax = hn::Abs(x);
-  const V<D> e = hn::Exp(d, hn::Mul(C(d, -2.0), ax));  // coth|x| = (1 + e)/(1 - e)
+  const V<D> y = hn::Mul(C(d, -2.0), ax);
+  const Mk<D> closed = hn::And(hn::Ge(ax, C(d, 0.1)), hn::Le(ax, C(d, 40.0)));
+  const V<D> e = near ? exp_near(d, y, *near, hn::And(update, closed))
+                      : hn::Exp(d, y);  // coth|x| = (1 + e)/(1 - e)
   const V<D> ome = hn::Sub(C(d, 1.0), e);
   const V<D> q = hn::Div(C(d, 1.0), hn::Mul(x, ome));
   const V<D> inv_x = hn::Mul(ome, q);
@@ -79,9 +139,11 @@ HWY_INLINE void langevin_pair(D d, V<D> x, V<D>& L, V<D>& dL) {
 // exp(-r), q(r) = (1 - exp(-r))/r and dq/dr = (E - q)/r (magnetic.hpp, lag_weights_and_slope_from):
 // Taylor series for q at r < 1e-2 (where dq/dr divides by r, and is -1/2 at r <= 1e-12), one
 // reciprocal of r beyond; one division per lane either way.
+// With `near` (lag_weights_and_slope_near), exp(-r) by exp_near; the lanes of `update` take it.
 template <class D>
-HWY_INLINE void lag_weights_and_slope(D d, V<D> r, V<D>& E, V<D>& q, V<D>& dq_dr) {
-  E = hn::Exp(d, hn::Neg(r));
+HWY_INLINE void lag_weights_and_slope(D d, V<D> r, V<D>& E, V<D>& q, V<D>& dq_dr, ExpLanes<D>* near,
+                                      Mk<D> update) {
+  E = near ? exp_near(d, hn::Neg(r), *near, update) : hn::Exp(d, hn::Neg(r));
   const V<D> qt = hn::Sub(
       C(d, 1.0),
       hn::Mul(
@@ -105,9 +167,10 @@ HWY_INLINE void lag_weights_and_slope(D d, V<D> r, V<D>& E, V<D>& q, V<D>& dq_dr
 // Eq. (9), second line, integrated over one step (jiles_atherton.hpp,
 // ja_irreversible_update): M_irr relaxes towards M_an along the path length with "time
 // constant" k, pinned while (M_an - M_irr) delta <= 0. Returns M_irr1; dMirr = dM_irr1/dH_e1.
+// inv_k = 1/k; exp(-r) from `near` where given (its lanes of `update` that move take it).
 template <class D>
 HWY_INLINE V<D> ja_irreversible_update(D d, V<D> Mirr0, V<D> Man0, V<D> Man1, V<D> dMan1, V<D> dHe,
-                                       V<D> k, V<D>& dMirr) {
+                                       V<D> inv_k, V<D>& dMirr, ExpLanes<D>* near, Mk<D> update) {
   const V<D> zero = hn::Zero(d);
   const V<D> delta = hn::IfThenElse(hn::Gt(dHe, zero), C(d, 1.0), C(d, -1.0));
   const V<D> d0 = hn::Mul(hn::Sub(Man0, Mirr0), delta);
@@ -125,13 +188,13 @@ HWY_INLINE V<D> ja_irreversible_update(D d, V<D> Mirr0, V<D> Man0, V<D> Man1, V<
     s = hn::IfThenElse(cross, hn::Mul(s, frac), s);
   }
   const V<D> u0 = hn::IfThenElse(cross, Mirr0, Man0);
-  const V<D> r = hn::Div(s, k);
+  const V<D> r = hn::Mul(s, inv_k);
   V<D> E, q, dq_dr;
-  lag_weights_and_slope(d, r, E, q, dq_dr);
+  lag_weights_and_slope(d, r, E, q, dq_dr, near, hn::AndNot(still, update));
   const V<D> a0 = hn::Sub(Mirr0, u0), a1 = hn::Sub(Man1, u0);
   const V<D> dm =
       hn::Add(hn::Mul(hn::Sub(C(d, 1.0), q), dMan1),
-              hn::Mul(hn::Div(ds, k), hn::Sub(hn::Mul(hn::Neg(a0), E), hn::Mul(a1, dq_dr))));
+              hn::Mul(hn::Mul(ds, inv_k), hn::Sub(hn::Mul(hn::Neg(a0), E), hn::Mul(a1, dq_dr))));
   dMirr = hn::IfThenElse(still, zero, dm);
   const V<D> m1 = hn::Sub(hn::Add(Man1, hn::Mul(a0, E)), hn::Mul(a1, q));
   return hn::IfThenElse(still, Mirr0, m1);
@@ -142,6 +205,7 @@ template <class D>
 struct JaLaneConstants {
   V<D> MsT, a, alpha, c, k;
   V<D> inv_a;  // 1/a (the scalar law's 1.0 / a_A_per_m, packed once: LaneData kJaInvA)
+  V<D> inv_k;  // 1/k (JaMoveStart::inv_k: LaneData kJaInvK)
 };
 
 // What a move depends on at its start only (jiles_atherton.hpp, ja_move_start_near): H_e0 and
@@ -149,9 +213,11 @@ struct JaLaneConstants {
 // the law's last evaluation (x_at = H_e / a, L and L' there: the rod's kAnX, kAnL, kAnDL) is
 // within 1e-7 of x0 = H_e0 / a, M_an(H_e0) = M_s^T (L + L' (x0 - x_at)); elsewhere (x_at NaN:
 // nothing known) the Langevin function at x0, computed only where a lane needs it.
+// `near`: the exponentials of the move's last evaluation (none at its start).
 template <class D>
 struct JaLaneStart {
   V<D> He0, Man0;
+  JaExpLanes<D> near;
 };
 template <class D>
 HWY_INLINE JaLaneStart<D> ja_move_start(D d, V<D> H0, V<D> M0, const JaLaneConstants<D>& p,
@@ -166,11 +232,12 @@ HWY_INLINE JaLaneStart<D> ja_move_start(D d, V<D> H0, V<D> M0, const JaLaneConst
     langevin_pair(d, x0, Lx, dLx);
     L = hn::IfThenElse(near, L, Lx);
   }
-  return {He0, hn::Mul(p.MsT, L)};
+  return {He0, hn::Mul(p.MsT, L), no_exp_points(d)};
 }
 
 // One evaluation of eq. (9) at the end field H1 and a magnetisation iterate M1 (jiles_atherton.hpp,
-// ja_evaluate): M_irr1, F(M1) = (1-c) M_irr1 + c M_an(H1 + alpha M1) and chi_e = dF/dH_e.
+// ja_evaluate): M_irr1, F(M1) = (1-c) M_irr1 + c M_an(H1 + alpha M1) and chi_e = dF/dH_e. With
+// `near`, its exponentials from the move's last evaluation (the lanes of `update` take these).
 template <class D>
 struct JaLaneEvaluation {
   V<D> Mirr1, M, chi_e;
@@ -178,16 +245,17 @@ struct JaLaneEvaluation {
 };
 template <class D>
 HWY_INLINE JaLaneEvaluation<D> ja_evaluate(D d, const JaLaneStart<D>& st, V<D> H1, V<D> M1,
-                                           const JaLaneConstants<D>& p, V<D> Mirr0, V<D> inv_a) {
+                                           const JaLaneConstants<D>& p, V<D> Mirr0, V<D> inv_a,
+                                           JaExpLanes<D>* near = nullptr, Mk<D> update = Mk<D>()) {
   const V<D> He1 = hn::Add(H1, hn::Mul(p.alpha, M1));
   const V<D> x1 = hn::Mul(He1, inv_a);
   V<D> L1, dL1;
-  langevin_pair(d, x1, L1, dL1);
+  langevin_pair(d, x1, L1, dL1, near ? &near->langevin : nullptr, update);
   const V<D> Man1 = hn::Mul(p.MsT, L1);
   const V<D> dMan = hn::Mul(hn::Mul(p.MsT, inv_a), dL1);
   V<D> dMirr;
-  const V<D> Mirr1 =
-      ja_irreversible_update(d, Mirr0, st.Man0, Man1, dMan, hn::Sub(He1, st.He0), p.k, dMirr);
+  const V<D> Mirr1 = ja_irreversible_update(d, Mirr0, st.Man0, Man1, dMan, hn::Sub(He1, st.He0),
+                                            p.inv_k, dMirr, near ? &near->lag : nullptr, update);
   const V<D> one_c = hn::Sub(C(d, 1.0), p.c);
   return {Mirr1,
           hn::Add(hn::Mul(one_c, Mirr1), hn::Mul(p.c, Man1)),
@@ -253,7 +321,7 @@ struct JilesAthertonLanes {
   }
   template <class D>
   static HWY_INLINE Trial<D> joint_trial(D d, const JaLaneConstants<D>& p, const Rod<D>& r,
-                                         const Start<D>& st, V<D> H1, V<D> M_iter) {
+                                         Start<D>& st, V<D> H1, V<D> M_iter) {
     Trial<D> t;
     const V<D> inv_a = p.inv_a, H0 = r.H, Mirr0 = r.Mirr, M0 = r.M;
     const Mk<D> same = hn::Eq(H1, H0);  // ja_step_from's H1 == H0: nothing moves
@@ -263,7 +331,8 @@ struct JilesAthertonLanes {
       langevin_pair(d, hn::Mul(hn::Add(H0, hn::Mul(p.alpha, M0)), inv_a), L0, dL0);
       chi_same = hn::Mul(hn::Mul(hn::Mul(p.c, p.MsT), inv_a), dL0);
     }
-    JaLaneEvaluation<D> e = ja_evaluate(d, st, H1, M_iter, p, Mirr0, inv_a);
+    JaLaneEvaluation<D> e =
+        ja_evaluate(d, st, H1, M_iter, p, Mirr0, inv_a, &st.near, hn::Not(same));
     // the point carried to the next step: this evaluation's (not the safeguard's last), the
     // rod's own where nothing moves (JilesAthertonLaw::joint_trial)
     t.an_x = hn::IfThenElse(same, r.an_x, e.x1);

@@ -11,7 +11,7 @@ namespace gmasim::lanes {
 
 inline constexpr int kMaxRods = 8;
 // Lanes are padded to a multiple of the widest vector (AVX-512: 8 doubles); a padding lane
-// repeats lane 0 and is never read back.
+// repeats the last lane and is never read back.
 inline constexpr std::size_t kPad = 8;
 
 // Per rod and lane: the step's state (RodState's numbers), then the constants it reads
@@ -66,10 +66,15 @@ enum RodField : int {
   kPmMmf,
   kStrainBound,
   kFluxMs,
-  kJaInvA,     // 1 / a (the scalar law's inv_a)
-  kLengthPerArea,  // l / A (the consistent step's l_A)
-  kInvArea,    // 1 / A
-  kInvMassOsc, // 1 / m of the rod's oscillator (oscillator_step's inv_m)
+  kJaInvA,          // 1 / a (the scalar law's inv_a)
+  kLengthPerArea,   // l / A (the consistent step's l_A)
+  kInvArea,         // 1 / A
+  kInvMassOsc,      // 1 / m of the rod's oscillator (oscillator_step's inv_m)
+  kJaInvK,          // 1 / k (JaMoveStart::inv_k)
+  kInvMsTE,         // 1 / M_s^T of eq. (13) (RodConditions::inv_MsT_E_m_per_A)
+  kInvMsStrain,     // 1 / M_s of eq. (11) (RodConditions::inv_Ms_strain_m_per_A)
+  kAreaOverLength,  // A / l (eq. 17)
+  kFourSpOverLs,    // 4 sigma_p / lambda_s (eq. 11's 2 sigma_p / sigma_s times E)
   kRodFieldCount
 };
 
@@ -131,7 +136,8 @@ struct LaneData {
   Structure st;
   std::size_t n = 0, npad = 0;
   std::vector<double> g, r, cm;  // global, rod and circuit fields, each npad long
-  // How many joint trials of a live lane solved eq. (9) fully (the law's safeguard, ja_solve).
+  // How many joint trials of a live lane (not padding) solved eq. (9) fully (the law's safeguard,
+  // ja_solve).
   std::size_t full_solves = 0;
   // The consistent state's circuit solves: per live lane that needed one (State::newton_solves
   // summed over the lanes), and per vector of lanes (what the kernel ran).

@@ -16,45 +16,58 @@
 HWY_BEFORE_NAMESPACE();
 namespace gmasim::lanes::HWY_NAMESPACE {
 
-// Eq. (13): the Delta-E modulus at m = M/M_s^T (magnetostriction.hpp, delta_e_modulus), its
-// last term multiplied through by cos^2(pi m/2).
+// cos(pi m / 2) where |m| <= 1 by its Taylor series in t = m^2 to t^10 (truncation below 2e-17
+// absolute, no range reduction), hn::Cos where a lane is beyond (computed only then).
 template <class D>
-HWY_INLINE V<D> delta_e_modulus(D d, V<D> m, V<D> inv_Es, V<D> rot, V<D> coupling, V<D> mu0Ms2,
-                                V<D> S) {
-  const V<D> c = hn::Cos(d, hn::Mul(C(d, 0.5 * 3.14159265358979323846), m));
+HWY_INLINE V<D> cos_half_pi(D d, V<D> m) {
+  const V<D> t = hn::Mul(m, m), t2 = hn::Mul(t, t), t4 = hn::Mul(t2, t2), t8 = hn::Mul(t4, t4);
+  auto pair = [&](double a, double b) { return hn::Sub(C(d, a), hn::Mul(C(d, b), t)); };
+  const V<D> series = hn::Add(
+      hn::Add(
+          hn::Add(pair(1.0, 1.2337005501361697),
+                  hn::Mul(t2, pair(0.25366950790104803, 0.02086348076335296))),
+          hn::Mul(t4, hn::Add(pair(0.0009192602748394266, 2.5202042373060607e-05),
+                              hn::Mul(t2, pair(4.710874778818172e-07, 6.386603083791852e-09))))),
+      hn::Mul(t8, hn::Add(pair(6.565963114979473e-11, 5.294400200734623e-13),
+                          hn::Mul(t2, C(d, 3.437739179098607e-15)))));
+  const Mk<D> in = hn::Le(hn::Abs(m), C(d, 1.0));
+  if (hn::AllTrue(d, in)) return series;
+  return hn::IfThenElse(in, series, hn::Cos(d, hn::Mul(C(d, 1.5707963267948966), m)));
+}
+
+// Eq. (13): the Delta-E compliance 1/E at m = M/M_s^T (magnetostriction.hpp,
+// delta_e_compliance), its last term multiplied through by cos^2(pi m/2) (cos_half_pi: the
+// scalar's std::cos to a few 1e-16 absolute).
+template <class D>
+HWY_INLINE V<D> delta_e_compliance(D d, V<D> m, V<D> inv_Es, V<D> rot, V<D> coupling, V<D> mu0Ms2,
+                                   V<D> S) {
+  const V<D> c = cos_half_pi(d, m);
   const V<D> c2 = hn::Mul(c, c);
   const V<D> m2 = hn::Mul(m, m);
   const V<D> third = hn::Div(hn::Mul(hn::Mul(hn::Mul(coupling, coupling), m2), c2),
                              hn::Sub(mu0Ms2, hn::Mul(c2, S)));
-  return hn::Div(C(d, 1.0), hn::Add(hn::Add(inv_Es, hn::Mul(rot, hn::Sub(C(d, 1.0), m2))), third));
+  return hn::Add(hn::Add(inv_Es, hn::Mul(rot, hn::Sub(C(d, 1.0), m2))), third);
 }
 
 // Eq. (11)-(12): lambda = f(sigma_p) lambda_s m^2 with the prestress factor f at the
 // thresholds sigma_s = lambda_s E / 2, sigma_max = 3 lambda_s E / 2 (magnetostriction.hpp,
-// prestress_factor), its tanh from one exponential (tanh_absolute).
+// prestress_factor_at), its tanh from one exponential (tanh_absolute); u = 2 sigma_p / sigma_s,
+// given as (4 sigma_p / lambda_s) / E. The factor above sigma_s only where a lane needs it.
 template <class D>
-HWY_INLINE V<D> magnetostriction(D d, V<D> m, V<D> lambda_s, V<D> sigma_p, V<D> E) {
+HWY_INLINE V<D> magnetostriction(D d, V<D> m, V<D> lambda_s, V<D> sigma_p, V<D> E, V<D> u) {
   const V<D> ss = hn::Mul(hn::Mul(C(d, 0.5), lambda_s), E);
-  const V<D> smax = hn::Mul(hn::Mul(C(d, 1.5), lambda_s), E);
-  const V<D> u = hn::Div(hn::Mul(C(d, 2.0), sigma_p), ss);
   const V<D> e = hn::Exp(d, hn::Mul(C(d, -2.0), hn::Abs(u)));
   const V<D> ta = hn::Div(hn::Sub(C(d, 1.0), e), hn::Add(C(d, 1.0), e));
   const V<D> t = hn::IfThenElse(hn::Lt(u, hn::Zero(d)), hn::Neg(ta), ta);
   const V<D> base = hn::Add(C(d, 1.0), hn::Mul(C(d, 0.5), t));
-  const V<D> above = hn::Mul(hn::Sub(C(d, 1.0), hn::Div(hn::Sub(sigma_p, ss), smax)), base);
-  const V<D> f = hn::IfThenElse(hn::Le(sigma_p, ss), base, above);
+  const Mk<D> below = hn::Le(sigma_p, ss);
+  V<D> f = base;
+  if (!hn::AllTrue(d, below)) {
+    const V<D> smax = hn::Mul(hn::Mul(C(d, 1.5), lambda_s), E);
+    const V<D> above = hn::Mul(hn::Sub(C(d, 1.0), hn::Div(hn::Sub(sigma_p, ss), smax)), base);
+    f = hn::IfThenElse(below, base, above);
+  }
   return hn::Mul(hn::Mul(hn::Mul(f, lambda_s), m), m);
-}
-
-// c0 + c1 x + ... + c7 x^7 by Estrin's scheme (oscillator.hpp, polynomial7).
-template <class D>
-HWY_INLINE V<D> polynomial7(D d, V<D> x, const double (&c)[8]) {
-  const V<D> x2 = hn::Mul(x, x), x4 = hn::Mul(x2, x2);
-  const V<D> p01 = hn::Add(C(d, c[0]), hn::Mul(C(d, c[1]), x));
-  const V<D> p23 = hn::Add(C(d, c[2]), hn::Mul(C(d, c[3]), x));
-  const V<D> p45 = hn::Add(C(d, c[4]), hn::Mul(C(d, c[5]), x));
-  const V<D> p67 = hn::Add(C(d, c[6]), hn::Mul(C(d, c[7]), x));
-  return hn::Add(hn::Add(p01, hn::Mul(x2, p23)), hn::Mul(x4, hn::Add(p45, hn::Mul(x2, p67))));
 }
 
 // The closed form of the free row m e'' + c e' + k e = 0 over h (oscillator.hpp,
@@ -116,8 +129,6 @@ HWY_INLINE void oscillator_step(D d, V<D> m, V<D> inv_m, V<D> c, V<D> k, V<D> F0
   constexpr double kSinc[8] = {
       1.0,          1.0 / 6,          1.0 / 120,          1.0 / 5040,
       1.0 / 362880, 1.0 / 39916800.0, 1.0 / 6227020800.0, 1.0 / 1307674368000.0};
-  constexpr double kExp[8] = {1.0,      1.0,       1.0 / 2,   1.0 / 6,
-                              1.0 / 24, 1.0 / 120, 1.0 / 720, 1.0 / 5040};
   const V<D> g = hn::Div(hn::Sub(F1, F0), h);  // force rate [N/s]
   const V<D> inv_k = hn::Div(C(d, 1.0), k);
   const V<D> gck = hn::Mul(hn::Mul(g, c), inv_k);
@@ -132,7 +143,7 @@ HWY_INLINE void oscillator_step(D d, V<D> m, V<D> inv_m, V<D> c, V<D> k, V<D> F0
   if (!hn::AllFalse(d, series)) {  // the propagator's series, where a lane's step is short
     const V<D> Cu = polynomial7(d, u, kCos), Su = polynomial7(d, u, kSinc);
     const Mk<D> short_tau = hn::Le(hn::Abs(half_tau), C(d, 1.0 / 64));
-    V<D> E = polynomial7(d, half_tau, kExp);
+    V<D> E = exp_series7(d, half_tau);
     if (!hn::AllTrue(d, short_tau)) E = hn::IfThenElse(short_tau, E, hn::Exp(d, half_tau));
     const V<D> f0 = hn::Mul(E, hn::Sub(Cu, hn::Mul(half_tau, Su)));
     const V<D> f1h = hn::Mul(hn::Mul(E, Su), h);

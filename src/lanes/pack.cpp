@@ -61,9 +61,13 @@ bool same_structure(const lanes::Structure& a, const lanes::Structure& b) {
 }
 
 // Lane j's State scalars and constants (the GlobalField numbers), its failure record cleared.
-void pack_globals(LaneData& L, std::size_t j, const Model& m, const Conditions& c, const State& s,
-                  double sensor_area) {
+void pack_globals(LaneData& L, std::size_t j, const Model& m, const Conditions& c, const State& s) {
   using namespace lanes;
+  double sensor_area = 0.0;
+  for (int b : m.flux_sensor_branches)
+    sensor_area +=
+        c.rods[static_cast<std::size_t>(m.circuit.branches[static_cast<std::size_t>(b)].rod)]
+            .area_m2;
   auto glob = [&](int f) -> double& { return L.glob(f)[j]; };
   const double globals[] = {s.t_s,
                             s.current_A,
@@ -92,11 +96,6 @@ void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, 
   using namespace lanes;
   auto rod = [&](int f, int i) -> double& { return L.rod(f, i)[j]; };
   const int n = m.rod_count();
-  double sensor_area = 0.0;
-  for (int b : m.flux_sensor_branches)
-    sensor_area +=
-        c.rods[static_cast<std::size_t>(m.circuit.branches[static_cast<std::size_t>(b)].rod)]
-            .area_m2;
   for (int i = 0; i < n; ++i) {
     const RodState& r = s.rods[static_cast<std::size_t>(i)];
     const RodConditions& rc = c.rods[static_cast<std::size_t>(i)];
@@ -157,13 +156,18 @@ void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, 
         1.0 / rc.ja.a_A_per_m,
         rc.length_m / rc.area_m2,
         1.0 / rc.area_m2,
-        1.0 / rc.mass_osc_kg};
+        1.0 / rc.mass_osc_kg,
+        1.0 / rc.ja.k_A_per_m,
+        rc.inv_MsT_E_m_per_A,
+        rc.inv_Ms_strain_m_per_A,
+        rc.area_over_length_m,
+        4.0 * rc.sigma_p_Pa / m.material.lambda_s};
     for (int f = kRodStateCount; f < kRodFieldCount; ++f) rod(f, i) = constants[f - kRodStateCount];
     for (int b = 0; b < n; ++b) L.S(i, b)[j] = lr.S8[static_cast<std::size_t>(8 * i + b)];
     L.bt_coil(i)[j] = lr.bt_coil8[i];
     L.bt_pm(i)[j] = lr.bt_pm8[i];
   }
-  pack_globals(L, j, m, c, s, sensor_area);
+  pack_globals(L, j, m, c, s);
 }
 
 }  // namespace
@@ -182,7 +186,7 @@ LaneBatch::LaneBatch(std::span<const Model* const> models,
   d_->resize(n);
   d_->st = structure_of(*models[0], *conditions[0]);
   for (std::size_t j = 0; j < d_->npad; ++j) {
-    const std::size_t src = j < n ? j : 0;  // padding repeats lane 0
+    const std::size_t src = j < n ? j : n - 1;  // padding repeats the last lane
     const Model& m = *models[src];
     if (j < n && !same_structure(d_->st, structure_of(m, *conditions[src])))
       throw InputError(
@@ -217,10 +221,11 @@ void LaneBatch::step(std::span<const double> current_A, std::span<const double> 
                        width_one);
 }
 
-// The inputs of the lanes, padding lanes repeating lane 0's.
+// The inputs of the lanes, padding lanes repeating the last lane's (the lanes of its own vector:
+// no other lane's branches).
 void LaneBatch::pad_inputs(std::span<const double> a, std::vector<double>& to) const {
   std::copy(a.begin(), a.end(), to.begin());
-  std::fill(to.begin() + static_cast<std::ptrdiff_t>(a.size()), to.end(), a[0]);
+  std::fill(to.begin() + static_cast<std::ptrdiff_t>(a.size()), to.end(), a.back());
 }
 
 void LaneBatch::rest_increment(std::span<const double> current_A, std::span<const double> pm_scale,

@@ -1,6 +1,7 @@
 // simulate_lanes (gmasim/lanes.hpp): simulate() for many settings at once, the runs that
 // share a step count advancing together in a LaneBatch. Each lane's run is simulate()'s: the
 // same grid, rest state, records, checks, metrics and error texts (src/simulate/run.cpp).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -8,6 +9,7 @@
 
 #include "gmasim/errors.hpp"
 #include "gmasim/model/validity.hpp"
+#include "gmasim/physics/magnetic.hpp"
 #include "gmasim/simulate/lanes.hpp"
 #include "gmasim/simulate/run_loop.hpp"
 #include "simulate/record.hpp"
@@ -47,13 +49,42 @@ struct LaneRun {
   std::vector<double> rows;
   std::size_t staged = 0;
   // Appends the staged rows' first `columns` values (of `width`) to the series.
+  // Written by index into the grown column (no push_back per value: its end pointer was a chain).
   void flush(TimeSeries& ts, std::size_t width, std::size_t columns) {
-    for (std::size_t q = 0; q < columns; ++q)
-      for (std::size_t k = 0; k < staged; ++k) ts.columns[q].push_back(rows[k * width + q]);
+    for (std::size_t q = 0; q < columns; ++q) {
+      std::vector<double>& col = ts.columns[q];
+      const std::size_t at = col.size();
+      col.resize(at + staged);
+      double* o = col.data() + at;
+      for (std::size_t k = 0; k < staged; ++k) o[k] = rows[k * width + q];
+    }
     staged = 0;
   }
 };
 constexpr std::size_t kStagedRows = 64;
+
+// The lanes' drives at one time: Waveform::current_at of a biased sine (every lane of a group is
+// periodic), min + pp/2 (1 - cos 2 pi f t), the cosine taken once per distinct frequency (a
+// sweep's lanes share a few) -- the same operations, the same bits.
+struct Drives {
+  std::vector<double> freq, cosine;  // the distinct frequencies, their cos 2 pi f t
+  std::vector<std::size_t> of;       // lane -> its frequency's index
+  std::vector<const Waveform*> w;    // lane -> its waveform
+  void add(const Waveform& wf) {
+    std::size_t u = 0;
+    while (u < freq.size() && !(freq[u] == wf.frequency_Hz)) ++u;
+    if (u == freq.size()) freq.push_back(wf.frequency_Hz);
+    of.push_back(u);
+    w.push_back(&wf);
+  }
+  void at(double t, std::vector<double>& current) {
+    constexpr double two_pi = 2.0 * physics::kPi;
+    cosine.resize(freq.size());
+    for (std::size_t u = 0; u < freq.size(); ++u) cosine[u] = std::cos(two_pi * freq[u] * t);
+    for (std::size_t l = 0; l < w.size(); ++l)
+      current[l] = w[l]->min_A + 0.5 * w[l]->pp_A * (1.0 - cosine[of[l]]);
+  }
+};
 constexpr std::size_t kGlobalColumns = 6;  // run.cpp's make_columns: t_s .. y_stack_um
 
 // metrics_only: the rods' columns hold at most the rest state's row: none.
@@ -69,7 +100,30 @@ void finish(const SimulationSettings& s, const Plan& p, Result& r) {
   }
 }
 
-// The rest states (make_state), then the steps of the group in lanes.
+// The runs' settings (idx) and conditions, and their rest states: make_state's ramp for all of
+// them in lanes (make_states: equal to make_state to the lanes' rounding); none where a ramp
+// fails (then each run makes its own, make_state, and its error is the run's).
+std::vector<State> rest_states(const Model& m, std::span<const SimulationSettings> settings,
+                               const std::vector<std::size_t>& idx, std::vector<LaneRun>& runs) {
+  const std::vector<const Model*> models(runs.size(), &m);
+  std::vector<const Conditions*> conds;
+  std::vector<double> I0;
+  for (std::size_t q = 0; q < idx.size(); ++q) {
+    LaneRun& lr = runs[q];
+    const SimulationSettings& s = settings[idx[q]];
+    lr.setting = idx[q];
+    lr.c = make_conditions(m, s.temperature_C, s.freeze);
+    conds.push_back(&lr.c);
+    I0.push_back(s.waveform.current_at(0.0));
+  }
+  try {
+    return make_states(models, conds, I0);
+  } catch (const DivergenceError&) {
+    return {};
+  }
+}
+
+// The rest states (rest_states), then the steps of the group in lanes.
 void run_group(const Model& m, std::span<const SimulationSettings> settings,
                const std::vector<std::size_t>& idx, const Plan& p, bool metrics_only,
                std::vector<Result>& out) {
@@ -79,17 +133,16 @@ void run_group(const Model& m, std::span<const SimulationSettings> settings,
   std::vector<const Conditions*> conds;
   std::vector<const State*> states;
   std::vector<std::size_t> lane_of;  // lane -> run
+  std::vector<State> rest = rest_states(m, settings, idx, runs);
   for (std::size_t q = 0; q < idx.size(); ++q) {
     LaneRun& lr = runs[q];
     const SimulationSettings& s = settings[idx[q]];
     Result& r = out[idx[q]];
-    lr.setting = idx[q];
-    lr.c = make_conditions(m, s.temperature_C, s.freeze);
     r.dt_s = p.dt_s;
     r.thermal_expansion_start_um = r.thermal_expansion_um = lr.c.thermal_expansion_m * 1e6;
     make_columns(m, r.series, static_cast<std::size_t>(p.steps / s.record_every + 2));
     try {
-      lr.st = make_state(m, lr.c, s.waveform.current_at(0.0));
+      lr.st = rest.empty() ? make_state(m, lr.c, s.waveform.current_at(0.0)) : std::move(rest[q]);
       lr.st.energy.enabled = false;
       check_physical_validity(m, lr.c, lr.st, 0.0);
       if (metrics_only)
@@ -113,13 +166,13 @@ void run_group(const Model& m, std::span<const SimulationSettings> settings,
     for (std::size_t l = 0; l < n; ++l) runs[lane_of[l]].rows.resize(kStagedRows * width);
     std::vector<double> current(n), dt(n, p.dt_s), t1(n);
     std::size_t live = n;
+    Drives drives;
+    for (std::size_t l = 0; l < n; ++l) drives.add(settings[runs[lane_of[l]].setting].waveform);
 
     for (long k = 1; k <= p.steps && live > 0; ++k) {
       const double t = 0.0 + static_cast<double>(k) * p.dt_s;  // the Uniform clock
-      for (std::size_t l = 0; l < n; ++l) {
-        current[l] = settings[runs[lane_of[l]].setting].waveform.current_at(t);
-        t1[l] = t;
-      }
+      drives.at(t, current);
+      std::fill(t1.begin(), t1.end(), t);
       batch.step(current, dt, t1);
       for (std::size_t l = 0; l < n; ++l) {
         LaneRun& lr = runs[lane_of[l]];

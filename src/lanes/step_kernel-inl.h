@@ -63,11 +63,56 @@ struct RodStates {
 // phi_r = ((B^T u - S z)_r + F_r) / R_r. ok is false where a pivot is not positive or z is
 // not finite. One division per pivot and per rod branch (their reciprocals), as rod_solve and
 // solve_circuit.
+// Three rods (the built-in actuator): netlist.cpp's rod_solve3, A = S + diag(R) solved by its
+// adjugate with one division, Sylvester's criterion for the pivots.
+template <class D>
+HWY_INLINE Mk<D> circuit_solve3(const Chunk<D>& c, const V<D>* R, const V<D>* mmf, V<D> I, V<D> pm,
+                                V<D>* phi) {
+  const D d = c.d;
+  auto S = [&](int a, int b) { return hn::LoadU(d, c.L.S(a, b) + c.j); };
+  V<D> inv_R[3], DF[3], Btu[3], x[3];
+  for (int a = 0; a < 3; ++a) {
+    inv_R[a] = hn::Div(C(d, 1.0), R[a]);
+    DF[a] = hn::Mul(mmf[a], inv_R[a]);
+    Btu[a] = hn::Add(hn::Mul(I, hn::LoadU(d, c.L.bt_coil(a) + c.j)),
+                     hn::Mul(pm, hn::LoadU(d, c.L.bt_pm(a) + c.j)));
+  }
+  for (int a = 0; a < 3; ++a)
+    x[a] = hn::Sub(Btu[a], hn::Add(hn::Add(hn::Mul(S(a, 0), DF[0]), hn::Mul(S(a, 1), DF[1])),
+                                   hn::Mul(S(a, 2), DF[2])));
+  const V<D> a00 = hn::Add(S(0, 0), R[0]), a10 = S(1, 0), a11 = hn::Add(S(1, 1), R[1]);
+  const V<D> a20 = S(2, 0), a21 = S(2, 1), a22 = hn::Add(S(2, 2), R[2]);
+  auto minor = [&](V<D> p, V<D> q, V<D> r, V<D> s) {
+    return hn::Sub(hn::Mul(p, q), hn::Mul(r, s));
+  };
+  const V<D> c00 = minor(a11, a22, a21, a21), c01 = minor(a20, a21, a10, a22);
+  const V<D> c02 = minor(a10, a21, a20, a11), c11 = minor(a00, a22, a20, a20);
+  const V<D> c12 = minor(a10, a20, a00, a21), m2 = minor(a00, a11, a10, a10);
+  const V<D> det = hn::Add(hn::Add(hn::Mul(a00, c00), hn::Mul(a10, c01)), hn::Mul(a20, c02));
+  const V<D> zero = hn::Zero(d);
+  Mk<D> ok = hn::And(hn::And(hn::Gt(a00, zero), hn::Gt(m2, zero)), hn::Gt(det, zero));
+  const V<D> inv_det = hn::Div(C(d, 1.0), det);
+  auto row = [&](V<D> p, V<D> q, V<D> r) {
+    return hn::Add(hn::Add(hn::Mul(p, x[0]), hn::Mul(q, x[1])), hn::Mul(r, x[2]));
+  };
+  V<D> z[3] = {hn::Add(hn::Mul(row(c00, c01, c02), inv_det), DF[0]),
+               hn::Add(hn::Mul(row(c01, c11, c12), inv_det), DF[1]),
+               hn::Add(hn::Mul(row(c02, c12, m2), inv_det), DF[2])};
+  for (int a = 0; a < 3; ++a) ok = hn::And(ok, hn::IsFinite(z[a]));
+  for (int a = 0; a < 3; ++a) {
+    const V<D> sz =
+        hn::Add(hn::Add(hn::Mul(S(a, 0), z[0]), hn::Mul(S(a, 1), z[1])), hn::Mul(S(a, 2), z[2]));
+    phi[a] = hn::Mul(hn::Add(hn::Sub(Btu[a], sz), mmf[a]), inv_R[a]);
+  }
+  return ok;
+}
+
 template <class D>
 HWY_INLINE Mk<D> circuit_solve(const Chunk<D>& c, const V<D>* R, const V<D>* mmf, V<D> I, V<D> pm,
                                V<D>* phi) {
   const D d = c.d;
   const int n = c.n;
+  if (n == 3) return circuit_solve3(c, R, mmf, I, pm, phi);
   V<D> S[kMaxRods][kMaxRods], A[kMaxRods][kMaxRods], DF[kMaxRods], Btu[kMaxRods], x[kMaxRods],
       piv[kMaxRods], inv_piv[kMaxRods], inv_R[kMaxRods];
   for (int a = 0; a < n; ++a) {
@@ -115,15 +160,16 @@ HWY_INLINE Mk<D> circuit_solve(const Chunk<D>& c, const V<D>* R, const V<D>* mmf
 
 template <class D>
 HWY_INLINE JaLaneConstants<D> ja_constants(const Chunk<D>& c, int i) {
-  return {c.rod(kMsTMag, i), c.rod(kJaA, i), c.rod(kJaAlpha, i),
-          c.rod(kJaC, i),    c.rod(kJaK, i), c.rod(kJaInvA, i)};
+  return {c.rod(kMsTMag, i), c.rod(kJaA, i),    c.rod(kJaAlpha, i), c.rod(kJaC, i),
+          c.rod(kJaK, i),    c.rod(kJaInvA, i), c.rod(kJaInvK, i)};
 }
 
 // A lane that has stopped keeps the trial of the iterate it stopped at; the others take t
-// (and count its full solves of the law, LaneData::full_solves).
+// (and count its full solves of the law in the lanes that are not padding, LaneData::full_solves).
 template <class D, class M, class T>
-HWY_INLINE void take_trial(D d, M done, const T& t, T& tr, std::size_t& full_solves) {
-  if (!hn::AllFalse(d, t.solved)) full_solves += hn::CountTrue(d, hn::AndNot(done, t.solved));
+HWY_INLINE void take_trial(D d, M done, M real, const T& t, T& tr, std::size_t& full_solves) {
+  if (!hn::AllFalse(d, t.solved))
+    full_solves += hn::CountTrue(d, hn::And(real, hn::AndNot(done, t.solved)));
   tr.M = hn::IfThenElse(done, tr.M, t.M);
   tr.dM_dH = hn::IfThenElse(done, tr.dM_dH, t.dM_dH);
   tr.Mirr = hn::IfThenElse(done, tr.Mirr, t.Mirr);
@@ -136,9 +182,10 @@ HWY_INLINE void take_trial(D d, M done, const T& t, T& tr, std::size_t& full_sol
 }
 
 // Per rod, what the Newton solve fixes at the step's start and what it ends with.
+// g = 2 kappa / h (eddy_static_field_trapezoid; 0 at rest).
 template <class Law, class D>
 struct Magnetic {
-  V<D> H[kMaxRods], Mg[kMaxRods], B0[kMaxRods], Bs[kMaxRods];
+  V<D> H[kMaxRods], Mg[kMaxRods], B0[kMaxRods], Bs[kMaxRods], g[kMaxRods];
   typename Law::template Trial<D> trial[kMaxRods];
 };
 
@@ -184,6 +231,25 @@ HWY_INLINE Mk<D> stopped(D d, int n, Mk<D> done, V<D> worst, V<D> worst_rod, int
   return stop;
 }
 
+// Rod i's flux density B0 at the step's start, its eddy terms e0 = H_c - H and g = 2 kappa / h
+// and the first guess (H, M) of newton_fields; quasi_static: no eddy term, the guess (H_n, M_n).
+template <class Law, class D>
+HWY_INLINE void first_guess(const Chunk<D>& c, const RodStates<D>& s, int i, V<D> two_over_h,
+                            bool quasi_static, Magnetic<Law, D>& mg, V<D>& e0) {
+  const D d = c.d;
+  mg.B0[i] = hn::Mul(C(d, physics::kMu0), hn::Add(s.f[kH][i], s.f[kM][i]));
+  if (quasi_static) {
+    e0 = mg.g[i] = hn::Zero(d);
+    mg.H[i] = s.f[kH][i];
+    mg.Mg[i] = s.f[kM][i];
+    return;
+  }
+  e0 = hn::Sub(s.f[kHc][i], s.f[kH][i]);
+  mg.g[i] = hn::Mul(c.rod(kKappa, i), two_over_h);
+  mg.H[i] = hn::Add(hn::Mul(C(d, 3.0), hn::Sub(s.f[kH][i], s.f[kHprev][i])), s.f[kHprev2][i]);
+  mg.Mg[i] = hn::Add(hn::Mul(C(d, 3.0), hn::Sub(s.f[kM][i], s.f[kMprev][i])), s.f[kMprev2][i]);
+}
+
 // Newton's method on the rods' fields and magnetisations jointly (model/step.cpp,
 // consistent_magnetic_update): the first guess extrapolated quadratically from the last three
 // steps (H = 3 (H_n - H_n-1) + H_n-2, M likewise); at each iterate (H*, M*) each rod's law
@@ -205,7 +271,9 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
   const D d = c.d;
   const int n = c.n;
   constexpr double kMu0 = physics::kMu0;
-  V<D> g[kMaxRods], e0[kMaxRods], inv_mud[kMaxRods];
+  V<D> e0[kMaxRods], inv_mud[kMaxRods];
+  const V<D>* g = mg.g;
+  const V<D> two_over_h = hn::Div(C(d, 2.0), h);
   typename Law::template Start<D> start[kMaxRods];
   typename Law::template Rod<D> rod[kMaxRods];
   JaLaneConstants<D> ja[kMaxRods];
@@ -213,19 +281,10 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
     ja[i] = ja_constants(c, i);
     rod[i] = {s.f[kH][i], s.f[kMirr][i], s.f[kM][i], s.f[kAnX][i], s.f[kAnL][i], s.f[kAnDL][i]};
     start[i] = Law::begin_move(d, ja[i], rod[i]);
-    mg.B0[i] = hn::Mul(C(d, kMu0), hn::Add(s.f[kH][i], s.f[kM][i]));
-    if (quasi_static) {
-      e0[i] = g[i] = hn::Zero(d);
-      mg.H[i] = s.f[kH][i];
-      mg.Mg[i] = s.f[kM][i];
-      continue;
-    }
-    e0[i] = hn::Sub(s.f[kHc][i], s.f[kH][i]);
-    g[i] = hn::Div(hn::Mul(C(d, 2.0), c.rod(kKappa, i)), h);
-    mg.H[i] = hn::Add(hn::Mul(C(d, 3.0), hn::Sub(s.f[kH][i], s.f[kHprev][i])), s.f[kHprev2][i]);
-    mg.Mg[i] = hn::Add(hn::Mul(C(d, 3.0), hn::Sub(s.f[kM][i], s.f[kMprev][i])), s.f[kMprev2][i]);
+    first_guess(c, s, i, two_over_h, quasi_static, mg, e0[i]);
   }
   Mk<D> done = fails.failed;
+  const Mk<D> real = hn::FirstN(d, c.j < c.L.n ? c.L.n - c.j : 0);
   for (int it = 0; !hn::AllTrue(d, done); ++it) {
     V<D> R[kMaxRods], mmf[kMaxRods], phi[kMaxRods];
     V<D> law_steps = hn::Zero(d);  // sum over the rods of |M_next - M*|
@@ -233,7 +292,7 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
     for (int i = 0; i < n; ++i) {
       const auto t = Law::joint_trial(d, ja[i], rod[i], start[i], mg.H[i], mg.Mg[i]);
       auto& tr = mg.trial[i];
-      take_trial(d, done, t, tr, c.L.full_solves);
+      take_trial(d, done, real, t, tr, c.L.full_solves);
       laws_hold = hn::And(laws_hold, tr.converged);
       law_steps = hn::Add(law_steps, hn::Abs(hn::Sub(tr.M_next, mg.Mg[i])));
       mg.Bs[i] = hn::Mul(C(d, kMu0), hn::Add(mg.H[i], tr.M_next));
@@ -285,7 +344,7 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
 // trial at H1 as it is (its M, M_irr and flux density B1), the eddy field (eq. 7,
 // trapezoidal), the first guess's histories, mu_r = 1 + dM/dH and the rod's flux.
 template <class Law, class D>
-HWY_INLINE void commit_fields(const Chunk<D>& c, RodStates<D>& s, V<D> h, bool quasi_static,
+HWY_INLINE void commit_fields(const Chunk<D>& c, RodStates<D>& s, bool quasi_static,
                               const Magnetic<Law, D>& mg) {
   const D d = c.d;
   constexpr double kMu0 = physics::kMu0;
@@ -296,13 +355,10 @@ HWY_INLINE void commit_fields(const Chunk<D>& c, RodStates<D>& s, V<D> h, bool q
     s.f[kMprev][i] = s.f[kM][i];
     s.f[kMirr][i] = tr.Mirr;
     s.f[kM][i] = tr.M;
-    // eddy_static_field_trapezoid: H1 + 2 kappa (B1 - B0)/h - (Hc0 - H0); at rest H_c = H1
-    s.f[kHc][i] =
-        quasi_static
-            ? H1
-            : hn::Sub(hn::Add(H1, hn::Div(hn::Mul(hn::Mul(C(d, 2.0), kappa), hn::Sub(B1, mg.B0[i])),
-                                          h)),
-                      hn::Sub(s.f[kHc][i], s.f[kH][i]));
+    // eddy_static_field_trapezoid: H1 + g (B1 - B0) - (Hc0 - H0); at rest H_c = H1
+    s.f[kHc][i] = quasi_static ? H1
+                               : hn::Sub(hn::Add(H1, hn::Mul(mg.g[i], hn::Sub(B1, mg.B0[i]))),
+                                         hn::Sub(s.f[kHc][i], s.f[kH][i]));
     s.f[kHprev2][i] = s.f[kHprev][i];
     s.f[kHprev][i] = s.f[kH][i];
     s.f[kH][i] = H1;

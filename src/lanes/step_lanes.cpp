@@ -24,14 +24,18 @@ HWY_INLINE void mechanics(const Chunk<D>& c, RodStates<D>& s, V<D> h, V<D> t1, F
   for (int i = 0; i < n; ++i) {
     F0[i] = s.f[kF][i];
     K0[i] = hn::Add(s.f[kKRod][i], s.f[kKLoad][i]);
+    // rod_laws.hpp, update_rod_mechanics: the reciprocals are the conditions'
     const V<D> M = s.f[kM][i], A = c.rod(kArea, i);
-    const V<D> E = delta_e_modulus(d, hn::Div(M, c.rod(kMsTE, i)), c.rod(kInvEs, i), c.rod(kRot, i),
-                                   c.rod(kCoupling, i), c.rod(kMu0Ms2, i), c.rod(kSdE, i));
+    const V<D> inv_E =
+        delta_e_compliance(d, hn::Mul(M, c.rod(kInvMsTE, i)), c.rod(kInvEs, i), c.rod(kRot, i),
+                           c.rod(kCoupling, i), c.rod(kMu0Ms2, i), c.rod(kSdE, i));
+    const V<D> E = hn::Div(C(d, 1.0), inv_E);
     s.f[kE][i] = E;
     s.f[kLambda][i] =
-        magnetostriction(d, hn::Div(M, c.rod(kMsStrain, i)), lambda_s, c.rod(kSigmaP, i), E);
+        magnetostriction(d, hn::Mul(M, c.rod(kInvMsStrain, i)), lambda_s, c.rod(kSigmaP, i), E,
+                         hn::Mul(c.rod(kFourSpOverLs, i), inv_E));
     s.f[kF][i] = hn::Mul(hn::Mul(s.f[kLambda][i], E), A);
-    s.f[kKRod][i] = hn::Div(hn::Mul(E, A), c.rod(kLength, i));
+    s.f[kKRod][i] = hn::Mul(E, c.rod(kAreaOverLength, i));
   }
   V<D> compliance[kMaxRods];  // 1 / k_rod, each rod's once (the chains share them)
   for (int i = 0; i < n; ++i) compliance[i] = hn::Div(C(d, 1.0), s.f[kKRod][i]);
@@ -79,7 +83,7 @@ HWY_INLINE void mount_and_outputs(const Chunk<D>& c, RodStates<D>& s, V<D>* g, V
   for (int k = 0; k < st.sensor_count; ++k)
     phi = hn::Add(phi, s.f[kPhi][st.sensor_rods[static_cast<std::size_t>(k)]]);
   g[kBSensor] = hn::Div(phi, c.glob(kSensorArea));
-  for (int i = 0; i < c.n; ++i) s.f[kB][i] = hn::Div(s.f[kPhi][i], c.rod(kArea, i));
+  for (int i = 0; i < c.n; ++i) s.f[kB][i] = hn::Mul(s.f[kPhi][i], c.rod(kInvArea, i));
 }
 
 // run_loop's checks after the step (gmasim/run_loop.hpp, advance): y and B finite, every
@@ -159,7 +163,7 @@ HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
   const V<D> t1 = hn::Add(g[kT], h);  // step()'s t1 = s.t_s + h
   Magnetic<JilesAthertonLanes, D> mg;
   newton_fields<JilesAthertonLanes>(c, s, I, c.glob(kPmScale), h, t1, false, mg, fails);
-  commit_fields<JilesAthertonLanes>(c, s, h, false, mg);
+  commit_fields<JilesAthertonLanes>(c, s, false, mg);
   for (int i = 0; i < c.n; ++i) {
     fails.check(d, s.f[kH][i], C(d, 1e9), kFailH, i, t1);
     fails.check(d, s.f[kM][i], hn::Mul(C(d, 1.5), c.rod(kMsTMag, i)), kFailM, i, t1);
@@ -188,7 +192,7 @@ HWY_INLINE void ramp_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
   const V<D> one = C(d, 1.0), t = hn::Zero(d);
   Magnetic<JilesAthertonLanes, D> mg;
   newton_fields<JilesAthertonLanes>(c, s, I, pm, one, t, true, mg, fails);
-  commit_fields<JilesAthertonLanes>(c, s, one, true, mg);
+  commit_fields<JilesAthertonLanes>(c, s, true, mg);
   const Mk<D> keep = hn::AndNot(fails.failed, alive);
   store_rods(c, s, keep);
   store_fails(c, fails);
@@ -202,7 +206,9 @@ HWY_INLINE void chunk(D d, LaneData& L, std::size_t j, const StepInputs& in) {
     step_chunk(d, L, j, in);
 }
 
-// All lanes, in chunks of the target's width (or of 1: the reference instance).
+// All lanes, in chunks of the target's width (or of 1: the reference instance). The lanes left
+// after the full chunks take a vector of half the width where they fit in it, not a full one of
+// padding.
 void StepAll(LaneData& L, const StepInputs& in, bool width_one) {
   if (width_one) {
     const hn::CappedTag<double, 1> d1;
@@ -211,7 +217,14 @@ void StepAll(LaneData& L, const StepInputs& in, bool width_one) {
   }
   const hn::ScalableTag<double> d;
   const std::size_t w = hn::Lanes(d);
-  for (std::size_t j = 0; j < L.npad; j += w) chunk(d, L, j, in);
+  std::size_t j = 0;
+  for (; j + w <= L.n; j += w) chunk(d, L, j, in);
+  const std::size_t rest = L.n - j;
+  if (rest == 0) return;
+  if (w >= 4 && rest <= w / 2)
+    chunk(hn::CappedTag<double, HWY_MAX(1, HWY_LANES(double) / 2)>(), L, j, in);
+  else
+    chunk(d, L, j, in);
 }
 
 int WidthOf() { return static_cast<int>(hn::Lanes(hn::ScalableTag<double>())); }
