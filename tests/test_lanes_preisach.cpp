@@ -197,7 +197,7 @@ TEST(PreisachLanes, FollowTheScalarStep) {
   }
 }
 
-// make_states (the ramp in lanes, rest_increment) against make_state; observed 0 to 1e-15
+// make_states (the ramp in lanes, rest_increment) against make_state; observed 1.5e-14
 // relative; tolerance 1e-13. The increment and the step allocate nothing.
 TEST(PreisachLanes, MakeStatesMatchMakeState) {
   const std::size_t n = 6;
@@ -243,7 +243,7 @@ TEST(PreisachLanes, MakeStatesMatchMakeState) {
 }
 
 // simulate_lanes (what `gmasim sweep` runs) against simulate(): the metrics of biased and
-// bipolar sines at three temperatures; observed 1e-14 of the stroke; tolerance 1e-11.
+// bipolar sines at three temperatures; observed 1.2e-13 of the stroke; tolerance 1e-12.
 TEST(PreisachLanes, SimulateLanesMatchesSimulate) {
   std::vector<SimulationSettings> set;
   for (double T : {20.0, 50.0, 80.0})
@@ -256,6 +256,7 @@ TEST(PreisachLanes, SimulateLanesMatchesSimulate) {
     }
   const std::vector<Result> got = simulate_lanes(model(), set);
   ASSERT_EQ(got.size(), set.size());
+  double worst = 0.0;
   for (std::size_t i = 0; i < set.size(); ++i) {
     const Result ref = simulate(model(), set[i]);
     ASSERT_FALSE(got[i].diverged) << got[i].error;
@@ -263,10 +264,16 @@ TEST(PreisachLanes, SimulateLanesMatchesSimulate) {
     EXPECT_EQ(got[i].series.rows(), ref.series.rows());
     const double scale = std::fabs(ref.metrics.stroke_um);
     EXPECT_GT(scale, 0.0);
-    EXPECT_NEAR(got[i].metrics.stroke_um, ref.metrics.stroke_um, 1e-11 * scale);
-    EXPECT_NEAR(got[i].metrics.hysteresis_um, ref.metrics.hysteresis_um, 1e-11 * scale);
-    EXPECT_NEAR(got[i].metrics.B_pp_T, ref.metrics.B_pp_T, 1e-11 * ref.metrics.B_pp_T);
+    auto rel = [&](double x, double r, double of) {
+      const double e = std::fabs(x - r) / of;
+      worst = std::max(worst, e);
+      EXPECT_LE(e, 1e-12) << "setting " << i;
+    };
+    rel(got[i].metrics.stroke_um, ref.metrics.stroke_um, scale);
+    rel(got[i].metrics.hysteresis_um, ref.metrics.hysteresis_um, scale);
+    rel(got[i].metrics.B_pp_T, ref.metrics.B_pp_T, ref.metrics.B_pp_T);
   }
+  std::printf("Preisach simulate_lanes vs simulate: largest relative difference %.3g\n", worst);
 }
 
 }  // namespace preisach_lanes_test
