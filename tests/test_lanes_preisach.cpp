@@ -137,8 +137,8 @@ TEST(PreisachLanes, FallbackTargetsEqualTheirWidthOneInstance) {
 // extrema, and whether it passes one (wiping out the pair) or stops a rounding short of it is
 // decided by the last digits -- such a pair encloses a triangle of measure ~(1e-13)^2, nothing in
 // M. Compared: y (of 1 um), B, H (of 1e4 A/m), M, M_irr (of 1e5 A/m), mu_r, and the point the
-// stack is at (x_now, mu_now). Observed largest relative difference 1.7e-10 (y; H 5.9e-11, M
-// 4.6e-11, at one Newton decision; 1e-12 elsewhere); tolerance 2e-9.
+// stack is at (x_now, mu_now). Observed largest relative difference 3.7e-11 to 1.7e-10 (y, at
+// one Newton decision, which the last digits place; ~1e-12 elsewhere); tolerance 2e-9.
 TEST(PreisachLanes, FollowTheScalarStep) {
   const std::size_t n = 9;
   const PreisachRuns runs(n);

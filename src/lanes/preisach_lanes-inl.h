@@ -2,10 +2,10 @@
 // magnetisation-law seam's second lane entry (docs/lanes.md, "Preisach lanes"). Each lane's
 // extrema stack is its own (their depths differ): the search of the stack for the extremum a move
 // continues from (physics::preisach_base) and the commit run lane by lane on the lane's
-// PreisachHistory; the Everett function (8 bins, each side's Gaussian terms: an erfc and two
-// exponentials) and the law's Newton solve run over the lanes, masked per lane, operation for
-// operation physics::everett and physics::preisach_magnetisation. The vector erfc is Cody's
-// rational Chebyshev approximation (erfc_cody). Included once per target by
+// PreisachHistory; the Everett function (8 bins, each side's Gaussian terms: an erfc whose
+// exp(-z^2) the density shares) and the law's Newton solve run over the lanes, masked per lane,
+// operation for operation physics::everett and physics::preisach_magnetisation otherwise. The
+// vector erfc is Cody's rational Chebyshev approximation (erfc_cody). Included once per target by
 // src/lanes/step_lanes.cpp (hwy/foreach_target.h); it includes the kernel (step_kernel-inl.h).
 #if defined(GMASIM_LANES_PREISACH_INL_H_) == defined(HWY_TARGET_TOGGLE)
 #ifdef GMASIM_LANES_PREISACH_INL_H_
@@ -32,9 +32,10 @@ namespace gmasim::lanes::HWY_NAMESPACE {
 // with t = |x| truncated to 1/16 (no rounding of x^2 enters the exponent); 0 beyond |x| =
 // 26.543 (below the smallest double); erfc(-|x|) = 2 - erfc(|x|). Against glibc's erfc at 4e6
 // random arguments in [-10, 27] (a standalone check of this function, SSE4): at most 4.8 units in
-// the last place (1.1e-15 relative).
+// the last place (1.1e-15 relative). gauss receives exp(-x^2) (the product above; 0 beyond 26.543),
+// which the Gaussian density takes. Each branch is evaluated only where a lane needs it.
 template <class D>
-HWY_INLINE V<D> erfc_cody(D d, V<D> x) {
+HWY_INLINE V<D> erfc_cody(D d, V<D> x, V<D>& gauss) {
   static constexpr double a[5] = {3.16112374387056560e00, 1.13864154151050156e02,
                                   3.77485237685302021e02, 3.20937758913846947e03,
                                   1.85777706184603153e-1};
@@ -57,56 +58,61 @@ HWY_INLINE V<D> erfc_cody(D d, V<D> x) {
   constexpr double kRsqrtPi = 5.6418958354775628695e-1;
   const V<D> one = C(d, 1.0);
   const V<D> y = hn::Min(hn::Abs(x), C(d, 26.543));
-  // |x| <= 0.46875
   const V<D> ysq = hn::Mul(y, y);
-  V<D> num = hn::Mul(C(d, a[4]), ysq), den = ysq;
-  for (int i = 0; i < 3; ++i) {
-    num = hn::Mul(hn::Add(num, C(d, a[i])), ysq);
-    den = hn::Mul(hn::Add(den, C(d, b[i])), ysq);
+  const Mk<D> is_small = hn::Le(y, C(d, 0.46875)), is_mid = hn::Le(y, C(d, 4.0));
+  V<D> small = one, mid = one, tail = one, num, den;
+  if (!hn::AllFalse(d, is_small)) {  // |x| <= 0.46875
+    num = hn::Mul(C(d, a[4]), ysq);
+    den = ysq;
+    for (int i = 0; i < 3; ++i) {
+      num = hn::Mul(hn::Add(num, C(d, a[i])), ysq);
+      den = hn::Mul(hn::Add(den, C(d, b[i])), ysq);
+    }
+    small = hn::Sub(one, hn::Div(hn::Mul(x, hn::Add(num, C(d, a[3]))), hn::Add(den, C(d, b[3]))));
   }
-  const V<D> small =
-      hn::Sub(one, hn::Div(hn::Mul(x, hn::Add(num, C(d, a[3]))), hn::Add(den, C(d, b[3]))));
-  // 0.46875 < |x| <= 4
-  num = hn::Mul(C(d, c[8]), y);
-  den = y;
-  for (int i = 0; i < 7; ++i) {
-    num = hn::Mul(hn::Add(num, C(d, c[i])), y);
-    den = hn::Mul(hn::Add(den, C(d, dd[i])), y);
+  if (!hn::AllFalse(d, hn::AndNot(is_small, is_mid))) {  // 0.46875 < |x| <= 4
+    num = hn::Mul(C(d, c[8]), y);
+    den = y;
+    for (int i = 0; i < 7; ++i) {
+      num = hn::Mul(hn::Add(num, C(d, c[i])), y);
+      den = hn::Mul(hn::Add(den, C(d, dd[i])), y);
+    }
+    mid = hn::Div(hn::Add(num, C(d, c[7])), hn::Add(den, C(d, dd[7])));
   }
-  const V<D> mid = hn::Div(hn::Add(num, C(d, c[7])), hn::Add(den, C(d, dd[7])));
-  // |x| > 4
-  const V<D> z = hn::Div(one, ysq);
-  num = hn::Mul(C(d, p[5]), z);
-  den = z;
-  for (int i = 0; i < 4; ++i) {
-    num = hn::Mul(hn::Add(num, C(d, p[i])), z);
-    den = hn::Mul(hn::Add(den, C(d, q[i])), z);
+  if (!hn::AllTrue(d, is_mid)) {  // |x| > 4
+    const V<D> z = hn::Div(one, ysq);
+    num = hn::Mul(C(d, p[5]), z);
+    den = z;
+    for (int i = 0; i < 4; ++i) {
+      num = hn::Mul(hn::Add(num, C(d, p[i])), z);
+      den = hn::Mul(hn::Add(den, C(d, q[i])), z);
+    }
+    tail = hn::Div(hn::Sub(C(d, kRsqrtPi),
+                           hn::Div(hn::Mul(z, hn::Add(num, C(d, p[4]))), hn::Add(den, C(d, q[4])))),
+                   y);
   }
-  const V<D> tail = hn::Div(hn::Sub(C(d, kRsqrtPi), hn::Div(hn::Mul(z, hn::Add(num, C(d, p[4]))),
-                                                            hn::Add(den, C(d, q[4])))),
-                            y);
   const V<D> t = hn::Mul(hn::Trunc(hn::Mul(y, C(d, 16.0))), C(d, 1.0 / 16.0));
   const V<D> del = hn::Mul(hn::Sub(y, t), hn::Add(y, t));
-  const V<D> gauss = hn::Mul(hn::Exp(d, hn::Neg(hn::Mul(t, t))), hn::Exp(d, hn::Neg(del)));
-  V<D> big = hn::Mul(gauss, hn::IfThenElse(hn::Le(y, C(d, 4.0)), mid, tail));
-  big = hn::IfThenElse(hn::Ge(y, C(d, 26.543)), hn::Zero(d), big);
+  gauss = hn::Mul(hn::Exp(d, hn::Neg(hn::Mul(t, t))), hn::Exp(d, hn::Neg(del)));
+  gauss = hn::IfThenElse(hn::Ge(y, C(d, 26.543)), hn::Zero(d), gauss);
+  V<D> big = hn::Mul(gauss, hn::IfThenElse(is_mid, mid, tail));
   big = hn::IfThenElse(hn::Lt(x, hn::Zero(d)), hn::Sub(C(d, 2.0), big), big);
-  return hn::IfThenElse(hn::Le(y, C(d, 0.46875)), small, big);
+  return hn::IfThenElse(is_small, small, big);
 }
 
 // physics::gauss_terms: the Gaussian f_u of standard deviation s at y, its CDF F, A = int F and
-// Y = int y F(y) dy.
+// Y = int y F(y) dy. The density's exp(-y^2 / (2 s^2)) is the erfc's exp(-z^2), z = -y/(s sqrt 2)
+// (the scalar evaluates exp(-0.5 (y/s)^2) apart: the two differ by the rounding of the exponent).
 template <class D>
 struct GaussLanes {
   V<D> F, f, A, Y;
 };
 template <class D>
 HWY_INLINE GaussLanes<D> gauss_terms(D d, V<D> y, V<D> s) {
-  const V<D> F =
-      hn::Mul(C(d, 0.5), erfc_cody(d, hn::Div(hn::Neg(y), hn::Mul(s, C(d, std::sqrt(2.0))))));
-  const V<D> ys = hn::Div(y, s);
-  const V<D> f = hn::Div(hn::Exp(d, hn::Mul(hn::Mul(C(d, -0.5), ys), ys)),
-                         hn::Mul(s, C(d, std::sqrt(2.0 * physics::kPi))));
+  V<D> gauss;
+  const V<D> F = hn::Mul(
+      C(d, 0.5), erfc_cody(d, hn::Div(hn::Neg(y), hn::Mul(s, C(d, std::sqrt(2.0)))), gauss));
+  const V<D> f = hn::Div(gauss, hn::Mul(s, C(d, std::sqrt(2.0 * physics::kPi))));
   const V<D> s2 = hn::Mul(s, s);
   const V<D> A = hn::Add(hn::Mul(y, F), hn::Mul(s2, f));
   const V<D> B = hn::Add(hn::Mul(hn::Mul(C(d, 0.5), hn::Add(hn::Mul(y, y), s2)), F),
