@@ -302,6 +302,8 @@ HWY_NOINLINE void ja_solve(D d, Mk<D> todo, const JaLaneStart<D>& st, V<D> H1, V
 // 0.2); there M_iter := M, g := 0 and the slope terms come from that solution's chi_e.
 struct JilesAthertonLanes {
   template <class D>
+  using Constants = JaLaneConstants<D>;
+  template <class D>
   using Start = JaLaneStart<D>;
   // The rod's state at the step's start: H, M_irr, M and the law's last evaluation (RodState's
   // an_x, an_L, an_dL).

@@ -7,6 +7,8 @@
 #include <cstddef>
 #include <vector>
 
+#include "lanes/preisach_lane_data.hpp"
+
 namespace gmasim::lanes {
 
 inline constexpr int kMaxRods = 8;
@@ -125,6 +127,7 @@ enum FailCode : int {
 // What every lane shares: the model's structure.
 struct Structure {
   int rods = 0;
+  bool preisach = false;  // the Preisach law (LaneData::pre); the Jiles-Atherton law otherwise
   bool mount = false, xT_in_output = false;
   int sensor_count = 0;
   std::array<int, kMaxRods> sensor_rods{};  // rods whose branches the flux sensor reads
@@ -136,6 +139,7 @@ struct LaneData {
   Structure st;
   std::size_t n = 0, npad = 0;
   std::vector<double> g, r, cm;  // global, rod and circuit fields, each npad long
+  PreisachLaneData pre;          // the Preisach law's constants and stacks (empty otherwise)
   // How many joint trials of a live lane (not padding) solved eq. (9) fully (the law's safeguard,
   // ja_solve).
   std::size_t full_solves = 0;

@@ -20,8 +20,9 @@ bool lanes_supported(const Model& m, std::string* why) {
     if (why) *why = reason;
     return false;
   };
-  if (m.options.magnetisation_law != MagnetisationLaw::JilesAtherton)
-    return no("the lanes have the Jiles-Atherton law only (no Preisach lanes yet)");
+  if (m.options.magnetisation_law != MagnetisationLaw::JilesAtherton &&
+      m.options.magnetisation_law != MagnetisationLaw::Preisach)
+    return no("the lanes have the Jiles-Atherton and Preisach laws only");
   if (m.options.magnetic_state != MagneticState::Consistent)
     return no("the lanes run the consistent magnetic state only");
   if (!m.circuit.lowrank.enabled) return no("the circuit is not on the low-rank path");
@@ -41,6 +42,7 @@ namespace {
 lanes::Structure structure_of(const Model& m, const Conditions& c) {
   lanes::Structure st;
   st.rods = m.rod_count();
+  st.preisach = m.options.magnetisation_law == MagnetisationLaw::Preisach;
   st.mount = m.sensor_mount.enabled;
   st.xT_in_output = m.options.thermal_expansion_in_output;
   for (int b : m.flux_sensor_branches)
@@ -55,9 +57,9 @@ lanes::Structure structure_of(const Model& m, const Conditions& c) {
 }
 
 bool same_structure(const lanes::Structure& a, const lanes::Structure& b) {
-  return a.rods == b.rods && a.mount == b.mount && a.xT_in_output == b.xT_in_output &&
-         a.sensor_count == b.sensor_count && a.sensor_rods == b.sensor_rods && a.chain == b.chain &&
-         a.chain_count == b.chain_count;
+  return a.rods == b.rods && a.preisach == b.preisach && a.mount == b.mount &&
+         a.xT_in_output == b.xT_in_output && a.sensor_count == b.sensor_count &&
+         a.sensor_rods == b.sensor_rods && a.chain == b.chain && a.chain_count == b.chain_count;
 }
 
 // Lane j's State scalars and constants (the GlobalField numbers), its failure record cleared.
@@ -88,6 +90,27 @@ void pack_globals(LaneData& L, std::size_t j, const Model& m, const Conditions& 
                             m.sensor_mount.enabled ? 1.0 / m.sensor_mount.mass_kg : 0.0};
   for (int f = 0; f <= kMountInvMass; ++f) glob(f) = globals[f];
   for (int f = kFail; f < kGlobalFieldCount; ++f) glob(f) = 0.0;
+}
+
+// Lane j's Preisach constants (RodConditions::preisach) and its rods' extrema stacks.
+void pack_preisach(LaneData& L, std::size_t j, const Conditions& c, const State& s) {
+  using namespace lanes;
+  const int n = L.st.rods;
+  for (int i = 0; i < n; ++i) {
+    const physics::PreisachCoefficients& p = c.rods[static_cast<std::size_t>(i)].preisach;
+    auto at = [&](int f) -> double& { return L.pre.field(f, i, n)[j]; };
+    at(kPreC) = p.c;
+    at(kPreAlpha) = p.alpha;
+    at(kPreA) = p.a_A_per_m;
+    at(kPreInvA) = 1.0 / p.a_A_per_m;  // the scalar law's inv_a
+    at(kPreInvHc) = 1.0 / p.Hc_A_per_m;
+    at(kPreSigmaU) = p.dist.sigma_u;
+    for (int b = 0; b <= physics::kPreisachBins; ++b)
+      at(kPreEdge0 + b) = p.dist.edge[static_cast<std::size_t>(b)];
+    for (int b = 0; b < physics::kPreisachBins; ++b)
+      at(kPreDensity0 + b) = p.dist.density[static_cast<std::size_t>(b)];
+    L.pre.history(i)[j] = s.rods[static_cast<std::size_t>(i)].preisach;
+  }
 }
 
 // Lane j's numbers from its model, conditions and state.
@@ -168,6 +191,7 @@ void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, 
     L.bt_pm(i)[j] = lr.bt_pm8[i];
   }
   pack_globals(L, j, m, c, s);
+  if (L.st.preisach) pack_preisach(L, j, c, s);
 }
 
 }  // namespace
@@ -185,13 +209,14 @@ LaneBatch::LaneBatch(std::span<const Model* const> models,
     if (!lanes_supported(*m, &why)) throw InputError("lanes: " + why);
   d_->resize(n);
   d_->st = structure_of(*models[0], *conditions[0]);
+  if (d_->st.preisach) d_->pre.resize(d_->st.rods, d_->npad);
   for (std::size_t j = 0; j < d_->npad; ++j) {
     const std::size_t src = j < n ? j : n - 1;  // padding repeats the last lane
     const Model& m = *models[src];
     if (j < n && !same_structure(d_->st, structure_of(m, *conditions[src])))
       throw InputError(
           fmt::format("lanes: simulation {} has another structure than simulation 0 "
-                      "(rods, load chains, sensor, mount)",
+                      "(rods, magnetisation law, load chains, sensor, mount)",
                       j));
     pack_lane(*d_, j, m, *conditions[src], *states[src], circuit_lowrank_view(m.circuit));
   }
@@ -274,6 +299,7 @@ void LaneBatch::unpack(std::size_t j, State& s) const {
                                             &r.an_L,
                                             &r.an_dL};
     for (int f = 0; f < kRodStateCount; ++f) *fields[f] = L.rod(f, i)[j];
+    if (L.st.preisach) r.preisach = L.pre.history(i)[j];
   }
   double* const globals[kGlobalStateCount] = {&s.t_s, &s.current_A, &s.y_m,         &s.y_stack_m,
                                               &s.q_m, &s.z_m,       &s.z_v_m_per_s, &s.B_T};

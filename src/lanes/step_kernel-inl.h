@@ -164,6 +164,16 @@ HWY_INLINE JaLaneConstants<D> ja_constants(const Chunk<D>& c, int i) {
           c.rod(kJaK, i),    c.rod(kJaInvA, i), c.rod(kJaInvK, i)};
 }
 
+// The law's hooks (one overload per law; the Preisach law's in preisach_lanes-inl.h): the rod's
+// constants and state at the step's start, and the commit of a law state the kernel does not
+// hold in RodStates (after the step, in the lanes that keep it; the JA law has none).
+template <class D>
+HWY_INLINE void law_rod(const Chunk<D>& c, const RodStates<D>& s, int i, JaLaneConstants<D>& k,
+                        typename JilesAthertonLanes::template Rod<D>& r) {
+  k = ja_constants(c, i);
+  r = {s.f[kH][i], s.f[kMirr][i], s.f[kM][i], s.f[kAnX][i], s.f[kAnL][i], s.f[kAnDL][i]};
+}
+
 // A lane that has stopped keeps the trial of the iterate it stopped at; the others take t
 // (and count its full solves of the law in the lanes that are not padding, LaneData::full_solves).
 template <class D, class M, class T>
@@ -188,6 +198,8 @@ struct Magnetic {
   V<D> H[kMaxRods], Mg[kMaxRods], B0[kMaxRods], Bs[kMaxRods], g[kMaxRods];
   typename Law::template Trial<D> trial[kMaxRods];
 };
+template <class D>
+HWY_INLINE void law_commit(const Chunk<D>&, const Magnetic<JilesAthertonLanes, D>&, Mk<D>) {}
 
 // model/step.cpp's next_correction_within_tolerance per lane: after an undamped correction the
 // next one is bounded by 2 law_steps (the sum of the laws' own steps |M_next - M*|); true where
@@ -276,11 +288,10 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
   const V<D> two_over_h = hn::Div(C(d, 2.0), h);
   typename Law::template Start<D> start[kMaxRods];
   typename Law::template Rod<D> rod[kMaxRods];
-  JaLaneConstants<D> ja[kMaxRods];
+  typename Law::template Constants<D> k[kMaxRods];
   for (int i = 0; i < n; ++i) {
-    ja[i] = ja_constants(c, i);
-    rod[i] = {s.f[kH][i], s.f[kMirr][i], s.f[kM][i], s.f[kAnX][i], s.f[kAnL][i], s.f[kAnDL][i]};
-    start[i] = Law::begin_move(d, ja[i], rod[i]);
+    law_rod(c, s, i, k[i], rod[i]);
+    start[i] = Law::begin_move(d, k[i], rod[i]);
     first_guess(c, s, i, two_over_h, quasi_static, mg, e0[i]);
   }
   Mk<D> done = fails.failed;
@@ -290,7 +301,7 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
     V<D> law_steps = hn::Zero(d);  // sum over the rods of |M_next - M*|
     Mk<D> laws_hold = hn::FirstN(d, hn::Lanes(d));
     for (int i = 0; i < n; ++i) {
-      const auto t = Law::joint_trial(d, ja[i], rod[i], start[i], mg.H[i], mg.Mg[i]);
+      const auto t = Law::joint_trial(d, k[i], rod[i], start[i], mg.H[i], mg.Mg[i]);
       auto& tr = mg.trial[i];
       take_trial(d, done, real, t, tr, c.L.full_solves);
       laws_hold = hn::And(laws_hold, tr.converged);

@@ -6,6 +6,7 @@
 #define HWY_TARGET_INCLUDE "lanes/step_lanes.cpp"
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
 #include "hwy/highway.h"
+#include "lanes/preisach_lanes-inl.h"
 #include "lanes/step_kernel-inl.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -151,7 +152,7 @@ HWY_INLINE void store_rods(const Chunk<D>& c, const RodStates<D>& s, Mk<D> keep)
 
 // One step of lanes [j, j + Lanes(d)): load, the stages, store where the lane is still alive
 // (a lane that fails keeps its state before the step, as simulate() records it).
-template <class D>
+template <class Law, class D>
 HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in) {
   const Chunk<D> c{d, L, j, L.st.rods};
   RodStates<D> s = load_rods(c, false);
@@ -161,9 +162,9 @@ HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
   const Mk<D> alive = hn::Not(fails.failed);
   const V<D> I = hn::LoadU(d, in.current_A + j), h = hn::LoadU(d, in.dt_s + j);
   const V<D> t1 = hn::Add(g[kT], h);  // step()'s t1 = s.t_s + h
-  Magnetic<JilesAthertonLanes, D> mg;
-  newton_fields<JilesAthertonLanes>(c, s, I, c.glob(kPmScale), h, t1, false, mg, fails);
-  commit_fields<JilesAthertonLanes>(c, s, false, mg);
+  Magnetic<Law, D> mg;
+  newton_fields<Law>(c, s, I, c.glob(kPmScale), h, t1, false, mg, fails);
+  commit_fields<Law>(c, s, false, mg);
   for (int i = 0; i < c.n; ++i) {
     fails.check(d, s.f[kH][i], C(d, 1e9), kFailH, i, t1);
     fails.check(d, s.f[kM][i], hn::Mul(C(d, 1.5), c.rod(kMsTMag, i)), kFailM, i, t1);
@@ -174,6 +175,7 @@ HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
   g[kCurrent] = I;
   run_loop_checks(c, s, g, g[kT], fails);
   const Mk<D> keep = hn::AndNot(fails.failed, alive);  // alive and not failed now
+  law_commit(c, mg, keep);
   store_rods(c, s, keep);
   for (int f = 0; f < kGlobalStateCount; ++f) hn::BlendedStore(g[f], keep, d, L.glob(f) + j);
   store_fails(c, fails);
@@ -182,7 +184,7 @@ HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
 // One increment of make_state's ramp (model/step.cpp, quasi_static_magnetic_update on the
 // consistent state) for lanes [j, j + Lanes(d)): the magnetic state at rest at the current and
 // the magnets' scale of the increment; a lane that fails keeps its state.
-template <class D>
+template <class Law, class D>
 HWY_INLINE void ramp_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in) {
   const Chunk<D> c{d, L, j, L.st.rods};
   RodStates<D> s = load_rods(c, true);
@@ -190,20 +192,28 @@ HWY_INLINE void ramp_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
   const Mk<D> alive = hn::Not(fails.failed);
   const V<D> I = hn::LoadU(d, in.current_A + j), pm = hn::LoadU(d, in.pm_scale + j);
   const V<D> one = C(d, 1.0), t = hn::Zero(d);
-  Magnetic<JilesAthertonLanes, D> mg;
-  newton_fields<JilesAthertonLanes>(c, s, I, pm, one, t, true, mg, fails);
-  commit_fields<JilesAthertonLanes>(c, s, true, mg);
+  Magnetic<Law, D> mg;
+  newton_fields<Law>(c, s, I, pm, one, t, true, mg, fails);
+  commit_fields<Law>(c, s, true, mg);
   const Mk<D> keep = hn::AndNot(fails.failed, alive);
+  law_commit(c, mg, keep);
   store_rods(c, s, keep);
   store_fails(c, fails);
 }
 
 template <class D>
 HWY_INLINE void chunk(D d, LaneData& L, std::size_t j, const StepInputs& in) {
+  if (L.st.preisach) {  // the law's lane entry (preisach_lanes-inl.h)
+    if (in.quasi_static)
+      ramp_chunk<PreisachLanes>(d, L, j, in);
+    else
+      step_chunk<PreisachLanes>(d, L, j, in);
+    return;
+  }
   if (in.quasi_static)
-    ramp_chunk(d, L, j, in);
+    ramp_chunk<JilesAthertonLanes>(d, L, j, in);
   else
-    step_chunk(d, L, j, in);
+    step_chunk<JilesAthertonLanes>(d, L, j, in);
 }
 
 // All lanes, in chunks of the target's width (or of 1: the reference instance). The lanes left

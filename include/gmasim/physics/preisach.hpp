@@ -129,46 +129,66 @@ struct PreisachPoint {
   bool push = false;  // the move reverses: x_now becomes an extremum
 };
 
-inline PreisachPoint preisach_point(const PreisachDistribution& d, const PreisachHistory& h,
-                                    double x1) {
-  PreisachPoint r;
+// Where a move to x1 continues from (preisach_point's search of the stack, without the Everett
+// function): the base extremum (index, or n for x_now), its input and up-switched measure and
+// moments, the direction, and whether the move reverses. same: x1 == x_now (nothing moves).
+struct PreisachBase {
+  double xb = 0, mub = 0, mcb = 0, mub_u = 0;
+  int base = 0;
+  bool up = false, push = false, same = false;
+};
+inline PreisachBase preisach_base(const PreisachHistory& h, double x1) {
+  PreisachBase r;
   if (x1 == h.x_now) {
-    r = {h.mu_now, h.mc_now, h.mu_u_now, 0.0, h.n, false};
+    r = {h.x_now, h.mu_now, h.mc_now, h.mu_u_now, h.n, false, false, true};
     return r;
   }
   const bool rising_now = (h.n - 1) % 2 == 1;  // the last entry is a minimum
-  const bool up = x1 > h.x_now;
-  r.push = up != rising_now;
+  r.up = x1 > h.x_now;
+  r.push = r.up != rising_now;
   int len = h.n + (r.push ? 1 : 0);
   auto xs = [&](int k) { return k == h.n ? h.x_now : h.x[k]; };
   // Wiping-out: passing the extremum before the base removes the base and that extremum.
-  while (len >= 3 && (up ? x1 >= xs(len - 2) : x1 <= xs(len - 2))) len -= 2;
+  while (len >= 3 && (r.up ? x1 >= xs(len - 2) : x1 <= xs(len - 2))) len -= 2;
   r.base = len - 1;
-  const double xb = xs(r.base);
-  const double mub = r.base == h.n ? h.mu_now : h.mu[r.base];
-  const double mcb = r.base == h.n ? h.mc_now : h.mc[r.base];
-  const double mub_u = r.base == h.n ? h.mu_u_now : h.mu_u[r.base];
-  if (up) {  // the triangle T(x1, xb) switches up
-    const Everett e = everett(d, x1, xb);
-    r.mu = mub + e.E;
-    r.mc = mcb + e.Ec;
-    r.mu_u = mub_u + e.Eu;
+  r.xb = xs(r.base);
+  r.mub = r.base == h.n ? h.mu_now : h.mu[r.base];
+  r.mcb = r.base == h.n ? h.mc_now : h.mc[r.base];
+  r.mub_u = r.base == h.n ? h.mu_u_now : h.mu_u[r.base];
+  return r;
+}
+
+inline PreisachPoint preisach_point(const PreisachDistribution& d, const PreisachHistory& h,
+                                    double x1) {
+  PreisachPoint r;
+  const PreisachBase b = preisach_base(h, x1);
+  if (b.same) {
+    r = {h.mu_now, h.mc_now, h.mu_u_now, 0.0, h.n, false};
+    return r;
+  }
+  r.push = b.push;
+  r.base = b.base;
+  if (b.up) {  // the triangle T(x1, xb) switches up
+    const Everett e = everett(d, x1, b.xb);
+    r.mu = b.mub + e.E;
+    r.mc = b.mcb + e.Ec;
+    r.mu_u = b.mub_u + e.Eu;
     r.dmu_dx = e.dE_da;
   } else {  // the triangle T(xb, x1) switches down
-    const Everett e = everett(d, xb, x1);
-    r.mu = mub - e.E;
-    r.mc = mcb - e.Ec;
-    r.mu_u = mub_u - e.Eu;
+    const Everett e = everett(d, b.xb, x1);
+    r.mu = b.mub - e.E;
+    r.mc = b.mcb - e.Ec;
+    r.mu_u = b.mub_u - e.Eu;
     r.dmu_dx = -e.dE_db;
   }
   return r;
 }
 
-// Moves the history to x1 (the point preisach_point computed): pushes x_now if the move
-// reverses (forgetting the innermost pair first if the stack is full), pops what the move
-// wiped out, and records the change of the h_c moment (the switching loss, physics below).
-inline void preisach_commit(const PreisachDistribution& d, PreisachHistory& h, double x1) {
-  const PreisachPoint p = preisach_point(d, h, x1);
+// Moves the history to x1, given the point p = preisach_point(d, h, x1) (its mu, mc, mu_u and
+// base): pushes x_now if the move reverses (forgetting the innermost pair first if the stack
+// is full), pops what the move wiped out, and records the change of the h_c moment (the
+// switching loss, physics below).
+inline void preisach_commit_point(PreisachHistory& h, double x1, const PreisachPoint& p) {
   h.last_dmc = std::fabs(p.mc - h.mc_now);
   if (x1 == h.x_now) return;
   if (p.base == h.n) {  // the move reverses at x_now and wipes nothing: x_now is an extremum
@@ -188,6 +208,11 @@ inline void preisach_commit(const PreisachDistribution& d, PreisachHistory& h, d
   h.mu_now = p.mu;
   h.mc_now = p.mc;
   h.mu_u_now = p.mu_u;
+}
+
+// Moves the history to x1 (preisach_commit_point at the point preisach_point computes).
+inline void preisach_commit(const PreisachDistribution& d, PreisachHistory& h, double x1) {
+  preisach_commit_point(h, x1, preisach_point(d, h, x1));
 }
 
 // Positive then negative saturation (the two sentinels), then an AC demagnetisation about

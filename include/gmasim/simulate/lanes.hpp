@@ -21,7 +21,8 @@ namespace lanes {
 struct LaneData;
 }
 
-// Whether lanes can advance model m: the Jiles-Atherton law, the consistent magnetic state, a
+// Whether lanes can advance model m: the Jiles-Atherton or the Preisach law (docs/lanes.md,
+// "Preisach lanes"; a batch holds one law), the consistent magnetic state, a
 // circuit on the low-rank path (gmasim/circuit.hpp) with the flux sensor on rod branches, at
 // most 8 rods. `why` receives the reason when not.
 bool lanes_supported(const Model& m, std::string* why = nullptr);
