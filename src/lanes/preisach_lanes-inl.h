@@ -136,7 +136,7 @@ struct EverettLanes {
   V<D> E, Ec, Eu, dE_da, dE_db;
 };
 template <class D>
-HWY_INLINE EverettLanes<D> everett(D d, const PreisachLaneConstants<D>& k, V<D> a, V<D> b) {
+HWY_NOINLINE EverettLanes<D> everett(D d, const PreisachLaneConstants<D>& k, V<D> a, V<D> b) {
   const V<D> zero = hn::Zero(d), s = k.s;
   EverettLanes<D> e{zero, zero, zero, zero, zero};
   const Mk<D> a_inf = hn::IsInf(a), b_inf = hn::IsInf(b), valid = hn::Gt(a, b);
@@ -181,8 +181,8 @@ struct PreisachPointLanes {
   V<D> mu, mc, mu_u, dmu_dx;
 };
 template <class D>
-HWY_INLINE PreisachPointLanes<D> preisach_point(D d, const PreisachLaneConstants<D>& k,
-                                                const physics::PreisachHistory* h, V<D> x) {
+HWY_NOINLINE PreisachPointLanes<D> preisach_point(D d, const PreisachLaneConstants<D>& k,
+                                                  const physics::PreisachHistory* h, V<D> x) {
   constexpr std::size_t W = kPad;  // the widest vector's lanes (lane_data.hpp)
   const std::size_t n = hn::Lanes(d);
   double xs[W], xb[W], mub[W], mcb[W], mubu[W], up[W], same[W];

@@ -4,6 +4,8 @@
 // (CMakeLists.txt): each lane equals the width-1 instance bit for bit.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "lanes/step_lanes.cpp"
+#include <type_traits>
+
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
 #include "hwy/highway.h"
 #include "lanes/preisach_lanes-inl.h"
@@ -201,40 +203,47 @@ HWY_INLINE void ramp_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
   store_fails(c, fails);
 }
 
-template <class D>
+template <class Law, class D>
 HWY_INLINE void chunk(D d, LaneData& L, std::size_t j, const StepInputs& in) {
-  if (L.st.preisach) {  // the law's lane entry (preisach_lanes-inl.h)
-    if (in.quasi_static)
-      ramp_chunk<PreisachLanes>(d, L, j, in);
-    else
-      step_chunk<PreisachLanes>(d, L, j, in);
-    return;
-  }
   if (in.quasi_static)
-    ramp_chunk<JilesAthertonLanes>(d, L, j, in);
+    ramp_chunk<Law>(d, L, j, in);
   else
-    step_chunk<JilesAthertonLanes>(d, L, j, in);
+    step_chunk<Law>(d, L, j, in);
 }
 
-// All lanes, in chunks of the target's width (or of 1: the reference instance). The lanes left
-// after the full chunks take a vector of half the width where they fit in it, not a full one of
-// padding.
-void StepAll(LaneData& L, const StepInputs& in, bool width_one) {
+// The chunks of one law. The lanes left after the full chunks take a vector of half the width
+// where they fit in it, not a full one of padding (the Jiles-Atherton law; the Preisach law's
+// kernel is compiled for the full width and width 1 only: a third instance per SIMD target
+// cost 30 s of the CI's compile).
+template <class Law>
+void step_law(LaneData& L, const StepInputs& in, bool width_one) {
   if (width_one) {
     const hn::CappedTag<double, 1> d1;
-    for (std::size_t j = 0; j < L.npad; ++j) chunk(d1, L, j, in);
+    for (std::size_t j = 0; j < L.npad; ++j) chunk<Law>(d1, L, j, in);
     return;
   }
   const hn::ScalableTag<double> d;
   const std::size_t w = hn::Lanes(d);
   std::size_t j = 0;
-  for (; j + w <= L.n; j += w) chunk(d, L, j, in);
+  for (; j + w <= L.n; j += w) chunk<Law>(d, L, j, in);
   const std::size_t rest = L.n - j;
   if (rest == 0) return;
-  if (w >= 4 && rest <= w / 2)
-    chunk(hn::CappedTag<double, HWY_MAX(1, HWY_LANES(double) / 2)>(), L, j, in);
+  if constexpr (std::is_same_v<Law, JilesAthertonLanes>) {
+    if (w >= 4 && rest <= w / 2) {
+      chunk<Law>(hn::CappedTag<double, HWY_MAX(1, HWY_LANES(double) / 2)>(), L, j, in);
+      return;
+    }
+  }
+  chunk<Law>(d, L, j, in);
+}
+
+// All lanes, in chunks of the target's width (or of 1: the reference instance), by the law the
+// batch holds (preisach_lanes-inl.h for the Preisach law's hooks).
+void StepAll(LaneData& L, const StepInputs& in, bool width_one) {
+  if (L.st.preisach)
+    step_law<PreisachLanes>(L, in, width_one);
   else
-    chunk(d, L, j, in);
+    step_law<JilesAthertonLanes>(L, in, width_one);
 }
 
 int WidthOf() { return static_cast<int>(hn::Lanes(hn::ScalableTag<double>())); }
