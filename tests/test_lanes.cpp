@@ -21,9 +21,11 @@
 #include "gmasim/simulate/lanes.hpp"
 #include "gmasim/simulate/simulate.hpp"
 #include "hwy/targets.h"
+#include "lanes_test_util.hpp"
 
 namespace {
 
+using gmasim_test::expect_lanes_equal_width_one;
 using gmasim_test::mdma;
 
 using namespace gmasim;
@@ -86,35 +88,9 @@ std::vector<double> numbers(const State& s) {
   return v;
 }
 
-// Steps every lane of a and b (b: the width-1 instance) and checks bitwise equality.
-void expect_lanes_equal_width_one(const Runs& runs, long steps) {
-  LaneBatch a = runs.batch(), b = runs.batch();
-  const std::size_t n = runs.c.size();
-  std::vector<double> cur(n), dt(n, kDt), t1(n);
-  State sa = runs.s[0], sb = runs.s[0];
-  for (long k = 1; k <= steps; ++k) {
-    const double t = static_cast<double>(k) * kDt;
-    for (std::size_t i = 0; i < n; ++i) {
-      cur[i] = runs.current(i, t);
-      t1[i] = t;
-    }
-    a.step(cur, dt, t1);
-    b.step(cur, dt, t1, true);
-    if (k % 50 != 0 && k != steps) continue;
-    for (std::size_t i = 0; i < n; ++i) {
-      a.unpack(i, sa);
-      b.unpack(i, sb);
-      const auto va = numbers(sa), vb = numbers(sb);
-      ASSERT_EQ(0, std::memcmp(va.data(), vb.data(), va.size() * sizeof(double)))
-          << "lane " << i << " step " << k << " target " << lanes_target();
-      ASSERT_FALSE(a.diverged(i)) << a.error(i);
-    }
-  }
-}
-
 TEST(Lanes, EachLaneEqualsTheWidthOneInstance) {
   // 11 lanes: one full AVX-512 vector and a partial one (padding).
-  expect_lanes_equal_width_one(Runs(11), 1500);
+  expect_lanes_equal_width_one(Runs(11), 1500, kDt, numbers);
   std::printf("lanes: target %s, %d doubles per vector\n", lanes_target().c_str(), lanes_width());
 }
 
@@ -155,7 +131,7 @@ TEST(Lanes, FallbackTargetsAgree) {
     ++tried;
     std::printf("fallback %s: %d doubles per vector\n", hwy::TargetName(target), lanes_width());
     EXPECT_LE(lanes_width(), best_width);
-    expect_lanes_equal_width_one(runs, 400);
+    expect_lanes_equal_width_one(runs, 400, kDt, numbers);
     LaneBatch b = runs.batch();
     run(b, got);
     double worst = 0.0;

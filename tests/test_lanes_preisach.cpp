@@ -20,6 +20,7 @@
 #include "gmasim/simulate/lanes.hpp"
 #include "gmasim/simulate/simulate.hpp"
 #include "hwy/targets.h"
+#include "lanes_test_util.hpp"
 
 namespace preisach_lanes_test {
 
@@ -80,36 +81,11 @@ std::vector<double> state_numbers(const State& s) {
   return v;
 }
 
-void expect_width_one(const PreisachRuns& runs, long steps) {
-  LaneBatch a = runs.batch(), b = runs.batch();
-  const std::size_t n = runs.c.size();
-  std::vector<double> cur(n), dt(n, kStep), t1(n);
-  State sa = runs.s[0], sb = runs.s[0];
-  for (long k = 1; k <= steps; ++k) {
-    const double t = static_cast<double>(k) * kStep;
-    for (std::size_t i = 0; i < n; ++i) {
-      cur[i] = runs.current(i, t);
-      t1[i] = t;
-    }
-    a.step(cur, dt, t1);
-    b.step(cur, dt, t1, true);
-    if (k % 50 != 0 && k != steps) continue;
-    for (std::size_t i = 0; i < n; ++i) {
-      ASSERT_FALSE(a.diverged(i)) << a.error(i);
-      a.unpack(i, sa);
-      b.unpack(i, sb);
-      const auto va = state_numbers(sa), vb = state_numbers(sb);
-      ASSERT_EQ(va.size(), vb.size()) << "lane " << i << " step " << k;
-      ASSERT_EQ(0, std::memcmp(va.data(), vb.data(), va.size() * sizeof(double)))
-          << "lane " << i << " step " << k << " target " << lanes_target();
-    }
-  }
-}
-
 TEST(PreisachLanes, EachLaneEqualsTheWidthOneInstance) {
   std::string why;
   ASSERT_TRUE(lanes_supported(model(), &why)) << why;
-  expect_width_one(PreisachRuns(11), 600);  // a full AVX-512 vector and a partial one
+  gmasim_test::expect_lanes_equal_width_one(
+      PreisachRuns(11), 600, kStep, state_numbers);  // a full AVX-512 vector and a partial one
 }
 
 // The fallback targets (SSE4, and EMU128 / SCALAR where compiled): each lane equals its width-1
@@ -122,7 +98,7 @@ TEST(PreisachLanes, FallbackTargetsEqualTheirWidthOneInstance) {
     const auto targets = hwy::SupportedAndGeneratedTargets();
     if (targets.empty() || targets.front() != target) continue;
     ++tried;
-    expect_width_one(runs, 200);
+    gmasim_test::expect_lanes_equal_width_one(runs, 200, kStep, state_numbers);
   }
   hwy::SetSupportedTargetsForTest(0);
   EXPECT_GE(tried, 1);

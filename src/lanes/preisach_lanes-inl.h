@@ -341,19 +341,11 @@ HWY_INLINE void law_rod(const Chunk<D>& c, const RodStates<D>& s, int i,
 template <class D, class M>
 HWY_INLINE void take_trial(D, M done, M /*real*/, const PreisachLaneTrial<D>& t,
                            PreisachLaneTrial<D>& tr, std::size_t&) {
-  tr.M = hn::IfThenElse(done, tr.M, t.M);
-  tr.dM_dH = hn::IfThenElse(done, tr.dM_dH, t.dM_dH);
-  tr.Mirr = hn::IfThenElse(done, tr.Mirr, t.Mirr);
-  tr.inv_mu_r = hn::IfThenElse(done, tr.inv_mu_r, t.inv_mu_r);
-  tr.M_next = hn::IfThenElse(done, tr.M_next, t.M_next);
-  tr.an_x = hn::IfThenElse(done, tr.an_x, t.an_x);
-  tr.an_L = hn::IfThenElse(done, tr.an_L, t.an_L);
-  tr.an_dL = hn::IfThenElse(done, tr.an_dL, t.an_dL);
+  keep_common_trial(done, t, tr);
   tr.x1 = hn::IfThenElse(done, tr.x1, t.x1);
   tr.mu = hn::IfThenElse(done, tr.mu, t.mu);
   tr.mc = hn::IfThenElse(done, tr.mc, t.mc);
   tr.mu_u = hn::IfThenElse(done, tr.mu_u, t.mu_u);
-  tr.converged = hn::Or(hn::And(done, tr.converged), hn::AndNot(done, t.converged));
   tr.solved = hn::Or(hn::And(done, tr.solved), hn::AndNot(done, t.solved));
   tr.moved = hn::Or(hn::And(done, tr.moved), hn::AndNot(done, t.moved));
 }

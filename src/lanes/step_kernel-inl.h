@@ -174,12 +174,10 @@ HWY_INLINE void law_rod(const Chunk<D>& c, const RodStates<D>& s, int i, JaLaneC
   r = {s.f[kH][i], s.f[kMirr][i], s.f[kM][i], s.f[kAnX][i], s.f[kAnL][i], s.f[kAnDL][i]};
 }
 
-// A lane that has stopped keeps the trial of the iterate it stopped at; the others take t
-// (and count its full solves of the law in the lanes that are not padding, LaneData::full_solves).
-template <class D, class M, class T>
-HWY_INLINE void take_trial(D d, M done, M real, const T& t, T& tr, std::size_t& full_solves) {
-  if (!hn::AllFalse(d, t.solved))
-    full_solves += hn::CountTrue(d, hn::And(real, hn::AndNot(done, t.solved)));
+// The fields every law's trial has (the Jiles-Atherton law's are all of them): a lane that has
+// stopped keeps those of the iterate it stopped at, the others take t's.
+template <class M, class T>
+HWY_INLINE void keep_common_trial(M done, const T& t, T& tr) {
   tr.M = hn::IfThenElse(done, tr.M, t.M);
   tr.dM_dH = hn::IfThenElse(done, tr.dM_dH, t.dM_dH);
   tr.Mirr = hn::IfThenElse(done, tr.Mirr, t.Mirr);
@@ -189,6 +187,15 @@ HWY_INLINE void take_trial(D d, M done, M real, const T& t, T& tr, std::size_t& 
   tr.an_L = hn::IfThenElse(done, tr.an_L, t.an_L);
   tr.an_dL = hn::IfThenElse(done, tr.an_dL, t.an_dL);
   tr.converged = hn::Or(hn::And(done, tr.converged), hn::AndNot(done, t.converged));
+}
+
+// A lane that has stopped keeps the trial of the iterate it stopped at; the others take t
+// (and count its full solves of the law in the lanes that are not padding, LaneData::full_solves).
+template <class D, class M, class T>
+HWY_INLINE void take_trial(D d, M done, M real, const T& t, T& tr, std::size_t& full_solves) {
+  if (!hn::AllFalse(d, t.solved))
+    full_solves += hn::CountTrue(d, hn::And(real, hn::AndNot(done, t.solved)));
+  keep_common_trial(done, t, tr);
 }
 
 // Per rod, what the Newton solve fixes at the step's start and what it ends with.
