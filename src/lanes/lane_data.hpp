@@ -46,8 +46,6 @@ enum RodField : int {
   kLength = kRodStateCount,
   kArea,
   kMsTMag,
-  kMsTE,
-  kMsStrain,
   kInvEs,
   kRot,
   kCoupling,
