@@ -64,7 +64,7 @@ struct LaneRun {
 constexpr std::size_t kStagedRows = 64;
 
 // The lanes' drives at one time: Waveform::current_at of a biased sine (every lane of a group is
-// periodic), min + pp/2 (1 - cos 2 pi f t), the cosine taken once per distinct frequency (a
+// periodic), Waveform::biased_sine_from_cos with the cosine taken once per distinct frequency (a
 // sweep's lanes share a few) -- the same operations, the same bits.
 struct Drives {
   std::vector<double> freq, cosine;  // the distinct frequencies, their cos 2 pi f t
@@ -82,7 +82,7 @@ struct Drives {
     cosine.resize(freq.size());
     for (std::size_t u = 0; u < freq.size(); ++u) cosine[u] = std::cos(two_pi * freq[u] * t);
     for (std::size_t l = 0; l < w.size(); ++l)
-      current[l] = w[l]->min_A + 0.5 * w[l]->pp_A * (1.0 - cosine[of[l]]);
+      current[l] = w[l]->biased_sine_from_cos(cosine[of[l]]);
   }
 };
 constexpr std::size_t kGlobalColumns = 6;  // run.cpp's make_columns: t_s .. y_stack_um

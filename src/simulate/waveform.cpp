@@ -22,7 +22,7 @@ double Waveform::current_at(double t) const {
   constexpr double two_pi = 2.0 * physics::kPi;
   switch (kind) {
     case WaveformKind::BiasedSine:
-      return min_A + 0.5 * pp_A * (1.0 - std::cos(two_pi * frequency_Hz * t));
+      return biased_sine_from_cos(std::cos(two_pi * frequency_Hz * t));
     case WaveformKind::DC:
       return level_A;
     case WaveformKind::Step:

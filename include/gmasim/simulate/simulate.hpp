@@ -35,6 +35,11 @@ struct Waveform {
   std::string table_source;
 
   double current_at(double t_s) const;  // [A]
+  // BiasedSine's current [A] at a time whose cos(2 pi f t) is given: current_at's formula, for
+  // callers that take the cosine once for many waveforms of one frequency (simulate_lanes).
+  double biased_sine_from_cos(double cos_2pi_f_t) const {
+    return min_A + 0.5 * pp_A * (1.0 - cos_2pi_f_t);
+  }
   bool periodic() const { return kind == WaveformKind::BiasedSine; }
   double period_s() const { return 1.0 / frequency_Hz; }
 };
