@@ -6,9 +6,11 @@
 //   --benchmark_filter=Objective
 #include <benchmark/benchmark.h>
 
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <vector>
 
 #include "gmasim/identify/identify.hpp"
 #include "gmasim/io/io.hpp"
@@ -70,6 +72,38 @@ void BM_Objective12Conditions_scalar(benchmark::State& bs) { objective_evals(bs,
 void BM_Objective12Conditions_batched(benchmark::State& bs) { objective_evals(bs, true); }
 BENCHMARK(BM_Objective12Conditions_scalar)->Arg(200)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Objective12Conditions_batched)->Arg(200)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// A batch of 16 points, the central-difference columns of the 8 parameters around a point (what
+// the refinement's Jacobian and the profile evaluate; a first population is a batch too):
+// scalar, one residuals() per point on the scalar step; batched, one rms_pct_batch with the
+// points' records in shared SIMD lanes, a vector holding one record across 8 points.
+void objective_batch(benchmark::State& bs, bool lanes) {
+  const Objective& obj = objective(static_cast<int>(bs.range(0)), lanes);
+  std::vector<double> c = obj.start_unit();
+  c[0] = 0.4;
+  std::vector<std::vector<double>> u;
+  for (std::size_t j = 0; j < c.size(); ++j)
+    for (double h : {-1e-4, 1e-4}) {
+      u.push_back(c);
+      u.back()[j] += h;
+    }
+  for (auto _ : bs) {
+    if (lanes) {
+      benchmark::DoNotOptimize(obj.rms_pct_batch(u));
+    } else {
+      for (const auto& v : u) benchmark::DoNotOptimize(obj.rms_pct(v));
+    }
+  }
+  const auto evals = static_cast<double>(bs.iterations()) * static_cast<double>(u.size());
+  bs.SetItemsProcessed(static_cast<std::int64_t>(evals));
+  bs.counters["evals_per_s"] = benchmark::Counter(evals, benchmark::Counter::kIsRate);
+  bs.counters["simd_lanes"] = lanes ? lanes_width() : 1;
+  bs.SetLabel(lanes ? "16 points' records in lanes on " + lanes_target() : "scalar step()");
+}
+void BM_ObjectiveBatch16_scalar(benchmark::State& bs) { objective_batch(bs, false); }
+void BM_ObjectiveBatch16_batched(benchmark::State& bs) { objective_batch(bs, true); }
+BENCHMARK(BM_ObjectiveBatch16_scalar)->Arg(200)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ObjectiveBatch16_batched)->Arg(200)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 BENCHMARK(BM_Objective12Conditions)
     ->Arg(200)

@@ -30,35 +30,6 @@
 namespace gmasim::identify_detail {
 namespace {
 
-// Thrown by an island's fitness once a stop was requested (SIGINT/SIGTERM): the evaluation in
-// progress finishes, every later one of the batch or generation throws at once, so a stop during
-// the first population or a long generation takes effect within one evaluation (issue 19,
-// item 4). pagmo keeps an island's population when its evolution throws.
-struct SearchStopped : std::exception {
-  const char* what() const noexcept override { return "the search was stopped"; }
-};
-
-// The pagmo user-defined problem: minimise the weighted RMS error [%] over u in [0, 1]^n.
-// Copied into every island; the copies share only the immutable Objective. `stop` (the
-// islands' copies only; null for the checkpoint's re-evaluation) makes an evaluation throw
-// SearchStopped once it is set.
-struct GmaProblem {
-  std::shared_ptr<const Objective> obj;
-  const std::atomic<bool>* stop = nullptr;
-
-  pagmo::vector_double fitness(const pagmo::vector_double& u) const {
-    if (stop && stop->load(std::memory_order_relaxed)) throw SearchStopped{};
-    return {obj ? obj->rms_pct(u) : Objective::kPenalty};
-  }
-  std::pair<pagmo::vector_double, pagmo::vector_double> get_bounds() const {
-    const std::size_t n = obj ? obj->dim() : 1;
-    return {pagmo::vector_double(n, 0.0), pagmo::vector_double(n, 1.0)};
-  }
-  std::string get_name() const { return "gmasim identify: weighted RMS error [%]"; }
-  // fitness() is const and touches no shared mutable state.
-  pagmo::thread_safety get_thread_safety() const { return pagmo::thread_safety::constant; }
-};
-
 unsigned mix_seed(unsigned seed, int rank, int island, int generation) {
   std::uint64_t z =
       (static_cast<std::uint64_t>(seed) << 32) ^ (static_cast<std::uint64_t>(rank) << 20) ^

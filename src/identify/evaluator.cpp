@@ -1,6 +1,5 @@
 // Batch evaluation of the objective over worker threads and MPI ranks.
 #include <algorithm>
-#include <atomic>
 #include <thread>
 
 #include "internal.hpp"
@@ -68,19 +67,28 @@ std::vector<char> BatchEvaluator::evaluate(const std::vector<std::vector<double>
   for (std::size_t i = 0; i < P; ++i)
     if (static_cast<int>(i % static_cast<std::size_t>(R)) == me) mine.push_back(i);
 
-  // Each worker writes only its own points' slots: nothing mutable is shared but the index.
-  std::atomic<std::size_t> next{0};
-  auto work = [&]() {
-    for (std::size_t k = next.fetch_add(1); k < mine.size(); k = next.fetch_add(1)) {
+  // The points split into one contiguous share per worker thread, each share one batch
+  // evaluation (Objective::residuals_batch: its points' records share SIMD lanes). Each worker
+  // writes only its own points' slots; a result does not depend on the split.
+  const std::size_t nt = std::min<std::size_t>(static_cast<std::size_t>(threads_), mine.size());
+  auto work = [&](std::size_t t) {
+    const std::size_t b = mine.size() * t / nt, e = mine.size() * (t + 1) / nt;
+    std::vector<const double*> u;
+    std::vector<double*> r;
+    for (std::size_t k = b; k < e; ++k) {
+      u.push_back(points[mine[k]].data());
+      r.push_back(res[mine[k]].data());
+    }
+    const std::vector<char> done = obj_.residuals_batch(u, r);
+    for (std::size_t k = b; k < e; ++k) {
       const std::size_t i = mine[k];
-      ok[i] = obj_.residuals(points[i].data(), res[i].data()) ? 1 : 0;
+      ok[i] = done[k - b];
       if (!ok[i]) std::fill(res[i].begin(), res[i].end(), 0.0);
     }
   };
-  const std::size_t nt = std::min<std::size_t>(static_cast<std::size_t>(threads_), mine.size());
   std::vector<std::thread> pool;
-  for (std::size_t t = 1; t < nt; ++t) pool.emplace_back(work);
-  work();
+  for (std::size_t t = 1; t < nt; ++t) pool.emplace_back(work, t);
+  if (nt > 0) work(0);
   for (auto& t : pool) t.join();
 
   if (R > 1) {  // every slot is non-zero on exactly one rank: the sum is exact

@@ -39,12 +39,33 @@ pagmo::vector_double PoolBfe::operator()(const pagmo::problem& p,
   const std::size_t nx = p.get_nx(), nf = p.get_nf();
   const std::size_t count = nx == 0 ? 0 : dvs.size() / nx;
   pagmo::vector_double out(count * nf);
-  parallel_for(count, threads, [&](std::size_t k) {
-    const pagmo::vector_double x(dvs.begin() + static_cast<std::ptrdiff_t>(k * nx),
-                                 dvs.begin() + static_cast<std::ptrdiff_t>((k + 1) * nx));
-    const pagmo::vector_double fk = p.fitness(x);  // counts the evaluation (atomically)
-    std::copy(fk.begin(), fk.end(), out.begin() + static_cast<std::ptrdiff_t>(k * nf));
+  auto point = [&](std::size_t k) {
+    return pagmo::vector_double(dvs.begin() + static_cast<std::ptrdiff_t>(k * nx),
+                                dvs.begin() + static_cast<std::ptrdiff_t>((k + 1) * nx));
+  };
+  const GmaProblem* g = p.extract<GmaProblem>();
+  if (!g || !g->obj) {
+    parallel_for(count, threads, [&](std::size_t k) {
+      const pagmo::vector_double fk = p.fitness(point(k));  // counts the evaluation (atomically)
+      std::copy(fk.begin(), fk.end(), out.begin() + static_cast<std::ptrdiff_t>(k * nf));
+    });
+    return out;
+  }
+  // Batches of at most kBatch points, at least one per thread: a stop takes effect within a
+  // batch (SearchStopped, as fitness() throws it).
+  constexpr std::size_t kBatch = 16;
+  const std::size_t nt = static_cast<std::size_t>(std::max(threads, 1));
+  const std::size_t per = std::clamp<std::size_t>((count + nt - 1) / nt, 1, kBatch);
+  const std::size_t batches = (count + per - 1) / per;
+  parallel_for(batches, threads, [&](std::size_t q) {  // nf is 1
+    g->check_stop();
+    const std::size_t b = q * per, e = std::min(count, b + per);
+    std::vector<std::vector<double>> u;
+    for (std::size_t k = b; k < e; ++k) u.push_back(point(k));
+    const std::vector<double> f = g->obj->rms_pct_batch(u);
+    std::copy(f.begin(), f.end(), out.begin() + static_cast<std::ptrdiff_t>(b));
   });
+  p.increment_fevals(count);  // as p.fitness() would have counted them
   return out;
 }
 

@@ -4,13 +4,18 @@
 // happens between epochs, in island order, so the search is the same on every machine.
 #pragma once
 
+#include <atomic>
 #include <exception>
 #include <functional>
+#include <memory>
 #include <pagmo/algorithm.hpp>
 #include <pagmo/population.hpp>
 #include <pagmo/problem.hpp>
 #include <pagmo/types.hpp>
+#include <string>
 #include <vector>
+
+#include "gmasim/identify/identify.hpp"
 
 namespace gmasim::identify_detail {
 
@@ -18,8 +23,42 @@ namespace gmasim::identify_detail {
 // first exception after every task has ended.
 void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t)>& f);
 
+// Thrown by an island's fitness once a stop was requested (SIGINT/SIGTERM): the evaluation in
+// progress finishes, every later one of the batch or generation throws at once, so a stop during
+// the first population or a long generation takes effect within one evaluation (issue 19,
+// item 4). pagmo keeps an island's population when its evolution throws.
+struct SearchStopped : std::exception {
+  const char* what() const noexcept override { return "the search was stopped"; }
+};
+
+// The pagmo user-defined problem: minimise the weighted RMS error [%] over u in [0, 1]^n.
+// Copied into every island; the copies share only the immutable Objective. `stop` (the
+// islands' copies only; null for the checkpoint's re-evaluation) makes an evaluation throw
+// SearchStopped once it is set.
+struct GmaProblem {
+  std::shared_ptr<const Objective> obj;
+  const std::atomic<bool>* stop = nullptr;
+
+  void check_stop() const {
+    if (stop && stop->load(std::memory_order_relaxed)) throw SearchStopped{};
+  }
+  pagmo::vector_double fitness(const pagmo::vector_double& u) const {
+    check_stop();
+    return {obj ? obj->rms_pct(u) : Objective::kPenalty};
+  }
+  std::pair<pagmo::vector_double, pagmo::vector_double> get_bounds() const {
+    const std::size_t n = obj ? obj->dim() : 1;
+    return {pagmo::vector_double(n, 0.0), pagmo::vector_double(n, 1.0)};
+  }
+  std::string get_name() const { return "gmasim identify: weighted RMS error [%]"; }
+  // fitness() is const and touches no shared mutable state.
+  pagmo::thread_safety get_thread_safety() const { return pagmo::thread_safety::constant; }
+};
+
 // A pagmo batch fitness evaluator over `threads` threads (the problem must be
-// thread_safety::constant: its fitness is called concurrently on one object).
+// thread_safety::constant: its fitness is called concurrently on one object). For a
+// GmaProblem, each thread's contiguous share of the points is one Objective::rms_pct_batch
+// (their records in shared SIMD lanes; the same values as fitness() point by point).
 struct PoolBfe {
   int threads = 1;
   pagmo::vector_double operator()(const pagmo::problem& p, const pagmo::vector_double& dvs) const;

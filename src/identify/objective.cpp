@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <set>
 #include <span>
 
@@ -376,6 +377,80 @@ std::vector<double> Objective::theta_per_unit() const {
 }
 
 bool Objective::residuals(const double* u, double* r) const { return impl_->residuals(u, r); }
+
+std::vector<char> Objective::Impl::residuals_batch(std::span<const double* const> u,
+                                                   std::span<double* const> r) const {
+  const std::size_t P = u.size();
+  std::vector<char> ok(P, 0);
+  std::deque<Model> models;         // stable addresses
+  std::vector<std::size_t> shared;  // the points whose records share the lanes
+  std::vector<const Model*> shared_models;
+  for (std::size_t i = 0; i < P; ++i) {
+    try {
+      models.push_back(model_at(u[i]));
+    } catch (const InputError&) {
+      continue;  // residuals() fails at u[i] alike
+    }
+    if (records_in_lanes(models.back())) {
+      shared.push_back(i);
+      shared_models.push_back(&models.back());
+    } else {
+      ok[i] = residuals_at(models.back(), r[i], nullptr) ? 1 : 0;
+    }
+  }
+  std::vector<identify_detail::RecordOutputs> out;
+  std::vector<char> failed;
+  bool batched = shared.size() > 1;
+  if (batched) {
+    try {
+      identify_detail::run_records_lanes(shared_models, record_measurements(), record_flux(),
+                                         settings, out, &failed);
+    } catch (const InputError&) {  // a state at rest failed (make_states): each point alone
+      batched = false;
+    } catch (const DivergenceError&) {
+      batched = false;
+    }
+  }
+  for (std::size_t j = 0; j < shared.size(); ++j) {
+    const std::size_t i = shared[j];
+    if (!batched)
+      ok[i] = residuals_at(*shared_models[j], r[i], nullptr) ? 1 : 0;
+    else if (!failed[j])
+      ok[i] = residuals_at(*shared_models[j], r[i], nullptr, &out[j]) ? 1 : 0;
+  }
+  return ok;
+}
+
+std::vector<char> Objective::residuals_batch(std::span<const double* const> u,
+                                             std::span<double* const> r) const {
+  if (u.size() != r.size())
+    throw InputError(
+        fmt::format("residuals_batch: {} points but {} residual vectors", u.size(), r.size()));
+  return impl_->residuals_batch(u, r);
+}
+
+std::vector<double> Objective::rms_pct_batch(const std::vector<std::vector<double>>& u) const {
+  const std::size_t P = u.size();
+  std::vector<std::vector<double>> r(P, std::vector<double>(impl_->m));
+  std::vector<const double*> up(P);
+  std::vector<double*> rp(P);
+  for (std::size_t i = 0; i < P; ++i) {
+    if (u[i].size() != dim())
+      throw InputError(
+          fmt::format("rms_pct_batch: point {} has {} values, the fit {}", i, u[i].size(), dim()));
+    up[i] = u[i].data();
+    rp[i] = r[i].data();
+  }
+  const std::vector<char> ok = impl_->residuals_batch(up, rp);
+  std::vector<double> f(P, kPenalty);
+  for (std::size_t i = 0; i < P; ++i) {
+    if (!ok[i]) continue;
+    double ss = 0.0;
+    for (double v : r[i]) ss += v * v;
+    f[i] = std::sqrt(ss);
+  }
+  return f;
+}
 
 double Objective::rms_pct(const std::vector<double>& u) const {
   std::vector<double> r(impl_->m);

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -91,26 +92,29 @@ struct Objective::Impl {
     return compile(spec);
   }
 
-  // The records' residuals. Throws InputError / DivergenceError.
-  void record_residuals(const Model& model, StartCache& starts, double* r) const {
+  // Whether the records run in SIMD lanes at this model (identify/record_lanes.hpp).
+  bool records_in_lanes(const Model& model) const {
+    return settings.lanes && conds.size() > 1 && all_records_in_lanes(model);
+  }
+
+  // The records' residuals: from `done` (the records already run in lanes, a batch
+  // evaluation), else run here. Throws InputError / DivergenceError.
+  void record_residuals(const Model& model, StartCache& starts, double* r,
+                        identify_detail::RecordOutputs* done = nullptr) const {
     std::vector<double> y, B;
-    std::vector<std::vector<double>> ys, Bs;
-    const bool lanes = settings.lanes && conds.size() > 1 && all_records_in_lanes(model);
-    if (lanes) {  // every record in its own SIMD lane (identify/record_lanes.hpp)
-      std::vector<const Measurement*> recs;
-      std::vector<bool> flux;
-      for (const auto& cd : conds) {
-        recs.push_back(&data.items[cd.index]);
-        flux.push_back(cd.flux);
-      }
-      identify_detail::run_records_lanes(model, recs, flux, settings, ys, Bs);
+    identify_detail::RecordOutputs lanes_out;
+    const bool lanes = done != nullptr || records_in_lanes(model);
+    if (lanes && !done) {  // every record in its own SIMD lane (identify/record_lanes.hpp)
+      identify_detail::run_records_lanes(model, record_measurements(), record_flux(), settings,
+                                         lanes_out.response, lanes_out.B_T);
+      done = &lanes_out;
     }
     for (std::size_t k = 0; k < conds.size(); ++k) {
       const CondData& cd = conds[k];
       const Measurement& meas = data.items[cd.index];
       if (lanes) {
-        y.swap(ys[k]);
-        B.swap(Bs[k]);
+        y.swap(done->response[k]);
+        B.swap(done->B_T[k]);
       } else {
         identify_detail::run_record_from_start(model, starts, meas, settings, y,
                                                cd.flux ? &B : nullptr);
@@ -124,6 +128,17 @@ struct Objective::Impl {
         if (cd.flux) r[cd.rB_offset + i - cd.compare_begin] = cd.B_scale * (B[i] - meas.flux_T[i]);
       }
     }
+  }
+
+  std::vector<const Measurement*> record_measurements() const {
+    std::vector<const Measurement*> recs;
+    for (const auto& cd : conds) recs.push_back(&data.items[cd.index]);
+    return recs;
+  }
+  std::vector<bool> record_flux() const {
+    std::vector<bool> flux;
+    for (const auto& cd : conds) flux.push_back(cd.flux);
+    return flux;
   }
 
   bool all_records_in_lanes(const Model& model) const {
@@ -192,9 +207,19 @@ struct Objective::Impl {
 
   bool residuals(const double* u, double* r, std::string* why = nullptr) const {
     try {
-      const Model model = model_at(u);
+      return residuals_at(model_at(u), r, why);
+    } catch (const InputError& e) {
+      if (why) *why = e.what();
+      return false;
+    }
+  }
+
+  // residuals() at a compiled model; `done`: its records' outputs, already run in lanes.
+  bool residuals_at(const Model& model, double* r, std::string* why,
+                    identify_detail::RecordOutputs* done = nullptr) const {
+    try {
       StartCache starts(model);
-      record_residuals(model, starts, r);
+      record_residuals(model, starts, r, done);
       if (!targets.empty()) {
         std::vector<SineMetrics> sm;
         std::vector<double> res;
@@ -218,6 +243,10 @@ struct Objective::Impl {
       }
     return true;
   }
+
+  // Objective::residuals_batch (objective.cpp).
+  std::vector<char> residuals_batch(std::span<const double* const> u,
+                                    std::span<double* const> r) const;
 
   static double target_value(const TargetData& td, const std::vector<SineMetrics>& sm,
                              const std::vector<double>& res) {

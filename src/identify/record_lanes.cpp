@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <deque>
+#include <stdexcept>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/model/validity.hpp"
@@ -140,42 +141,12 @@ std::vector<State> rest_states(const std::vector<const Model*>& models,
   return make_states(um, uc, ui);
 }
 
-}  // namespace
-
-void run_records_lanes(const Model& m, const std::vector<const Measurement*>& records,
-                       const std::vector<bool>& flux, const ObjectiveSettings& s,
-                       std::vector<std::vector<double>>& response,
-                       std::vector<std::vector<double>>& B_T) {
-  const std::size_t n = records.size();
-  response.resize(n);
-  B_T.resize(n);
-  std::vector<LaneRecord> runs(n);
-  std::deque<Model> preloaded;  // stable addresses
-  std::vector<const Model*> models(n);
-  std::vector<const Conditions*> conds(n);
-  std::vector<const State*> states(n);
-  std::vector<double> I0(n);
-  std::vector<std::size_t> start_of(n);
-  long longest = 0;
-  for (std::size_t k = 0; k < n; ++k) {
-    LaneRecord& lr = runs[k];
-    lr.meas = records[k];
-    lr.response = &response[k];
-    lr.B = flux[k] ? &B_T[k] : nullptr;
-    set_up(lr, m, preloaded, s);
-    models[k] = lr.model;
-    conds[k] = &lr.c;
-    I0[k] = lr.I0;
-    longest = std::max(longest, lr.total);
-  }
-  const std::vector<State> rest = rest_states(models, conds, I0, start_of);
-  for (std::size_t k = 0; k < n; ++k) {
-    LaneRecord& lr = runs[k];
-    lr.st = rest[start_of[k]];
-    lr.st.t_s = lr.meas->t_s.front();
-    lr.begin_pass(lr.passes == 1);
-    states[k] = &lr.st;
-  }
+// The records' steps, all lanes at once; a lane whose candidate failed is left to idle.
+void step_records(std::vector<LaneRecord>& runs, const std::vector<const Model*>& models,
+                  const std::vector<const Conditions*>& conds,
+                  const std::vector<const State*>& states, long longest, std::size_t P,
+                  std::vector<char>* failed) {
+  const std::size_t n = runs.size();
   LaneBatch batch(models, conds, states);
   std::vector<double> current(n), dt(n), t1(n);
   std::vector<double> t_prev(n);
@@ -189,6 +160,13 @@ void run_records_lanes(const Model& m, const std::vector<const Measurement*>& re
         t_prev[k] = lr.grid.t0_s;
         batch.set_time(k, lr.grid.t0_s);
       }
+      if (k % P != 0) {  // the record's other candidates: its grid and drive, computed once
+        dt[k] = dt[k - 1];
+        t_prev[k] = t_prev[k - 1];
+        t1[k] = t1[k - 1];
+        current[k] = current[k - 1];
+        continue;
+      }
       const double t =
           kk == steps ? lr.grid.t1_s : lr.grid.t0_s + static_cast<double>(kk) * lr.grid.dt_s;
       dt[k] = q > lr.total ? lr.grid.dt_s : t - t_prev[k];
@@ -200,7 +178,12 @@ void run_records_lanes(const Model& m, const std::vector<const Measurement*>& re
     for (std::size_t k = 0; k < n; ++k) {
       LaneRecord& lr = runs[k];
       if (q > lr.total) continue;
-      if (batch.diverged(k)) throw DivergenceError(batch.error(k));
+      if (failed && (*failed)[k % P]) continue;
+      if (batch.diverged(k)) {
+        if (!failed) throw DivergenceError(batch.error(k));
+        (*failed)[k % P] = 1;  // the candidate's residuals() fails: its outputs are not used
+        continue;
+      }
       const long pass = (q - 1) / lr.grid.steps;
       const bool last = pass + 1 == lr.passes;
       lr.after_step(batch, k, t1[k], last);
@@ -211,6 +194,65 @@ void run_records_lanes(const Model& m, const std::vector<const Measurement*>& re
       }
     }
   }
+}
+
+}  // namespace
+
+void run_records_lanes(const Model& m, const std::vector<const Measurement*>& records,
+                       const std::vector<bool>& flux, const ObjectiveSettings& s,
+                       std::vector<std::vector<double>>& response,
+                       std::vector<std::vector<double>>& B_T) {
+  const Model* const one[1] = {&m};
+  std::vector<RecordOutputs> out(1);
+  run_records_lanes(one, records, flux, s, out, nullptr);
+  response = std::move(out[0].response);
+  B_T = std::move(out[0].B_T);
+}
+
+void run_records_lanes(std::span<const Model* const> candidates,
+                       const std::vector<const Measurement*>& records,
+                       const std::vector<bool>& flux, const ObjectiveSettings& s,
+                       std::vector<RecordOutputs>& out, std::vector<char>* failed) {
+  const std::size_t P = candidates.size(), R = records.size(), n = P * R;
+  out.resize(P);
+  for (auto& o : out) {
+    o.response.resize(R);
+    o.B_T.resize(R);
+  }
+  if (failed) failed->assign(P, 0);
+  // Lane l = k P + c: record k of candidate c, so that a vector holds one record across the
+  // candidates (the same drive and grid: the lanes' Newton iterations and branches agree).
+  std::vector<LaneRecord> runs(n);
+  std::deque<Model> preloaded;  // stable addresses
+  std::vector<const Model*> models(n);
+  std::vector<const Conditions*> conds(n);
+  std::vector<const State*> states(n);
+  std::vector<double> I0(n);
+  std::vector<std::size_t> start_of(n);
+  long longest = 0;
+  for (std::size_t l = 0; l < n; ++l) {
+    const std::size_t k = l / P, c = l % P;
+    LaneRecord& lr = runs[l];
+    lr.meas = records[k];
+    lr.response = &out[c].response[k];
+    lr.B = flux[k] ? &out[c].B_T[k] : nullptr;
+    set_up(lr, *candidates[c], preloaded, s);
+    if (c > 0 && (lr.grid.steps != runs[l - c].grid.steps || lr.total != runs[l - c].total))
+      throw std::logic_error("run_records_lanes: a record's grid depends on the candidate");
+    models[l] = lr.model;
+    conds[l] = &lr.c;
+    I0[l] = lr.I0;
+    longest = std::max(longest, lr.total);
+  }
+  const std::vector<State> rest = rest_states(models, conds, I0, start_of);
+  for (std::size_t l = 0; l < n; ++l) {
+    LaneRecord& lr = runs[l];
+    lr.st = rest[start_of[l]];
+    lr.st.t_s = lr.meas->t_s.front();
+    lr.begin_pass(lr.passes == 1);
+    states[l] = &lr.st;
+  }
+  step_records(runs, models, conds, states, longest, P, failed);
 }
 
 }  // namespace gmasim::identify_detail

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <span>
 #include <vector>
 
 #include "gmasim/identify/identify.hpp"
@@ -23,5 +24,21 @@ void run_records_lanes(const Model& m, const std::vector<const Measurement*>& re
                        const std::vector<bool>& flux, const ObjectiveSettings& s,
                        std::vector<std::vector<double>>& response,
                        std::vector<std::vector<double>>& B_T);
+
+// One candidate's record outputs: response[k] and B_T[k] (if flux[k]) per record.
+struct RecordOutputs {
+  std::vector<std::vector<double>> response, B_T;
+};
+
+// The same records for several models at once (the candidates of a batch evaluation): lane
+// k P + c is record k of candidate c, so that a vector of lanes holds one record across the
+// candidates. out[c] is what run_records_lanes(*candidates[c], ...) gives, bit for bit (each
+// lane is the width-1 kernel's; no lane reads another). With `failed`, a candidate whose record
+// diverges gets failed[c] = 1 (its outputs unspecified) and the others go on; without it, the
+// first divergence throws as above. Rest states that fail throw (make_states).
+void run_records_lanes(std::span<const Model* const> candidates,
+                       const std::vector<const Measurement*>& records,
+                       const std::vector<bool>& flux, const ObjectiveSettings& s,
+                       std::vector<RecordOutputs>& out, std::vector<char>* failed);
 
 }  // namespace gmasim::identify_detail

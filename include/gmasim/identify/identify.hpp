@@ -14,6 +14,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -274,6 +275,15 @@ class Objective {
   // Normalised residuals: sum of squares = (weighted RMS %)^2. False if the parameters are
   // invalid for the model or the simulation diverged (r is then unspecified).
   bool residuals(const double* u, double* r) const;
+  // residuals() at several points at once: ok[i] and r[i] (residual_count() values each) are
+  // what residuals(u[i], r[i]) gives, bit for bit. With settings().lanes the points' records
+  // share SIMD lanes, a vector holding one record across the points (the candidates of a
+  // population or a Jacobian's columns: their lanes iterate and branch alike), which is the
+  // speed-up over calling residuals() per point (docs/lanes.md, "Candidates in lanes").
+  std::vector<char> residuals_batch(std::span<const double* const> u,
+                                    std::span<double* const> r) const;
+  // rms_pct() at several points at once (residuals_batch).
+  std::vector<double> rms_pct_batch(const std::vector<std::vector<double>>& u) const;
   // sqrt(sum r^2): the weighted RMS error [%]; kPenalty when residuals() fails.
   double rms_pct(const std::vector<double>& u) const;
   // Why residuals() fails at u (the InputError or DivergenceError message), "" if it does not.
