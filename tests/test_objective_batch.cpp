@@ -54,7 +54,7 @@ std::vector<std::vector<double>> batch_points(const Objective& obj) {
     }
   u.push_back({0.1, 0.9, 0.3});
   u.push_back({0.8, 0.2, 2.0});  // c0 = 9: an invalid model
-  u.push_back(c);                 // a repeat
+  u.push_back(c);                // a repeat
   u.push_back({0.55, 0.45, 0.2});
   return u;
 }
@@ -99,7 +99,8 @@ TEST(ObjectiveBatch, EqualsThePointsBitForBitWithoutLanes) {
 }
 
 // The batch's lanes follow the scalar objective (lanes = false) as residuals() does in lanes:
-// to the lanes' rounding (Lanes.ObjectiveResidualsMatchTheScalarRuns: ~1e-10 % of p-p).
+// to the lanes' rounding: observed 1.8e-15 % of RMS apart (AVX-512), tolerance 1e-13 % (the
+// rounding differs between SIMD targets).
 TEST(ObjectiveBatch, FollowsTheScalarObjective) {
   const Objective& lanes = batch_objective(true);
   const Objective& scalar = batch_objective(false);
@@ -108,7 +109,7 @@ TEST(ObjectiveBatch, FollowsTheScalarObjective) {
   double worst = 0.0;
   for (std::size_t i = 0; i < u.size(); ++i) {
     worst = std::max(worst, std::fabs(a[i] - b[i]));
-    EXPECT_NEAR(a[i], b[i], 1e-8) << "point " << i;
+    EXPECT_NEAR(a[i], b[i], 1e-13) << "point " << i;  // observed 1.8e-15 %
   }
   std::printf("objective batch in lanes vs scalar: largest RMS difference %.3g %%\n", worst);
 }
