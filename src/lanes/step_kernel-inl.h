@@ -63,6 +63,7 @@ struct Fails {
   V<D> code, value, rod, t, bound;
   void mark(D d, Mk<D> m, FailCode c, V<D> val, int rod_index, V<D> time, V<D> limit) {
     const Mk<D> nw = hn::AndNot(failed, m);
+    if (hn::AllFalse(d, nw)) return;  // the common case: no new failure
     bound = hn::IfThenElse(nw, limit, bound);
     code = hn::IfThenElse(nw, hn::Set(d, static_cast<double>(c)), code);
     value = hn::IfThenElse(nw, val, value);
