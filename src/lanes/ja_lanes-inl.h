@@ -53,18 +53,17 @@ struct ExpLanes {
   V<D> y, e;
 };
 // series.hpp's exp_near per lane: e^y from the known e^{y_prev} where |y - y_prev| <= 1/64
-// (e^{y_prev} exp_series7(y - y_prev)), hn::Exp elsewhere (computed only where a lane of
-// `update` needs it: the others' values are not used). The lanes of `update` take (y, e^y) as
-// their point.
+// (e^{y_prev} exp_series7(y - y_prev)), hn::Exp elsewhere (computed only where a lane needs
+// it). The lanes of `update` take (y, e^y) as their point.
 template <class D>
 HWY_INLINE V<D> exp_near(D d, V<D> y, ExpLanes<D>& p, Mk<D> update) {
   const V<D> dy = hn::Sub(y, p.y);
   const Mk<D> near = hn::Le(hn::Abs(dy), C(d, 1.0 / 64));  // false where y_prev is NaN
   V<D> e;
-  if (hn::AllTrue(d, hn::Or(near, hn::Not(update))))
-    e = hn::Mul(p.e, exp_series7(d, dy));
-  else if (hn::AllFalse(d, near))  // a move's first evaluation
+  if (hn::AllFalse(d, near))  // a move's first evaluation
     e = hn::Exp(d, y);
+  else if (hn::AllTrue(d, near))
+    e = hn::Mul(p.e, exp_series7(d, dy));
   else
     e = hn::IfThenElse(near, hn::Mul(p.e, exp_series7(d, dy)), hn::Exp(d, y));
   p.y = hn::IfThenElse(update, y, p.y);
