@@ -20,15 +20,40 @@
 HWY_BEFORE_NAMESPACE();
 namespace gmasim::lanes::HWY_NAMESPACE {
 
-// W lanes of the LaneData from lane j: loads, and the per-lane failure record.
+// W lanes of the LaneData from lane j: loads, and the per-lane failure record. The addresses
+// of lane j's rod, global and circuit fields (LaneData::rod, glob, S, bt_coil, bt_pm) from
+// their bases and stride held here: read through L, they were reloaded after every vector
+// store (which may alias L) -- a tenth of the kernel's instructions.
 template <class D>
 struct Chunk {
   D d;
   LaneData& L;
   std::size_t j;
   int n;  // rods
-  V<D> rod(int f, int i) const { return hn::LoadU(d, L.rod(f, i) + j); }
-  V<D> glob(int f) const { return hn::LoadU(d, L.glob(f) + j); }
+  double *rb, *gb, *cb;
+  std::size_t np;  // LaneData::npad
+  Chunk(D d_, LaneData& L_, std::size_t j_)
+      : d(d_),
+        L(L_),
+        j(j_),
+        n(L_.st.rods),
+        rb(L_.r.data() + j_),
+        gb(L_.g.data() + j_),
+        cb(L_.cm.data() + j_),
+        np(L_.npad) {}
+  double* rod_at(int f, int i) const {
+    return rb + (static_cast<std::size_t>(f) * kMaxRods + static_cast<std::size_t>(i)) * np;
+  }
+  double* glob_at(int f) const { return gb + static_cast<std::size_t>(f) * np; }
+  double* S_at(int a, int b) const { return cb + static_cast<std::size_t>(a * kMaxRods + b) * np; }
+  double* bt_coil_at(int a) const {
+    return cb + static_cast<std::size_t>(kMaxRods * kMaxRods + a) * np;
+  }
+  double* bt_pm_at(int a) const {
+    return cb + static_cast<std::size_t>(kMaxRods * kMaxRods + kMaxRods + a) * np;
+  }
+  V<D> rod(int f, int i) const { return hn::LoadU(d, rod_at(f, i)); }
+  V<D> glob(int f) const { return hn::LoadU(d, glob_at(f)); }
 };
 
 // The first failure of each lane in this step: code, value, rod and time (kFail...).
@@ -38,6 +63,7 @@ struct Fails {
   V<D> code, value, rod, t, bound;
   void mark(D d, Mk<D> m, FailCode c, V<D> val, int rod_index, V<D> time, V<D> limit) {
     const Mk<D> nw = hn::AndNot(failed, m);
+    if (hn::AllFalse(d, nw)) return;  // the common case: no new failure
     bound = hn::IfThenElse(nw, limit, bound);
     code = hn::IfThenElse(nw, hn::Set(d, static_cast<double>(c)), code);
     value = hn::IfThenElse(nw, val, value);
@@ -69,13 +95,13 @@ template <class D>
 HWY_INLINE Mk<D> circuit_solve3(const Chunk<D>& c, const V<D>* R, const V<D>* mmf, V<D> I, V<D> pm,
                                 V<D>* phi) {
   const D d = c.d;
-  auto S = [&](int a, int b) { return hn::LoadU(d, c.L.S(a, b) + c.j); };
+  auto S = [&](int a, int b) { return hn::LoadU(d, c.S_at(a, b)); };
   V<D> inv_R[3], DF[3], Btu[3], x[3];
   for (int a = 0; a < 3; ++a) {
     inv_R[a] = hn::Div(C(d, 1.0), R[a]);
     DF[a] = hn::Mul(mmf[a], inv_R[a]);
-    Btu[a] = hn::Add(hn::Mul(I, hn::LoadU(d, c.L.bt_coil(a) + c.j)),
-                     hn::Mul(pm, hn::LoadU(d, c.L.bt_pm(a) + c.j)));
+    Btu[a] = hn::Add(hn::Mul(I, hn::LoadU(d, c.bt_coil_at(a))),
+                     hn::Mul(pm, hn::LoadU(d, c.bt_pm_at(a))));
   }
   for (int a = 0; a < 3; ++a)
     x[a] = hn::Sub(Btu[a], hn::Add(hn::Add(hn::Mul(S(a, 0), DF[0]), hn::Mul(S(a, 1), DF[1])),
@@ -118,9 +144,9 @@ HWY_INLINE Mk<D> circuit_solve(const Chunk<D>& c, const V<D>* R, const V<D>* mmf
   for (int a = 0; a < n; ++a) {
     inv_R[a] = hn::Div(C(d, 1.0), R[a]);
     DF[a] = hn::Mul(mmf[a], inv_R[a]);
-    Btu[a] = hn::Add(hn::Mul(I, hn::LoadU(d, c.L.bt_coil(a) + c.j)),
-                     hn::Mul(pm, hn::LoadU(d, c.L.bt_pm(a) + c.j)));
-    for (int b = 0; b < n; ++b) S[a][b] = hn::LoadU(d, c.L.S(a, b) + c.j);
+    Btu[a] = hn::Add(hn::Mul(I, hn::LoadU(d, c.bt_coil_at(a))),
+                     hn::Mul(pm, hn::LoadU(d, c.bt_pm_at(a))));
+    for (int b = 0; b < n; ++b) S[a][b] = hn::LoadU(d, c.S_at(a, b));
   }
   for (int a = 0; a < n; ++a) {
     V<D> sdf = hn::Zero(d);

@@ -123,11 +123,11 @@ HWY_INLINE Fails<D> load_fails(const Chunk<D>& c) {
 }
 template <class D>
 HWY_INLINE void store_fails(const Chunk<D>& c, const Fails<D>& f) {
-  hn::StoreU(f.code, c.d, c.L.glob(kFail) + c.j);
-  hn::StoreU(f.value, c.d, c.L.glob(kFailValue) + c.j);
-  hn::StoreU(f.rod, c.d, c.L.glob(kFailRod) + c.j);
-  hn::StoreU(f.t, c.d, c.L.glob(kFailT) + c.j);
-  hn::StoreU(f.bound, c.d, c.L.glob(kFailBound) + c.j);
+  hn::StoreU(f.code, c.d, c.glob_at(kFail));
+  hn::StoreU(f.value, c.d, c.glob_at(kFailValue));
+  hn::StoreU(f.rod, c.d, c.glob_at(kFailRod));
+  hn::StoreU(f.t, c.d, c.glob_at(kFailT));
+  hn::StoreU(f.bound, c.d, c.glob_at(kFailBound));
 }
 
 // The rods' state of lanes [j, j + Lanes(d)), loaded field by field. A full step writes its
@@ -149,14 +149,14 @@ HWY_INLINE RodStates<D> load_rods(const Chunk<D>& c, bool outputs) {
 template <class D>
 HWY_INLINE void store_rods(const Chunk<D>& c, const RodStates<D>& s, Mk<D> keep) {
   for (int f = 0; f < kRodStateCount; ++f)
-    for (int i = 0; i < c.n; ++i) hn::BlendedStore(s.f[f][i], keep, c.d, c.L.rod(f, i) + c.j);
+    for (int i = 0; i < c.n; ++i) hn::BlendedStore(s.f[f][i], keep, c.d, c.rod_at(f, i));
 }
 
 // One step of lanes [j, j + Lanes(d)): load, the stages, store where the lane is still alive
 // (a lane that fails keeps its state before the step, as simulate() records it).
 template <class Law, class D>
 HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in) {
-  const Chunk<D> c{d, L, j, L.st.rods};
+  const Chunk<D> c(d, L, j);
   RodStates<D> s = load_rods(c, false);
   V<D> g[kGlobalStateCount];
   for (int f = 0; f < kGlobalStateCount; ++f) g[f] = c.glob(f);
@@ -179,7 +179,7 @@ HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
   const Mk<D> keep = hn::AndNot(fails.failed, alive);  // alive and not failed now
   law_commit(c, mg, keep);
   store_rods(c, s, keep);
-  for (int f = 0; f < kGlobalStateCount; ++f) hn::BlendedStore(g[f], keep, d, L.glob(f) + j);
+  for (int f = 0; f < kGlobalStateCount; ++f) hn::BlendedStore(g[f], keep, d, c.glob_at(f));
   store_fails(c, fails);
 }
 
@@ -188,7 +188,7 @@ HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
 // the magnets' scale of the increment; a lane that fails keeps its state.
 template <class Law, class D>
 HWY_INLINE void ramp_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in) {
-  const Chunk<D> c{d, L, j, L.st.rods};
+  const Chunk<D> c(d, L, j);
   RodStates<D> s = load_rods(c, true);
   Fails<D> fails = load_fails(c);
   const Mk<D> alive = hn::Not(fails.failed);
