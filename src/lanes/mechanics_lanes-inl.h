@@ -9,6 +9,7 @@
 #define GMASIM_LANES_MECHANICS_INL_H_
 #endif
 
+#include "gmasim/mechanics/oscillator.hpp"
 #include "hwy/contrib/math/math-inl.h"
 #include "hwy/highway.h"
 #include "lanes/ja_lanes-inl.h"
@@ -73,7 +74,8 @@ HWY_INLINE V<D> magnetostriction(D d, V<D> m, V<D> lambda_s, V<D> sigma_p, V<D> 
 // The closed form of the free row m e'' + c e' + k e = 0 over h (oscillator.hpp,
 // oscillator_free_closed_form): under-, over- or critically damped per lane, each regime
 // computed only where a lane is in it. Out of line: the rare path (steps long against the
-// row's period), so that oscillator_step's common one stays small in the inlined kernel.
+// row's period: |w_d h| > 2), so that oscillator_step's common one stays small in the inlined
+// kernel.
 template <class D>
 HWY_NOINLINE void oscillator_closed_form(D d, V<D> m, V<D> c, V<D> k, V<D> h, V<D> e0, V<D> ed0,
                                          V<D>& e1, V<D>& ed1) {
@@ -116,19 +118,26 @@ HWY_NOINLINE void oscillator_closed_form(D d, V<D> m, V<D> c, V<D> k, V<D> h, V<
   }
 }
 
+// oscillator.hpp's oscillator_series_doubled per lane: (C, S) of exp(N / 2) to those of exp(N),
+// in the lanes of `where`.
+template <class D>
+HWY_INLINE void oscillator_series_doubled(D, V<D> u_half, Mk<D> where, V<D>& C, V<D>& S) {
+  const V<D> C2 = hn::Add(hn::Mul(C, C), hn::Mul(u_half, hn::Mul(S, S)));
+  const V<D> S2 = hn::Mul(C, S);
+  C = hn::IfThenElse(where, C2, C);
+  S = hn::IfThenElse(where, S2, S);
+}
+
 // Eq. (15), one diagonal row m x'' + c x' + k x = F(t) with F linear over the step, exact
 // (mechanics.hpp, oscillator_step; inv_m = 1/m): the free row by the series of its propagator
 // (oscillator_propagator: f0 = e^(tau/2) (C - tau/2 S), f1 = e^(tau/2) S, C and S summed in u =
-// tau^2/4 - delta, e^(tau/2) by its series where |tau/2| <= 1/64) where |u| <= 1/4, by the
-// closed form in the lanes beyond (oscillator_closed_form, only where a lane needs it).
+// tau^2/4 - delta -- at u / 4 and doubled once where 1/4 < |u| <= 1, at u / 16 and doubled twice
+// where 1 < |u| <= 4, each only where a lane needs it -- e^(tau/2) by its series where |tau/2|
+// <= 1/64) where |u| <= 4, by the closed form in the lanes beyond (oscillator_closed_form, only
+// where a lane needs it).
 template <class D>
 HWY_INLINE void oscillator_step(D d, V<D> m, V<D> inv_m, V<D> c, V<D> k, V<D> F0, V<D> F1, V<D> h,
                                 V<D>& x, V<D>& v) {
-  constexpr double kCos[8] = {1.0,         1.0 / 2,       1.0 / 24,          1.0 / 720,
-                              1.0 / 40320, 1.0 / 3628800, 1.0 / 479001600.0, 1.0 / 87178291200.0};
-  constexpr double kSinc[8] = {
-      1.0,          1.0 / 6,          1.0 / 120,          1.0 / 5040,
-      1.0 / 362880, 1.0 / 39916800.0, 1.0 / 6227020800.0, 1.0 / 1307674368000.0};
   const V<D> g = hn::Div(hn::Sub(F1, F0), h);  // force rate [N/s]
   const V<D> inv_k = hn::Div(C(d, 1.0), k);
   const V<D> gck = hn::Mul(hn::Mul(g, c), inv_k);
@@ -138,10 +147,21 @@ HWY_INLINE void oscillator_step(D d, V<D> m, V<D> inv_m, V<D> c, V<D> k, V<D> F0
   const V<D> c_m = hn::Mul(c, inv_m), k_m = hn::Mul(k, inv_m);
   const V<D> half_tau = hn::Mul(C(d, 0.5), hn::Mul(hn::Neg(c_m), h));
   const V<D> u = hn::Sub(hn::Mul(half_tau, half_tau), hn::Mul(hn::Mul(k_m, h), h));
-  const Mk<D> series = hn::Le(hn::Abs(u), C(d, 0.25));
+  const V<D> au = hn::Abs(u);
+  const Mk<D> series = hn::Le(au, C(d, 4.0));
   V<D> e1 = hn::Zero(d), ed1 = hn::Zero(d);
   if (!hn::AllFalse(d, series)) {  // the propagator's series, where a lane's step is short
-    const V<D> Cu = polynomial7(d, u, kCos), Su = polynomial7(d, u, kSinc);
+    const Mk<D> once = hn::Gt(au, C(d, 0.25)), twice = hn::Gt(au, C(d, 1.0));
+    const bool halved = !hn::AllFalse(d, once), halved_twice = !hn::AllFalse(d, twice);
+    V<D> us = u;
+    if (halved) {
+      const V<D> u4 = hn::Mul(C(d, 0.25), u), u16 = hn::Mul(C(d, 0.0625), u);
+      us = hn::IfThenElse(twice, u16, hn::IfThenElse(once, u4, u));
+    }
+    V<D> Cu = polynomial7(d, us, physics::kOscillatorCos);
+    V<D> Su = polynomial7(d, us, physics::kOscillatorSinc);
+    if (halved_twice) oscillator_series_doubled(d, hn::Mul(C(d, 0.0625), u), twice, Cu, Su);
+    if (halved) oscillator_series_doubled(d, hn::Mul(C(d, 0.25), u), once, Cu, Su);
     const Mk<D> short_tau = hn::Le(hn::Abs(half_tau), C(d, 1.0 / 64));
     V<D> E = exp_series7(d, half_tau);
     if (!hn::AllTrue(d, short_tau)) E = hn::IfThenElse(short_tau, E, hn::Exp(d, half_tau));

@@ -45,14 +45,17 @@ struct LaneRun {
   State st;
   bool live = false;
   long first_recorded = 0;  // metrics_only: the step before the last period's window
+  // metrics_only: the columns the metrics read (t_s, current_A, y_um, B_T) over the window, kept
+  // here instead of the series.
+  std::vector<std::vector<double>> window;
   // Rows staged before they are appended to the series column by column (LaneBatch::record_row).
   std::vector<double> rows;
   std::size_t staged = 0;
-  // Appends the staged rows' first `columns` values (of `width`) to the series.
+  // Appends the staged rows' first `columns` values (of `width`) to cols.
   // Written by index into the grown column (no push_back per value: its end pointer was a chain).
-  void flush(TimeSeries& ts, std::size_t width, std::size_t columns) {
+  void flush(std::vector<std::vector<double>>& cols, std::size_t width, std::size_t columns) {
     for (std::size_t q = 0; q < columns; ++q) {
-      std::vector<double>& col = ts.columns[q];
+      std::vector<double>& col = cols[q];
       const std::size_t at = col.size();
       col.resize(at + staged);
       double* o = col.data() + at;
@@ -85,19 +88,17 @@ struct Drives {
       current[l] = w[l]->biased_sine_from_cos(cosine[of[l]]);
   }
 };
-constexpr std::size_t kGlobalColumns = 6;  // run.cpp's make_columns: t_s .. y_stack_um
+constexpr std::size_t kWindowColumns = 4;  // metrics_only: t_s, current_A, y_um, B_T
 
-// metrics_only: the rods' columns hold at most the rest state's row: none.
-void drop_rod_columns(TimeSeries& ts) {
-  for (std::size_t q = kGlobalColumns; q < ts.columns.size(); ++q) ts.columns[q].clear();
-}
-
-void finish(const SimulationSettings& s, const Plan& p, Result& r) {
+void finish(const SimulationSettings& s, const Plan& p, const LaneRun& lr, bool metrics_only,
+            Result& r) {
   if (r.series.rows() > 0) r.thermal_expansion_um = r.series.column("xT_um").back();
-  if (!r.diverged) {
-    r.metrics = compute_metrics(r.series, p.duration_s - s.waveform.period_s(), p.duration_s);
-    r.has_metrics = true;
-  }
+  if (r.diverged) return;
+  const double t0 = p.duration_s - s.waveform.period_s(), t1 = p.duration_s;
+  const auto& w = lr.window;
+  r.metrics = metrics_only ? compute_metrics(w[0], w[1], w[2], w[3], t0, t1)
+                           : compute_metrics(r.series, t0, t1);
+  r.has_metrics = true;
 }
 
 // The runs' settings (idx) and conditions, and their rest states: make_state's ramp for all of
@@ -123,16 +124,19 @@ std::vector<State> rest_states(const Model& m, std::span<const SimulationSetting
   }
 }
 
-// The rest states (rest_states), then the steps of the group in lanes.
-void run_group(const Model& m, std::span<const SimulationSettings> settings,
-               const std::vector<std::size_t>& idx, const Plan& p, bool metrics_only,
-               std::vector<Result>& out) {
-  const auto wall0 = std::chrono::steady_clock::now();
-  std::vector<LaneRun> runs(idx.size());
+// The lanes of a group: each run's rest state (rest_states), its first row (the rest state's,
+// where the record starts there) and its lane; a run whose rest state fails its checks gets
+// its error and no lane.
+struct Lanes {
   std::vector<const Model*> models;
   std::vector<const Conditions*> conds;
   std::vector<const State*> states;
   std::vector<std::size_t> lane_of;  // lane -> run
+};
+Lanes start_runs(const Model& m, std::span<const SimulationSettings> settings,
+                 const std::vector<std::size_t>& idx, const Plan& p, bool metrics_only,
+                 std::vector<LaneRun>& runs, std::vector<Result>& out) {
+  Lanes ln;
   std::vector<State> rest = rest_states(m, settings, idx, runs);
   for (std::size_t q = 0; q < idx.size(); ++q) {
     LaneRun& lr = runs[q];
@@ -140,68 +144,101 @@ void run_group(const Model& m, std::span<const SimulationSettings> settings,
     Result& r = out[idx[q]];
     r.dt_s = p.dt_s;
     r.thermal_expansion_start_um = r.thermal_expansion_um = lr.c.thermal_expansion_m * 1e6;
-    make_columns(m, r.series, static_cast<std::size_t>(p.steps / s.record_every + 2));
+    make_columns(m, r.series,
+                 metrics_only ? 0 : static_cast<std::size_t>(p.steps / s.record_every + 2));
     try {
       lr.st = rest.empty() ? make_state(m, lr.c, s.waveform.current_at(0.0)) : std::move(rest[q]);
       lr.st.energy.enabled = false;
       check_physical_validity(m, lr.c, lr.st, 0.0);
-      if (metrics_only)
+      if (metrics_only) {
         lr.first_recorded = p.steps - std::lround(s.waveform.period_s() / p.dt_s) - 1;
-      if (lr.first_recorded <= 0) record(lr.c, lr.st, r.series);
+        const long rows = (p.steps - std::max(lr.first_recorded, 0L)) / s.record_every + 3;
+        lr.window.assign(kWindowColumns, {});
+        for (auto& col : lr.window) col.reserve(static_cast<std::size_t>(rows));
+      }
+      if (lr.first_recorded <= 0 && metrics_only) {  // record()'s t_s, current_A, y_um, B_T
+        const State& st = lr.st;
+        const double row[kWindowColumns] = {st.t_s, st.current_A, st.y_m * 1e6, st.B_T};
+        for (std::size_t w = 0; w < kWindowColumns; ++w) lr.window[w].push_back(row[w]);
+      } else if (lr.first_recorded <= 0) {
+        record(lr.c, lr.st, r.series);
+      }
       lr.live = true;
-      models.push_back(&m);
-      conds.push_back(&lr.c);
-      states.push_back(&lr.st);
-      lane_of.push_back(q);
+      ln.models.push_back(&m);
+      ln.conds.push_back(&lr.c);
+      ln.states.push_back(&lr.st);
+      ln.lane_of.push_back(q);
     } catch (const DivergenceError& e) {
       r.diverged = true;
       r.error = e.what();
     }
   }
-  if (!lane_of.empty()) {
-    LaneBatch batch(models, conds, states);
-    const std::size_t n = lane_of.size(), width = batch.record_width();
-    // metrics_only: the global columns (t_s .. y_stack_um), all the metrics read
-    const std::size_t columns = metrics_only ? kGlobalColumns : width;
-    for (std::size_t l = 0; l < n; ++l) runs[lane_of[l]].rows.resize(kStagedRows * width);
-    std::vector<double> current(n), dt(n, p.dt_s), t1(n);
-    std::size_t live = n;
-    Drives drives;
-    for (std::size_t l = 0; l < n; ++l) drives.add(settings[runs[lane_of[l]].setting].waveform);
+  return ln;
+}
 
-    for (long k = 1; k <= p.steps && live > 0; ++k) {
-      const double t = 0.0 + static_cast<double>(k) * p.dt_s;  // the Uniform clock
-      drives.at(t, current);
-      std::fill(t1.begin(), t1.end(), t);
-      batch.step(current, dt, t1);
-      for (std::size_t l = 0; l < n; ++l) {
-        LaneRun& lr = runs[lane_of[l]];
-        if (!lr.live) continue;
-        Result& r = out[lr.setting];
-        if (batch.diverged(l)) {
-          lr.flush(r.series, width, columns);
-          r.diverged = true;
-          r.error = batch.error(l);
-          lr.live = false;
-          --live;
-          continue;
-        }
-        r.steps = k;
-        if (k >= lr.first_recorded &&
-            (k % settings[lr.setting].record_every == 0 || k == p.steps)) {
-          batch.record_row(l, lr.c.thermal_expansion_m, lr.rows.data() + lr.staged * width);
-          if (++lr.staged == kStagedRows || k == p.steps) lr.flush(r.series, width, columns);
-        }
+// The steps of a group's lanes, each lane's rows staged and appended: the series' columns, or,
+// metrics_only, the window's (t, the current, y and B: what record() writes there).
+void step_runs(const Lanes& ln, std::span<const SimulationSettings> settings, const Plan& p,
+               bool metrics_only, std::vector<LaneRun>& runs, std::vector<Result>& out) {
+  LaneBatch batch(ln.models, ln.conds, ln.states);
+  const std::size_t n = ln.lane_of.size();
+  const std::size_t width = metrics_only ? kWindowColumns : batch.record_width();
+  for (std::size_t l = 0; l < n; ++l) runs[ln.lane_of[l]].rows.resize(kStagedRows * width);
+  std::vector<double> current(n), dt(n, p.dt_s), t1(n);
+  std::size_t live = n;
+  Drives drives;
+  for (std::size_t l = 0; l < n; ++l) drives.add(settings[runs[ln.lane_of[l]].setting].waveform);
+  auto columns = [&](LaneRun& lr) -> std::vector<std::vector<double>>& {
+    return metrics_only ? lr.window : out[lr.setting].series.columns;
+  };
+  for (long k = 1; k <= p.steps && live > 0; ++k) {
+    const double t = 0.0 + static_cast<double>(k) * p.dt_s;  // the Uniform clock
+    drives.at(t, current);
+    std::fill(t1.begin(), t1.end(), t);
+    batch.step(current, dt, t1);
+    for (std::size_t l = 0; l < n; ++l) {
+      LaneRun& lr = runs[ln.lane_of[l]];
+      if (!lr.live) continue;
+      Result& r = out[lr.setting];
+      if (batch.diverged(l)) {
+        lr.flush(columns(lr), width, width);
+        r.diverged = true;
+        r.error = batch.error(l);
+        lr.live = false;
+        --live;
+        continue;
       }
+      r.steps = k;
+      if (k < lr.first_recorded || (k % settings[lr.setting].record_every != 0 && k != p.steps))
+        continue;
+      double* row = lr.rows.data() + lr.staged * width;
+      if (metrics_only) {  // the lane's t and current are the step's (LaneBatch::record_row)
+        row[0] = t;
+        row[1] = current[l];
+        row[2] = batch.y_m(l) * 1e6;
+        row[3] = batch.B_T(l);
+      } else {
+        batch.record_row(l, lr.c.thermal_expansion_m, row);
+      }
+      if (++lr.staged == kStagedRows || k == p.steps) lr.flush(columns(lr), width, width);
     }
   }
+}
+
+// The rest states, then the steps of the group in lanes.
+void run_group(const Model& m, std::span<const SimulationSettings> settings,
+               const std::vector<std::size_t>& idx, const Plan& p, bool metrics_only,
+               std::vector<Result>& out) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  std::vector<LaneRun> runs(idx.size());
+  const Lanes ln = start_runs(m, settings, idx, p, metrics_only, runs, out);
+  if (!ln.lane_of.empty()) step_runs(ln, settings, p, metrics_only, runs, out);
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   for (const LaneRun& lr : runs) {
     Result& r = out[lr.setting];
-    if (metrics_only) drop_rod_columns(r.series);
     r.wall_time_s = wall / static_cast<double>(runs.size());
-    finish(settings[lr.setting], p, r);
+    finish(settings[lr.setting], p, lr, metrics_only, r);
   }
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <vector>
 
 #include "gmasim/model/model.hpp"
 #include "gmasim/simulate/simulate.hpp"
@@ -14,5 +15,11 @@ namespace gmasim {
 void make_columns(const Model& m, TimeSeries& ts, std::size_t reserve);
 // One row of the series from the state at the end of a step.
 void record(const Conditions& c, const State& s, TimeSeries& ts);
+
+// compute_metrics (src/simulate/metrics.cpp) from the columns it reads, held apart from a
+// series (simulate_lanes' metrics_only runs keep only these, over the metrics window).
+Metrics compute_metrics(const std::vector<double>& t_s, const std::vector<double>& current_A,
+                        const std::vector<double>& y_um, const std::vector<double>& B_T,
+                        double t0_s, double t1_s);
 
 }  // namespace gmasim

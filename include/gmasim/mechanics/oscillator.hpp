@@ -17,26 +17,42 @@ namespace gmasim::physics {
 // (2j)! (cos w_d h) and S = sum u^j / (2j+1)! (sin(w_d h) / (w_d h); cosh and
 // sinh where u > 0, over-damped), and
 //   f1 = e^(tau/2) S,   f0 = e^(tau/2) (C - tau/2 S).
-// Where |u| <= 1/4 (w_d h <= 1/2: at least 12 steps per period) C and S are
-// summed to u^7 (truncation below 1e-18; Estrin's scheme), e^(tau/2) likewise
-// to (tau/2)^7 where |tau/2| <= 1/64 (below 1e-19) and by std::exp beyond: no
-// sincos or square root, every damping alike. valid = false beyond |u| = 1/4:
-// the closed form.
+// C and S are summed to u^7 (truncation below 1e-18; Estrin's scheme) where |u|
+// <= 1/4 (w_d h <= 1/2: at least 12 steps per period); beyond, up to |u| = 4
+// (w_d h <= 2), at u / 4 or u / 16 and doubled once or twice
+// (oscillator_series_doubled: exp(N) = exp(N/2)^2), e^(tau/2) by its series to
+// (tau/2)^7 where |tau/2| <= 1/64 (below 1e-19) and by std::exp beyond: no sincos
+// or square root, every damping alike. valid = false beyond |u| = 4 (steps
+// longer than a third of the row's period): the closed form.
 struct OscillatorPropagator {
   double f0, f1;
   bool valid;
 };
+inline constexpr double kOscillatorCos[8] = {
+    1.0,         1.0 / 2,       1.0 / 24,          1.0 / 720,
+    1.0 / 40320, 1.0 / 3628800, 1.0 / 479001600.0, 1.0 / 87178291200.0};
+inline constexpr double kOscillatorSinc[8] = {
+    1.0,          1.0 / 6,          1.0 / 120,          1.0 / 5040,
+    1.0 / 362880, 1.0 / 39916800.0, 1.0 / 6227020800.0, 1.0 / 1307674368000.0};
+// One doubling: (C, S) of exp(N / 2), whose (N / 2)^2 = u_half I, to those of exp(N) =
+// exp(N / 2)^2 = (C^2 + u_half S^2) I + (C S) N.
+inline void oscillator_series_doubled(double u_half, double &C, double &S) {
+  const double c = C;
+  C = c * c + u_half * (S * S);
+  S = c * S;
+}
 // decay: the last e^(tau/2) taken by std::exp (physics::exp_cached; a run's step repeats it).
 inline OscillatorPropagator oscillator_propagator(double tau, double delta, ExpPoint &decay) {
   const double half_tau = 0.5 * tau;
   const double u = half_tau * half_tau - delta;
-  if (!(std::fabs(u) <= 0.25)) return {0.0, 0.0, false};
-  constexpr double kCos[8] = {1.0,         1.0 / 2,       1.0 / 24,          1.0 / 720,
-                              1.0 / 40320, 1.0 / 3628800, 1.0 / 479001600.0, 1.0 / 87178291200.0};
-  constexpr double kSinc[8] = {
-      1.0,          1.0 / 6,          1.0 / 120,          1.0 / 5040,
-      1.0 / 362880, 1.0 / 39916800.0, 1.0 / 6227020800.0, 1.0 / 1307674368000.0};
-  const double C = polynomial7(u, kCos), S = polynomial7(u, kSinc);
+  const double au = std::fabs(u);
+  if (!(au <= 4.0)) return {0.0, 0.0, false};
+  // The halvings: none where |u| <= 1/4, one (u / 4) to |u| = 1, two (u / 16) to 4.
+  const int halvings = au <= 0.25 ? 0 : (au <= 1.0 ? 1 : 2);
+  const double us = halvings == 0 ? u : (halvings == 1 ? 0.25 * u : 0.0625 * u);
+  double C = polynomial7(us, kOscillatorCos), S = polynomial7(us, kOscillatorSinc);
+  if (halvings == 2) oscillator_series_doubled(0.0625 * u, C, S);
+  if (halvings >= 1) oscillator_series_doubled(0.25 * u, C, S);
   const double E =
       std::fabs(half_tau) <= 1.0 / 64 ? exp_series7(half_tau) : exp_cached(half_tau, decay);
   return {E * (C - half_tau * S), E * S, true};
@@ -48,7 +64,7 @@ inline OscillatorPropagator oscillator_propagator(double tau, double delta) {
 
 // The closed form of the free row over h (under-, critically or over-damped)
 // from (e0, e0'): where the series of oscillator_propagator does not apply
-// (long steps).
+// (steps longer than a third of the row's period).
 [[gnu::noinline]] inline void oscillator_free_closed_form(double m, double c, double k, double h,
                                                           double e0, double ed0, double &e1,
                                                           double &ed1) {

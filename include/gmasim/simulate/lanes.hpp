@@ -107,10 +107,10 @@ std::vector<State> make_states(std::span<const Model* const> models,
 // simulate() for many settings of one model: the settings the lanes can run (no
 // self-heating, no energy ledger, a model lanes_supported) advance together in lanes,
 // grouped by their step count; the others run simulate(). Results in the order of the
-// settings; the same validation and errors as simulate(). metrics_only: a lane's series holds
-// only the rows of its metrics window (the last period) and the one before it, enough for the
-// metrics, which are those of the full record (what a sweep keeps), and of the run's global
-// columns only (t_s .. y_stack_um: the rods' columns are empty).
+// settings; the same validation and errors as simulate(). metrics_only: a lane keeps only what
+// its metrics read -- t, the current, y and B over its metrics window (the last period) and the
+// row before it -- and its metrics are those of the full record (what a sweep keeps); the
+// series' columns are left empty.
 std::vector<Result> simulate_lanes(const Model& m, std::span<const SimulationSettings> settings,
                                    bool metrics_only = false);
 
