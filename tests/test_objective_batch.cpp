@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "gmasim/errors.hpp"
 #include "gmasim/identify/identify.hpp"
 #include "gmasim/io/io.hpp"
 
