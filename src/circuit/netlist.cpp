@@ -36,7 +36,7 @@ struct NodalBuffers {
   Eigen::MatrixXd G;
   Eigen::VectorXd rhs;  // holds the node potentials psi after a solve
   Eigen::LLT<Eigen::MatrixXd> llt;
-  SmallVector v, z;  // low-rank path: rod potential drops B^T psi, and D F + z
+  SmallVector z;  // low-rank path: the rod branches' fluxes
 };
 
 NodalBuffersPtr::NodalBuffersPtr() = default;
@@ -198,7 +198,6 @@ void CircuitWorkspace::resize(const Circuit& c) {
   // enum (UBSan, issue 8). compute() sets both; step() refactorises in place, no allocation.
   nb.llt.compute(Eigen::MatrixXd::Identity(n, n));
   const int k = static_cast<int>(c.rod_branch.size());
-  nb.v = SmallVector::Zero(k);
   nb.z = SmallVector::Zero(k);
   reluctance.assign(c.branches.size(), 0.0);
   mmf.assign(c.branches.size(), 0.0);
@@ -228,30 +227,23 @@ double potential_drop(const CircuitBranch& br, const Eigen::VectorXd& psi) {
   return (br.from >= 0 ? psi(br.from) : 0.0) - (br.to >= 0 ? psi(br.to) : 0.0);
 }
 
-// The k x k part of the low-rank solve, with D = diag(1/R_rod), F the rods' own MMFs and
-// u = I psi_coil + pm psi_pm:
-//   v = B^T u - S D F,  (D^-1 + S) z' = v,  z = z' + D F,  B^T psi = B^T u - S z.
-// Leaves z in ws.z and the rod potential drops B^T psi in ws.v. The matrix D^-1 + S has the
-// same (dense, k x k) structure every step; it is factorised as L D L^T without square roots
-// in fixed storage, unrolled for K = 1, 2, 4 rods (the hot path of the consistent state's Newton
-// solve; three rods: rod_solve3), K = 0 for any k <= 8. Allocation-free. False if a pivot is not
-// positive.
+// The k x k part of the low-rank solve. With D = diag(1/R_rod), F the rods' own MMFs and
+// u = I psi_coil + pm psi_pm, the node potentials are psi = u - W z with z = D (B^T psi + F):
+// z is the rod branches' fluxes phi_r = (drop_r + F_r) / R_r, and B^T psi = B^T u - S z gives
+//   (diag(R) + S) z = B^T u + F,
+// one k x k solve for the rod fluxes themselves (no reciprocal of R). Leaves z in ws.z. The
+// matrix diag(R) + S has the same (dense, k x k) structure every step; it is factorised as
+// L D L^T without square roots in fixed storage, unrolled for K = 1, 2, 4 rods (the hot path of
+// the consistent state's Newton solve; three rods: rod_solve3), K = 0 for any k <= 8.
+// Allocation-free. False if a pivot is not positive or z is not finite.
 template <int K>
-bool rod_solve(const CircuitMatrices& L, const double* R, const double* inv_R, const double* mmf,
-               double current_A, double pm_scale, int k_any, NodalBuffers& ws) {
+bool rod_solve(const CircuitMatrices& L, const double* R, const double* mmf, double current_A,
+               double pm_scale, int k_any, NodalBuffers& ws) {
   const int k = K > 0 ? K : k_any;
   // Written before read (no zero fill: hot path).
-  double A[64], DF[8], Btu[8], x[8], piv[8], inv_piv[8];
+  double A[64], x[8], piv[8], inv_piv[8];
   const double* S = L.S8.data();
-  for (int r = 0; r < k; ++r) {
-    DF[r] = mmf[r] * inv_R[r];
-    Btu[r] = current_A * L.bt_coil8[r] + pm_scale * L.bt_pm8[r];
-  }
-  for (int r = 0; r < k; ++r) {
-    double SDF = 0.0;
-    for (int q = 0; q < k; ++q) SDF += S[8 * r + q] * DF[q];
-    x[r] = Btu[r] - SDF;
-  }
+  for (int r = 0; r < k; ++r) x[r] = current_A * L.bt_coil8[r] + pm_scale * L.bt_pm8[r] + mmf[r];
   for (int j = 0; j < k; ++j) {  // L D L^T of S + diag(R), unit L below the diagonal of A
     double d = S[9 * j] + R[j];
     for (int p = 0; p < j; ++p) d -= A[8 * j + p] * A[8 * j + p] * piv[p];
@@ -271,34 +263,22 @@ bool rod_solve(const CircuitMatrices& L, const double* R, const double* inv_R, c
     for (int p = i + 1; p < k; ++p) x[i] -= A[8 * p + i] * x[p];
   }
   bool finite = true;
-  for (int r = 0; r < k; ++r) {
-    x[r] += DF[r];
-    finite = finite && std::isfinite(x[r]);
-  }
+  for (int r = 0; r < k; ++r) finite = finite && std::isfinite(x[r]);
   if (!finite) return false;
-  for (int r = 0; r < k; ++r) {
-    double Sz = 0.0;
-    for (int q = 0; q < k; ++q) Sz += S[8 * r + q] * x[q];
-    ws.z(r) = x[r];
-    ws.v(r) = Btu[r] - Sz;
-  }
+  for (int r = 0; r < k; ++r) ws.z(r) = x[r];
   return true;
 }
 
-// rod_solve for three rods (the built-in actuator), straight-line: D^-1 + S = A is solved by its
-// adjugate, z' = adj(A) v / det A, one division. The pivot test of the L D L^T form is
-// Sylvester's criterion on the leading minors (d_1 = a00, d_2 = m2 / a00, d_3 = det / m2 all
+// rod_solve for three rods (the built-in actuator), straight-line: A = S + diag(R) is solved by
+// its adjugate, z = adj(A) (B^T u + F) / det A, one division. The pivot test of the L D L^T form
+// is Sylvester's criterion on the leading minors (d_1 = a00, d_2 = m2 / a00, d_3 = det / m2 all
 // > 0). Allocation-free. False if a leading minor is not positive or z is not finite.
-bool rod_solve3(const CircuitMatrices& L, const double* R, const double* inv_R, const double* mmf,
-                double current_A, double pm_scale, NodalBuffers& ws) {
+bool rod_solve3(const CircuitMatrices& L, const double* R, const double* mmf, double current_A,
+                double pm_scale, NodalBuffers& ws) {
   const double* S = L.S8.data();  // rows 0, 1, 2 at S, S + 8, S + 16
-  const double DF0 = mmf[0] * inv_R[0], DF1 = mmf[1] * inv_R[1], DF2 = mmf[2] * inv_R[2];
-  const double Btu0 = current_A * L.bt_coil8[0] + pm_scale * L.bt_pm8[0];
-  const double Btu1 = current_A * L.bt_coil8[1] + pm_scale * L.bt_pm8[1];
-  const double Btu2 = current_A * L.bt_coil8[2] + pm_scale * L.bt_pm8[2];
-  const double x0 = Btu0 - (S[0] * DF0 + S[1] * DF1 + S[2] * DF2);
-  const double x1 = Btu1 - (S[8] * DF0 + S[9] * DF1 + S[10] * DF2);
-  const double x2 = Btu2 - (S[16] * DF0 + S[17] * DF1 + S[18] * DF2);
+  const double x0 = current_A * L.bt_coil8[0] + pm_scale * L.bt_pm8[0] + mmf[0];
+  const double x1 = current_A * L.bt_coil8[1] + pm_scale * L.bt_pm8[1] + mmf[1];
+  const double x2 = current_A * L.bt_coil8[2] + pm_scale * L.bt_pm8[2] + mmf[2];
   // A = S + diag(R), its lower triangle (as the L D L^T form reads it).
   const double a00 = S[0] + R[0], a10 = S[8], a11 = S[9] + R[1];
   const double a20 = S[16], a21 = S[17], a22 = S[18] + R[2];
@@ -308,16 +288,13 @@ bool rod_solve3(const CircuitMatrices& L, const double* R, const double* inv_R, 
   const double det = a00 * c00 + a10 * c01 + a20 * c02;
   if (!(a00 > 0.0 && m2 > 0.0 && det > 0.0)) return false;
   const double inv_det = 1.0 / det;
-  const double z0 = (c00 * x0 + c01 * x1 + c02 * x2) * inv_det + DF0;
-  const double z1 = (c01 * x0 + c11 * x1 + c12 * x2) * inv_det + DF1;
-  const double z2 = (c02 * x0 + c12 * x1 + m2 * x2) * inv_det + DF2;
+  const double z0 = (c00 * x0 + c01 * x1 + c02 * x2) * inv_det;
+  const double z1 = (c01 * x0 + c11 * x1 + c12 * x2) * inv_det;
+  const double z2 = (c02 * x0 + c12 * x1 + m2 * x2) * inv_det;
   if (!(std::isfinite(z0) && std::isfinite(z1) && std::isfinite(z2))) return false;
   ws.z(0) = z0;
   ws.z(1) = z1;
   ws.z(2) = z2;
-  ws.v(0) = Btu0 - (S[0] * z0 + S[1] * z1 + S[2] * z2);
-  ws.v(1) = Btu1 - (S[8] * z0 + S[9] * z1 + S[10] * z2);
-  ws.v(2) = Btu2 - (S[16] * z0 + S[17] * z1 + S[18] * z2);
   return true;
 }
 
@@ -330,40 +307,38 @@ bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_
   const CircuitMatrices& L = *c.matrices;
   NodalBuffers& nb = *ws.nodal.get();
   const int k = static_cast<int>(c.rod_branch.size());
-  std::array<double, 8> mmf, inv_R;  // written for r < k before they are read
+  std::array<double, 8> mmf;  // written for r < k before it is read
   const double* R = rod_reluctance_per_H.data();
-  for (int r = 0; r < k; ++r) {
+  for (int r = 0; r < k; ++r)
     mmf[static_cast<std::size_t>(r)] =
         branch_mmf(c.branches[static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)])],
                    current_A, pm_scale, ws);
-    inv_R[static_cast<std::size_t>(r)] = 1.0 / R[r];  // one division per rod branch and solve
-  }
   bool ok = false;
   switch (k) {
     case 1:
-      ok = rod_solve<1>(L, R, inv_R.data(), mmf.data(), current_A, pm_scale, k, nb);
+      ok = rod_solve<1>(L, R, mmf.data(), current_A, pm_scale, k, nb);
       break;
     case 2:
-      ok = rod_solve<2>(L, R, inv_R.data(), mmf.data(), current_A, pm_scale, k, nb);
+      ok = rod_solve<2>(L, R, mmf.data(), current_A, pm_scale, k, nb);
       break;
     case 3:
-      ok = rod_solve3(L, R, inv_R.data(), mmf.data(), current_A, pm_scale, nb);
+      ok = rod_solve3(L, R, mmf.data(), current_A, pm_scale, nb);
       break;
     case 4:
-      ok = rod_solve<4>(L, R, inv_R.data(), mmf.data(), current_A, pm_scale, k, nb);
+      ok = rod_solve<4>(L, R, mmf.data(), current_A, pm_scale, k, nb);
       break;
     default:
-      ok = rod_solve<0>(L, R, inv_R.data(), mmf.data(), current_A, pm_scale, k, nb);
+      ok = rod_solve<0>(L, R, mmf.data(), current_A, pm_scale, k, nb);
   }
   if (!ok) return false;
-  // The rod fluxes from the k x k solve, phi_r = (drop_r + F_r) / R_r (the same numbers
-  // whether or not the other branches are wanted); the others from the node potentials.
+  // The rod fluxes are the k x k solve's z (the same numbers whether or not the other branches
+  // are wanted); the others from the node potentials.
   for (int r = 0; r < k; ++r) {
     const auto ur = static_cast<std::size_t>(r);
     const auto b = static_cast<std::size_t>(c.rod_branch[ur]);
     ws.reluctance[b] = R[r];
     ws.mmf[b] = mmf[ur];
-    ws.phi[b] = (nb.v(r) + mmf[ur]) * inv_R[ur];
+    ws.phi[b] = nb.z(r);
   }
   if (!all_branches) return true;
   nb.rhs.noalias() = current_A * L.psi_coil + pm_scale * L.psi_pm;
