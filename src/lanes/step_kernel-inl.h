@@ -83,12 +83,11 @@ struct RodStates {
   V<D> f[kRodStateCount][kMaxRods];
 };
 
-// The low-rank circuit solve (circuit/netlist.cpp, rod_solve and set_flux) per lane: with
-// D = diag(1/R), F the rods' MMFs and u = I psi_coil + pm psi_pm:  v = B^T u - S D F,
-// (D^-1 + S) z' = v (L D L^T, no square roots), z = z' + D F,
-// phi_r = ((B^T u - S z)_r + F_r) / R_r. ok is false where a pivot is not positive or z is
-// not finite. One division per pivot and per rod branch (their reciprocals), as rod_solve and
-// solve_circuit.
+// The low-rank circuit solve (circuit/netlist.cpp, rod_solve and solve_circuit) per lane: with
+// F the rods' MMFs and u = I psi_coil + pm psi_pm, the rod fluxes themselves solve
+//   (diag(R) + S) phi = B^T u + F
+// (L D L^T, no square roots; no reciprocal of R). ok is false where a pivot is not positive or
+// phi is not finite. One division per pivot, as rod_solve.
 // Three rods (the built-in actuator): netlist.cpp's rod_solve3, A = S + diag(R) solved by its
 // adjugate with one division, Sylvester's criterion for the pivots.
 template <class D>
@@ -96,16 +95,11 @@ HWY_INLINE Mk<D> circuit_solve3(const Chunk<D>& c, const V<D>* R, const V<D>* mm
                                 V<D>* phi) {
   const D d = c.d;
   auto S = [&](int a, int b) { return hn::LoadU(d, c.S_at(a, b)); };
-  V<D> inv_R[3], DF[3], Btu[3], x[3];
-  for (int a = 0; a < 3; ++a) {
-    inv_R[a] = hn::Div(C(d, 1.0), R[a]);
-    DF[a] = hn::Mul(mmf[a], inv_R[a]);
-    Btu[a] = hn::Add(hn::Mul(I, hn::LoadU(d, c.bt_coil_at(a))),
-                     hn::Mul(pm, hn::LoadU(d, c.bt_pm_at(a))));
-  }
+  V<D> x[3];
   for (int a = 0; a < 3; ++a)
-    x[a] = hn::Sub(Btu[a], hn::Add(hn::Add(hn::Mul(S(a, 0), DF[0]), hn::Mul(S(a, 1), DF[1])),
-                                   hn::Mul(S(a, 2), DF[2])));
+    x[a] = hn::Add(hn::Add(hn::Mul(I, hn::LoadU(d, c.bt_coil_at(a))),
+                           hn::Mul(pm, hn::LoadU(d, c.bt_pm_at(a)))),
+                   mmf[a]);
   const V<D> a00 = hn::Add(S(0, 0), R[0]), a10 = S(1, 0), a11 = hn::Add(S(1, 1), R[1]);
   const V<D> a20 = S(2, 0), a21 = S(2, 1), a22 = hn::Add(S(2, 2), R[2]);
   auto minor = [&](V<D> p, V<D> q, V<D> r, V<D> s) {
@@ -121,15 +115,10 @@ HWY_INLINE Mk<D> circuit_solve3(const Chunk<D>& c, const V<D>* R, const V<D>* mm
   auto row = [&](V<D> p, V<D> q, V<D> r) {
     return hn::Add(hn::Add(hn::Mul(p, x[0]), hn::Mul(q, x[1])), hn::Mul(r, x[2]));
   };
-  V<D> z[3] = {hn::Add(hn::Mul(row(c00, c01, c02), inv_det), DF[0]),
-               hn::Add(hn::Mul(row(c01, c11, c12), inv_det), DF[1]),
-               hn::Add(hn::Mul(row(c02, c12, m2), inv_det), DF[2])};
-  for (int a = 0; a < 3; ++a) ok = hn::And(ok, hn::IsFinite(z[a]));
-  for (int a = 0; a < 3; ++a) {
-    const V<D> sz =
-        hn::Add(hn::Add(hn::Mul(S(a, 0), z[0]), hn::Mul(S(a, 1), z[1])), hn::Mul(S(a, 2), z[2]));
-    phi[a] = hn::Mul(hn::Add(hn::Sub(Btu[a], sz), mmf[a]), inv_R[a]);
-  }
+  phi[0] = hn::Mul(row(c00, c01, c02), inv_det);
+  phi[1] = hn::Mul(row(c01, c11, c12), inv_det);
+  phi[2] = hn::Mul(row(c02, c12, m2), inv_det);
+  for (int a = 0; a < 3; ++a) ok = hn::And(ok, hn::IsFinite(phi[a]));
   return ok;
 }
 
@@ -139,19 +128,12 @@ HWY_INLINE Mk<D> circuit_solve(const Chunk<D>& c, const V<D>* R, const V<D>* mmf
   const D d = c.d;
   const int n = c.n;
   if (n == 3) return circuit_solve3(c, R, mmf, I, pm, phi);
-  V<D> S[kMaxRods][kMaxRods], A[kMaxRods][kMaxRods], DF[kMaxRods], Btu[kMaxRods], x[kMaxRods],
-      piv[kMaxRods], inv_piv[kMaxRods], inv_R[kMaxRods];
+  V<D> S[kMaxRods][kMaxRods], A[kMaxRods][kMaxRods], x[kMaxRods], piv[kMaxRods], inv_piv[kMaxRods];
   for (int a = 0; a < n; ++a) {
-    inv_R[a] = hn::Div(C(d, 1.0), R[a]);
-    DF[a] = hn::Mul(mmf[a], inv_R[a]);
-    Btu[a] = hn::Add(hn::Mul(I, hn::LoadU(d, c.bt_coil_at(a))),
-                     hn::Mul(pm, hn::LoadU(d, c.bt_pm_at(a))));
+    x[a] = hn::Add(hn::Add(hn::Mul(I, hn::LoadU(d, c.bt_coil_at(a))),
+                           hn::Mul(pm, hn::LoadU(d, c.bt_pm_at(a)))),
+                   mmf[a]);
     for (int b = 0; b < n; ++b) S[a][b] = hn::LoadU(d, c.S_at(a, b));
-  }
-  for (int a = 0; a < n; ++a) {
-    V<D> sdf = hn::Zero(d);
-    for (int b = 0; b < n; ++b) sdf = hn::Add(sdf, hn::Mul(S[a][b], DF[b]));
-    x[a] = hn::Sub(Btu[a], sdf);
   }
   Mk<D> ok = hn::FirstN(d, hn::Lanes(d));
   for (int j = 0; j < n; ++j) {  // L D L^T of S + diag(R), unit L below the diagonal of A
@@ -173,13 +155,8 @@ HWY_INLINE Mk<D> circuit_solve(const Chunk<D>& c, const V<D>* R, const V<D>* mmf
     for (int p = i + 1; p < n; ++p) x[i] = hn::Sub(x[i], hn::Mul(A[p][i], x[p]));
   }
   for (int a = 0; a < n; ++a) {
-    x[a] = hn::Add(x[a], DF[a]);
+    phi[a] = x[a];
     ok = hn::And(ok, hn::IsFinite(x[a]));
-  }
-  for (int a = 0; a < n; ++a) {
-    V<D> sz = hn::Zero(d);
-    for (int b = 0; b < n; ++b) sz = hn::Add(sz, hn::Mul(S[a][b], x[b]));
-    phi[a] = hn::Mul(hn::Add(hn::Sub(Btu[a], sz), mmf[a]), inv_R[a]);
   }
   return ok;
 }
