@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <vector>
 
 #include "gmasim/identify/identify.hpp"
@@ -55,6 +56,13 @@ void BM_Objective12Conditions(benchmark::State& bs) {
   bs.counters["steps_per_period"] =
       benchmark::Counter(static_cast<double>(bs.range(0)), benchmark::Counter::kAvgThreads);
 }
+// The counters of a scalar / batched pair: evaluations per second, lanes, and the path.
+void eval_counters(benchmark::State& bs, double evals, bool lanes, const std::string& what) {
+  bs.SetItemsProcessed(static_cast<std::int64_t>(evals));
+  bs.counters["evals_per_s"] = benchmark::Counter(evals, benchmark::Counter::kIsRate);
+  bs.counters["simd_lanes"] = lanes ? lanes_width() : 1;
+  bs.SetLabel(lanes ? what + "lanes on " + lanes_target() : "scalar step()");
+}
 // The same evaluation with its 12 records in SIMD lanes (batched) and one scalar run per
 // record (scalar), side by side in one run: the items/s ratio is the lanes' speed-up.
 void objective_evals(benchmark::State& bs, bool lanes) {
@@ -62,11 +70,7 @@ void objective_evals(benchmark::State& bs, bool lanes) {
   std::vector<double> u = obj.start_unit();
   u[0] = 0.4;
   for (auto _ : bs) benchmark::DoNotOptimize(obj.rms_pct(u));
-  bs.SetItemsProcessed(bs.iterations());
-  bs.counters["evals_per_s"] =
-      benchmark::Counter(static_cast<double>(bs.iterations()), benchmark::Counter::kIsRate);
-  bs.counters["simd_lanes"] = lanes ? lanes_width() : 1;
-  bs.SetLabel(lanes ? "lanes on " + lanes_target() : "scalar step()");
+  eval_counters(bs, static_cast<double>(bs.iterations()), lanes, "");
 }
 void BM_Objective12Conditions_scalar(benchmark::State& bs) { objective_evals(bs, false); }
 void BM_Objective12Conditions_batched(benchmark::State& bs) { objective_evals(bs, true); }
@@ -94,11 +98,8 @@ void objective_batch(benchmark::State& bs, bool lanes) {
       for (const auto& v : u) benchmark::DoNotOptimize(obj.rms_pct(v));
     }
   }
-  const auto evals = static_cast<double>(bs.iterations()) * static_cast<double>(u.size());
-  bs.SetItemsProcessed(static_cast<std::int64_t>(evals));
-  bs.counters["evals_per_s"] = benchmark::Counter(evals, benchmark::Counter::kIsRate);
-  bs.counters["simd_lanes"] = lanes ? lanes_width() : 1;
-  bs.SetLabel(lanes ? "16 points' records in lanes on " + lanes_target() : "scalar step()");
+  eval_counters(bs, static_cast<double>(bs.iterations()) * static_cast<double>(u.size()), lanes,
+                "16 points' records in ");
 }
 void BM_ObjectiveBatch16_scalar(benchmark::State& bs) { objective_batch(bs, false); }
 void BM_ObjectiveBatch16_batched(benchmark::State& bs) { objective_batch(bs, true); }
