@@ -138,9 +138,12 @@ TEST(Metrics, LoopMetricsEqualTheirPlainForm) {
         EXPECT_EQ(L.stroke_um, plain_pp(y)) << rows << " " << noise << " " << closing;
         EXPECT_EQ(L.B_pp_T, plain_pp(refined(c.t, c.B, b, e))) << rows << " " << noise;
         EXPECT_EQ(L.hysteresis_um, plain_hysteresis(I, y)) << rows << " " << noise;
-        checks += 3;
+        // The stroke alone (no hysteresis: the refined y is not stored, refined_peak_to_peak)
+        const LoopMetrics S = loop_metrics(c.t, c.I, c.y, c.B, b, e, {true, false, false});
+        EXPECT_EQ(S.stroke_um, plain_pp(y)) << rows << " " << noise << " " << closing;
+        checks += 4;
       }
-  EXPECT_EQ(checks, 72);
+  EXPECT_EQ(checks, 96);
 }
 
 TEST(Metrics, HysteresisWidthEqualsItsPlainFormOnRoughLoops) {
@@ -168,8 +171,10 @@ TEST(Metrics, RefinedPeakToPeakFallsBackWhereASampleIsNotFinite) {
   w.B[50] = std::numeric_limits<double>::infinity();
   w.y[60] = std::nan("");
   const LoopMetrics L = loop_metrics(w.t, w.I, w.y, w.B, 1, 201);
+  const LoopMetrics S = loop_metrics(w.t, w.I, w.y, w.B, 1, 201, {true, false, false});
   const double B_pp = plain_pp(refined(w.t, w.B, 1, 201));
   const double stroke = plain_pp(refined(w.t, w.y, 1, 201));
   EXPECT_TRUE(L.B_pp_T == B_pp || (std::isnan(L.B_pp_T) && std::isnan(B_pp)));
   EXPECT_TRUE(L.stroke_um == stroke || (std::isnan(L.stroke_um) && std::isnan(stroke)));
+  EXPECT_TRUE(S.stroke_um == stroke || (std::isnan(S.stroke_um) && std::isnan(stroke)));
 }

@@ -299,11 +299,13 @@ LoopMetrics loop_metrics(const std::vector<double>& t, const std::vector<double>
   thread_local std::vector<double> I, y;  // refined; per thread (identify: 7 per candidate)
   const double nan = std::numeric_limits<double>::quiet_NaN();
   LoopMetrics L{nan, nan, nan};
-  if (want.stroke) L.stroke_um = refined_peak_to_peak(t, y_um, b, e, y);
-  if (want.hysteresis) {
+  if (want.hysteresis) {  // the refined y stored once, for the stroke too
     refine_window(t, y_um, b, e, y);
+    if (want.stroke) L.stroke_um = peak_to_peak(y);
     refine_window(t, current_A, b, e, I);
     L.hysteresis_um = hysteresis_width(I, y, 0, y.size());
+  } else if (want.stroke) {
+    L.stroke_um = refined_peak_to_peak(t, y_um, b, e, y);
   }
   if (want.B_pp) L.B_pp_T = refined_peak_to_peak(t, B_T, b, e, I);
   return L;
