@@ -4,11 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <vector>
 
 #include "gmasim/model/model.hpp"
 #include "gmasim/simulate/lanes.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 namespace gmasim_test {
 
@@ -41,6 +44,35 @@ void expect_lanes_equal_width_one(const Runs& runs, long steps, double dt_s, Num
           << "lane " << i << " step " << k << " target " << gmasim::lanes_target();
     }
   }
+}
+
+// simulate_lanes(m, set) against simulate(m, set[i]) per setting: no divergence, metrics, the
+// same rows, and the stroke, the hysteresis (both relative to the stroke) and B p-p (relative
+// to itself) within `tol`. Returns the largest relative difference.
+inline double expect_simulate_lanes_matches(const gmasim::Model& m,
+                                            const std::vector<gmasim::SimulationSettings>& set,
+                                            double tol) {
+  const std::vector<gmasim::Result> got = gmasim::simulate_lanes(m, set);
+  EXPECT_EQ(got.size(), set.size());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < std::min(got.size(), set.size()); ++i) {
+    const gmasim::Result ref = gmasim::simulate(m, set[i]);
+    EXPECT_FALSE(got[i].diverged) << got[i].error;
+    EXPECT_TRUE(got[i].has_metrics) << "setting " << i;
+    if (got[i].diverged || !got[i].has_metrics) continue;
+    EXPECT_EQ(got[i].series.rows(), ref.series.rows()) << "setting " << i;
+    const double scale = std::fabs(ref.metrics.stroke_um);
+    EXPECT_GT(scale, 0.0) << "setting " << i;
+    auto rel = [&](double x, double r, double of) {
+      const double e = std::fabs(x - r) / of;
+      worst = std::max(worst, e);
+      EXPECT_LE(e, tol) << "setting " << i;
+    };
+    rel(got[i].metrics.stroke_um, ref.metrics.stroke_um, scale);
+    rel(got[i].metrics.hysteresis_um, ref.metrics.hysteresis_um, scale);
+    rel(got[i].metrics.B_pp_T, ref.metrics.B_pp_T, std::fabs(ref.metrics.B_pp_T));
+  }
+  return worst;
 }
 
 }  // namespace gmasim_test

@@ -420,7 +420,8 @@ TEST(Lanes, MakeStatesMatchMakeState) {
   }
 }
 
-// simulate_lanes: each setting's metrics as simulate() gives them, to the lanes' tolerance.
+// simulate_lanes: each setting's metrics as simulate() gives them, to the lanes' tolerance
+// (1e-9 relative: the stroke and hysteresis of the stroke, B p-p of itself).
 TEST(Lanes, SimulateLanesMatchesSimulate) {
   std::vector<SimulationSettings> set;
   for (double T : {20.0, 60.0, 110.0})
@@ -431,18 +432,8 @@ TEST(Lanes, SimulateLanesMatchesSimulate) {
       s.periods = 1;
       set.push_back(s);
     }
-  const std::vector<Result> got = simulate_lanes(mdma(), set);
-  ASSERT_EQ(got.size(), set.size());
-  for (std::size_t i = 0; i < set.size(); ++i) {
-    const Result ref = simulate(mdma(), set[i]);
-    ASSERT_FALSE(got[i].diverged) << got[i].error;
-    ASSERT_TRUE(got[i].has_metrics);
-    EXPECT_EQ(got[i].series.rows(), ref.series.rows());
-    EXPECT_NEAR(got[i].metrics.stroke_um, ref.metrics.stroke_um, 1e-9 * ref.metrics.stroke_um);
-    EXPECT_NEAR(got[i].metrics.hysteresis_um, ref.metrics.hysteresis_um,
-                1e-9 * ref.metrics.stroke_um);
-    EXPECT_NEAR(got[i].metrics.B_pp_T, ref.metrics.B_pp_T, 1e-9 * ref.metrics.B_pp_T);
-  }
+  const double worst = gmasim_test::expect_simulate_lanes_matches(mdma(), set, 1e-9);
+  std::printf("simulate_lanes vs simulate: largest relative difference %.3g\n", worst);
 }
 
 // The identify objective with its records in lanes (identify/record_lanes.cpp) against one

@@ -230,25 +230,7 @@ TEST(PreisachLanes, SimulateLanesMatchesSimulate) {
       s.periods = 2;
       set.push_back(s);
     }
-  const std::vector<Result> got = simulate_lanes(model(), set);
-  ASSERT_EQ(got.size(), set.size());
-  double worst = 0.0;
-  for (std::size_t i = 0; i < set.size(); ++i) {
-    const Result ref = simulate(model(), set[i]);
-    ASSERT_FALSE(got[i].diverged) << got[i].error;
-    ASSERT_TRUE(got[i].has_metrics);
-    EXPECT_EQ(got[i].series.rows(), ref.series.rows());
-    const double scale = std::fabs(ref.metrics.stroke_um);
-    EXPECT_GT(scale, 0.0);
-    auto rel = [&](double x, double r, double of) {
-      const double e = std::fabs(x - r) / of;
-      worst = std::max(worst, e);
-      EXPECT_LE(e, 1e-12) << "setting " << i;
-    };
-    rel(got[i].metrics.stroke_um, ref.metrics.stroke_um, scale);
-    rel(got[i].metrics.hysteresis_um, ref.metrics.hysteresis_um, scale);
-    rel(got[i].metrics.B_pp_T, ref.metrics.B_pp_T, ref.metrics.B_pp_T);
-  }
+  const double worst = gmasim_test::expect_simulate_lanes_matches(model(), set, 1e-12);
   std::printf("Preisach simulate_lanes vs simulate: largest relative difference %.3g\n", worst);
 }
 
