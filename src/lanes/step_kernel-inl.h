@@ -83,6 +83,16 @@ struct RodStates {
   V<D> f[kRodStateCount][kMaxRods];
 };
 
+// Rod a's right-hand side of the k x k system, (B^T u + F)_a = I (B^T psi_coil)_a + pm
+// (B^T psi_pm)_a + F_a (rod_solve's x, in its order of operations).
+template <class D>
+HWY_INLINE V<D> rod_rhs(const Chunk<D>& c, int a, V<D> I, V<D> pm, V<D> F) {
+  const D d = c.d;
+  return hn::Add(
+      hn::Add(hn::Mul(I, hn::LoadU(d, c.bt_coil_at(a))), hn::Mul(pm, hn::LoadU(d, c.bt_pm_at(a)))),
+      F);
+}
+
 // The low-rank circuit solve (circuit/netlist.cpp, rod_solve and solve_circuit) per lane: with
 // F the rods' MMFs and u = I psi_coil + pm psi_pm, the rod fluxes themselves solve
 //   (diag(R) + S) phi = B^T u + F
@@ -96,10 +106,7 @@ HWY_INLINE Mk<D> circuit_solve3(const Chunk<D>& c, const V<D>* R, const V<D>* mm
   const D d = c.d;
   auto S = [&](int a, int b) { return hn::LoadU(d, c.S_at(a, b)); };
   V<D> x[3];
-  for (int a = 0; a < 3; ++a)
-    x[a] = hn::Add(hn::Add(hn::Mul(I, hn::LoadU(d, c.bt_coil_at(a))),
-                           hn::Mul(pm, hn::LoadU(d, c.bt_pm_at(a)))),
-                   mmf[a]);
+  for (int a = 0; a < 3; ++a) x[a] = rod_rhs(c, a, I, pm, mmf[a]);
   const V<D> a00 = hn::Add(S(0, 0), R[0]), a10 = S(1, 0), a11 = hn::Add(S(1, 1), R[1]);
   const V<D> a20 = S(2, 0), a21 = S(2, 1), a22 = hn::Add(S(2, 2), R[2]);
   auto minor = [&](V<D> p, V<D> q, V<D> r, V<D> s) {
@@ -130,9 +137,7 @@ HWY_INLINE Mk<D> circuit_solve(const Chunk<D>& c, const V<D>* R, const V<D>* mmf
   if (n == 3) return circuit_solve3(c, R, mmf, I, pm, phi);
   V<D> S[kMaxRods][kMaxRods], A[kMaxRods][kMaxRods], x[kMaxRods], piv[kMaxRods], inv_piv[kMaxRods];
   for (int a = 0; a < n; ++a) {
-    x[a] = hn::Add(hn::Add(hn::Mul(I, hn::LoadU(d, c.bt_coil_at(a))),
-                           hn::Mul(pm, hn::LoadU(d, c.bt_pm_at(a)))),
-                   mmf[a]);
+    x[a] = rod_rhs(c, a, I, pm, mmf[a]);
     for (int b = 0; b < n; ++b) S[a][b] = hn::LoadU(d, c.S_at(a, b));
   }
   Mk<D> ok = hn::FirstN(d, hn::Lanes(d));
