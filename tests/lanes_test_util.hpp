@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <initializer_list>
 #include <vector>
 
 #include "gmasim/model/model.hpp"
@@ -44,6 +45,22 @@ void expect_lanes_equal_width_one(const Runs& runs, long steps, double dt_s, Num
           << "lane " << i << " step " << k << " target " << gmasim::lanes_target();
     }
   }
+}
+
+// Biased-sine settings over temperatures x peak-to-peak currents [A] at f_Hz, `periods` each.
+inline std::vector<gmasim::SimulationSettings> biased_sine_settings(
+    std::initializer_list<double> temperatures_C, std::initializer_list<double> pp_A, double f_Hz,
+    double periods) {
+  std::vector<gmasim::SimulationSettings> set;
+  for (double T : temperatures_C)
+    for (double pp : pp_A) {
+      gmasim::SimulationSettings s;
+      s.temperature_C = T;
+      s.waveform = gmasim::biased_sine(pp, f_Hz);
+      s.periods = periods;
+      set.push_back(s);
+    }
+  return set;
 }
 
 // simulate_lanes(m, set) against simulate(m, set[i]) per setting: no divergence, metrics, the

@@ -423,15 +423,8 @@ TEST(Lanes, MakeStatesMatchMakeState) {
 // simulate_lanes: each setting's metrics as simulate() gives them, to the lanes' tolerance
 // (1e-9 relative: the stroke and hysteresis of the stroke, B p-p of itself).
 TEST(Lanes, SimulateLanesMatchesSimulate) {
-  std::vector<SimulationSettings> set;
-  for (double T : {20.0, 60.0, 110.0})
-    for (double pp : {4.0, 8.0}) {
-      SimulationSettings s;
-      s.temperature_C = T;
-      s.waveform = biased_sine(pp, 50.0);
-      s.periods = 1;
-      set.push_back(s);
-    }
+  const std::vector<SimulationSettings> set =
+      gmasim_test::biased_sine_settings({20.0, 60.0, 110.0}, {4.0, 8.0}, 50.0, 1);
   const double worst = gmasim_test::expect_simulate_lanes_matches(mdma(), set, 1e-9);
   std::printf("simulate_lanes vs simulate: largest relative difference %.3g\n", worst);
 }

@@ -221,15 +221,8 @@ TEST(PreisachLanes, MakeStatesMatchMakeState) {
 // simulate_lanes (what `gmasim sweep` runs) against simulate(): the metrics of biased and
 // bipolar sines at three temperatures; observed 1.2e-13 of the stroke; tolerance 1e-12.
 TEST(PreisachLanes, SimulateLanesMatchesSimulate) {
-  std::vector<SimulationSettings> set;
-  for (double T : {20.0, 50.0, 80.0})
-    for (double pp : {2.0, 6.0}) {
-      SimulationSettings s;
-      s.temperature_C = T;
-      s.waveform = biased_sine(pp, 100.0);
-      s.periods = 2;
-      set.push_back(s);
-    }
+  const std::vector<SimulationSettings> set =
+      gmasim_test::biased_sine_settings({20.0, 50.0, 80.0}, {2.0, 6.0}, 100.0, 2);
   const double worst = gmasim_test::expect_simulate_lanes_matches(model(), set, 1e-12);
   std::printf("Preisach simulate_lanes vs simulate: largest relative difference %.3g\n", worst);
 }
