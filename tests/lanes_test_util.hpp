@@ -16,6 +16,20 @@
 
 namespace gmasim_test {
 
+// One lane per (c[i], s[i]) of model m (the lane tests' runs).
+inline gmasim::LaneBatch lane_batch(const gmasim::Model& m,
+                                    const std::vector<gmasim::Conditions>& c,
+                                    const std::vector<gmasim::State>& s) {
+  std::vector<const gmasim::Model*> mp(c.size(), &m);
+  std::vector<const gmasim::Conditions*> cp;
+  std::vector<const gmasim::State*> sp;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    cp.push_back(&c[i]);
+    sp.push_back(&s[i]);
+  }
+  return gmasim::LaneBatch(mp, cp, sp);
+}
+
 // Steps every lane of two batches of runs.batch() (the second as the width-1 instance) for
 // `steps` steps of dt_s with runs.current(i, t) and, every 50 steps and at the last, checks that
 // numbers(state) of each lane is the same bit for bit. Runs: c (the conditions, one per lane),

@@ -45,16 +45,7 @@ struct Runs {
   double current(std::size_t i, double t) const {
     return 0.5 * pp[i] * (1.0 - std::cos(2.0 * 3.141592653589793 * 10.0 * t));
   }
-  LaneBatch batch() const {
-    std::vector<const Model*> m(c.size(), &mdma());
-    std::vector<const Conditions*> cp;
-    std::vector<const State*> sp;
-    for (std::size_t i = 0; i < c.size(); ++i) {
-      cp.push_back(&c[i]);
-      sp.push_back(&s[i]);
-    }
-    return LaneBatch(m, cp, sp);
-  }
+  LaneBatch batch() const { return gmasim_test::lane_batch(mdma(), c, s); }
 };
 
 constexpr double kDt = 10e-6;

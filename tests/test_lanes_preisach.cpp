@@ -53,16 +53,7 @@ struct PreisachRuns {
     const double w = kTwoPi * freq[i] * t;
     return amp[i] * (std::sin(w) + 0.4 * std::sin(3.0 * w));
   }
-  LaneBatch batch() const {
-    std::vector<const Model*> m(c.size(), &model());
-    std::vector<const Conditions*> cp;
-    std::vector<const State*> sp;
-    for (std::size_t i = 0; i < c.size(); ++i) {
-      cp.push_back(&c[i]);
-      sp.push_back(&s[i]);
-    }
-    return LaneBatch(m, cp, sp);
-  }
+  LaneBatch batch() const { return gmasim_test::lane_batch(model(), c, s); }
 };
 
 // The numbers step() sets, and each rod's extrema stack (depth, entries, the point now).
