@@ -135,6 +135,44 @@ TEST(Sweep, ADivergedPointIsRecordedAndTheSweepContinues) {
   EXPECT_NE(res.points[1].error.find("diverged"), std::string::npos) << res.points[1].error;
 }
 
+// Without lanes a sweep point records only the metrics' window (simulate_metrics_only), not the
+// series: its metrics are simulate()'s at its settings, bit for bit; so is a diverged point's
+// error.
+TEST(Sweep, ScalarPointsAreSimulateBitForBit) {
+  SweepRequest r;
+  r.temperatures_C = {20, 70};
+  // The coil of the test above: 1000 A diverges, 6 mA is the MDMA's 6 A.
+  r.current_min_A = -3e-3;
+  r.currents_pp_A = {6e-3, 1000.0};
+  r.frequencies_Hz = {37};
+  r.periods = 2;
+  r.lanes = false;
+  ModelSpec spec = builtin_model_spec();
+  spec.set("circuit.branches.phi4.coil_turns", 7.2e6);
+  const Model m = compile(spec);
+  const SweepResult res = run_sweep(m, r);
+  ASSERT_EQ(res.points.size(), 4u);
+  int diverged = 0;
+  for (const SweepPoint& p : res.points) {
+    SimulationSettings s;
+    s.temperature_C = p.temperature_C;
+    s.waveform = biased_sine(p.current_pp_A, p.frequency_Hz, r.current_min_A);
+    s.periods = r.periods;
+    const Result full = simulate(m, s);
+    EXPECT_EQ(p.diverged, full.diverged);
+    EXPECT_EQ(p.error, full.error);
+    diverged += p.diverged ? 1 : 0;
+    if (full.diverged) continue;
+    EXPECT_EQ(p.metrics.stroke_um, full.metrics.stroke_um);  // bitwise
+    EXPECT_EQ(p.metrics.hysteresis_um, full.metrics.hysteresis_um);
+    EXPECT_EQ(p.metrics.B_pp_T, full.metrics.B_pp_T);
+    EXPECT_EQ(p.metrics.y_mean_um, full.metrics.y_mean_um);
+    EXPECT_EQ(p.metrics.window_start_s, full.metrics.window_start_s);
+    EXPECT_GT(p.metrics.stroke_um, 1.0);
+  }
+  EXPECT_EQ(diverged, 2);
+}
+
 TEST(Sweep, BadRequestsAreClearInputErrors) {
   const Model& m = mdma();
   auto run = [&](auto edit) {

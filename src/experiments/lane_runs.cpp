@@ -7,6 +7,7 @@
 
 #include "experiments/parallel.hpp"
 #include "gmasim/simulate/lanes.hpp"
+#include "simulate/record.hpp"
 
 namespace gmasim::detail {
 
@@ -17,7 +18,11 @@ void simulate_settings(const Model& m, std::span<const SimulationSettings> setti
   const std::size_t n = settings.size();
   if (!(lanes && lanes_supported(m))) {
     parallel_for(
-        n, threads, [&](std::size_t i) { take(i, simulate(m, settings[i])); }, progress);
+        n, threads,
+        [&](std::size_t i) {
+          take(i, metrics_only ? simulate_metrics_only(m, settings[i]) : simulate(m, settings[i]));
+        },
+        progress);
     return;
   }
   const std::size_t blocks = std::max<std::size_t>(1, std::min<std::size_t>(threads, n));

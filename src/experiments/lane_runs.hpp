@@ -15,8 +15,9 @@ namespace gmasim::detail {
 // worker threads; each i once: write only slot i). With `lanes` and a model lanes_supported, one
 // block of settings per thread advances in SIMD lanes (simulate_lanes; a lane's numbers depend
 // neither on the other lanes nor on the blocks, so neither on the thread count); otherwise one
-// simulate() per setting on `threads` threads (resolved, >= 1). metrics_only as
-// simulate_lanes's (the lanes only). progress(done, n) once per setting, serialised.
+// simulate() per setting on `threads` threads (resolved, >= 1). metrics_only: the results keep
+// their metrics but no series (simulate_lanes' metrics_only in lanes, simulate_metrics_only one
+// by one). progress(done, n) once per setting, serialised.
 void simulate_settings(const Model& m, std::span<const SimulationSettings> settings, int threads,
                        bool lanes, bool metrics_only,
                        const std::function<void(std::size_t, Result&&)>& take,

@@ -22,4 +22,10 @@ Metrics compute_metrics(const std::vector<double>& t_s, const std::vector<double
                         const std::vector<double>& y_um, const std::vector<double>& B_T,
                         double t0_s, double t1_s);
 
+// simulate() for a caller that keeps only the metrics (sweeps, compensate's searches: the
+// scalar counterpart of simulate_lanes' metrics_only): a periodic run without energy ledger or
+// self-heating records only compute_metrics' columns over the last period, and returns no
+// series; its metrics, steps and errors are simulate()'s, bit for bit. Other runs: simulate().
+Result simulate_metrics_only(const Model& m, const SimulationSettings& s);
+
 }  // namespace gmasim

@@ -325,6 +325,28 @@ struct EnergyWindow {
   }
 };
 
+// A metrics-only run's record (simulate_metrics_only): the columns compute_metrics reads (t_s,
+// current_A, y_um, B_T: what record() writes there), from the row before the last period's
+// window on, at the record's rows; no other column.
+struct MetricsWindow {
+  bool enabled = false;
+  long first = 0;  // the first step recorded (<= 0: the rest state's row too)
+  std::vector<double> t_s, current_A, y_um, B_T;
+
+  void start(long nsteps, long period_steps, long record_every) {
+    enabled = true;
+    first = nsteps - period_steps - 1;
+    const auto rows = static_cast<std::size_t>((nsteps - std::max(first, 0L)) / record_every + 3);
+    for (auto* col : {&t_s, &current_A, &y_um, &B_T}) col->reserve(rows);
+  }
+  void push(const State& st) {
+    t_s.push_back(st.t_s);
+    current_A.push_back(st.current_A);
+    y_um.push_back(st.y_m * 1e6);
+    B_T.push_back(st.B_T);
+  }
+};
+
 // What simulate() does after each step: self-heating (which may replace the Conditions the
 // loop reads), the decimated record, the step count and the progress callback.
 struct SimulationRecorder {
@@ -333,6 +355,7 @@ struct SimulationRecorder {
   Conditions& c;  // the object run_loop() reads at every step
   SelfHeatingRun& heat;
   EnergyWindow& energy;
+  MetricsWindow& window;
   Result& r;
   long nsteps, report_every;
 
@@ -341,7 +364,12 @@ struct SimulationRecorder {
     energy.at(m, c, st, k, p.dt_s);
     if (heat.enabled) heat.after_step(m, s, c, st, p.dt_s, k == nsteps, r);
     energy.open(m, c, st, k);
-    if (k % s.record_every == 0 || k == nsteps) record(c, st, r.series);
+    if (k % s.record_every == 0 || k == nsteps) {
+      if (!window.enabled)
+        record(c, st, r.series);
+      else if (k >= window.first)
+        window.push(st);
+    }
     r.steps = k;
     if (s.progress && (k % report_every == 0 || k == nsteps))
       s.progress(static_cast<std::size_t>(k), static_cast<std::size_t>(nsteps));
@@ -435,7 +463,11 @@ void validate(const SimulationSettings& s) {
   }
 }
 
-Result simulate(const Model& m, const SimulationSettings& s) {
+namespace {
+
+// simulate(), or, metrics_only (a periodic run without energy ledger or self-heating), the same
+// run recording only the metrics' window (MetricsWindow).
+Result run_simulation(const Model& m, const SimulationSettings& s, bool metrics_only) {
   const auto& w = s.waveform;
   validate(s);
   const RunLength L = run_length(s);
@@ -447,7 +479,11 @@ Result simulate(const Model& m, const SimulationSettings& s) {
   Result r;
   r.dt_s = L.grid.dt_s;
   r.thermal_expansion_start_um = r.thermal_expansion_um = c.thermal_expansion_m * 1e6;
-  make_columns(m, r.series, static_cast<std::size_t>(nsteps / s.record_every + 2));
+  MetricsWindow window;
+  if (metrics_only && w.periodic() && !s.energy_ledger && !s.self_heating.enabled)
+    window.start(nsteps, std::lround(w.period_s() / L.grid.dt_s), s.record_every);
+  else
+    make_columns(m, r.series, static_cast<std::size_t>(nsteps / s.record_every + 2));
   SelfHeatingRun heat(m, s, L, r);
   EnergyWindow energy;
   energy.enabled = s.energy_ledger || s.self_heating.enabled;
@@ -459,12 +495,15 @@ Result simulate(const Model& m, const SimulationSettings& s) {
     State st = make_state(m, c, w.current_at(0.0));
     st.energy.enabled = energy.enabled;
     check_physical_validity(m, c, st, 0.0);  // the rest state too (gmasim/model/validity.hpp)
-    record(c, st, r.series);
+    if (!window.enabled)
+      record(c, st, r.series);
+    else if (window.first <= 0)
+      window.push(st);
     energy.open(m, c, st, 0);
     heat.begin(c, st, r);
     run_loop(
         m, c, st, L.grid, [&w](double t) { return w.current_at(t); },
-        SimulationRecorder{m, s, c, heat, energy, r, nsteps, std::max(1L, nsteps / 100)});
+        SimulationRecorder{m, s, c, heat, energy, window, r, nsteps, std::max(1L, nsteps / 100)});
     energy.finish(r);
   } catch (const DivergenceError& e) {
     r.diverged = true;
@@ -473,7 +512,12 @@ Result simulate(const Model& m, const SimulationSettings& s) {
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   // Self-heating moves the expansion: the value at the end of the run (the last row's xT_um).
   if (r.series.rows() > 0) r.thermal_expansion_um = r.series.column("xT_um").back();
-  if (!r.diverged && w.periodic()) {
+  if (!r.diverged && window.enabled) {
+    const double per = w.period_s();
+    r.metrics = compute_metrics(window.t_s, window.current_A, window.y_um, window.B_T,
+                                duration - per, duration);
+    r.has_metrics = true;
+  } else if (!r.diverged && w.periodic()) {
     const double per = w.period_s();
     r.metrics = compute_metrics(r.series, duration - per, duration);
     r.has_metrics = true;
@@ -483,6 +527,14 @@ Result simulate(const Model& m, const SimulationSettings& s) {
     if (w.kind == WaveformKind::Step) r.step = step_metrics(r.series, w.step_time_s);
   }
   return r;
+}
+
+}  // namespace
+
+Result simulate(const Model& m, const SimulationSettings& s) { return run_simulation(m, s, false); }
+
+Result simulate_metrics_only(const Model& m, const SimulationSettings& s) {
+  return run_simulation(m, s, true);
 }
 
 }  // namespace gmasim
