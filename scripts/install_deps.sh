@@ -11,7 +11,7 @@ PACKAGES=(
   pybind11-dev python3-dev python3-numpy python3-scipy python3-matplotlib python3-pytest
   python3-pip python3-venv python3-setuptools python3-wheel
   libpagmo-dev libboost-serialization-dev libtbb-dev libopenmpi-dev openmpi-bin libceres-dev
-  clang-format git ca-certificates
+  clang-format git ca-certificates valgrind
 )
 
 missing=()

@@ -21,6 +21,11 @@ absolute times are printed for reference only. Sections:
      BM_FullModelStep/0 and /1 from one run, interleaved (issue 22, item 1: /0 <= 500 ns and
      /0 <= /1; the count decides where the shared machine's timings cannot).
 
+--step-budget N (the ctest step_instruction_budget): only the callgrind counts, no timing;
+exits 1 unless the consistent step costs at most N instructions per step and no more than the
+printed reading's (/0 <= /1). Instruction counts do not swing with the shared machine's load,
+so a stray allocation or a slower law shows here where a timing would not.
+
 Standard library only (numpy for section 2, as bench/numpy_rk4_printed.py needs it).
 """
 from __future__ import annotations
@@ -196,6 +201,23 @@ def callgrind_section(bindir: pathlib.Path, reps: int, work: pathlib.Path) -> st
                   "median CPU ns per step (interleaved)", "range ns"], rows)
 
 
+def step_budget_check(bindir: pathlib.Path, budget: int, work: pathlib.Path) -> int:
+    """--step-budget: /0 <= budget instructions per step and /0 <= /1 (callgrind), 0 if both."""
+    exe = bindir / "gmasim_bench"
+    if not exe.is_file():
+        sys.exit(f"performance.py: --step-budget: no {exe} (build gmasim_bench, a Release preset)")
+    if not shutil.which("valgrind"):
+        sys.exit("performance.py: --step-budget: no valgrind on PATH (scripts/install_deps.sh)")
+    ir = {arg: callgrind_step_instructions(exe, arg, work)[0] for arg in (0, 1)}
+    print(f"step() instructions per step (callgrind): /0 consistent state {ir[0]:.0f}, "
+          f"/1 printed reading {ir[1]:.0f}, ratio {ir[0] / ir[1]:.3f}; budget /0 <= {budget}")
+    ok = ir[0] <= budget and ir[0] <= ir[1]
+    if not ok:
+        print("performance.py: FAIL: the consistent step exceeds its budget or the printed "
+              "reading's step (issue 22, item 1; docs/performance.md)")
+    return 0 if ok else 1
+
+
 def identify_cmd(gm: str, out: pathlib.Path, islands: int, threads: int) -> list[str]:
     return [gm, "identify", "--model", str(ROOT / "calibration/start/consistent.toml"),
             "--fit", str(ROOT / "calibration/consistent.toml"), "--out", str(out / "m.toml"),
@@ -267,7 +289,14 @@ def main() -> int:
     ap.add_argument("--reps", type=int, default=3, help="repetitions per timing (median), >= 1")
     ap.add_argument("--sections", default="bench,numpy,scaling,growth",
                     help="comma-separated subset of bench, numpy, scaling, growth, callgrind")
+    ap.add_argument("--step-budget", type=int, default=None, metavar="N",
+                    help="only check: /0 <= N instructions per step and /0 <= /1 (callgrind)")
     a = ap.parse_args()
+    if a.step_budget is not None:
+        if not 1000 <= a.step_budget <= 10**7:
+            sys.exit(f"performance.py: --step-budget {a.step_budget}: must be in [1000, 1e7]")
+        with tempfile.TemporaryDirectory(prefix="gmasim_step_budget_") as tmp:
+            return step_budget_check(pathlib.Path(a.bin).resolve(), a.step_budget, pathlib.Path(tmp))
     if not 1 <= a.reps <= 50:
         sys.exit(f"performance.py: --reps {a.reps}: must be in [1, 50]")
     bindir = pathlib.Path(a.bin).resolve()
