@@ -113,6 +113,7 @@ struct RecordLanes {
   std::vector<LaneRecordOut> out;
   std::vector<char>* failed = nullptr;
   std::vector<double> frac;  // the step's samples' interpolation fractions
+  std::size_t stopped = 0;   // the lanes diverged so far (LaneBatch::diverged_count)
 };
 
 // The samples at or before t0 of a pass (from the state the pass starts at: the rest state or
@@ -177,10 +178,13 @@ void next_step(RecordLanes& L, long q, LaneBatch& batch, std::vector<double>& cu
 void after_step(RecordLanes& L, long q, const LaneBatch& batch) {
   const std::size_t P = L.P;
   std::vector<char>* failed = L.failed;
+  const std::size_t stopped = batch.diverged_count();
+  const bool new_stops = stopped != L.stopped;  // else no lane needs its check
+  L.stopped = stopped;
   for (std::size_t k = 0; k < L.rec.size(); ++k) {
     LaneRecordRun& rr = L.rec[k];
     if (q > rr.total) continue;
-    for (std::size_t c = 0; c < P; ++c) {
+    for (std::size_t c = 0; new_stops && c < P; ++c) {
       if (failed && (*failed)[c]) continue;
       if (batch.diverged(k * P + c)) {
         if (!failed) throw DivergenceError(batch.error(k * P + c));
