@@ -214,18 +214,26 @@ struct Objective::Impl {
     }
   }
 
-  // residuals() at a compiled model; `done`: its records' outputs, already run in lanes.
+  // What target_runs gives a point: its sine runs' metrics and its resonance targets' values.
+  struct TargetOutputs {
+    std::vector<SineMetrics> sm;
+    std::vector<double> res;
+  };
+
+  // residuals() at a compiled model; `done`: its records' outputs, already run in lanes;
+  // `targets_done`: its targets' runs, already run (targets_batch).
   bool residuals_at(const Model& model, double* r, std::string* why,
-                    identify_detail::RecordOutputs* done = nullptr) const {
+                    identify_detail::RecordOutputs* done = nullptr,
+                    const TargetOutputs* targets_done = nullptr) const {
     try {
       StartCache starts(model);
       record_residuals(model, starts, r, done);
       if (!targets.empty()) {
-        std::vector<SineMetrics> sm;
-        std::vector<double> res;
-        target_runs(model, starts, sm, res);
+        TargetOutputs own;
+        if (!targets_done) target_runs(model, starts, own.sm, own.res);
+        const TargetOutputs& t = targets_done ? *targets_done : own;
         for (const auto& td : targets) {
-          const double sim = target_value(td, sm, res);
+          const double sim = target_value(td, t.sm, t.res);
           r[td.r_index] = td.r_scale * (sim - td.t.value);
         }
       }
@@ -247,6 +255,14 @@ struct Objective::Impl {
   // Objective::residuals_batch (objective.cpp).
   std::vector<char> residuals_batch(std::span<const double* const> u,
                                     std::span<double* const> r) const;
+  // target_runs for several models at once (objective_batch.cpp), where target_runs takes the
+  // lanes with more than one sine run: their start states and ramps in one make_states batch,
+  // their sine runs in one batch of lanes (sine k of model c in lane k P + c), each model's
+  // outputs equal to target_runs's bit for bit. failed[c] = 1 where model c's target_runs would
+  // throw. Returns false (nothing computed) where the batch does not apply or a start state fails
+  // (make_states throws): then each model runs target_runs alone.
+  bool targets_batch(const std::vector<const Model*>& models, std::vector<TargetOutputs>& out,
+                     std::vector<char>& failed) const;
 
   static double target_value(const TargetData& td, const std::vector<SineMetrics>& sm,
                              const std::vector<double>& res) {
