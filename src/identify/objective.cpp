@@ -337,6 +337,11 @@ Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const F
   add_targets(I, start_model, W);
   check_run_lengths(I);
   for (auto& run : I.sine_runs) run.drive_A = identify_detail::sine_drive(run, I.settings);
+  for (auto& cd : I.conds) {  // the records' drives on their grids (the records' lanes)
+    const Measurement& meas = I.data.items[cd.index];
+    if (meas.drive_kind == DriveInput::Current && !meas.condition.quasi_static)
+      cd.drive_A = identify_detail::record_drive(meas, I.settings);
+  }
   lay_out_residuals(I, W);
   impl_ = std::move(impl);
 }
@@ -409,7 +414,7 @@ std::vector<char> Objective::Impl::residuals_batch(std::span<const double* const
   } else if (batched) {
     try {
       identify_detail::run_records_lanes(shared_models, record_measurements(), record_flux(),
-                                         settings, out, &failed);
+                                         settings, out, &failed, record_drives());
     } catch (const InputError&) {  // a state at rest failed (make_states): each point alone
       batched = false;
     } catch (const DivergenceError&) {

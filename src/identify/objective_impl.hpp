@@ -39,6 +39,9 @@ struct CondData {
   bool flux = false;
   double ppB = 0, B_scale = 0;
   std::size_t r_offset = 0, rB_offset = 0;
+  // A timed, current-driven record's coil current on its grid (record_drive, computed once for
+  // the records' lanes); empty for the others.
+  std::vector<double> drive_A;
 };
 
 struct TargetData {
@@ -106,7 +109,7 @@ struct Objective::Impl {
     const bool lanes = done != nullptr || records_in_lanes(model);
     if (lanes && !done) {  // every record in its own SIMD lane (identify/record_lanes.hpp)
       identify_detail::run_records_lanes(model, record_measurements(), record_flux(), settings,
-                                         lanes_out.response, lanes_out.B_T);
+                                         lanes_out.response, lanes_out.B_T, record_drives());
       done = &lanes_out;
     }
     for (std::size_t k = 0; k < conds.size(); ++k) {
@@ -134,6 +137,11 @@ struct Objective::Impl {
     std::vector<const Measurement*> recs;
     for (const auto& cd : conds) recs.push_back(&data.items[cd.index]);
     return recs;
+  }
+  std::vector<const std::vector<double>*> record_drives() const {
+    std::vector<const std::vector<double>*> d;
+    for (const auto& cd : conds) d.push_back(&cd.drive_A);
+    return d;
   }
   std::vector<bool> record_flux() const {
     std::vector<bool> flux;

@@ -36,6 +36,7 @@ struct LaneRecordRun {
   double grid_prev = 0, t = 0;     // the grid's previous time and the step's (t_k)
   double t_prev = 0;               // the samples' interpolation: the previous step's time
   std::size_t j = 0, table_j = 1;  // the next sample; the drive table's interval
+  const std::vector<double>* drive = nullptr;  // record_drive's currents, if computed
 
   // The record's drive at t (record_run.cpp, TableDrive: forward-moving linear interpolation).
   double current_at(double tt) {
@@ -164,7 +165,8 @@ void next_step(RecordLanes& L, long q, LaneBatch& batch, std::vector<double>& cu
     const double d = q > rr.total ? rr.grid.dt_s : t - rr.grid_prev;
     rr.grid_prev = t;
     rr.t = t;
-    const double I = rr.current_at(t);
+    const double I =
+        rr.drive && q <= rr.total ? (*rr.drive)[static_cast<std::size_t>(rr.kk)] : rr.current_at(t);
     const std::size_t l0 = k * L.P;
     std::fill_n(current.begin() + static_cast<std::ptrdiff_t>(l0), L.P, I);
     std::fill_n(dt.begin() + static_cast<std::ptrdiff_t>(l0), L.P, d);
@@ -271,13 +273,29 @@ void set_up_lanes(RecordLanes& L, std::span<const Model* const> candidates,
 
 }  // namespace
 
+std::vector<double> record_drive(const Measurement& meas, const ObjectiveSettings& s) {
+  LaneRecordRun rr;
+  rr.meas = &meas;
+  set_up_record(rr, s);
+  const long steps = rr.grid.steps;
+  if (steps > kMaxStoredDriveSteps) return {};
+  std::vector<double> d(static_cast<std::size_t>(steps) + 1, 0.0);
+  for (long kk = 1; kk <= steps; ++kk) {  // next_step's times, from the start of a pass
+    const double t =
+        kk == steps ? rr.grid.t1_s : rr.grid.t0_s + static_cast<double>(kk) * rr.grid.dt_s;
+    d[static_cast<std::size_t>(kk)] = rr.current_at(t);
+  }
+  return d;
+}
+
 void run_records_lanes(const Model& m, const std::vector<const Measurement*>& records,
                        const std::vector<bool>& flux, const ObjectiveSettings& s,
                        std::vector<std::vector<double>>& response,
-                       std::vector<std::vector<double>>& B_T) {
+                       std::vector<std::vector<double>>& B_T,
+                       const std::vector<const std::vector<double>*>& drive_A) {
   const Model* const one[1] = {&m};
   std::vector<RecordOutputs> out(1);
-  run_records_lanes(one, records, flux, s, out, nullptr);
+  run_records_lanes(one, records, flux, s, out, nullptr, drive_A);
   response = std::move(out[0].response);
   B_T = std::move(out[0].B_T);
 }
@@ -285,7 +303,8 @@ void run_records_lanes(const Model& m, const std::vector<const Measurement*>& re
 void run_records_lanes(std::span<const Model* const> candidates,
                        const std::vector<const Measurement*>& records,
                        const std::vector<bool>& flux, const ObjectiveSettings& s,
-                       std::vector<RecordOutputs>& out, std::vector<char>* failed) {
+                       std::vector<RecordOutputs>& out, std::vector<char>* failed,
+                       const std::vector<const std::vector<double>*>& drive_A) {
   const std::size_t P = candidates.size(), R = records.size(), n = P * R;
   out.resize(P);
   for (auto& o : out) {
@@ -304,6 +323,7 @@ void run_records_lanes(std::span<const Model* const> candidates,
   for (std::size_t k = 0; k < R; ++k) {
     L.rec[k].meas = records[k];
     set_up_record(L.rec[k], s);
+    if (k < drive_A.size() && drive_A[k] && !drive_A[k]->empty()) L.rec[k].drive = drive_A[k];
     longest = std::max(longest, L.rec[k].total);
   }
   std::deque<Model> preloaded;  // stable addresses
