@@ -99,6 +99,57 @@ TEST(ObjectiveBatch, EqualsThePointsBitForBitWithoutLanes) {
   expect_batch_equals_points(batch_objective(false));
 }
 
+// An objective with scalar targets besides its records: the sine runs of the stroke, hysteresis,
+// B_pp and change targets share the batch's lanes across the points too (targets_batch), with
+// the frf target's DC settling beside them (40 periods: the settling fits in the sines' length),
+// and the modulus and resonance targets from the start states made in one batch. Without
+// records (no data), the points' targets share the lanes alike.
+const Objective& targets_objective(bool with_records) {
+  static const MeasurementSet data = [] {
+    SyntheticRequest req;
+    req.samples_per_period = 50;
+    req.objective.steps_per_period = 100;
+    req.temperatures_C = {20};
+    return synthesize_measurements(load_model(""), req);
+  }();
+  static const FitSpec fit = [] {
+    FitSpec f = load_fit_spec(
+        "rod1.ja.k0_A_per_m:1500:6000:log,material.chi_m:8:50:log,rod1.ja.c0:0.01:0.3:log");
+    auto add = [&](TargetKind k, double T, double pp, double freq, double value) {
+      FitTarget t;
+      t.kind = k;
+      t.temperature_C = T;
+      t.current_pp_A = pp;
+      t.frequency_Hz = freq;
+      t.value = value;
+      t.scale = value;
+      f.targets.push_back(t);
+    };
+    add(TargetKind::StrokeUm, 20, 8, 10, 50);
+    add(TargetKind::HysteresisUm, 70, 8, 100, 5);
+    add(TargetKind::BppT, 45, 6, 10, 0.5);
+    add(TargetKind::StrokeChangePct, 70, 8, 10, -10);
+    add(TargetKind::ResonanceHz, 20, 8, 10, 1000);
+    add(TargetKind::FrfPeakHz, 20, 8, 10, 1000);
+    add(TargetKind::ModulusGPa, 45, 8, 10, 30);
+    return f;
+  }();
+  auto make = [](bool records) {
+    ObjectiveSettings s;
+    s.steps_per_period = 100;
+    s.target_periods = 40;
+    s.flux_weight = 1.0;
+    return Objective(builtin_model_spec(), records ? data : MeasurementSet{}, fit, s);
+  };
+  static const Objective both = make(true), targets_only = make(false);
+  return with_records ? both : targets_only;
+}
+
+TEST(ObjectiveBatch, TargetsEqualThePointsBitForBit) {
+  expect_batch_equals_points(targets_objective(true));
+  expect_batch_equals_points(targets_objective(false));
+}
+
 // The batch's lanes follow the scalar objective (lanes = false) as residuals() does in lanes:
 // to the lanes' rounding: observed 1.8e-15 % of RMS apart (AVX-512), tolerance 1e-13 % (the
 // rounding differs between SIMD targets).

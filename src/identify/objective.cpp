@@ -337,6 +337,11 @@ Objective::Objective(const ModelSpec& start, const MeasurementSet& data, const F
   add_targets(I, start_model, W);
   check_run_lengths(I);
   for (auto& run : I.sine_runs) run.drive_A = identify_detail::sine_drive(run, I.settings);
+  for (auto& cd : I.conds) {  // the records' drives on their grids (the records' lanes)
+    const Measurement& meas = I.data.items[cd.index];
+    if (meas.drive_kind == DriveInput::Current && !meas.condition.quasi_static)
+      cd.drive_A = identify_detail::record_drive(meas, I.settings);
+  }
   lay_out_residuals(I, W);
   impl_ = std::move(impl);
 }
@@ -391,7 +396,9 @@ std::vector<char> Objective::Impl::residuals_batch(std::span<const double* const
     } catch (const InputError&) {
       continue;  // residuals() fails at u[i] alike
     }
-    if (records_in_lanes(models.back())) {
+    // the points without records share the lanes of their targets' runs (targets_batch)
+    const bool no_records = conds.empty() && settings.lanes && lanes_supported(models.back());
+    if (records_in_lanes(models.back()) || no_records) {
       shared.push_back(i);
       shared_models.push_back(&models.back());
     } else {
@@ -401,22 +408,41 @@ std::vector<char> Objective::Impl::residuals_batch(std::span<const double* const
   std::vector<identify_detail::RecordOutputs> out;
   std::vector<char> failed;
   bool batched = shared.size() > 1;
-  if (batched) {
+  if (batched && conds.empty()) {
+    out.resize(shared.size());
+    failed.assign(shared.size(), 0);
+  } else if (batched) {
     try {
       identify_detail::run_records_lanes(shared_models, record_measurements(), record_flux(),
-                                         settings, out, &failed);
+                                         settings, out, &failed, record_drives());
     } catch (const InputError&) {  // a state at rest failed (make_states): each point alone
       batched = false;
     } catch (const DivergenceError&) {
       batched = false;
     }
   }
+  // The targets of the points whose records ran: their sine runs in shared lanes too.
+  std::vector<std::size_t> live;
+  std::vector<const Model*> live_models;
+  for (std::size_t j = 0; batched && j < shared.size(); ++j) {
+    if (failed[j]) continue;
+    live.push_back(j);
+    live_models.push_back(shared_models[j]);
+  }
+  std::vector<TargetOutputs> tout;
+  std::vector<char> tfailed;
+  const bool targets_done = !targets.empty() && targets_batch(live_models, tout, tfailed);
+  std::vector<const TargetOutputs*> tdone(shared.size(), nullptr);
+  for (std::size_t q = 0; targets_done && q < live.size(); ++q) {
+    if (tfailed[q]) failed[live[q]] = 1;  // its residuals() fails in its targets
+    tdone[live[q]] = &tout[q];
+  }
   for (std::size_t j = 0; j < shared.size(); ++j) {
     const std::size_t i = shared[j];
     if (!batched)
       ok[i] = residuals_at(*shared_models[j], r[i], nullptr) ? 1 : 0;
     else if (!failed[j])
-      ok[i] = residuals_at(*shared_models[j], r[i], nullptr, &out[j]) ? 1 : 0;
+      ok[i] = residuals_at(*shared_models[j], r[i], nullptr, &out[j], tdone[j]) ? 1 : 0;
   }
   return ok;
 }

@@ -39,6 +39,9 @@ struct CondData {
   bool flux = false;
   double ppB = 0, B_scale = 0;
   std::size_t r_offset = 0, rB_offset = 0;
+  // A timed, current-driven record's coil current on its grid (record_drive, computed once for
+  // the records' lanes); empty for the others.
+  std::vector<double> drive_A;
 };
 
 struct TargetData {
@@ -106,7 +109,7 @@ struct Objective::Impl {
     const bool lanes = done != nullptr || records_in_lanes(model);
     if (lanes && !done) {  // every record in its own SIMD lane (identify/record_lanes.hpp)
       identify_detail::run_records_lanes(model, record_measurements(), record_flux(), settings,
-                                         lanes_out.response, lanes_out.B_T);
+                                         lanes_out.response, lanes_out.B_T, record_drives());
       done = &lanes_out;
     }
     for (std::size_t k = 0; k < conds.size(); ++k) {
@@ -134,6 +137,11 @@ struct Objective::Impl {
     std::vector<const Measurement*> recs;
     for (const auto& cd : conds) recs.push_back(&data.items[cd.index]);
     return recs;
+  }
+  std::vector<const std::vector<double>*> record_drives() const {
+    std::vector<const std::vector<double>*> d;
+    for (const auto& cd : conds) d.push_back(&cd.drive_A);
+    return d;
   }
   std::vector<bool> record_flux() const {
     std::vector<bool> flux;
@@ -214,18 +222,26 @@ struct Objective::Impl {
     }
   }
 
-  // residuals() at a compiled model; `done`: its records' outputs, already run in lanes.
+  // What target_runs gives a point: its sine runs' metrics and its resonance targets' values.
+  struct TargetOutputs {
+    std::vector<SineMetrics> sm;
+    std::vector<double> res;
+  };
+
+  // residuals() at a compiled model; `done`: its records' outputs, already run in lanes;
+  // `targets_done`: its targets' runs, already run (targets_batch).
   bool residuals_at(const Model& model, double* r, std::string* why,
-                    identify_detail::RecordOutputs* done = nullptr) const {
+                    identify_detail::RecordOutputs* done = nullptr,
+                    const TargetOutputs* targets_done = nullptr) const {
     try {
       StartCache starts(model);
       record_residuals(model, starts, r, done);
       if (!targets.empty()) {
-        std::vector<SineMetrics> sm;
-        std::vector<double> res;
-        target_runs(model, starts, sm, res);
+        TargetOutputs own;
+        if (!targets_done) target_runs(model, starts, own.sm, own.res);
+        const TargetOutputs& t = targets_done ? *targets_done : own;
         for (const auto& td : targets) {
-          const double sim = target_value(td, sm, res);
+          const double sim = target_value(td, t.sm, t.res);
           r[td.r_index] = td.r_scale * (sim - td.t.value);
         }
       }
@@ -247,6 +263,14 @@ struct Objective::Impl {
   // Objective::residuals_batch (objective.cpp).
   std::vector<char> residuals_batch(std::span<const double* const> u,
                                     std::span<double* const> r) const;
+  // target_runs for several models at once (objective_batch.cpp), where target_runs takes the
+  // lanes with more than one sine run: their start states and ramps in one make_states batch,
+  // their sine runs in one batch of lanes (sine k of model c in lane k P + c), each model's
+  // outputs equal to target_runs's bit for bit. failed[c] = 1 where model c's target_runs would
+  // throw. Returns false (nothing computed) where the batch does not apply or a start state fails
+  // (make_states throws): then each model runs target_runs alone.
+  bool targets_batch(const std::vector<const Model*>& models, std::vector<TargetOutputs>& out,
+                     std::vector<char>& failed) const;
 
   static double target_value(const TargetData& td, const std::vector<SineMetrics>& sm,
                              const std::vector<double>& res) {

@@ -28,37 +28,67 @@ const std::pair<Conditions, State>& StartCache::get(double T, double I0) {
   return entries_.back().cs;
 }
 
-std::vector<State> StartCache::make_in_lanes(const std::vector<std::pair<double, double>>& T_I0,
-                                             const std::vector<const Conditions*>& extra_c,
-                                             const std::vector<double>& extra_I0) {
+std::vector<std::pair<double, double>> StartCache::missing(
+    const std::vector<std::pair<double, double>>& T_I0) const {
   std::vector<std::pair<double, double>> todo;
   for (const auto& k : T_I0) {
     bool cached = std::find(todo.begin(), todo.end(), k) != todo.end();
     for (const auto& e : entries_) cached = cached || (e.T == k.first && e.I0 == k.second);
     if (!cached) todo.push_back(k);
   }
-  const std::size_t n = todo.size(), ne = extra_c.size();
-  if (n + ne < 2) {  // one ramp: make_state, no lanes to share
-    std::vector<State> extra;
-    for (std::size_t k = 0; k < ne; ++k) extra.push_back(make_state(m_, *extra_c[k], extra_I0[k]));
-    return extra;
-  }
+  return todo;
+}
+
+std::vector<State> StartCache::make_in_lanes(const std::vector<std::pair<double, double>>& T_I0,
+                                             const std::vector<const Conditions*>& extra_c,
+                                             const std::vector<double>& extra_I0) {
+  StartCache* const self = this;
+  return std::move(make_in_lanes({self}, T_I0, {extra_c}, {extra_I0})[0]);
+}
+
+std::vector<std::vector<State>> StartCache::make_in_lanes(
+    const std::vector<StartCache*>& caches, const std::vector<std::pair<double, double>>& T_I0,
+    const std::vector<std::vector<const Conditions*>>& extra_c,
+    const std::vector<std::vector<double>>& extra_I0) {
+  const std::size_t P = caches.size();
+  std::vector<std::vector<State>> extra(P);
+  std::vector<std::vector<std::pair<double, double>>> todo(P);
   std::deque<Conditions> conds;  // stable addresses
+  std::vector<const Model*> models;
   std::vector<const Conditions*> cp;
   std::vector<double> I0;
-  for (const auto& [T, I] : todo) {
-    conds.push_back(make_conditions(m_, T));
-    cp.push_back(&conds.back());
-    I0.push_back(I);
+  std::vector<std::size_t> in_lanes;  // the caches whose ramps take the lanes
+  for (std::size_t p = 0; p < P; ++p) {
+    StartCache& sc = *caches[p];
+    todo[p] = sc.missing(T_I0);
+    const std::size_t ne = extra_c[p].size();
+    if (todo[p].size() + ne < 2) {  // one ramp: make_state, no lanes to share
+      for (std::size_t k = 0; k < ne; ++k)
+        extra[p].push_back(make_state(sc.m_, *extra_c[p][k], extra_I0[p][k]));
+      continue;
+    }
+    in_lanes.push_back(p);
+    for (const auto& [T, I] : todo[p]) {
+      conds.push_back(make_conditions(sc.m_, T));
+      cp.push_back(&conds.back());
+      I0.push_back(I);
+    }
+    cp.insert(cp.end(), extra_c[p].begin(), extra_c[p].end());
+    I0.insert(I0.end(), extra_I0[p].begin(), extra_I0[p].end());
+    models.insert(models.end(), todo[p].size() + ne, &sc.m_);
   }
-  cp.insert(cp.end(), extra_c.begin(), extra_c.end());
-  I0.insert(I0.end(), extra_I0.begin(), extra_I0.end());
-  const std::vector<const Model*> models(n + ne, &m_);
+  if (in_lanes.empty()) return extra;
   std::vector<State> st = make_states(models, cp, I0);
-  for (std::size_t k = 0; k < n; ++k)
-    entries_.push_back({todo[k].first, todo[k].second, {std::move(conds[k]), std::move(st[k])}});
-  st.erase(st.begin(), st.begin() + static_cast<std::ptrdiff_t>(n));
-  return st;
+  std::size_t at = 0;
+  for (std::size_t p : in_lanes) {
+    StartCache& sc = *caches[p];
+    for (const auto& [T, I] : todo[p]) {
+      sc.entries_.push_back({T, I, {std::move(conds.front()), std::move(st[at++])}});
+      conds.pop_front();
+    }
+    for (std::size_t k = 0; k < extra_c[p].size(); ++k) extra[p].push_back(std::move(st[at++]));
+  }
+  return extra;
 }
 
 SineGrid sine_target_grid(const SineRun& run, const ObjectiveSettings& s) {

@@ -27,12 +27,22 @@ class StartCache {
   std::vector<State> make_in_lanes(const std::vector<std::pair<double, double>>& T_I0,
                                    const std::vector<const Conditions*>& extra_c,
                                    const std::vector<double>& extra_I0);
+  // make_in_lanes for several caches (of models of one structure) at once: every cache's ramps
+  // in one make_states batch, each cache's entries and extra states those its own make_in_lanes
+  // makes (the lanes read no other lane). extra_c[p], extra_I0[p]: cache p's extra ramps.
+  static std::vector<std::vector<State>> make_in_lanes(
+      const std::vector<StartCache*>& caches, const std::vector<std::pair<double, double>>& T_I0,
+      const std::vector<std::vector<const Conditions*>>& extra_c,
+      const std::vector<std::vector<double>>& extra_I0);
 
  private:
   struct Entry {
     double T, I0;
     std::pair<Conditions, State> cs;
   };
+  // The (temperature, initial current) pairs not cached yet, each once.
+  std::vector<std::pair<double, double>> missing(
+      const std::vector<std::pair<double, double>>& T_I0) const;
   const Model& m_;
   std::deque<Entry> entries_;
 };
@@ -90,6 +100,23 @@ struct HeldRun {
 std::vector<SineMetrics> run_sines_lanes(const Model& m, const std::vector<SineRun>& runs,
                                          const ObjectiveSettings& s, StartCache& starts,
                                          const std::vector<HeldRun>& held = {});
+
+// One point of a batch of sine runs across points (the candidates of a batch evaluation): its
+// model (of the batch's structure), start states, held runs, and what the runs give.
+struct SinePoint {
+  const Model* m = nullptr;
+  StartCache* starts = nullptr;
+  std::vector<HeldRun> held;
+  std::vector<SineMetrics> metrics;  // per run, when not failed
+  bool failed = false;               // a run or held run of the point diverged
+};
+// run_sines_lanes for several points at once: sine k of point c in lane k P + c (a vector holds
+// one sine across the points), then every point's held runs. Each point's metrics and held
+// states are what run_sines_lanes(*m, runs, s, *starts, held) gives, bit for bit (each lane is
+// the width-1 kernel's; no lane reads another). throw_first: the first divergence throws as
+// above; else the point whose run diverges is failed and the others go on.
+void run_sines_lanes(std::vector<SinePoint>& points, const std::vector<SineRun>& runs,
+                     const ObjectiveSettings& s, bool throw_first);
 
 // A resonance_Hz (lowest eq. 15 oscillator frequency at the bias), frf_peak_Hz or
 // bandwidth_Hz (the small-signal frequency response of Fig. 15) target.

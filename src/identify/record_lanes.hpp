@@ -20,10 +20,13 @@ bool record_in_lanes(const Model& m, const Measurement& meas);
 // Runs the records (each record_in_lanes) in lanes: response[k] (and B_T[k] if flux[k]) as
 // run_record_from_start gives them, their rest states made in lanes too (make_states).
 // Throws the DivergenceError of the first record (in time) that diverges.
+// drive_A[k] (optional, per record): record_drive's currents of record k (the objective computes
+// them once); absent or empty: computed as the steps go.
 void run_records_lanes(const Model& m, const std::vector<const Measurement*>& records,
                        const std::vector<bool>& flux, const ObjectiveSettings& s,
                        std::vector<std::vector<double>>& response,
-                       std::vector<std::vector<double>>& B_T);
+                       std::vector<std::vector<double>>& B_T,
+                       const std::vector<const std::vector<double>*>& drive_A = {});
 
 // One candidate's record outputs: response[k] and B_T[k] (if flux[k]) per record.
 struct RecordOutputs {
@@ -39,6 +42,13 @@ struct RecordOutputs {
 void run_records_lanes(std::span<const Model* const> candidates,
                        const std::vector<const Measurement*>& records,
                        const std::vector<bool>& flux, const ObjectiveSettings& s,
-                       std::vector<RecordOutputs>& out, std::vector<char>* failed);
+                       std::vector<RecordOutputs>& out, std::vector<char>* failed,
+                       const std::vector<const std::vector<double>*>& drive_A = {});
+
+// The coil current of a timed, current-driven record at the times t_1 .. t_steps of its grid (one
+// pass; element 0 unused), as run_records_lanes computes them step by step (the same operations,
+// the same bits): what the objective computes once per record. Empty for a record of more than
+// kMaxStoredDriveSteps steps.
+std::vector<double> record_drive(const Measurement& meas, const ObjectiveSettings& s);
 
 }  // namespace gmasim::identify_detail

@@ -264,6 +264,11 @@ void LaneBatch::rest_increment(std::span<const double> current_A, std::span<cons
 }
 
 bool LaneBatch::diverged(std::size_t lane) const { return d_->glob(lanes::kFail)[lane] != 0.0; }
+std::size_t LaneBatch::diverged_count() const {
+  const double* fail = d_->glob(lanes::kFail);
+  return static_cast<std::size_t>(
+      std::count_if(fail, fail + d_->n, [](double f) { return f != 0.0; }));
+}
 std::size_t LaneBatch::full_solves() const { return d_->full_solves; }
 std::size_t LaneBatch::newton_solves() const { return d_->lane_solves; }
 std::size_t LaneBatch::vector_solves() const { return d_->vector_solves; }

@@ -191,11 +191,23 @@ void step_runs(const Lanes& ln, std::span<const SimulationSettings> settings, co
   auto columns = [&](LaneRun& lr) -> std::vector<std::vector<double>>& {
     return metrics_only ? lr.window : out[lr.setting].series.columns;
   };
-  for (long k = 1; k <= p.steps && live > 0; ++k) {
+  // The first step any lane records: before it, a step needs the lanes only where one of them
+  // stops (a lane's step count is set when it stops, or at the end).
+  long first_row = p.steps;
+  for (std::size_t l = 0; l < n; ++l) {
+    const LaneRun& lr = runs[ln.lane_of[l]];
+    first_row = std::min(first_row, std::max(lr.first_recorded, 1L));
+  }
+  std::size_t stopped = 0;  // the lanes diverged so far
+  long k = 1;
+  for (; k <= p.steps && live > 0; ++k) {
     const double t = 0.0 + static_cast<double>(k) * p.dt_s;  // the Uniform clock
     drives.at(t, current);
     std::fill(t1.begin(), t1.end(), t);
     batch.step(current, dt, t1);
+    const std::size_t now_stopped = batch.diverged_count();
+    if (k < first_row && now_stopped == stopped) continue;
+    stopped = now_stopped;
     for (std::size_t l = 0; l < n; ++l) {
       LaneRun& lr = runs[ln.lane_of[l]];
       if (!lr.live) continue;
@@ -204,11 +216,11 @@ void step_runs(const Lanes& ln, std::span<const SimulationSettings> settings, co
         lr.flush(columns(lr), width, width);
         r.diverged = true;
         r.error = batch.error(l);
+        r.steps = k - 1;
         lr.live = false;
         --live;
         continue;
       }
-      r.steps = k;
       if (k < lr.first_recorded || (k % settings[lr.setting].record_every != 0 && k != p.steps))
         continue;
       double* row = lr.rows.data() + lr.staged * width;
@@ -222,6 +234,10 @@ void step_runs(const Lanes& ln, std::span<const SimulationSettings> settings, co
       }
       if (++lr.staged == kStagedRows || k == p.steps) lr.flush(columns(lr), width, width);
     }
+  }
+  for (std::size_t l = 0; l < n; ++l) {  // the runs that did not stop: every step
+    const LaneRun& lr = runs[ln.lane_of[l]];
+    if (lr.live) out[lr.setting].steps = k - 1;
   }
 }
 

@@ -58,6 +58,8 @@ class LaneBatch {
   // Whether the lane stopped, and why: the DivergenceError text step() or run_loop() would
   // have thrown (time, rod, quantity, value). A stopped lane keeps its last good state.
   bool diverged(std::size_t lane) const;
+  // How many lanes have stopped so far (a caller checks its lanes only when this grows).
+  std::size_t diverged_count() const;
   // How many of the live lanes' law evaluations (per rod and Newton iterate, summed over the
   // steps so far) solved eq. (9) fully: the Jiles-Atherton law's safeguard where the joint
   // Newton iterate is far from eq. (9) (|g| > 1e-5 M_s^T), as the scalar law's joint_trial does.
