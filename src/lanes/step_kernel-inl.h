@@ -203,6 +203,10 @@ template <class D, class M, class T>
 HWY_INLINE void take_trial(D d, M done, M real, const T& t, T& tr, std::size_t& full_solves) {
   if (!hn::AllFalse(d, t.solved))
     full_solves += hn::CountTrue(d, hn::And(real, hn::AndNot(done, t.solved)));
+  if (hn::AllFalse(d, done)) {  // no lane has stopped (the first iterates): t as it is
+    tr = t;
+    return;
+  }
   keep_common_trial(done, t, tr);
 }
 
