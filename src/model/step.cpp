@@ -136,10 +136,12 @@ inline void linearise_rod_branch(const RodConditions& rc, double H, double Bs, d
 // three steps (H = 3 H_n - 3 H_n-1 + H_n-2), so that one correction usually converges (two
 // solves and two law evaluations a step).
 // quasi_static drops the eddy term (the at-rest ramp of make_state) and starts at H_n.
-template <class Law>
-void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, double current_A,
-                                double pm_scale, double h_s, bool quasi_static, double t1) {
-  const std::size_t n = s.rods.size();
+// N: the number of rods fixed at compile time (3, the built-in actuator: its loops unrolled), or 0
+// for any (consistent_magnetic_update chooses); the same operations in the same order either way.
+template <class Law, std::size_t N>
+void consistent_magnetic_update_n(const Model& m, const Conditions& c, State& s, double current_A,
+                                  double pm_scale, double h_s, bool quasi_static, double t1) {
+  const std::size_t n = N > 0 ? N : s.rods.size();
   std::array<double, 8> H, Mg, inv_mud, B0, e0, g, Bs;  // set before read (no fill)
   std::array<typename Law::MoveStart, 8> start;
   std::array<typename Law::JointTrial, 8> trial;
@@ -216,6 +218,14 @@ void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, d
                     quasi_static, g[i]);
     s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])] = s.rods[i].phi_Wb;
   }
+}
+template <class Law>
+void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, double current_A,
+                                double pm_scale, double h_s, bool quasi_static, double t1) {
+  if (s.rods.size() == 3)
+    consistent_magnetic_update_n<Law, 3>(m, c, s, current_A, pm_scale, h_s, quasi_static, t1);
+  else
+    consistent_magnetic_update_n<Law, 0>(m, c, s, current_A, pm_scale, h_s, quasi_static, t1);
 }
 
 // The magnetic state at rest (no eddy lag: eq. 7 with dB/dt = 0) moved along its

@@ -35,8 +35,11 @@ struct JilesAthertonLaw {
   // its last evaluation's exponentials: the next iterate is near and derives its own from them
   // (physics::JaExpPoints, exp_near), from the anchors the rod's last step left (RodState::ja_exp)
   // to the committed trial's, which keep them for the next step.
+  // recent: the exponentials' last values in this move's Newton solve (physics::ja_evaluate),
+  // none at its start: the later iterates take theirs from them (physics::exp_near).
   struct MoveStart : physics::JaMoveStart {
     physics::JaExpPoints near;
+    physics::JaExpPoints recent;
   };
   struct Trial {
     double M, dM_dH, Mirr;
@@ -47,7 +50,7 @@ struct JilesAthertonLaw {
     return {physics::ja_move_start_near(r.H_A_per_m, r.M_A_per_m, rc.MsT_mag, rc.ja,
                                         rc.ja_inv_a_m_per_A, rc.ja_inv_k_m_per_A, r.an_x,
                                         {r.an_L, r.an_dL}),
-            r.ja_exp};
+            r.ja_exp, physics::JaExpPoints{}};
   }
   static Trial trial_from(const RodConditions& rc, const RodState& r, const MoveStart& st,
                           double H1, double M_guess) {
@@ -85,8 +88,8 @@ struct JilesAthertonLaw {
       t.an_x = r.an_x;  // nothing evaluated: the rod's own point stays
       t.an_lv = {r.an_L, r.an_dL};
     } else {
-      const physics::JaEvaluation e = physics::ja_evaluate(st, H1, M_iter, rc.MsT_mag, rc.ja,
-                                                           r.Mirr_A_per_m, st.inv_a, st.near);
+      const physics::JaEvaluation e = physics::ja_evaluate(
+          st, H1, M_iter, rc.MsT_mag, rc.ja, r.Mirr_A_per_m, st.inv_a, st.near, &st.recent);
       t.an_x = e.x1;
       t.an_lv = e.lv;
       t.Mirr = e.Mirr1;

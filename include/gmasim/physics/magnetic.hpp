@@ -165,6 +165,10 @@ inline LagWeightsSlope lag_weights_and_slope_from(double r, double E) {
 inline LagWeightsSlope lag_weights_and_slope_near(double r, ExpPoint& p) {
   return lag_weights_and_slope_from(r, exp_near(-r, p));
 }
+// The same with the solve's last value beside the anchor (exp_near(y, p, recent)).
+inline LagWeightsSlope lag_weights_and_slope_near(double r, ExpPoint& p, ExpPoint& recent) {
+  return lag_weights_and_slope_from(r, exp_near(-r, p, recent));
+}
 
 // Exact update of the first-order lag  tau dH/dt = u(t) - H  over one step h with u
 // linear from u0 to u1 (first-order hold):
