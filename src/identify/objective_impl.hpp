@@ -11,6 +11,7 @@
 #include <deque>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "gmasim/errors.hpp"
@@ -92,7 +93,7 @@ struct Objective::Impl {
   Model model_at(const double* u) const {
     ModelSpec spec = start;
     for (std::size_t j = 0; j < params.size(); ++j) spec.set(params[j].key, to_param(j, u[j]));
-    return compile(spec);
+    return compile(std::move(spec));
   }
 
   // Whether the records run in SIMD lanes at this model (identify/record_lanes.hpp).

@@ -6,6 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/model/model.hpp"
@@ -55,14 +59,23 @@ void size_instances(const ModelSpec& spec, Model& m) {
 // lands in the Model field the row names. A number absent from the spec takes the row's
 // default (Defaulted tables) or stays 0 (the optional numbers of a branch).
 void land_parameters(const ModelSpec& spec, Model& m) {
+  // The table paths of the row's group instances with their dot ("rod2.ja."), formed once per
+  // run of rows of one group (the table lists a group's rows together).
+  std::optional<Group> group;
+  std::vector<std::string> prefixes;
+  std::string name;
   for (const ParamDef& row : parameter_table()) {
     if (row.lands == nullptr) continue;  // [circuit.reluctances_per_H]: summed per branch
+    if (group != row.group) {
+      group = row.group;
+      prefixes.clear();
+      for (const auto& instance : schema::group_instances(spec, row.group))
+        prefixes.push_back(schema::table_path(row.group, instance) + ".");
+    }
     const TableRule table = group_def(row.group).table;
     const bool alternative = !row.alternative.empty();  // absent: its alternative is given
-    const auto instances = schema::group_instances(spec, row.group);
-    for (std::size_t i = 0; i < instances.size(); ++i) {
-      const std::string name =
-          schema::table_path(row.group, instances[i]) + "." + std::string(row.key);
+    for (std::size_t i = 0; i < prefixes.size(); ++i) {
+      name.assign(prefixes[i]).append(row.key);
       const auto it = spec.params.find(name);
       if (it != spec.params.end())
         row.lands(m, i) = it->second.value;
@@ -197,6 +210,22 @@ void derive(const ModelSpec& spec, Model& m) {
   m.xT_sleeve_m_per_K = te.sleeve_alpha_per_K * te.sleeve_length_m;
 }
 
+// Everything of compile() but the Model's copy of the spec and the validity check, which reads
+// it (m.spec).
+Model build_model(const ModelSpec& spec) {
+  check_spec(spec);
+  Model m;
+  m.options = spec.options;
+  size_instances(spec, m);
+  land_parameters(spec, m);
+  m.preload_N = preload_force_N(spec);
+  build_circuit(spec, m);
+  build_flux_sensor(spec, m);
+  build_chains(spec, m);
+  derive(spec, m);
+  return m;
+}
+
 }  // namespace
 
 double preload_area_m2(const ModelSpec& spec) {
@@ -222,18 +251,16 @@ double preload_force_N(const ModelSpec& spec) {
 }
 
 Model compile(const ModelSpec& spec) {
-  check_spec(spec);
-  Model m;
+  Model m = build_model(spec);
   m.spec = spec;
-  m.options = spec.options;
-  size_instances(spec, m);
-  land_parameters(spec, m);
-  m.preload_N = preload_force_N(spec);
-  build_circuit(spec, m);
-  build_flux_sensor(spec, m);
-  build_chains(spec, m);
-  derive(spec, m);
   check_model_validity(m);  // gmasim/model/validity.hpp: no rod under a crushing prestress
+  return m;
+}
+
+Model compile(ModelSpec&& spec) {
+  Model m = build_model(spec);
+  m.spec = std::move(spec);
+  check_model_validity(m);
   return m;
 }
 

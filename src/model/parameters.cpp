@@ -398,25 +398,6 @@ const OptionDef kOptions[] = {
 
 #undef OPTION
 
-bool is_rod(const ModelSpec& spec, std::string_view name) {
-  return std::find(spec.rods.begin(), spec.rods.end(), name) != spec.rods.end();
-}
-
-// Whether table path `table` ("rod2.ja") is an instance of `path` ("<rod>.ja").
-bool path_matches(const ModelSpec& spec, std::string_view path, std::string_view table) {
-  const auto open = path.find('<');
-  if (open == std::string_view::npos) return path == table;
-  const auto close = path.find('>', open);
-  const std::string_view prefix = path.substr(0, open), suffix = path.substr(close + 1);
-  if (table.size() <= prefix.size() + suffix.size() || !table.starts_with(prefix) ||
-      !table.ends_with(suffix))
-    return false;
-  const std::string_view name =
-      table.substr(prefix.size(), table.size() - prefix.size() - suffix.size());
-  if (name.find('.') != std::string_view::npos) return false;
-  return path.substr(open, close - open + 1) != "<rod>" || is_rod(spec, name);
-}
-
 }  // namespace
 
 std::string_view rule_text(Rule r) {
@@ -500,18 +481,7 @@ const GroupDef& group_def(Group g) {
   throw std::logic_error("group_def: a group without a row");
 }
 
-const ParamDef* find_param_def(const ModelSpec& spec, std::string_view dotted) {
-  const auto dot = dotted.rfind('.');
-  if (dot == std::string_view::npos) return nullptr;
-  const std::string_view table = dotted.substr(0, dot), key = dotted.substr(dot + 1);
-  for (const auto& g : parameter_groups()) {
-    if (!path_matches(spec, g.path, table)) continue;
-    for (const auto& p : parameter_table())
-      if (p.group == g.group && (p.key == key || (p.key == "*" && !key.empty()))) return &p;
-    return nullptr;
-  }
-  return nullptr;
-}
+// find_param_def: src/model/param_lookup.cpp.
 
 const OptionDef* find_option_def(std::string_view key) {
   if (key.starts_with("options.")) key.remove_prefix(8);

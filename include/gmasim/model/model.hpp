@@ -284,6 +284,9 @@ struct Model {
 
 // Validates cross-field rules and builds the typed model. Throws InputError.
 Model compile(const ModelSpec& spec);
+// The same Model, the spec moved into Model::spec instead of copied (identify compiles a spec
+// per parameter point).
+Model compile(ModelSpec&& spec);
 
 // ---------------------------------------------------------------------------------------
 // Conditions: every temperature-dependent constant at one operating temperature.
