@@ -1,5 +1,5 @@
-// Shared by the lane tests (test_lanes.cpp, test_lanes_preisach.cpp): each lane of a batch
-// against the width-1 instance of the same kernel, bit for bit.
+// Shared by the lane tests (test_lanes.cpp, test_lanes_preisach.cpp, test_lanes_rods.cpp): each
+// lane of a batch against the width-1 instance of the same kernel, bit for bit.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -29,6 +29,31 @@ inline gmasim::LaneBatch lane_batch(const gmasim::Model& m,
   }
   return gmasim::LaneBatch(mp, cp, sp);
 }
+
+// n simulations of model m at rest, run i at T0_C + dT_C (i % cycle) degC, driven by currents
+// A (sin wt + 0.4 sin 3wt) of 1..4 A at 50..200 Hz: the third harmonic reverses the current
+// twice inside each half period (minor loops). The lane tests' runs (c, s, current, batch).
+struct ReversingRuns {
+  const gmasim::Model* m;
+  std::vector<gmasim::Conditions> c;
+  std::vector<gmasim::State> s;
+  std::vector<double> amp, freq;
+  ReversingRuns(const gmasim::Model& model, std::size_t n, double T0_C, double dT_C,
+                std::size_t cycle)
+      : m(&model) {
+    for (std::size_t i = 0; i < n; ++i) {
+      c.push_back(gmasim::make_conditions(model, T0_C + dT_C * static_cast<double>(i % cycle)));
+      amp.push_back(1.0 + 0.5 * static_cast<double>(i % 7));
+      freq.push_back(50.0 + 25.0 * static_cast<double>(i % 7));
+      s.push_back(gmasim::make_state(model, c.back(), 0.0));
+    }
+  }
+  double current(std::size_t i, double t) const {
+    const double w = 6.283185307179586 * freq[i] * t;
+    return amp[i] * (std::sin(w) + 0.4 * std::sin(3.0 * w));
+  }
+  gmasim::LaneBatch batch() const { return lane_batch(*m, c, s); }
+};
 
 // Steps every lane of two batches of runs.batch() (the second as the width-1 instance) for
 // `steps` steps of dt_s with runs.current(i, t) and, every 50 steps and at the last, checks that

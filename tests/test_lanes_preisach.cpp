@@ -33,27 +33,10 @@ const Model& model() {
 }
 
 constexpr double kStep = 10e-6;
-constexpr double kTwoPi = 6.283185307179586;
 
-// n simulations at rest at 0..80 degC, currents A (sin wt + 0.4 sin 3wt) of 1..4 A at 50..200 Hz:
-// the third harmonic reverses the current twice inside each half period (minor loops).
-struct PreisachRuns {
-  std::vector<Conditions> c;
-  std::vector<State> s;
-  std::vector<double> amp, freq;
-  explicit PreisachRuns(std::size_t n) {
-    for (std::size_t i = 0; i < n; ++i) {
-      c.push_back(make_conditions(model(), 10.0 * static_cast<double>(i % 9)));
-      amp.push_back(1.0 + 0.5 * static_cast<double>(i % 7));
-      freq.push_back(50.0 + 25.0 * static_cast<double>(i % 7));
-      s.push_back(make_state(model(), c.back(), 0.0));
-    }
-  }
-  double current(std::size_t i, double t) const {
-    const double w = kTwoPi * freq[i] * t;
-    return amp[i] * (std::sin(w) + 0.4 * std::sin(3.0 * w));
-  }
-  LaneBatch batch() const { return gmasim_test::lane_batch(model(), c, s); }
+// n Preisach runs at 0..80 degC (gmasim_test::ReversingRuns: minor loops).
+struct PreisachRuns : gmasim_test::ReversingRuns {
+  explicit PreisachRuns(std::size_t n) : ReversingRuns(model(), n, 0.0, 10.0, 9) {}
 };
 
 // The numbers step() sets, and each rod's extrema stack (depth, entries, the point now).

@@ -27,27 +27,10 @@ const Model& model() {
 }
 
 constexpr double kStep = 10e-6;
-constexpr double kTwoPi = 6.283185307179586;
 
-// n simulations at rest at 10..80 degC, currents A (sin wt + 0.4 sin 3wt) of 1..4 A at 50..200
-// Hz (the third harmonic reverses the current inside each half period).
-struct OneRodRuns {
-  std::vector<Conditions> c;
-  std::vector<State> s;
-  std::vector<double> amp, freq;
-  explicit OneRodRuns(std::size_t n) {
-    for (std::size_t i = 0; i < n; ++i) {
-      c.push_back(make_conditions(model(), 10.0 + 10.0 * static_cast<double>(i % 8)));
-      amp.push_back(1.0 + 0.5 * static_cast<double>(i % 7));
-      freq.push_back(50.0 + 25.0 * static_cast<double>(i % 7));
-      s.push_back(make_state(model(), c.back(), 0.0));
-    }
-  }
-  double current(std::size_t i, double t) const {
-    const double w = kTwoPi * freq[i] * t;
-    return amp[i] * (std::sin(w) + 0.4 * std::sin(3.0 * w));
-  }
-  LaneBatch batch() const { return gmasim_test::lane_batch(model(), c, s); }
+// n one-rod runs at 10..80 degC (gmasim_test::ReversingRuns).
+struct OneRodRuns : gmasim_test::ReversingRuns {
+  explicit OneRodRuns(std::size_t n) : ReversingRuns(model(), n, 10.0, 10.0, 8) {}
 };
 
 std::vector<double> state_numbers(const State& s) {

@@ -3,7 +3,6 @@
 #include <deque>
 #include <vector>
 
-#include "gmasim/experiments/frf_bias.hpp"
 #include "identify/objective_impl.hpp"
 
 namespace gmasim {
@@ -13,24 +12,6 @@ namespace {
 using identify_detail::BiasRamp;
 using identify_detail::SinePoint;
 using identify_detail::StartCache;
-
-// Every candidate's frf bias ramps (make_ramps_in_lanes's: the conditions of the target and of
-// its ramp), per res_runs; rc and I0 receive the ramps' conditions and currents in that order.
-void batch_bias_ramps(const Model& model, const std::vector<identify_detail::ResonanceRun>& runs,
-                      std::deque<BiasRamp>& ramps, std::vector<const Conditions*>& rc,
-                      std::vector<double>& I0, std::vector<std::size_t>& which) {
-  ramps.resize(runs.size());
-  const FrfRequest frf;
-  for (std::size_t k = 0; k < runs.size(); ++k) {
-    const identify_detail::ResonanceRun& run = runs[k];
-    if (run.kind != TargetKind::FrfPeakHz && run.kind != TargetKind::BandwidthHz) continue;
-    ramps[k].c = make_conditions(model, run.T);
-    ramps[k].ramp_c = bias_ramp_conditions(model, ramps[k].c, frf.bias_state);
-    rc.push_back(&ramps[k].ramp_c);
-    I0.push_back(run.bias);
-    which.push_back(k);
-  }
-}
 
 }  // namespace
 
@@ -51,7 +32,7 @@ bool Objective::Impl::targets_batch(const std::vector<const Model*>& models,
   try {  // make_ramps_in_lanes, for every candidate at once
     for (std::size_t c = 0; c < P; ++c) {
       caches.push_back(&starts.emplace_back(*models[c]));
-      batch_bias_ramps(*models[c], res_runs, ramps[c], rc[c], I0[c], which[c]);
+      identify_detail::bias_ramps(*models[c], res_runs, ramps[c], rc[c], I0[c], which[c]);
     }
     std::vector<std::vector<State>> st = StartCache::make_in_lanes(caches, target_starts(), rc, I0);
     for (std::size_t c = 0; c < P; ++c)

@@ -195,20 +195,11 @@ struct Objective::Impl {
   // (the other targets' entries unused).
   std::deque<identify_detail::BiasRamp> make_ramps_in_lanes(const Model& model,
                                                             StartCache& starts) const {
-    std::deque<identify_detail::BiasRamp> ramps(res_runs.size());
+    std::deque<identify_detail::BiasRamp> ramps;
     std::vector<const Conditions*> rc;
     std::vector<double> I0;
     std::vector<std::size_t> which;
-    const FrfRequest frf;
-    for (std::size_t k = 0; k < res_runs.size(); ++k) {
-      const ResonanceRun& run = res_runs[k];
-      if (run.kind != TargetKind::FrfPeakHz && run.kind != TargetKind::BandwidthHz) continue;
-      ramps[k].c = make_conditions(model, run.T);
-      ramps[k].ramp_c = bias_ramp_conditions(model, ramps[k].c, frf.bias_state);
-      rc.push_back(&ramps[k].ramp_c);
-      I0.push_back(run.bias);
-      which.push_back(k);
-    }
+    identify_detail::bias_ramps(model, res_runs, ramps, rc, I0, which);
     std::vector<State> st = starts.make_in_lanes(target_starts(), rc, I0);
     for (std::size_t j = 0; j < which.size(); ++j) ramps[which[j]].ramped = std::move(st[j]);
     return ramps;

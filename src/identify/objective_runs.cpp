@@ -225,6 +225,22 @@ void run_record_from_start(const Model& m, StartCache& starts, const Measurement
   run_record(mp, c, make_state(mp, c, I0), meas, s, response, B_T);
 }
 
+void bias_ramps(const Model& model, const std::vector<ResonanceRun>& res_runs,
+                std::deque<BiasRamp>& ramps, std::vector<const Conditions*>& rc,
+                std::vector<double>& I0, std::vector<std::size_t>& which) {
+  ramps.resize(res_runs.size());
+  const FrfRequest frf;
+  for (std::size_t k = 0; k < res_runs.size(); ++k) {
+    const ResonanceRun& run = res_runs[k];
+    if (run.kind != TargetKind::FrfPeakHz && run.kind != TargetKind::BandwidthHz) continue;
+    ramps[k].c = make_conditions(model, run.T);
+    ramps[k].ramp_c = bias_ramp_conditions(model, ramps[k].c, frf.bias_state);
+    rc.push_back(&ramps[k].ramp_c);
+    I0.push_back(run.bias);
+    which.push_back(k);
+  }
+}
+
 }  // namespace identify_detail
 
 void simulate_measurement(const Model& m, const Measurement& meas, const ObjectiveSettings& s,

@@ -136,6 +136,14 @@ struct BiasRamp {
   bool settled = false;
 };
 
+// The frf targets' bias ramps to make (those of kind frf_peak_Hz or bandwidth_Hz): ramps[k]'s
+// conditions (at the target's temperature, and of its ramp) for res_runs[k]; the ramps'
+// conditions, currents and indices k appended to rc, I0 and which, in that order (the
+// arguments of StartCache::make_in_lanes).
+void bias_ramps(const Model& model, const std::vector<ResonanceRun>& res_runs,
+                std::deque<BiasRamp>& ramps, std::vector<const Conditions*>& rc,
+                std::vector<double>& I0, std::vector<std::size_t>& which);
+
 // The frf targets' DC settlings (ramps[k] for res_runs[k] of kind frf_peak_Hz or bandwidth_Hz)
 // as held runs beside the sine runs, when they fit in the lanes the sines leave free (no more
 // vectors of lanes_width() lanes) and in their length (no more steps): each such ramp's state
