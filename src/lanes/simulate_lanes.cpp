@@ -275,7 +275,7 @@ std::vector<Result> simulate_lanes(const Model& m, std::span<const SimulationSet
     validate(s);
     if (!model_ok || s.self_heating.enabled || s.energy_ledger || !s.waveform.periodic() ||
         s.progress) {
-      out[i] = simulate(m, s);
+      out[i] = metrics_only ? simulate_metrics_only(m, s) : simulate(m, s);
       continue;
     }
     const Plan p = periodic_plan(s);

@@ -112,7 +112,7 @@ std::vector<State> make_states(std::span<const Model* const> models,
 // settings; the same validation and errors as simulate(). metrics_only: a lane keeps only what
 // its metrics read -- t, the current, y and B over its metrics window (the last period) and the
 // row before it -- and its metrics are those of the full record (what a sweep keeps); the
-// series' columns are left empty.
+// series' columns are left empty. Settings that do not take the lanes run simulate_metrics_only.
 std::vector<Result> simulate_lanes(const Model& m, std::span<const SimulationSettings> settings,
                                    bool metrics_only = false);
 
