@@ -329,9 +329,11 @@ void add_identify_files(CLI::App* sub, IdentifyArgs& a) {
 
 // identify: the global search (pagmo2 islands, MPI ranks).
 void add_search_options(CLI::App* sub, IdentifyOptions& o) {
-  sub->add_option("--algorithm", o.algorithm,
-                  "Island algorithm: sga (the paper's GA), de, sade, cmaes")
-      ->check(CLI::IsMember({"sga", "de", "sade", "cmaes"}))
+  sub->add_option(
+         "--algorithm", o.algorithm,
+         "Island algorithm: sga (the paper's GA), de, sade, cmaes, pso_gen (a generation's "
+         "particles evaluated together in SIMD lanes)")
+      ->check(CLI::IsMember({"sga", "de", "sade", "cmaes", "pso_gen"}))
       ->capture_default_str();
   sub->add_option("--islands", o.islands,
                   "Islands per rank (fixed: the result depends on it, not on the cores)")

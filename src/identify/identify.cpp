@@ -21,8 +21,9 @@ using Clock = std::chrono::steady_clock;
 // The options no other part checks before the search needs them.
 void check_options(const IdentifyOptions& o) {
   if (o.algorithm != "sga" && o.algorithm != "de" && o.algorithm != "sade" &&
-      o.algorithm != "cmaes")
-    throw InputError(fmt::format("--algorithm {}: must be sga, de, sade or cmaes", o.algorithm));
+      o.algorithm != "cmaes" && o.algorithm != "pso_gen")
+    throw InputError(
+        fmt::format("--algorithm {}: must be sga, de, sade, cmaes or pso_gen", o.algorithm));
   auto positive = [](int v, const char* what) {
     if (v < 1) throw InputError(fmt::format("{} {}: must be >= 1", what, v));
   };

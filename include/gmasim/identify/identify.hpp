@@ -379,7 +379,7 @@ struct IdentifyProgress {
 };
 
 struct IdentifyOptions {
-  std::string algorithm = "sga";  // sga (the paper's multi-island GA), de, sade, cmaes
+  std::string algorithm = "sga";  // sga (the paper's multi-island GA), de, sade, cmaes, pso_gen
   int islands = 4;                // fixed, not the core count: the islands are part of the search
   int population = 24;
   int generations = 60;   // total GA generations (a resumed run continues to this)
