@@ -45,9 +45,7 @@ struct LaneRun {
   State st;
   bool live = false;
   long first_recorded = 0;  // metrics_only: the step before the last period's window
-  // metrics_only: the columns the metrics read (t_s, current_A, y_um, B_T) over the window, kept
-  // here instead of the series.
-  std::vector<std::vector<double>> window;
+  MetricsWindow window;     // metrics_only: kept instead of the series
   // Rows staged before they are appended to the series column by column (LaneBatch::record_row).
   std::vector<double> rows;
   std::size_t staged = 0;
@@ -88,16 +86,13 @@ struct Drives {
       current[l] = w[l]->biased_sine_from_cos(cosine[of[l]]);
   }
 };
-constexpr std::size_t kWindowColumns = 4;  // metrics_only: t_s, current_A, y_um, B_T
 
 void finish(const SimulationSettings& s, const Plan& p, const LaneRun& lr, bool metrics_only,
             Result& r) {
   if (r.series.rows() > 0) r.thermal_expansion_um = r.series.column("xT_um").back();
   if (r.diverged) return;
   const double t0 = p.duration_s - s.waveform.period_s(), t1 = p.duration_s;
-  const auto& w = lr.window;
-  r.metrics = metrics_only ? compute_metrics(w[0], w[1], w[2], w[3], t0, t1)
-                           : compute_metrics(r.series, t0, t1);
+  r.metrics = metrics_only ? lr.window.metrics(t0, t1) : compute_metrics(r.series, t0, t1);
   r.has_metrics = true;
 }
 
@@ -151,15 +146,11 @@ Lanes start_runs(const Model& m, std::span<const SimulationSettings> settings,
       lr.st.energy.enabled = false;
       check_physical_validity(m, lr.c, lr.st, 0.0);
       if (metrics_only) {
-        lr.first_recorded = p.steps - std::lround(s.waveform.period_s() / p.dt_s) - 1;
-        const long rows = (p.steps - std::max(lr.first_recorded, 0L)) / s.record_every + 3;
-        lr.window.assign(kWindowColumns, {});
-        for (auto& col : lr.window) col.reserve(static_cast<std::size_t>(rows));
+        lr.window.start(p.steps, std::lround(s.waveform.period_s() / p.dt_s), s.record_every);
+        lr.first_recorded = lr.window.first;
       }
-      if (lr.first_recorded <= 0 && metrics_only) {  // record()'s t_s, current_A, y_um, B_T
-        const State& st = lr.st;
-        const double row[kWindowColumns] = {st.t_s, st.current_A, st.y_m * 1e6, st.B_T};
-        for (std::size_t w = 0; w < kWindowColumns; ++w) lr.window[w].push_back(row[w]);
+      if (lr.first_recorded <= 0 && metrics_only) {
+        lr.window.push(lr.st);
       } else if (lr.first_recorded <= 0) {
         record(lr.c, lr.st, r.series);
       }
@@ -182,14 +173,14 @@ void step_runs(const Lanes& ln, std::span<const SimulationSettings> settings, co
                bool metrics_only, std::vector<LaneRun>& runs, std::vector<Result>& out) {
   LaneBatch batch(ln.models, ln.conds, ln.states);
   const std::size_t n = ln.lane_of.size();
-  const std::size_t width = metrics_only ? kWindowColumns : batch.record_width();
+  const std::size_t width = metrics_only ? MetricsWindow::kColumns : batch.record_width();
   for (std::size_t l = 0; l < n; ++l) runs[ln.lane_of[l]].rows.resize(kStagedRows * width);
   std::vector<double> current(n), dt(n, p.dt_s), t1(n);
   std::size_t live = n;
   Drives drives;
   for (std::size_t l = 0; l < n; ++l) drives.add(settings[runs[ln.lane_of[l]].setting].waveform);
   auto columns = [&](LaneRun& lr) -> std::vector<std::vector<double>>& {
-    return metrics_only ? lr.window : out[lr.setting].series.columns;
+    return metrics_only ? lr.window.columns : out[lr.setting].series.columns;
   };
   // The first step any lane records: before it, a step needs the lanes only where one of them
   // stops (a lane's step count is set when it stops, or at the end).

@@ -325,28 +325,6 @@ struct EnergyWindow {
   }
 };
 
-// A metrics-only run's record (simulate_metrics_only): the columns compute_metrics reads (t_s,
-// current_A, y_um, B_T: what record() writes there), from the row before the last period's
-// window on, at the record's rows; no other column.
-struct MetricsWindow {
-  bool enabled = false;
-  long first = 0;  // the first step recorded (<= 0: the rest state's row too)
-  std::vector<double> t_s, current_A, y_um, B_T;
-
-  void start(long nsteps, long period_steps, long record_every) {
-    enabled = true;
-    first = nsteps - period_steps - 1;
-    const auto rows = static_cast<std::size_t>((nsteps - std::max(first, 0L)) / record_every + 3);
-    for (auto* col : {&t_s, &current_A, &y_um, &B_T}) col->reserve(rows);
-  }
-  void push(const State& st) {
-    t_s.push_back(st.t_s);
-    current_A.push_back(st.current_A);
-    y_um.push_back(st.y_m * 1e6);
-    B_T.push_back(st.B_T);
-  }
-};
-
 // What simulate() does after each step: self-heating (which may replace the Conditions the
 // loop reads), the decimated record, the step count and the progress callback.
 struct SimulationRecorder {
@@ -365,7 +343,7 @@ struct SimulationRecorder {
     if (heat.enabled) heat.after_step(m, s, c, st, p.dt_s, k == nsteps, r);
     energy.open(m, c, st, k);
     if (k % s.record_every == 0 || k == nsteps) {
-      if (!window.enabled)
+      if (!window.enabled())
         record(c, st, r.series);
       else if (k >= window.first)
         window.push(st);
@@ -495,7 +473,7 @@ Result run_simulation(const Model& m, const SimulationSettings& s, bool metrics_
     State st = make_state(m, c, w.current_at(0.0));
     st.energy.enabled = energy.enabled;
     check_physical_validity(m, c, st, 0.0);  // the rest state too (gmasim/model/validity.hpp)
-    if (!window.enabled)
+    if (!window.enabled())
       record(c, st, r.series);
     else if (window.first <= 0)
       window.push(st);
@@ -512,10 +490,9 @@ Result run_simulation(const Model& m, const SimulationSettings& s, bool metrics_
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   // Self-heating moves the expansion: the value at the end of the run (the last row's xT_um).
   if (r.series.rows() > 0) r.thermal_expansion_um = r.series.column("xT_um").back();
-  if (!r.diverged && window.enabled) {
+  if (!r.diverged && window.enabled()) {
     const double per = w.period_s();
-    r.metrics = compute_metrics(window.t_s, window.current_A, window.y_um, window.B_T,
-                                duration - per, duration);
+    r.metrics = window.metrics(duration - per, duration);
     r.has_metrics = true;
   } else if (!r.diverged && w.periodic()) {
     const double per = w.period_s();
