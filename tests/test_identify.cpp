@@ -307,6 +307,37 @@ TEST(Identify, ParticleSwarmEvaluatesItsGenerationsInBatches) {
               a.ga_rms_pct);
 }
 
+// The island algorithms in one list (kIslandAlgorithms): the options' check and its message, the
+// archipelago's factory and the CLI's choices read it. Every listed name runs a search; a name
+// not in it is refused before anything runs, with the list in the message.
+TEST(Identify, IslandAlgorithmsAreOneList) {
+  EXPECT_EQ(island_algorithm_list(), "sga, de, sade, cmaes or pso_gen");
+  EXPECT_FALSE(is_island_algorithm("ga"));
+  EXPECT_FALSE(is_island_algorithm(""));
+  const MeasurementSet set = synthesize_measurements(printed_fixture(), ci_request(0.0, 1));
+  IdentifyOptions o = ci_options();
+  o.generations = 1;
+  o.migrate_every = 1;
+  o.refine_iterations = 0;
+  o.profile = false;
+  for (const std::string_view name : kIslandAlgorithms) {
+    EXPECT_TRUE(is_island_algorithm(name));
+    o.algorithm = std::string(name);
+    const IdentifyResult r = identify(printed_spec(), set, eight_parameters(), o);
+    EXPECT_GT(r.stage_evaluations.search, 1L) << name;
+    EXPECT_LE(r.ga_rms_pct, r.start_rms_pct) << name;
+  }
+  o.algorithm = "ga";
+  try {
+    (void)identify(printed_spec(), set, eight_parameters(), o);
+    ADD_FAILURE() << "--algorithm ga was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--algorithm ga: must be sga, de, sade, cmaes or pso_gen"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 // ---- synthetic validation ---------------------------------------------------------------
 TEST(Identify, NoiseFreeDataRecoverTheTruthExactly) {
   const MeasurementSet set = synthesize_measurements(printed_fixture(), ci_request(0.0, 1));

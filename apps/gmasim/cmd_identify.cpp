@@ -333,7 +333,8 @@ void add_search_options(CLI::App* sub, IdentifyOptions& o) {
          "--algorithm", o.algorithm,
          "Island algorithm: sga (the paper's GA), de, sade, cmaes, pso_gen (a generation's "
          "particles evaluated together in SIMD lanes)")
-      ->check(CLI::IsMember({"sga", "de", "sade", "cmaes", "pso_gen"}))
+      ->check(CLI::IsMember(
+          std::vector<std::string>(std::begin(kIslandAlgorithms), std::end(kIslandAlgorithms))))
       ->capture_default_str();
   sub->add_option("--islands", o.islands,
                   "Islands per rank (fixed: the result depends on it, not on the cores)")

@@ -66,7 +66,7 @@ pagmo::algorithm make_algorithm(const std::string& name, unsigned gen, std::size
     a.set_bfe(pagmo::bfe{PoolBfe{1}});
     return pagmo::algorithm{a};
   }
-  throw InputError(fmt::format("algorithm '{}': must be sga, de, sade, cmaes or pso_gen", name));
+  throw InputError(fmt::format("algorithm '{}': must be {}", name, island_algorithm_list()));
 }
 
 std::vector<IslandPopulation> snapshot(const IslandRing& archi,

@@ -20,10 +20,9 @@ using Clock = std::chrono::steady_clock;
 
 // The options no other part checks before the search needs them.
 void check_options(const IdentifyOptions& o) {
-  if (o.algorithm != "sga" && o.algorithm != "de" && o.algorithm != "sade" &&
-      o.algorithm != "cmaes" && o.algorithm != "pso_gen")
+  if (!is_island_algorithm(o.algorithm))
     throw InputError(
-        fmt::format("--algorithm {}: must be sga, de, sade, cmaes or pso_gen", o.algorithm));
+        fmt::format("--algorithm {}: must be {}", o.algorithm, island_algorithm_list()));
   auto positive = [](int v, const char* what) {
     if (v < 1) throw InputError(fmt::format("{} {}: must be >= 1", what, v));
   };
@@ -203,6 +202,22 @@ void settle_optimum(const Objective& obj, BatchEvaluator& ev, const IdentifyOpti
 }
 
 }  // namespace
+
+std::string island_algorithm_list() {
+  std::string out;
+  const std::size_t n = std::size(kIslandAlgorithms);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i > 0) out += i + 1 == n ? " or " : ", ";
+    out += kIslandAlgorithms[i];
+  }
+  return out;
+}
+
+bool is_island_algorithm(std::string_view name) {
+  for (const std::string_view a : kIslandAlgorithms)
+    if (a == name) return true;
+  return false;
+}
 
 IdentifyResult identify(const ModelSpec& start, const MeasurementSet& data, const FitSpec& fit,
                         const IdentifyOptions& o) {

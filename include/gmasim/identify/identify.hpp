@@ -378,8 +378,16 @@ struct IdentifyProgress {
   double wall_s = 0.0;
 };
 
+// The island algorithms identify() knows (IdentifyOptions::algorithm), the one list the
+// options' check, the archipelago's factory and the CLI's choices read.
+inline constexpr std::string_view kIslandAlgorithms[] = {"sga", "de", "sade", "cmaes", "pso_gen"};
+// "sga, de, sade, cmaes or pso_gen": the list for an error message.
+std::string island_algorithm_list();
+// True where `name` is one of kIslandAlgorithms.
+bool is_island_algorithm(std::string_view name);
+
 struct IdentifyOptions {
-  std::string algorithm = "sga";  // sga (the paper's multi-island GA), de, sade, cmaes, pso_gen
+  std::string algorithm = "sga";  // one of kIslandAlgorithms (sga: the paper's multi-island GA)
   int islands = 4;                // fixed, not the core count: the islands are part of the search
   int population = 24;
   int generations = 60;   // total GA generations (a resumed run continues to this)
