@@ -10,6 +10,7 @@
 #define GMASIM_LANES_JA_INL_H_
 #endif
 
+#include "gmasim/physics/jiles_atherton.hpp"
 #include "hwy/contrib/math/math-inl.h"
 #include "hwy/highway.h"
 
@@ -297,9 +298,10 @@ HWY_NOINLINE void ja_solve(D d, Mk<D> todo, const JaLaneStart<D>& st, V<D> H1, V
 // (kMirr). A joint trial is one evaluation of eq. (9) at (H1, M_iter) (physics::ja_evaluate,
 // no inner solve): M = F(M_iter), M_irr, the slope dM/dH and 1/mu_r (ja_slope_terms), the
 // law's Newton step M_next = M_iter - g / (1 - alpha chi_e) and whether |g| <= 1e-12 M_s^T.
-// In the lanes where |g| > 1e-5 M_s^T (a poor guess) eq. (9) is solved at H1 (ja_solve, the
-// scalar law's ja_step_from) from the Newton-corrected guess M_iter - g / max(1 - alpha chi_e,
-// 0.2); there M_iter := M, g := 0 and the slope terms come from that solution's chi_e.
+// In the lanes where |g| > 1e-3 M_s^T (physics::ja_safeguard_residual: a poor guess) eq. (9) is
+// solved at H1 (ja_solve, the scalar law's ja_step_from) from the Newton-corrected guess M_iter - g
+// / max(1 - alpha chi_e, 0.2); there M_iter := M, g := 0 and the slope terms come from that
+// solution's chi_e.
 struct JilesAthertonLanes {
   template <class D>
   using Constants = JaLaneConstants<D>;
@@ -341,7 +343,8 @@ struct JilesAthertonLanes {
     t.an_L = hn::IfThenElse(same, r.an_L, e.L1);
     t.an_dL = hn::IfThenElse(same, r.an_dL, e.dL1);
     V<D> g = hn::Sub(M_iter, e.M);
-    const Mk<D> far = hn::AndNot(same, hn::Gt(hn::Abs(g), hn::Mul(C(d, 1e-5), p.MsT)));
+    const Mk<D> far = hn::AndNot(
+        same, hn::Gt(hn::Abs(g), hn::Mul(C(d, physics::ja_safeguard_residual(1.0)), p.MsT)));
     t.solved = far;
     if (!hn::AllFalse(d, far)) {  // far from eq. (9): solve it there
       V<D> dg = hn::Sub(C(d, 1.0), hn::Mul(p.alpha, e.chi_e));

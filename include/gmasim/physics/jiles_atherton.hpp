@@ -250,6 +250,16 @@ inline JaEvaluation ja_evaluate(const JaMoveStart& st, double H1, double M1, dou
 }
 // The tolerance on g = M1 - F(M1) at which eq. (9) counts as solved [A/m]: 1e-12 M_s^T.
 inline double ja_magnetisation_tolerance(double MsT_A_per_m) { return 1e-12 * MsT_A_per_m; }
+// The consistent state's safeguard [A/m]: where a joint Newton iterate's residual |g| exceeds
+// 1e-3 M_s^T, eq. (9) is solved at the trial field first (JilesAthertonLaw::joint_trial and
+// its lanes). A jump of the current from rest to 6 A in one step still leaves |g| above it
+// (tests/test_lanes.cpp, SafeguardSolvesEq9WhereTheScalarLawDoes); the quadratic first guess at
+// 200 steps a period mostly does not. It was 1e-5 M_s^T: the joint solve converges from these
+// guesses in a few more iterates, cheaper than the inner solve (measured in one gmasim_bench
+// run: the 12-condition objective on the scalar step 3.95 -> 3.10 ms an evaluation, its lanes
+// 1.94 -> 1.62 ms; 1e-2 and 1e-4 no better), and every result stays within the solve's tolerance
+// (calibration_smoke's start RMS moved 4e-12 relative; docs/calibration.md).
+inline double ja_safeguard_residual(double MsT_A_per_m) { return 1e-3 * MsT_A_per_m; }
 
 inline void ja_step_from(double H0, const JaMoveStart& st, double H1, double MsT_A_per_m,
                          const JaCoefficients& p, double Mirr0, double M0, double M_guess,

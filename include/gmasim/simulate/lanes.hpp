@@ -62,7 +62,7 @@ class LaneBatch {
   std::size_t diverged_count() const;
   // How many of the live lanes' law evaluations (per rod and Newton iterate, summed over the
   // steps so far) solved eq. (9) fully: the Jiles-Atherton law's safeguard where the joint
-  // Newton iterate is far from eq. (9) (|g| > 1e-5 M_s^T), as the scalar law's joint_trial does.
+  // Newton iterate is far from eq. (9) (|g| > 1e-3 M_s^T), as the scalar law's joint_trial does.
   std::size_t full_solves() const;
   // The consistent state's circuit solves so far: summed over the live lanes that needed one
   // (as State::newton_solves counts them), and per vector of lanes the kernel ran (a vector
