@@ -128,13 +128,41 @@ HWY_INLINE void oscillator_series_doubled(D, V<D> u_half, Mk<D> where, V<D>& C, 
   S = hn::IfThenElse(where, S2, S);
 }
 
+// The propagator's series of a long step (oscillator.hpp, oscillator_propagator where 4 < |u| <=
+// kOscillatorSeriesUnder, under-damped) in the lanes of `where`: C and S summed at u / 4^n and
+// doubled n times, n each lane's fewest halvings to |u| <= 1/4 (as many passes as the most of
+// them). Out of line: the rare path (steps longer than a third of the row's period; the
+// identification's low frequencies at 200 steps a period).
+template <class D>
+HWY_NOINLINE void oscillator_series_long(D d, V<D> u, Mk<D> where, V<D>& Cu, V<D>& Su) {
+  V<D> us = u, level = hn::Zero(d);
+  Mk<D> more = where;
+  int halvings = 0;
+  for (; !hn::AllFalse(d, more); ++halvings) {
+    us = hn::IfThenElse(more, hn::Mul(C(d, 0.25), us), us);
+    level = hn::IfThenElse(more, hn::Add(level, C(d, 1.0)), level);
+    more = hn::And(more, hn::Gt(hn::Abs(us), C(d, 0.25)));
+  }
+  V<D> Cl = polynomial7(d, us, physics::kOscillatorCos);
+  V<D> Sl = polynomial7(d, us, physics::kOscillatorSinc);
+  V<D> u_half = us;  // (N / 2^j)^2 = u / 4^j, in the lanes with j halvings or more
+  for (int j = halvings; j >= 1; --j) {
+    const Mk<D> at = hn::Ge(level, C(d, static_cast<double>(j)));
+    oscillator_series_doubled(d, u_half, at, Cl, Sl);
+    u_half = hn::IfThenElse(at, hn::Mul(C(d, 4.0), u_half), u_half);
+  }
+  Cu = hn::IfThenElse(where, Cl, Cu);
+  Su = hn::IfThenElse(where, Sl, Su);
+}
+
 // Eq. (15), one diagonal row m x'' + c x' + k x = F(t) with F linear over the step, exact
 // (mechanics.hpp, oscillator_step; inv_m = 1/m): the free row by the series of its propagator
 // (oscillator_propagator: f0 = e^(tau/2) (C - tau/2 S), f1 = e^(tau/2) S, C and S summed in u =
 // tau^2/4 - delta -- at u / 4 and doubled once where 1/4 < |u| <= 1, at u / 16 and doubled twice
-// where 1 < |u| <= 4, each only where a lane needs it -- e^(tau/2) by its series where |tau/2|
-// <= 1/64) where |u| <= 4, by the closed form in the lanes beyond (oscillator_closed_form, only
-// where a lane needs it).
+// where 1 < |u| <= 4, each only where a lane needs it; under-damped beyond, to
+// kOscillatorSeriesUnder, at u / 4^n doubled n times (oscillator_series_long) -- e^(tau/2) by its
+// series where |tau/2| <= 1/64), by the closed form in the lanes beyond (oscillator_closed_form,
+// only where a lane needs it).
 template <class D>
 HWY_INLINE void oscillator_step(D d, V<D> m, V<D> inv_m, V<D> c, V<D> k, V<D> F0, V<D> F1, V<D> h,
                                 V<D>& x, V<D>& v) {
@@ -148,7 +176,12 @@ HWY_INLINE void oscillator_step(D d, V<D> m, V<D> inv_m, V<D> c, V<D> k, V<D> F0
   const V<D> half_tau = hn::Mul(C(d, 0.5), hn::Mul(hn::Neg(c_m), h));
   const V<D> u = hn::Sub(hn::Mul(half_tau, half_tau), hn::Mul(hn::Mul(k_m, h), h));
   const V<D> au = hn::Abs(u);
-  const Mk<D> series = hn::Le(au, C(d, 4.0));
+  // the series where |u| <= 4 (halved at most twice), and where under-damped (u < 0) to
+  // kOscillatorSeriesUnder (oscillator_series_long)
+  const Mk<D> long_step = hn::AndNot(
+      hn::Le(au, C(d, 4.0)),
+      hn::And(hn::Lt(u, hn::Zero(d)), hn::Le(au, C(d, physics::kOscillatorSeriesUnder))));
+  const Mk<D> series = hn::Or(hn::Le(au, C(d, 4.0)), long_step);
   V<D> e1 = hn::Zero(d), ed1 = hn::Zero(d);
   if (!hn::AllFalse(d, series)) {  // the propagator's series, where a lane's step is short
     const Mk<D> once = hn::Gt(au, C(d, 0.25)), twice = hn::Gt(au, C(d, 1.0));
@@ -162,6 +195,7 @@ HWY_INLINE void oscillator_step(D d, V<D> m, V<D> inv_m, V<D> c, V<D> k, V<D> F0
     V<D> Su = polynomial7(d, us, physics::kOscillatorSinc);
     if (halved_twice) oscillator_series_doubled(d, hn::Mul(C(d, 0.0625), u), twice, Cu, Su);
     if (halved) oscillator_series_doubled(d, hn::Mul(C(d, 0.25), u), once, Cu, Su);
+    if (!hn::AllFalse(d, long_step)) oscillator_series_long(d, u, long_step, Cu, Su);
     const Mk<D> short_tau = hn::Le(hn::Abs(half_tau), C(d, 1.0 / 64));
     V<D> E = exp_series7(d, half_tau);
     if (!hn::AllTrue(d, short_tau)) E = hn::IfThenElse(short_tau, E, hn::Exp(d, half_tau));

@@ -17,13 +17,19 @@ namespace gmasim::physics {
 // (2j)! (cos w_d h) and S = sum u^j / (2j+1)! (sin(w_d h) / (w_d h); cosh and
 // sinh where u > 0, over-damped), and
 //   f1 = e^(tau/2) S,   f0 = e^(tau/2) (C - tau/2 S).
-// C and S are summed to u^7 (truncation below 1e-18; Estrin's scheme) where |u|
-// <= 1/4 (w_d h <= 1/2: at least 12 steps per period); beyond, up to |u| = 4
-// (w_d h <= 2), at u / 4 or u / 16 and doubled once or twice
-// (oscillator_series_doubled: exp(N) = exp(N/2)^2), e^(tau/2) by its series to
-// (tau/2)^7 where |tau/2| <= 1/64 (below 1e-19) and by std::exp beyond: no sincos
-// or square root, every damping alike. valid = false beyond |u| = 4 (steps
-// longer than a third of the row's period): the closed form.
+// C and S are summed to u^7 (truncation below 1e-18; Estrin's scheme) at u / 4^n, n the
+// fewest halvings that bring it within 1/4 (none where w_d h <= 1/2: at least 12 steps per
+// period), and doubled n times (oscillator_series_doubled: exp(N) = exp(N/2)^2); e^(tau/2) by
+// its series to (tau/2)^7 where |tau/2| <= 1/64 (below 1e-19) and by std::exp beyond: no sincos
+// or square root, every damping alike. Over-damped (u > 0) up to |u| = 4 (w_d h <= 2: cosh and
+// sinh grow with u and cancel against e^(tau/2)); under-damped (u < 0) up to |u| =
+// kOscillatorSeriesUnder (w_d h <= 256, eight halvings): the doublings turn (C, S w_d h) as
+// rotations, their rounding growing as 2^n -- 5.6e-14 of e^(tau/2) at the cap against a long
+// double reference, where the closed form is 1.7e-14 off (tests/test_physics.cpp,
+// Oscillator.LongStepsTakeTheSeriesToItsCap). A step of many of the row's periods (the
+// identification's 200 steps a period at 10 Hz: w_d h ~ 40 for the 8-13 kHz rods) takes the
+// series; valid = false beyond the caps: the closed form.
+inline constexpr double kOscillatorSeriesUnder = 65536.0;  // 4^8
 struct OscillatorPropagator {
   double f0, f1;
   bool valid;
@@ -46,13 +52,19 @@ inline OscillatorPropagator oscillator_propagator(double tau, double delta, ExpP
   const double half_tau = 0.5 * tau;
   const double u = half_tau * half_tau - delta;
   const double au = std::fabs(u);
-  if (!(au <= 4.0)) return {0.0, 0.0, false};
-  // The halvings: none where |u| <= 1/4, one (u / 4) to |u| = 1, two (u / 16) to 4.
-  const int halvings = au <= 0.25 ? 0 : (au <= 1.0 ? 1 : 2);
-  const double us = halvings == 0 ? u : (halvings == 1 ? 0.25 * u : 0.0625 * u);
+  if (!(au <= 4.0) && !(u < 0.0 && au <= kOscillatorSeriesUnder)) return {0.0, 0.0, false};
+  // The halvings: none where |u| <= 1/4, one (u / 4) to |u| = 1, two (u / 16) to 4, ...
+  // (exact: powers of two).
+  int halvings = 0;
+  double us = u;
+  while (std::fabs(us) > 0.25) {
+    us *= 0.25;
+    ++halvings;
+  }
   double C = polynomial7(us, kOscillatorCos), S = polynomial7(us, kOscillatorSinc);
-  if (halvings == 2) oscillator_series_doubled(0.0625 * u, C, S);
-  if (halvings >= 1) oscillator_series_doubled(0.25 * u, C, S);
+  // exp(N / 2^j) to exp(N / 2^(j-1)), j = halvings .. 1: (N / 2^j)^2 = u / 4^j
+  double u_half = us;
+  for (int j = halvings; j >= 1; --j, u_half *= 4.0) oscillator_series_doubled(u_half, C, S);
   const double E =
       std::fabs(half_tau) <= 1.0 / 64 ? exp_series7(half_tau) : exp_cached(half_tau, decay);
   return {E * (C - half_tau * S), E * S, true};
