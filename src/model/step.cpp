@@ -297,11 +297,10 @@ State demagnetised_state_law(const Model& m, const Conditions& c, double current
 }
 
 template <class Law>
-State make_state_law(const Model& m, const Conditions& c, double current_A) {
+State make_state_law(const Model& m, const Conditions& c, double current_A, int ramp_steps) {
   State s = demagnetised_state_law<Law>(m, c, current_A);
   // Quasi-static ramp of the total MMF from zero (demagnetised rods, no field) to its
   // value at t = 0, along the initial magnetisation curve; no eddy lag (at rest).
-  const int ramp_steps = kRestRampSteps;
   for (int k = 1; k <= ramp_steps; ++k) {
     const double f = static_cast<double>(k) / ramp_steps;
     s.energy.enabled = k == ramp_steps;  // the last increment solves every branch (the ledger's
@@ -334,8 +333,14 @@ State demagnetised_state(const Model& m, const Conditions& c, double current_A) 
 }
 
 State make_state(const Model& m, const Conditions& c, double current_A) {
+  return make_state(m, c, current_A, kRestRampSteps);
+}
+
+State make_state(const Model& m, const Conditions& c, double current_A, int ramp_increments) {
+  if (ramp_increments < 1)
+    throw InputError(fmt::format("make_state: ramp_increments {}: must be >= 1", ramp_increments));
   return with_magnetisation_law(m.options.magnetisation_law, [&](auto law) {
-    return make_state_law<decltype(law)>(m, c, current_A);
+    return make_state_law<decltype(law)>(m, c, current_A, ramp_increments);
   });
 }
 

@@ -430,6 +430,11 @@ struct State {
 // Sizes every buffer, and places the actuator at rest in its quasi-static equilibrium
 // under current_A, demagnetised (M_irr = 0) before the field is applied.
 State make_state(const Model& m, const Conditions& c, double current_A);
+// The same with the quasi-static ramp in `ramp_increments` equal increments of the current and
+// the magnets' MMF (make_state: kRestRampSteps, gmasim/model/step_stages.hpp); the rest state
+// converges at second order in the increment (tests/test_model.cpp,
+// RestState.RampConvergesAtSecondOrder). Throws InputError for ramp_increments < 1.
+State make_state(const Model& m, const Conditions& c, double current_A, int ramp_increments);
 
 // Moves the actuator quasi-statically (the limit of a vanishing frequency) to current_A:
 // the magnetic state follows its hysteresis loop without eddy lag (eq. 7 with dB/dt = 0,
