@@ -73,9 +73,9 @@ HWY_INLINE V<D> magnetostriction(D d, V<D> m, V<D> lambda_s, V<D> sigma_p, V<D> 
 
 // The closed form of the free row m e'' + c e' + k e = 0 over h (oscillator.hpp,
 // oscillator_free_closed_form): under-, over- or critically damped per lane, each regime
-// computed only where a lane is in it. Out of line: the rare path (steps long against the
-// row's period: |w_d h| > 2), so that oscillator_step's common one stays small in the inlined
-// kernel.
+// computed only where a lane is in it. Out of line: the rare path (beyond the series'
+// caps: over-damped |u| > 4, under-damped w_d h > 256), so that oscillator_step's common one stays
+// small in the inlined kernel.
 template <class D>
 HWY_NOINLINE void oscillator_closed_form(D d, V<D> m, V<D> c, V<D> k, V<D> h, V<D> e0, V<D> ed0,
                                          V<D>& e1, V<D>& ed1) {

@@ -75,8 +75,8 @@ inline OscillatorPropagator oscillator_propagator(double tau, double delta) {
 }
 
 // The closed form of the free row over h (under-, critically or over-damped)
-// from (e0, e0'): where the series of oscillator_propagator does not apply
-// (steps longer than a third of the row's period).
+// from (e0, e0'): where the series of oscillator_propagator does not apply (over-damped
+// beyond |u| = 4, under-damped beyond kOscillatorSeriesUnder: w_d h > 256).
 [[gnu::noinline]] inline void oscillator_free_closed_form(double m, double c, double k, double h,
                                                           double e0, double ed0, double &e1,
                                                           double &ed1) {
