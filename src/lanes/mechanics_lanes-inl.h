@@ -131,7 +131,7 @@ HWY_INLINE void oscillator_series_doubled(D, V<D> u_half, Mk<D> where, V<D>& C, 
 // The propagator's series of a long step (oscillator.hpp, oscillator_propagator where 4 < |u| <=
 // kOscillatorSeriesUnder, under-damped) in the lanes of `where`: C and S summed at u / 4^n and
 // doubled n times, n each lane's fewest halvings to |u| <= 1/4 (as many passes as the most of
-// them). Out of line: the rare path (steps longer than a third of the row's period; the
+// them). Out of line: the rare path (steps longer than a third of the row's period: the
 // identification's low frequencies at 200 steps a period).
 template <class D>
 HWY_NOINLINE void oscillator_series_long(D d, V<D> u, Mk<D> where, V<D>& Cu, V<D>& Su) {

@@ -68,8 +68,8 @@ struct JilesAthertonLaw {
   // chi_e) the circuit is linearised about, and whether eq. (9) holds at M_iter to its
   // tolerance (|g| <= 1e-12 M_s^T). At H1 == H0 nothing moves (ja_step_from): M = M_next = M0.
   // Where |g| > 1e-3 M_s^T (physics::ja_safeguard_residual: a poor guess, large or violent
-  // steps) eq. (9) is solved at H1 by
-  // ja_step_from from the Newton-corrected guess, as before the joint solve: M_next = M.
+  // steps) eq. (9) is solved at H1 by ja_step_from from the Newton-corrected guess, as before
+  // the joint solve: M_next = M.
   struct JointTrial : Trial {
     double inv_mu_r, M_next;
     double an_x;                       // where the law was evaluated (H_e / a)
@@ -97,8 +97,8 @@ struct JilesAthertonLaw {
       t.M = e.M;
       chi_e = e.chi_e;
       g = M_iter - e.M;
-      if (std::fabs(g) >
-          physics::ja_safeguard_residual(rc.MsT_mag)) {  // far from eq. (9): solve it
+      const bool far = std::fabs(g) > physics::ja_safeguard_residual(rc.MsT_mag);
+      if (far) {  // far from eq. (9): solve it (ja_step_from)
         physics::ja_step_from(r.H_A_per_m, st, H1, rc.MsT_mag, rc.ja, r.Mirr_A_per_m, r.M_A_per_m,
                               M_iter - g / std::max(1.0 - rc.ja.alpha * chi_e, 0.2), t.Mirr, t.M,
                               chi_e);

@@ -47,11 +47,11 @@ inline void hold_history(RodState& r) {
 // settled at rest after it (histories, mechanics at rest, outputs).
 // 400 increments: the rest state converges at second order in them and is within 5e-10 of the
 // stroke of its limit here (4.8e-10 at 150 degC, 7.8e-11 at 20 degC: tests/test_model.cpp,
-// RestState.RampConvergesAtSecondOrder). The ramp is a fifth of an identification's evaluation
-// (200 steps a period, 2 periods); 200 increments would keep the rest state within 2e-9 of the
-// stroke and three periods later leave no digit changed, but the calibration's search then
-// takes another path (fit RMS 46.5 % against 46.4 %, the same claims) and moves some 40 quoted
-// numbers of the docs: not done (docs/performance.md).
+// RestState.RampConvergesAtSecondOrder). The ramp is a quarter of a batched identification
+// evaluation's profile (200 steps a period, 2 periods); 200 increments would keep the rest
+// state within 2e-9 of the stroke and three periods later leave no digit changed, but the
+// calibration's search then takes another path (fit RMS 46.5 % against 46.4 %, the same
+// claims) and moves some 40 quoted numbers of the docs: not done (docs/performance.md).
 inline constexpr int kRestRampSteps = 400;
 State demagnetised_state(const Model& m, const Conditions& c, double current_A);
 void settle_at_rest(const Model& m, const Conditions& c, State& s);
