@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <iterator>
+#include <string>
 #include <string_view>
 
 #include "hwy/targets.h"
@@ -40,9 +42,13 @@ struct BenchSimdTarget {
       }
       return;
     }
-    std::fprintf(stderr,
-                 "gmasim_bench: GMASIM_BENCH_SIMD=%s: must be avx3, avx2, sse4, emu128 or scalar\n",
-                 env);
+    std::string names;  // "avx3, avx2, sse4, emu128 or scalar": the table's names
+    const std::size_t n = std::size(kTargets);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (i > 0) names += i + 1 == n ? " or " : ", ";
+      names += kTargets[i].name;
+    }
+    std::fprintf(stderr, "gmasim_bench: GMASIM_BENCH_SIMD=%s: must be %s\n", env, names.c_str());
     std::exit(2);
   }
 };
