@@ -136,7 +136,7 @@ struct Structure {
 struct LaneData {
   Structure st;
   std::size_t n = 0, npad = 0;
-  std::vector<double> g, r, cm;  // global, rod and circuit fields, each npad long
+  LaneArray g, r, cm;  // global, rod and circuit fields, each npad long (64-byte aligned)
   PreisachLaneData pre;          // the Preisach law's constants and stacks (empty otherwise)
   // How many joint trials of a live lane (not padding) solved eq. (9) fully (the law's safeguard,
   // ja_solve).
