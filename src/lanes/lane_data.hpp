@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "lanes/lane_array.hpp"
 #include "lanes/preisach_lane_data.hpp"
 
 namespace gmasim::lanes {
@@ -136,8 +137,8 @@ struct Structure {
 struct LaneData {
   Structure st;
   std::size_t n = 0, npad = 0;
-  LaneArray g, r, cm;  // global, rod and circuit fields, each npad long (64-byte aligned)
-  PreisachLaneData pre;          // the Preisach law's constants and stacks (empty otherwise)
+  LaneArray g, r, cm;    // global, rod and circuit fields, each npad long (64-byte aligned)
+  PreisachLaneData pre;  // the Preisach law's constants and stacks (empty otherwise)
   // How many joint trials of a live lane (not padding) solved eq. (9) fully (the law's safeguard,
   // ja_solve).
   std::size_t full_solves = 0;

@@ -7,29 +7,12 @@
 #pragma once
 
 #include <cstddef>
-#include <new>
 #include <vector>
 
 #include "gmasim/physics/preisach.hpp"
+#include "lanes/lane_array.hpp"
 
 namespace gmasim::lanes {
-
-// The lanes' arrays start on a 64-byte boundary: with npad a multiple of 8 doubles, every
-// vector of a full chunk is then one aligned cache line (an AVX-512 load or store of an array
-// from std::vector's 16-byte alignment spans two lines: the batched sweep measured its rods'
-// loads and stores at 10.8 % of its samples).
-template <class T>
-struct CacheLineAllocator {
-  using value_type = T;
-  static constexpr std::align_val_t kAlign{64};
-  CacheLineAllocator() = default;
-  template <class U>
-  CacheLineAllocator(const CacheLineAllocator<U>&) noexcept {}
-  T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), kAlign)); }
-  void deallocate(T* p, std::size_t) noexcept { ::operator delete(p, kAlign); }
-  friend bool operator==(const CacheLineAllocator&, const CacheLineAllocator&) { return true; }
-};
-using LaneArray = std::vector<double, CacheLineAllocator<double>>;
 
 // Per rod and lane: physics::PreisachCoefficients (and M_s^T's companions 1/H_c, 1/a, packed once).
 enum PreisachField : int {
