@@ -12,6 +12,7 @@
 #include <string>
 #include <string_view>
 
+#include "gmasim/errors.hpp"
 #include "hwy/targets.h"
 
 namespace {
@@ -42,13 +43,10 @@ struct BenchSimdTarget {
       }
       return;
     }
-    std::string names;  // "avx3, avx2, sse4, emu128 or scalar": the table's names
-    const std::size_t n = std::size(kTargets);
-    for (std::size_t i = 0; i < n; ++i) {
-      if (i > 0) names += i + 1 == n ? " or " : ", ";
-      names += kTargets[i].name;
-    }
-    std::fprintf(stderr, "gmasim_bench: GMASIM_BENCH_SIMD=%s: must be %s\n", env, names.c_str());
+    std::string_view names[std::size(kTargets)];  // the table's names, for the message
+    for (std::size_t i = 0; i < std::size(kTargets); ++i) names[i] = kTargets[i].name;
+    std::fprintf(stderr, "gmasim_bench: GMASIM_BENCH_SIMD=%s: must be %s\n", env,
+                 gmasim::choice_list(names).c_str());
     std::exit(2);
   }
 };

@@ -4,8 +4,10 @@
 
 #include <cstddef>
 #include <limits>
+#include <span>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace gmasim {
 
@@ -23,6 +25,9 @@ class InputError : public std::runtime_error {
 
 // "file:line: message" (line omitted when 0).
 std::string located(const std::string& file, long line, const std::string& message);
+
+// The choices of a "must be ..." message: "a, b or c" ("a" for one, "" for none).
+std::string choice_list(std::span<const std::string_view> names);
 
 class DivergenceError : public std::runtime_error {
  public:

@@ -39,4 +39,13 @@ DivergenceError::DivergenceError(double time_s_, std::string rod_, std::string q
       quantity(std::move(quantity_)),
       value(value_) {}
 
+std::string choice_list(std::span<const std::string_view> names) {
+  std::string out;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) out += i + 1 == names.size() ? " or " : ", ";
+    out += names[i];
+  }
+  return out;
+}
+
 }  // namespace gmasim

@@ -203,15 +203,7 @@ void settle_optimum(const Objective& obj, BatchEvaluator& ev, const IdentifyOpti
 
 }  // namespace
 
-std::string island_algorithm_list() {
-  std::string out;
-  const std::size_t n = std::size(kIslandAlgorithms);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (i > 0) out += i + 1 == n ? " or " : ", ";
-    out += kIslandAlgorithms[i];
-  }
-  return out;
-}
+std::string island_algorithm_list() { return choice_list(kIslandAlgorithms); }
 
 bool is_island_algorithm(std::string_view name) {
   for (const std::string_view a : kIslandAlgorithms)
