@@ -67,8 +67,12 @@ TEST(LaneUsers, CompensateSearchesMatchTheScalarSearches) {
   std::printf("compensate lanes vs scalar: drive %.3g, strokes %.3g relative\n", worst_x, worst_s);
 }
 
-// The 20-150 degC runs (Fig. 19 rows and the retention) in lanes against simulate(). Observed
-// 1.6e-14 relative; tolerance 2e-13.
+// The 20-150 degC runs (Fig. 19 rows and the retention) in lanes against simulate(). A lane and
+// step() may end Newton's solve on different iterates within its field tolerance (1e-11 |H|): their
+// exponentials and sums round differently. Observed 3e-14 for every number but one since the
+// regeneration of stop 34 (1.6e-14 before): the 150 degC, 10 A retention stroke, 1.6e-12 (1e-10
+// um; 1.6e-12 at 1, 2 and 4 periods, 1e-14 at 3 and 6: one sample's iterate, not a drift).
+// Tolerance 2e-11: about 10x that, and twice the solve's own relative tolerance.
 TEST(LaneUsers, ParamsVsTemperatureMatchesTheScalarRuns) {
   ParamsVsTemperatureRequest r;
   r.temperatures_C = {20, 80, 150};
@@ -89,7 +93,7 @@ TEST(LaneUsers, ParamsVsTemperatureMatchesTheScalarRuns) {
         std::max({worst, rel(a.retention[i].stroke_um, b.retention[i].stroke_um),
                   rel(a.retention[i].hysteresis_um, b.retention[i].hysteresis_um),
                   rel(a.retention[i].stroke_retention_pct, b.retention[i].stroke_retention_pct)});
-  EXPECT_LE(worst, 2e-13);
+  EXPECT_LE(worst, 2e-11);
   std::printf("params-vs-temperature lanes vs scalar: %.3g relative\n", worst);
 }
 
