@@ -6,6 +6,7 @@
     /usr/bin/python3 calibration/calibrate.py --list
     /usr/bin/python3 calibration/calibrate.py --smoke         # one reading, small budget, vs reference
     /usr/bin/python3 calibration/calibrate.py --smoke --write-reference
+    /usr/bin/python3 calibration/calibrate.py --check [NAME...]  # rerun at the committed budget, vs the committed outputs
 
 The calibration is a pure function of committed inputs: calibration/readings.toml (the readings,
 the search settings), each reading's fixed start model (calibration/start/) and fit spec, and
@@ -27,6 +28,7 @@ import json
 import math
 import os
 import pathlib
+import re
 import shutil
 import subprocess
 import sys
@@ -274,6 +276,87 @@ def smoke(bin_: str, cfg: dict, work: pathlib.Path | None, write_reference: bool
     return 0
 
 
+# `--check`: the committed outputs are what `calibrate.py <reading>` writes on this code. The
+# rerun goes to a scratch directory; its model must equal the committed one line for line (but
+# the line that dates the run), its fit report's parameters and fit RMS to CHECK_REL_TOL, its
+# claims row for row, and an installed model (models/mdma.toml) must be the committed model
+# under the install header. The smoke run's budget is too small to see a search that moved in
+# its last digits (after d143ea3 it still passed while the full calibration had moved).
+CHECK_REL_TOL = 1e-14
+DATED = re.compile(r"^# Calibrated by .* on \S+ \(")
+
+
+def undated(text: str, scratch: pathlib.Path | None = None) -> list[str]:
+    """The model's lines but the dated one; the scratch directory's path read as calibration/models."""
+    if scratch is not None:
+        text = text.replace(rel(scratch), rel(HERE / "models"))
+    return [ln for ln in text.splitlines() if not DATED.match(ln)]
+
+
+def check(bin_: str, cfg: dict, names: list[str]) -> int:
+    known = {r["name"]: r for r in cfg["reading"]}
+    todo = [known[n] for n in names] if names else [r for r in cfg["reading"] if "install" in r]
+    problems: list[str] = []
+    tmp = pathlib.Path(tempfile.mkdtemp(prefix="gmasim_calibration_check_"))
+    try:
+        for reading in todo:
+            name = reading["name"]
+            committed = HERE / "models"
+            fresh = {k: v for k, v in reading.items() if k != "install"}
+            calibrate(bin_, fresh, cfg.get("search", {}), tmp)
+            mine = []
+            got_model, was_model = tmp / f"{name}.toml", committed / f"{name}.toml"
+            if not was_model.is_file():
+                mine.append(f"{rel(was_model)} does not exist")
+            else:
+                got, was = undated(got_model.read_text(), tmp), undated(was_model.read_text())
+                if got != was:
+                    diff = [f"{a!r} -> {b!r}" for a, b in zip(was, got) if a != b][:4]
+                    mine.append(f"{rel(was_model)}: {sum(a != b for a, b in zip(was, got)) + abs(len(got) - len(was))} "
+                                f"line(s) differ from the rerun, e.g. " + "; ".join(diff))
+                if "install" in reading:
+                    dest = HERE / reading["install"]
+                    want = INSTALL_HEADER.format(name=name) + was_model.read_text()
+                    if not dest.is_file() or dest.read_text() != want:
+                        mine.append(f"{rel(dest)} is not {rel(was_model)} under the install header "
+                                    f"(edited by hand, or installed from another run)")
+            was_fit_path = committed / f"{name}_report" / "fit_report.json"
+            was_claims_path = committed / f"{name}_reproduce" / "claims.json"
+            if was_fit_path.is_file() and was_claims_path.is_file():
+                got_fit, was_fit = read_fit(tmp / f"{name}_report" / "fit_report.json"), read_fit(was_fit_path)
+                if set(got_fit["parameters"]) != set(was_fit["parameters"]):
+                    mine.append(f"fitted parameters {sorted(got_fit['parameters'])} != committed "
+                                f"{sorted(was_fit['parameters'])}")
+                for p, v in was_fit["parameters"].items():
+                    g = got_fit["parameters"].get(p)
+                    if g is not None and not close(g, v, CHECK_REL_TOL):
+                        mine.append(f"{p} = {g!r}, committed {v!r}")
+                if not close(got_fit["rms_pct"], was_fit["rms_pct"], CHECK_REL_TOL):
+                    mine.append(f"fit RMS {got_fit['rms_pct']!r} %, committed {was_fit['rms_pct']!r} %")
+                got_c = read_claims(tmp / f"{name}_reproduce" / "claims.json")
+                was_c = read_claims(was_claims_path)
+                if got_c["rows"] != was_c["rows"]:
+                    moved = [str(r.get("id", i)) for i, (r, q) in
+                             enumerate(zip(got_c["rows"], was_c["rows"])) if r != q]
+                    mine.append(f"claims: {got_c['pass']} of {got_c['applicable']} pass (committed "
+                                f"{was_c['pass']} of {was_c['applicable']}); rows that differ: {', '.join(moved[:6])}")
+            else:
+                mine.append(f"{rel(was_fit_path)} or {rel(was_claims_path)} does not exist")
+            if mine:
+                problems.append(f"{name}: the committed calibration is not what `calibrate.py {name}` writes "
+                                f"on this code; rerun it (or scripts/regenerate.sh) and commit its outputs:")
+                problems += ["  " + m for m in mine]
+            else:
+                print(f"calibrate.py --check: {name} reproduces its committed outputs (model line for line, "
+                      f"{len(read_fit(was_fit_path)['parameters'])} parameters and the fit RMS within "
+                      f"{CHECK_REL_TOL:g}, every claim row)")
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    for p in problems:
+        print("calibrate.py --check: " + p, file=sys.stderr)
+    return 1 if problems else 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -286,6 +369,9 @@ def main(argv=None) -> int:
                     help="rerun the [smoke] reading on its small budget and compare with reference/<reading>.json")
     ap.add_argument("--write-reference", action="store_true", help="with --smoke: rewrite the reference")
     ap.add_argument("--work", help="with --smoke: keep the run's outputs in this directory")
+    ap.add_argument("--check", action="store_true",
+                    help="rerun the named readings (default: the installed ones) at the committed budget in a "
+                         "scratch directory and compare with their committed outputs; writes nothing in the tree")
     a = ap.parse_args(argv)
     try:
         cfg = load_readings(pathlib.Path(a.config))
@@ -297,6 +383,8 @@ def main(argv=None) -> int:
             raise CalibrationError("--write-reference goes with --smoke")
         if not pathlib.Path(a.bin).is_file():
             raise CalibrationError(f"gmasim not found at {a.bin} (build it, or pass --bin / set GMASIM_BIN)")
+        if a.check and (a.smoke or a.write_reference or a.work):
+            raise CalibrationError("--check goes alone (not with --smoke, --write-reference or --work)")
         if a.smoke:
             if a.readings:
                 raise CalibrationError("--smoke runs the [smoke] reading of readings.toml; name no readings")
@@ -305,6 +393,8 @@ def main(argv=None) -> int:
         for n in a.readings:
             if n not in known:
                 raise CalibrationError(f"unknown reading {n}; readings.toml lists: {', '.join(known)}")
+        if a.check:
+            return check(a.bin, cfg, a.readings)
         todo = [known[n] for n in a.readings] if a.readings else cfg["reading"]
         out = HERE / "models"
         for r in todo:
