@@ -295,7 +295,7 @@ def undated(text: str, scratch: pathlib.Path | None = None) -> list[str]:
 
 def check(bin_: str, cfg: dict, names: list[str]) -> int:
     known = {r["name"]: r for r in cfg["reading"]}
-    todo = [known[n] for n in names] if names else [r for r in cfg["reading"] if "install" in r]
+    todo = [known[n] for n in names] if names else cfg["reading"]
     problems: list[str] = []
     tmp = pathlib.Path(tempfile.mkdtemp(prefix="gmasim_calibration_check_"))
     try:
@@ -370,7 +370,7 @@ def main(argv=None) -> int:
     ap.add_argument("--write-reference", action="store_true", help="with --smoke: rewrite the reference")
     ap.add_argument("--work", help="with --smoke: keep the run's outputs in this directory")
     ap.add_argument("--check", action="store_true",
-                    help="rerun the named readings (default: the installed ones) at the committed budget in a "
+                    help="rerun the named readings (default: every reading) at the committed budget in a "
                          "scratch directory and compare with their committed outputs; writes nothing in the tree")
     a = ap.parse_args(argv)
     try:
