@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates everything that is written from the calibrated model, in the order the files
 # depend on each other, after a change that moves the step's results (even in their last
-# digits: calibration_smoke compares the start model's RMS with the committed fit report).
+# digits: calibration_smoke compares the start model's RMS with the committed fit report, and
+# calibration_reproduces reruns every reading at the committed budget and compares its outputs).
 #
 #   bash scripts/regenerate.sh            # the built-in reading (consistent) and what follows
 #   bash scripts/regenerate.sh --all      # every reading of calibration/readings.toml
