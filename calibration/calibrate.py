@@ -344,7 +344,8 @@ def check(bin_: str, cfg: dict, names: list[str]) -> int:
                 mine.append(f"{rel(was_fit_path)} or {rel(was_claims_path)} does not exist")
             if mine:
                 problems.append(f"{name}: the committed calibration is not what `calibrate.py {name}` writes "
-                                f"on this code; rerun it (or scripts/regenerate.sh) and commit its outputs:")
+                                f"on this code; rerun it (scripts/regenerate.sh{'' if 'install' in reading else ' --all'}) "
+                                f"and commit its outputs:")
                 problems += ["  " + m for m in mine]
             else:
                 print(f"calibrate.py --check: {name} reproduces its committed outputs (model line for line, "
