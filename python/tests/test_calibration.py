@@ -95,3 +95,63 @@ def test_training_set_is_declared_in_the_fit_spec_and_installed():
     predicted = [c for c in applicable if c not in declared]
     assert len(declared) + len(predicted) == len(applicable)
     assert len(predicted) >= len(declared)  # most claims test the model
+
+
+def _fake_rerun(edit=None):
+    """A stand-in for calibrate(): writes the committed outputs of the reading into the scratch
+    directory (what a rerun that reproduces them writes), then applies edit(out, name)."""
+    import shutil
+
+    def fake(bin_, reading, search, out, quick=False):
+        name = reading["name"]
+        src = SOURCE_DIR / "calibration" / "models"
+        shutil.copy(src / f"{name}.toml", out / f"{name}.toml")
+        for d in (f"{name}_report", f"{name}_reproduce"):
+            shutil.copytree(src / d, out / d)
+        if edit:
+            edit(out, name)
+        return {}
+    return fake
+
+
+def test_check_passes_a_rerun_that_writes_the_committed_outputs(monkeypatch, capsys):
+    cfg = calibrate.load_readings(SOURCE_DIR / "calibration" / "readings.toml")
+    monkeypatch.setattr(calibrate, "calibrate", _fake_rerun())
+    assert calibrate.check("unused", cfg, ["consistent"]) == 0
+    assert "consistent reproduces its committed outputs" in capsys.readouterr().out
+
+
+def test_check_names_what_moved(monkeypatch, capsys):
+    """A parameter moved in its 12th digit, in the model and the fit report: both are named."""
+    import json
+
+    def edit(out, name):
+        model = out / f"{name}.toml"
+        text = model.read_text()
+        line = next(ln for ln in text.splitlines() if ln.startswith("Es_Pa = "))
+        model.write_text(text.replace(line, "Es_Pa = 88157990000.0" + line[line.index("  #"):]))
+        rep = out / f"{name}_report" / "fit_report.json"
+        doc = json.loads(rep.read_text())
+        for p in doc["parameters"]:
+            if p["name"] == "material.Es_Pa":
+                p["value"] *= 1 + 1e-12
+        rep.write_text(json.dumps(doc))
+
+    cfg = calibrate.load_readings(SOURCE_DIR / "calibration" / "readings.toml")
+    monkeypatch.setattr(calibrate, "calibrate", _fake_rerun(edit))
+    assert calibrate.check("unused", cfg, ["consistent"]) == 1
+    err = capsys.readouterr().err
+    assert "consistent: the committed calibration is not what `calibrate.py consistent` writes" in err
+    assert "calibration/models/consistent.toml: 1 line(s) differ" in err
+    assert "material.Es_Pa = " in err
+    assert "scripts/regenerate.sh)" in err  # the installed reading: regenerate.sh without --all
+
+
+def test_undated_ignores_the_date_and_reads_scratch_paths_as_committed(tmp_path):
+    scratch = tmp_path / "s"
+    a = ("# Calibrated by `gmasim identify` on 2026-11-28T22:17:39Z (docs/identify.md).\n"
+         f"# report: {calibrate.rel(scratch)}/consistent_report\nx = 1\n")
+    b = ("# Calibrated by `gmasim identify` on 2026-11-29T01:00:00Z (docs/identify.md).\n"
+         "# report: calibration/models/consistent_report\nx = 1\n")
+    assert calibrate.undated(a, scratch) == calibrate.undated(b)
+    assert calibrate.undated(a, scratch) != calibrate.undated(b.replace("x = 1", "x = 2"))
