@@ -280,6 +280,24 @@ TEST(Validate, SimulationSettingsAreRefusedBeforeAnyWork) {
               s.duration_s = 0.01;
             }),
             "step time = nan s: must be a finite number");
+  for (const double t :
+       {0.0, -1.0, 0.01, 1e308})  // no step inside the run: refused, not a 0 stroke
+    EXPECT_THAT(err([t](S& s) {
+                  s.waveform.kind = gmasim::WaveformKind::Step;
+                  s.waveform.step_to_A = 1.0;
+                  s.waveform.step_time_s = t;
+                  s.duration_s = 0.01;
+                }),
+                HasSubstr("(--step-time): must be inside the run, 0 < t < 0.01 s"))
+        << t;
+  // the chirp's extremes, not only its offset and amplitude
+  EXPECT_THAT(err([](S& s) {
+                s.waveform.kind = gmasim::WaveformKind::Chirp;
+                s.waveform.offset_A = 900.0;
+                s.waveform.amplitude_A = 900.0;
+                s.duration_s = 0.01;
+              }),
+              HasSubstr("chirp maximum (offset + amplitude) = 1800 A"));
   EXPECT_EQ(err([](S& s) {
               s.waveform.kind = gmasim::WaveformKind::Table;
               s.waveform.table_t_s = {100.0, 100.01};

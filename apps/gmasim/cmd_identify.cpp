@@ -95,7 +95,9 @@ std::vector<FileArg> identify_inputs(const IdentifyArgs& a, const MeasurementSet
 
 // What it writes: the model, the checkpoint, the report directory's files.
 std::vector<FileArg> identify_outputs(const IdentifyArgs& a) {
-  std::vector<FileArg> out = {{a.out, "--out"}};
+  // the report directory itself too: --report equal to --out created a directory where the
+  // model was to be written, and the finished search was lost
+  std::vector<FileArg> out = {{a.out, "--out"}, {a.report, "--report"}};
   if (!a.opt.checkpoint_path.empty()) out.push_back({a.opt.checkpoint_path, "--checkpoint"});
   for (auto& f : files_in(
            a.report,
@@ -217,7 +219,15 @@ int run_identify_body(IdentifyArgs& a, Communicator& comm) {
     o.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / local);
   }
   if (root) {
-    // Fail on an unwritable destination before hours of search, not after.
+    // Fail on an unwritable destination before hours of search, not after: a file's path that
+    // is a directory too.
+    for (const auto& [path, flag] :
+         {std::pair{a.out, "--out"}, std::pair{a.opt.checkpoint_path, "--checkpoint"}}) {
+      std::error_code ec;
+      if (!path.empty() && fs::is_directory(path, ec))
+        throw InputError(fmt::format("{} {}: is a directory; name the file to write", flag,
+                                     clip_for_message(path)));
+    }
     const fs::path out(a.out);
     if (out.has_parent_path()) ensure_output_dir(out.parent_path().string());
     ensure_output_dir(a.report);

@@ -198,14 +198,20 @@ int run_sensitivity_cmd(SensitivityArgs& a) {
   a.req.parameters = parameters_of(a, spec);
   a.req.only = a.quantities;
   std::vector<std::string> outputs;
+  std::vector<FileArg> output_args;  // the same files, by flag: no two flags may share one
+  for (const auto& [o, flag] : {std::pair{a.json, "--json"}, std::pair{a.csv, "--csv"}})
+    if (!o.empty() && o != "-") output_args.push_back({o, flag});
   for (const auto& o : {a.json, a.csv})
     if (!o.empty()) outputs.push_back(o);
   if (a.out.empty() && a.json.empty() && a.csv.empty()) a.out = "out/sensitivity";
   if (!a.out.empty())
     for (const char* name : {"sensitivity.csv", "sensitivity.json", "identifiability.json",
-                             "sensitivity.png", "sensitivity.svg"})
+                             "sensitivity.png", "sensitivity.svg"}) {
       outputs.push_back((fs::path(a.out) / name).string());
+      output_args.push_back({outputs.back(), "--out"});
+    }
   refuse_overwrite(a, outputs);
+  require_outputs_distinct({}, output_args, {});
   if (!a.out.empty()) ensure_output_dir(a.out);
 
   const SensitivityResult r =

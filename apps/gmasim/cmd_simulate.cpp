@@ -15,6 +15,7 @@
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/simulate_fields.hpp"
 #include "gmasim/io/io.hpp"
+#include "gmasim/model/model.hpp"
 #include "gmasim/model/validate.hpp"
 #include "gmasim/simulate/simulate.hpp"
 #include "request_options.hpp"
@@ -356,12 +357,28 @@ int run_simulate(const SimulateArgs& a) {
     one.temperature_C = temps.front();
     return run_one(model, one);
   }
+  // Every temperature is checked, and its directory named, before the first run: a bad one
+  // last in the list left the others' outputs and an empty directory; two that print alike
+  // (20 and 20.0000001: T20C) wrote one directory twice.
+  std::vector<std::string> names;
+  for (const double T : temps) {
+    (void)make_conditions(model, T, {});
+    std::string name = fmt::format("T{:g}C", T);
+    for (std::size_t q = 0; q < names.size(); ++q)
+      if (names[q] == name)
+        throw InputError(fmt::format(
+            "--temperature: {:.17g} and {:.17g} degC both write {}/{}: give distinct temperatures "
+            "(they are named to 6 significant digits)",
+            temps[q], T, a.out, name));
+    names.push_back(std::move(name));
+  }
   int rc = 0;
   std::vector<std::string> dirs;
-  for (const double T : temps) {
+  for (std::size_t q = 0; q < temps.size(); ++q) {
+    const double T = temps[q];
     SimulateArgs one = a;
     one.temperature_C = T;
-    one.out = (std::filesystem::path(a.out) / fmt::format("T{:g}C", T)).string();
+    one.out = (std::filesystem::path(a.out) / names[q]).string();
     one.plot = false;
     rc = std::max(rc, run_one(model, one));
     dirs.push_back(one.out);

@@ -32,8 +32,16 @@ void print_error(const std::string& what) {
 // parse as doubles, and an unused flag (--step-time nan without a step waveform) would
 // otherwise pass silently (issue 8). CLI11 names such options' type "FLOAT".
 namespace {
+// No value may be empty either: CLI11 converts '' to 0 for a number and to the flag's default for
+// a path (--temperatures '' ran at 0 degC, --model '' took the built-in model).
 void check_options(const CLI::App& app) {
   for (const CLI::Option* o : app.get_options()) {
+    if (o->get_items_expected_max() > 0)
+      for (const std::string& v : o->results())
+        if (v.empty())
+          throw InputError(fmt::format(
+              "{} '': an empty value (give a value, or leave the flag out for its default)",
+              o->get_name()));
     if (o->get_type_name().find("FLOAT") == std::string::npos) continue;
     for (const std::string& v : o->results()) {
       char* end = nullptr;
@@ -234,20 +242,25 @@ int main(int argc, char** argv) {
     }
     return 1;
   } catch (const gmasim::cli::UsageError& e) {
+    gmasim::remove_created_output_dirs_if_empty();
     gmasim::cli::print_error(e.what());
     return 1;
   } catch (const gmasim::InputError& e) {
+    gmasim::remove_created_output_dirs_if_empty();
     gmasim::cli::print_error(e.what());
     return 2;
   } catch (const gmasim::DivergenceError& e) {
+    gmasim::remove_created_output_dirs_if_empty();
     gmasim::cli::print_error(e.what());
     return 3;
   } catch (const std::bad_alloc&) {
+    gmasim::remove_created_output_dirs_if_empty();
     gmasim::cli::print_error(
         "out of memory: the run needs more memory than the system gives it (MemAvailable, "
         "ulimit -v); record less often (--record-every), shorten the run or lower --threads");
     return 2;
   } catch (const std::exception& e) {
+    gmasim::remove_created_output_dirs_if_empty();
     gmasim::cli::print_error(fmt::format("internal error: {}", e.what()));
     return 4;
   }

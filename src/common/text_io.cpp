@@ -1,6 +1,8 @@
 #include "common/text_io.hpp"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <charconv>
@@ -15,7 +17,21 @@ namespace gmasim::io_detail {
 
 std::string read_text_file(const std::string& path, std::string_view what,
                            OnReadError on_read_error) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
+  // Opened without blocking, then read blocking: open(2) of a FIFO that nobody writes waited for
+  // ever (mkfifo ff; gmasim model check ff); now it reads as empty. A pipe with a writer
+  // (--waveform <(...)) is read whole, as before.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  std::FILE* f = nullptr;
+  if (fd >= 0) {
+    const int flags = ::fcntl(fd, F_GETFL);
+    if (flags >= 0) (void)::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
+    f = ::fdopen(fd, "rb");
+    if (!f) {
+      const int e = errno;
+      ::close(fd);
+      errno = e;
+    }
+  }
   if (!f) {
     throw InputError(
         located(path, 0, fmt::format("cannot open {} ({})", what, std::strerror(errno))));

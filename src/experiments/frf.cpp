@@ -83,6 +83,10 @@ void check_request(const FrfRequest& r) {
   (void)checked_count(r.points, kMaxFrfPoints, "frequency points (--points)");
   require_in(r.amplitude_A, 0.0, kMaxCurrent_A, "amplitude (--amplitude)", "A");
   require_in(r.bias_A, -kMaxCurrent_A, kMaxCurrent_A, "bias current (--bias)", "A");
+  require_in(r.bias_A + r.amplitude_A, -kMaxCurrent_A, kMaxCurrent_A,
+             "peak current (--bias + --amplitude)", "A");
+  require_in(r.bias_A - r.amplitude_A, -kMaxCurrent_A, kMaxCurrent_A,
+             "lowest current (--bias - --amplitude)", "A");
   require_int_in(r.settle_periods, 1, 1000000, "settle periods");
   require_int_in(r.measure_periods, 1, 1000000, "measure periods");
   // Golden section shrinks its bracket by 0.618 per evaluation: 100 reach 1e-21 of it, far below

@@ -159,6 +159,13 @@ ParamsVsTemperatureResult run_params_vs_temperature(const Model& m,
   detail::simulate_settings(
       m, settings, resolve_thread_count(r.threads, n), r.lanes, false,
       [&](std::size_t i, Result&& out) { runs[i] = point_run(m, r, out, i % nc == op); });
+  // A diverged run ends the command with its diagnosis (as sweep, frf and ablate do), instead
+  // of tables of NaN with exit 0.
+  for (std::size_t i = 0; i < n; ++i)
+    if (runs[i].diverged)
+      throw DivergenceError(fmt::format(
+          "params-vs-temperature: the run at {:g} degC, {:g} A peak-to-peak, {:g} Hz diverged: {}",
+          r.temperatures_C[i / nc], currents[i % nc], r.frequency_Hz, runs[i].error));
 
   ParamsVsTemperatureResult res;
   add_law_rows(m, r, conds, runs, nc, op, res);

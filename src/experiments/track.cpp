@@ -177,12 +177,26 @@ long detail::track_substeps(const TrackRequest& r) {
   const double Ts = 1.0 / r.sample_rate_Hz;
   double f_max = 0.0;
   for (double f : r.frequencies_Hz) f_max = std::max(f_max, f);
+  // A given dt must fit in a PID sample (a longer one became the sample period silently)
+  if (r.dt_s > 0.0 && !(r.dt_s <= Ts * (1.0 + 1e-12)))
+    throw InputError(fmt::format(
+        "dt = {:g} s (--dt): longer than the PID sample period 1 / --sample-rate = {:g} s; give "
+        "dt <= {:g} s, or 0 for the automatic rule",
+        r.dt_s, Ts, Ts));
   const double dt_target =
       r.dt_s > 0.0 ? r.dt_s : std::min(kMaxDt_s, 1.0 / (kStepsPerPeriod * f_max));
   const long sub = steps_to_resolve(Ts / dt_target, 1, "plant steps per PID sample");
   double f_min = f_max;
   for (double f : r.frequencies_Hz) f_min = std::min(f_min, f);
   (void)StepGrid::sampled(0.0, Ts, r.periods / f_min / Ts, sub, "plant steps of the longest run");
+  // The example run's log (track_example.csv) holds a row per PID sample: bounded like a recorded
+  // series (--sample-rate 1e9 grew it to GBs before the run ended).
+  const double samples = r.periods / f_min / Ts;
+  if (samples > kMaxRecordedRows)
+    throw InputError(fmt::format(
+        "track: {:.4g} PID samples in the longest run ({:g} periods at {:g} Hz, --sample-rate {:g} "
+        "Hz) are logged for the example (limit {:g} rows); lower --sample-rate or --periods",
+        samples, r.periods, f_min, r.sample_rate_Hz, kMaxRecordedRows));
   return sub;
 }
 

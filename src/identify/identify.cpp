@@ -58,9 +58,20 @@ void check_options(const IdentifyOptions& o) {
         fmt::format("--migrants {}: must be < the population {}", o.migrants, o.population));
   if (o.generations < 0)
     throw InputError(fmt::format("--generations {}: must be >= 0", o.generations));
-  if (o.refine_iterations < 0) throw InputError("--refine-iterations: must be >= 0");
-  if (!(o.fd_step > 0.0 && o.fd_step < 0.1)) throw InputError("--fd-step: must be in (0, 0.1)");
-  if (o.mpi_every < 0) throw InputError("--mpi-every: must be >= 0");
+  if (o.refine_iterations < 0)
+    throw InputError(fmt::format("--refine-iterations {}: must be >= 0", o.refine_iterations));
+  // Below ~1e-8 the central differences of a double objective are rounding: a Jacobian of zeros
+  // that the report then blamed on the data ("not determined").
+  if (!(o.fd_step >= 1e-8 && o.fd_step < 0.1))
+    throw InputError(
+        fmt::format("--fd-step {:g}: must be in [1e-8, 0.1) (a relative step; below "
+                    "1e-8 the differences are rounding)",
+                    o.fd_step));
+  if (o.mpi_every < 0) throw InputError(fmt::format("--mpi-every {}: must be >= 0", o.mpi_every));
+  if (o.checkpoint_every < 1)
+    throw InputError(
+        fmt::format("--checkpoint-every {}: must be >= 1 (generations between checkpoints)",
+                    o.checkpoint_every));
   if (o.profile_evaluations < -1)
     throw InputError(fmt::format(
         "--profile-evaluations {}: must be >= 0 (0: no limit), or -1 (as many as the search)",

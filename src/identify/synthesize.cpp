@@ -143,15 +143,19 @@ MeasurementSet synthesize_measurements(const Model& truth, const SyntheticReques
   Noise noise(r.seed);
   // A quasi-static record has no frequency: one record per (temperature, current).
   const std::vector<double> freqs = r.quasi_static ? std::vector<double>{1.0} : r.frequencies_Hz;
-  for (double T : r.temperatures_C) {
-    for (double pp : r.currents_pp_A) {
-      for (double f : freqs) {
-        Measurement m = record_skeleton(r, T, pp, f);
-        measure(truth, r, noise, m);
-        set.items.push_back(std::move(m));
-      }
-    }
-  }
+  // Every record named before any is simulated: two conditions that print alike (8 and
+  // 8.0000001 A, or a value listed twice) wrote one file twice and listed it twice.
+  for (double T : r.temperatures_C)
+    for (double pp : r.currents_pp_A)
+      for (double f : freqs) set.items.push_back(record_skeleton(r, T, pp, f));
+  for (std::size_t i = 0; i < set.items.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (set.items[j].path == set.items[i].path)
+        throw InputError(fmt::format(
+            "identify synthesize: two records are both named {} (conditions are named to 6 "
+            "significant digits): give distinct --temperatures, --currents and --frequencies",
+            set.items[i].path));
+  for (Measurement& m : set.items) measure(truth, r, noise, m);
   return set;
 }
 

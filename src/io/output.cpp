@@ -245,6 +245,19 @@ std::string read_input_file(const std::string& path, const std::string& what) {
   return io_detail::read_text_file(path, what);
 }
 
+namespace {
+std::mutex g_created_mutex;
+std::vector<std::string> g_created_dirs;  // by ensure_output_dir, in creation order (parents first)
+}  // namespace
+
+void remove_created_output_dirs_if_empty() {
+  const std::lock_guard<std::mutex> lock(g_created_mutex);
+  // in reverse creation order: a child before its parent; rmdir leaves a non-empty one
+  for (auto it = g_created_dirs.rbegin(); it != g_created_dirs.rend(); ++it)
+    (void)::rmdir(it->c_str());
+  g_created_dirs.clear();
+}
+
 void ensure_output_dir(const std::string& dir) {
   namespace fs = std::filesystem;
   if (dir.empty())
@@ -255,8 +268,19 @@ void ensure_output_dir(const std::string& dir) {
     throw InputError(located(dir, 0, fmt::format("output directory is not writable ({})", reason)));
   };
   std::error_code ec;
+  std::vector<std::string> missing;  // the directories this call creates, deepest first
+  for (fs::path q = fs::absolute(p, ec); !ec && !q.empty() && !fs::exists(q, ec);
+       q = q.parent_path()) {
+    missing.push_back(q.string());
+    if (q == q.parent_path()) break;
+  }
+  ec.clear();
   fs::create_directories(p, ec);
   if (ec) fail(ec.message());
+  {
+    const std::lock_guard<std::mutex> lock(g_created_mutex);
+    g_created_dirs.insert(g_created_dirs.end(), missing.rbegin(), missing.rend());
+  }
   if (!fs::is_directory(p, ec)) fail(ec ? ec.message() : "not a directory");
   const fs::path probe = p / fmt::format(".gmasim-write-test.{}", static_cast<long>(::getpid()));
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);

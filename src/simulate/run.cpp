@@ -181,15 +181,19 @@ struct SelfHeatingRun {
       if (s.waveform.periodic())
         want = s.waveform.period_s() * std::ceil(0.1 / s.waveform.period_s() - 1e-9);
     }
-    steps_per_interval = std::max(1L, std::lround(want / L.grid.dt_s));
-    interval_s = static_cast<double>(steps_per_interval) * L.grid.dt_s;
     const double tau = fastest_time_constant_s(*net);
-    if (interval_s > tau)
-      throw InputError(
+    auto too_long = [&](double step_s) {
+      return InputError(
           fmt::format("thermal step (--thermal-step) = {:.4g} s: longer than the thermal network's "
                       "fastest time constant "
                       "{:.4g} s (min C/G over coil, rods, housing); shorten the thermal step",
-                      interval_s, tau));
+                      step_s, tau));
+    };
+    // before the count: 1e14 s / 10 us overflowed lround's long, and the clamp made it 1 step
+    if (!(want <= 2.0 * tau)) throw too_long(want);
+    steps_per_interval = std::max(1L, std::lround(want / L.grid.dt_s));
+    interval_s = static_cast<double>(steps_per_interval) * L.grid.dt_s;
+    if (interval_s > tau) throw too_long(interval_s);
     T = T0 = {s.temperature_C, s.temperature_C, s.temperature_C};
     r.heating.names = {"t_s",      "coil_C",         "rods_C",      "housing_C",   "P_copper_W",
                        "P_eddy_W", "P_hysteresis_W", "P_damping_W", "P_ambient_W", "stroke_um",
@@ -378,10 +382,13 @@ void validate(const Waveform& w) {
       current(w.level_A, "current level");
       current(w.step_to_A, "step current");
       require_finite(w.step_time_s, "step time", "s");
+
       break;
     case WaveformKind::Chirp:
       current(w.offset_A, "chirp offset");
       require_in(w.amplitude_A, 0.0, kMaxCurrent_A, "chirp amplitude", "A");
+      current(w.offset_A + w.amplitude_A, "chirp maximum (offset + amplitude)");
+      current(w.offset_A - w.amplitude_A, "chirp minimum (offset - amplitude)");
       frequency(w.f0_Hz, "chirp start frequency");
       frequency(w.f1_Hz, "chirp end frequency");
       require_positive(w.duration_s, "chirp duration", "s");
@@ -429,6 +436,14 @@ void validate(const SimulationSettings& s) {
   }
   require_nonnegative(s.duration_s, "duration", "s");
   const RunLength L = run_length(s);
+  // A step at t <= 0 is not one (the rest state is made at current_at(0), the step's current),
+  // nor is one at or after the run's end: either ran with no step and a zero stroke.
+  if (s.waveform.kind == WaveformKind::Step &&
+      !(s.waveform.step_time_s > 0.0 && s.waveform.step_time_s < L.duration_s))
+    throw InputError(fmt::format(
+        "step time = {:g} s (--step-time): must be inside the run, 0 < t < {:g} s (the duration): "
+        "at t <= 0 the rest state is already at the step's current, after the end nothing steps",
+        s.waveform.step_time_s, L.duration_s));
   if (s.self_heating.enabled) {
     const auto& h = s.self_heating;
     require_nonnegative(h.thermal_step_s, "thermal step", "s");

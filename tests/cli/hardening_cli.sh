@@ -204,12 +204,64 @@ check "11 a rod in two branches: names, lines" 2 "two.toml:[0-9]+: circuit branc
 printf 't_s,current_A\n0,0\n0.001,1000.0001\n' >w_big.csv
 check "11 a waveform value out of range: file:line, the value" 2 "w_big.csv:3: current_A = 1000.0001 A: must be in \[-1000, 1000\] A" \
   "$B" simulate --waveform w_big.csv --out s11
-check "11 --out ''" 2 "output directory '' \(empty\): name a directory" "$B" simulate --periods 1 --out ''
+check "11 --out ''" 1 "--out '': an empty value \(give a value, or leave the flag out for its default\)" "$B" simulate --periods 1 --out ''
+# an empty value is refused for every flag that takes one: a number ('' was 0), a path ('' was
+# the default), a list ('' was one 0)
+check "11 --current-min ''" 1 "--current-min '': an empty value" "$B" simulate --periods 1 --current-min '' --out s11e
+check "11 --model ''" 1 "--model '': an empty value" "$B" simulate --periods 1 --model '' --out s11e
+check "11 sweep --temperatures ''" 1 "--temperatures '': an empty value" "$B" sweep --temperatures '' --out s11e
+check "11 --threads ''" 1 "--threads '': an empty value" "$B" sweep --threads '' --out s11e
+ok "11 a refused empty value leaves no output" test ! -e s11e
 check "11 a mistyped command" 1 "unknown command 'simulat' \(did you mean 'simulate'\?\)" "$B" simulat
 check "11 a mistyped flag" 1 "gmasim simulate: unknown flag --temprature \(did you mean --temperature\?\)" \
   "$B" simulate --temprature 20
 check "11 a unit in a number" 1 "--temperature '80C': not a number \(in degC, without the unit\)" \
   "$B" simulate --temperature 80C
+
+# ---- 12. the audit of stop 34: counts, sizes and files from typed numbers --------------------------
+check "12 --thermal-step 1e14 (overflowed to one 10 us step)" 2 \
+  "thermal step \(--thermal-step\) = 1e\+14 s: longer than the thermal network's fastest time constant" \
+  "$B" simulate --self-heating --thermal-step 1e14 --periods 2 --out s12
+check "12 two temperatures, one directory name" 2 \
+  "--temperature: 20 and 20.000000100000001 degC both write s12/T20C: give distinct temperatures" \
+  "$B" simulate --temperature 20,20.0000001 --periods 1 --out s12
+check "12 a bad temperature last in the list: refused before the first run" 2 "temperature 250 degC: outside" \
+  "$B" simulate --temperature 20,250 --periods 1 --out s12
+ok "12 ... and nothing of the refused runs is left" test ! -e s12
+check "12 synthesize: two records of one name" 2 "two records are both named T20_I8_f10.csv" \
+  "$B" identify synthesize --out s12 --currents 8,8.0000001 --frequencies 10 --temperatures 20
+check "12 sensitivity: --json and --csv one file" 2 "--csv x.out: the same file as --json x.out" \
+  "$B" sensitivity --param thermal_expansion.sleeve_length_m --claim thermal_model --json x.out --csv x.out
+mkfifo fifo
+check "12 a FIFO nobody writes: read as empty, no hang" 2 "fifo:1: missing table" timeout 20 "$B" model check fifo
+check "12 track: a PID log of 1e8 rows" 2 "track: 1e\+08 PID samples in the longest run .* \(limit 2e\+07 rows\)" \
+  "$B" track --temperatures 20 --amplitudes 10 --frequencies 10 --periods 1 --sample-rate 1e9 --out s12
+check "12 track: --dt above the PID sample period (was clamped)" 2 \
+  "dt = 1e\+308 s \(--dt\): longer than the PID sample period" \
+  "$B" track --temperatures 20 --amplitudes 10 --frequencies 10 --periods 1 --dt 1e308 --out s12
+for st in -1 0 0.01 1e308; do
+  check "12 --step-time $st: no step inside the run" 2 "step time = .* \(--step-time\): must be inside the run, 0 < t < 0.01 s" \
+    "$B" simulate --waveform-kind step --step-time "$st" --level 0 --step-to 1 --duration 0.01 --out s12
+done
+check "12 chirp: offset + amplitude beyond the current limit" 2 "chirp maximum \(offset \+ amplitude\) = 1800 A" \
+  "$B" simulate --waveform-kind chirp --offset 900 --amplitude 900 --duration 0.01 --out s12
+check "12 frf: bias + amplitude beyond the current limit" 2 "peak current \(--bias \+ --amplitude\) = 1000.9999 A" \
+  "$B" frf --bias 999.9999 --amplitude 1 --out s12
+check "12 params-vs-temperature: a diverged run is diagnosed (was NaN, exit 0)" 3 \
+  "params-vs-temperature: the run at 20 degC, .* diverged: diverged at t = .* H \[A/m\]" \
+  "$B" params-vs-temperature --model "$SRC/models/single_rod.toml" --set circuit.branches.coil.coil_turns=1e20 \
+  --temperatures 20,70 --periods 1 --out s12
+ok "12 refused and diverged runs leave no empty output directory" test ! -e s12
+check "12 identify: --report = --out (the fit was lost after the search)" 2 "--report o12.toml: the same file as --out o12.toml" \
+  "$B" "${ID[@]}" --data syn/manifest.toml --fit fit.toml --out o12.toml --report o12.toml
+mkdir -p d12
+check "12 identify: --out is a directory, refused before the search" 2 "--out d12: is a directory; name the file to write" \
+  "$B" "${ID[@]}" --data syn/manifest.toml --fit fit.toml --out d12
+check "12 identify: --checkpoint-every 0" 2 "--checkpoint-every 0: must be >= 1" \
+  "$B" "${ID[@]}" --data syn/manifest.toml --fit fit.toml --out o12.toml --checkpoint-every 0
+check "12 identify: --fd-step 1e-300 (a Jacobian of rounding)" 2 "--fd-step 1e-300: must be in \[1e-8, 0.1\)" \
+  "$B" "${ID[@]}" --data syn/manifest.toml --fit fit.toml --out o12.toml --fd-step 1e-300
+ok "12 ... and no output of the refused fits" test ! -e o12.toml
 
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]

@@ -84,6 +84,10 @@ std::string read_input_file(const std::string& path, const std::string& what);
 // Creates the directory (and parents) if needed and checks it is writable. An empty name is
 // refused (InputError "output directory '': ..."), never taken for the current directory.
 void ensure_output_dir(const std::string& dir);
+// Removes the directories ensure_output_dir() created in this process that are still empty (a
+// run refused after its output directory was made leaves nothing behind; one that wrote part
+// of its output keeps it).
+void remove_created_output_dirs_if_empty();
 
 // No output may overwrite an input (issue 19, item 1; docs/reliability.md, "Outputs"). A file
 // a command reads or writes, and the flag that names it in messages ("--out", "--data").
