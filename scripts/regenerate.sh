@@ -15,7 +15,8 @@
 #   3. rebuild: the built-in model is embedded in the binary at build time
 #   4. calibrate.py --smoke --write-reference (calibration/reference/consistent.json)
 #   5. docs/reproduction.md and docs/figures/ (the command of scripts/check_reproduction.sh)
-#   6. docs/parameters.md (gmasim model params --markdown)
+#   6. docs/parameters.md (gmasim model params --markdown), docs/claims.md (gmasim reproduce
+#      --claim-kinds)
 #   7. docs/model.md's time-step table (gmasim model check --dt-table, between its markers)
 #   8. the quoted numbers of docs/*.md (scripts/check_quoted_numbers.py): reported, not
 #      rewritten -- a prose number is edited by hand, with the sentence around it.
@@ -60,6 +61,8 @@ trap 'rm -rf "$T"' EXIT
 stage "6. docs/parameters.md"
 "$B" model params --markdown >docs/parameters.md.tmp
 mv docs/parameters.md.tmp docs/parameters.md
+"$B" reproduce --claim-kinds >docs/claims.md.tmp
+mv docs/claims.md.tmp docs/claims.md
 
 stage "7. docs/model.md time-step table"
 "$B" model check --dt-table >"$T/dt.txt"

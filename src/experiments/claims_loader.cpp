@@ -211,7 +211,15 @@ ClaimCondition read_condition(const Reader& rd, const toml::table* t, long claim
       if (!listed(kind.required, k.str()) && !listed(kind.optional, k.str()))
         rd.fail(line_of(v), fmt::format("{}: {} does not apply to kind {} (it uses: {})", where,
                                         k.str(), kind.name, join(kind.required)));
-      cond.*(key->field) = rd.number(v, k.str(), where);
+      const double x = rd.number(v, k.str(), where);
+      // a condition the study cannot hold (0 Hz, a negative current, below absolute zero) was
+      // scored "no sweep point at ..." instead of refused
+      const std::string_view name = k.str();
+      const bool temperature = name == "temperature_C" || name == "reference_temperature_C";
+      if (temperature ? !(x > -273.15) : !(x > 0.0))
+        rd.fail(line_of(v), fmt::format("{}: {} = {:g}: must be {}", where, name, x,
+                                        temperature ? "> -273.15 degC" : "> 0"));
+      cond.*(key->field) = x;
     }
   }
   for (const auto& k : kind.required) {

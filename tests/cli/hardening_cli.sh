@@ -262,6 +262,13 @@ check "12 identify: --checkpoint-every 0" 2 "--checkpoint-every 0: must be >= 1"
 check "12 identify: --fd-step 1e-300 (a Jacobian of rounding)" 2 "--fd-step 1e-300: must be in \[1e-8, 0.1\)" \
   "$B" "${ID[@]}" --data syn/manifest.toml --fit fit.toml --out o12.toml --fd-step 1e-300
 ok "12 ... and no output of the refused fits" test ! -e o12.toml
+awk '/frequency_Hz = / && !done {sub(/frequency_Hz = [0-9.]+/, "frequency_Hz = 0.0"); done = 1} {print}' \
+  "$SRC/data/claims.toml" >claims0.toml
+check "12 a claim's condition the study cannot hold: file:line" 2 "claims0.toml:[0-9]+: .*frequency_Hz = 0: must be > 0" \
+  "$B" reproduce --quick --no-figures --claims claims0.toml --out r12
+check "12 reproduce --compare: read before the study" 2 "nonexist.toml" \
+  "$B" reproduce --quick --no-figures --compare nonexist.toml --out r12
+ok "12 ... and no report of the refused studies" test ! -e r12
 
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]
