@@ -142,7 +142,17 @@ std::string parse_error_message(const CLI::App& app, const CLI::ParseError& e, i
     const CLI::Option* o = flag.starts_with("--") ? find_flag(where, flag) : nullptr;
     if (o != nullptr) {
       const bool integer = o->get_type_name().find("INT") != std::string::npos;
+      const bool is_unsigned = o->get_type_name().find("UINT") != std::string::npos;
       const std::string unit = unit_of(*o);
+      // a whole number the flag's type cannot hold: say so, not "not a whole number"
+      std::size_t digits = value.starts_with('-') || value.starts_with('+') ? 1 : 0;
+      const bool whole = integer && value.size() > digits &&
+                         value.find_first_not_of("0123456789", digits) == std::string::npos;
+      if (whole)
+        return fmt::format("{} {}: out of range ({})", flag, clip_for_message(value, 60),
+                           value.starts_with('-') && is_unsigned
+                               ? "must be >= 0"
+                               : "too large for the flag; see --help for its range");
       return fmt::format(
           "{} '{}': not {}{}; e.g. {} {}", flag, clip_for_message(value, 60),
           integer ? "a whole number" : "a number",

@@ -11,6 +11,8 @@
 #include "gmasim/experiments/compensate.hpp"
 #include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/io/io.hpp"
+#include "gmasim/model/validate.hpp"
+#include "gmasim/simulate/simulate.hpp"
 #include "request_options.hpp"
 
 namespace gmasim::cli {
@@ -89,6 +91,31 @@ int run_compensate_cmd(CompensateArgs& a) {
     a.track.amplitudes_um = parse_list(a.track_amplitudes, "--track-amplitudes", "um");
     a.track.frequencies_Hz = parse_list(a.track_frequencies, "--track-frequencies", "Hz");
     a.track.threads = a.req.threads;
+    // The tracking's numbers under compensate's own flag names, before the schedule's runs
+    // (track's checks named --amplitudes, --frequencies; the schedule's --current-min and
+    // --max-current, for --bias and --current-limit).
+    for (double A : a.track.amplitudes_um) {
+      require_finite(A, "tracking amplitude (--track-amplitudes)", "um");
+      if (!(A > 0.0 && A <= kMaxTrackAmplitude_um))
+        throw InputError(
+            fmt::format("tracking amplitude (--track-amplitudes) = {:g} um: must be "
+                        "in (0, {:g}] um",
+                        A, kMaxTrackAmplitude_um));
+    }
+    for (double f : a.track.frequencies_Hz) {
+      require_finite(f, "tracking frequency (--track-frequencies)", "Hz");
+      if (!(f > 0.0 && f <= kMaxFrequency_Hz))
+        throw InputError(
+            fmt::format("tracking frequency (--track-frequencies) = {:g} Hz: must be "
+                        "in (0, {:g}] Hz",
+                        f, kMaxFrequency_Hz));
+    }
+    require_in(a.track.current_limit_A, 0.0, kMaxCurrent_A,
+               "tracking current limit (--current-limit)", "A");
+    if (!(a.track.current_limit_A > 0.0))
+      throw InputError("tracking current limit (--current-limit) = 0 A: must be > 0 A");
+    require_in(a.track.bias_A, -a.track.current_limit_A, a.track.current_limit_A,
+               "tracking bias current (--bias)", "A");
   }
   prepare_output_dir(a.out, {"compensate"}, model_inputs(a.model));
   const CompensateResult res =
@@ -132,6 +159,11 @@ Runner add_compensate(CLI::App& app) {
         ->capture_default_str();
     sub->add_option("--current-limit", a.track.current_limit_A, "Tracking: amplifier limit +- [A]")
         ->capture_default_str();
+    // the tracking's flags with --no-track were ignored: a usage error instead
+    CLI::Option* no_track = sub->get_option("--no-track");
+    for (const char* flag : {"--track-temperatures", "--track-amplitudes", "--track-frequencies",
+                             "--bias", "--current-limit"})
+      no_track->excludes(sub->get_option(flag));
   };
   return add_experiment<CompensateArgs>(
       app,

@@ -406,6 +406,7 @@ void add_objective_options(CLI::App* sub, ObjectiveSettings& s) {
 void add_run_options(CLI::App* sub, IdentifyArgs& a) {
   sub->add_option("--checkpoint", a.opt.checkpoint_path, "Checkpoint file (written atomically)");
   sub->add_option("--checkpoint-every", a.opt.checkpoint_every, "Generations between checkpoints")
+      ->needs("--checkpoint")  // without a checkpoint file it was ignored
       ->capture_default_str();
   sub->add_option("--resume", a.opt.resume_path,
                   "Continue from a checkpoint (same data, spec, flags)");

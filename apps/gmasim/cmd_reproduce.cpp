@@ -3,9 +3,11 @@
 #include <fmt/ranges.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <mutex>
@@ -123,6 +125,12 @@ int run_reproduce_cmd(const ReproduceArgs& a) {
     return 0;
   }
   const Model model = load_model_args(a.model);
+  // A Python that cannot run ended in exit 0 with a note inside report.md only
+  if (!a.no_figures && ::access(a.python.c_str(), X_OK) != 0)
+    throw InputError(fmt::format(
+        "--python {}: not an executable ({}); the figures need a Python 3 with numpy and "
+        "matplotlib: give one, or --no-figures",
+        clip_for_message(a.python), std::strerror(errno)));
   const ClaimsData claims = a.claims.empty() ? builtin_claims() : load_claims(a.claims);
   if (!a.doc_notes.empty() && a.doc.empty())
     throw InputError("--doc-notes " + a.doc_notes +

@@ -120,6 +120,11 @@ void check_waveform_flags(const CLI::App& sub, const SimulateArgs& a) {
   const std::string kind = csv ? "csv" : a.kind;
   const std::string used_by =
       csv ? "--waveform " + clip_for_message(a.waveform_csv) : "--waveform-kind " + a.kind;
+  // the self-heating run's own flags, without --self-heating: ignored, so refused
+  for (const char* flag : {"--ambient", "--thermal-step"})
+    if (sub.count(flag) > 0 && !a.self_heating)
+      throw UsageError(fmt::format(
+          "{}: only a self-heating run uses it; add --self-heating, or remove {}", flag, flag));
   for (const auto& f : waveform_flags()) {
     if (sub.count(f.flag) == 0) continue;
     if (std::find(f.kinds.begin(), f.kinds.end(), kind) != f.kinds.end()) continue;

@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -42,6 +43,24 @@ void check_options(const CLI::App& app) {
           throw InputError(fmt::format(
               "{} '': an empty value (give a value, or leave the flag out for its default)",
               o->get_name()));
+    // An unsigned flag wraps a negative value (track --seed -1 ran as 2^64 - 1) and a 64-bit one
+    // saturates beyond its range (99999999999999999999999 did the same): refused.
+    if (o->get_type_name().find("INT") != std::string::npos) {
+      const bool is_unsigned = o->get_type_name().find("UINT") != std::string::npos;
+      for (const std::string& v : o->results()) {
+        const char* b = v.c_str() + (v.starts_with('+') ? 1 : 0);
+        const char* e = v.c_str() + v.size();
+        if (is_unsigned && v.starts_with('-'))
+          throw InputError(
+              fmt::format("{} {}: must be >= 0", o->get_name(), clip_error_message(v)));
+        long long sv = 0;
+        unsigned long long uv = 0;
+        const auto r = is_unsigned ? std::from_chars(b, e, uv) : std::from_chars(b, e, sv);
+        if (r.ec == std::errc::result_out_of_range)
+          throw InputError(fmt::format("{} {}: out of range (a 64-bit whole number)", o->get_name(),
+                                       clip_error_message(v)));
+      }
+    }
     if (o->get_type_name().find("FLOAT") == std::string::npos) continue;
     for (const std::string& v : o->results()) {
       char* end = nullptr;

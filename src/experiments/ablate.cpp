@@ -38,8 +38,10 @@ void check_request(const Model& m, const AblateRequest& r) {
   for (double f : r.frequencies_Hz)
     if (!(f > 0.0) || !std::isfinite(f))
       throw InputError(fmt::format("frequency (--frequencies) = {} Hz: must be > 0", f));
-  if (!(r.current_pp_A >= 0.0) || !std::isfinite(r.current_pp_A))
-    throw InputError(fmt::format("current peak-to-peak {} A: must be >= 0", r.current_pp_A));
+  // > 0: the errors are given in % of the stroke, which a zero drive does not have (inf, nan)
+  if (!(r.current_pp_A > 0.0) || !std::isfinite(r.current_pp_A))
+    throw InputError(
+        fmt::format("current peak-to-peak (--current-pp) = {} A: must be > 0", r.current_pp_A));
   if (!(r.periods >= 1.0) || !std::isfinite(r.periods))
     throw InputError(fmt::format("periods {}: must be >= 1", r.periods));
   (void)make_conditions(m, r.temperature_C);  // T < T_c

@@ -148,14 +148,19 @@ cd detail::stepped_sine_point(const Model& m, const Conditions& c, const State& 
   is.reserve(ts.capacity());
   const long first = sg.first;  // samples first+1 .. total: whole periods
   State s = bias;
-  run_loop(
-      m, c, s, sg.grid, [&](double t) { return stepped_sine_current_A(r, fr, t); },
-      [&](const State& st, const StepPoint& p) {
-        if (p.k <= first) return;
-        ts.push_back(p.t_s);
-        ys.push_back(st.y_m - lin.y0_m);
-        is.push_back(st.current_A - r.bias_A);
-      });
+  try {
+    run_loop(
+        m, c, s, sg.grid, [&](double t) { return stepped_sine_current_A(r, fr, t); },
+        [&](const State& st, const StepPoint& p) {
+          if (p.k <= first) return;
+          ts.push_back(p.t_s);
+          ys.push_back(st.y_m - lin.y0_m);
+          is.push_back(st.current_A - r.bias_A);
+        });
+  } catch (const DivergenceError& e) {  // the point's temperature and frequency, as the lanes
+    throw DivergenceError(fmt::format("frf: the stepped sine at {:g} degC, {:g} Hz diverged: {}",
+                                      c.temperature_C, fr, e.what()));
+  }
   return first_harmonic_ratio(ts, ys, is, fr);
 }
 

@@ -4,6 +4,8 @@
 // periods (first_harmonic_ratio's FirstHarmonicSums, accumulated step by step). The points are
 // sorted by their step count so that the lanes of a batch end close together; a lane that has ended
 // idles at its last time until the batch's longest point ends.
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -55,7 +57,10 @@ void run_batch(const Model& m, const std::vector<Conditions>& conds, const std::
     batch.step(current, dt, t1);
     for (std::size_t k = 0; k < n; ++k) {
       if (q > pts[k].sg.grid.steps) continue;
-      if (batch.diverged(k)) throw DivergenceError(batch.error(k));
+      if (batch.diverged(k))  // the point's temperature and frequency, then the run's diagnosis
+        throw DivergenceError(
+            fmt::format("frf: the stepped sine at {:g} degC, {:g} Hz diverged: {}",
+                        cs[k]->temperature_C, pts[k].f_Hz, batch.error(k)));
       if (q <= pts[k].sg.first) continue;
       sums[k].add(t1[k], pts[k].f_Hz, batch.y_m(k) - pts[k].y0_m, current[k] - r.bias_A);
     }

@@ -39,10 +39,13 @@ void check_request(const ParamsVsTemperatureRequest& r) {
   if (!(r.frequency_Hz > 0.0) || !std::isfinite(r.frequency_Hz))
     throw InputError(fmt::format("frequency (--frequency) = {} Hz: must be > 0", r.frequency_Hz));
   for (double pp : r.retention_currents_pp_A)
-    if (!(pp >= 0.0) || !std::isfinite(pp))
-      throw InputError(fmt::format("current peak-to-peak {} A: must be >= 0", pp));
-  if (!(r.current_pp_A >= 0.0) || !std::isfinite(r.current_pp_A))
-    throw InputError(fmt::format("current peak-to-peak {} A: must be >= 0", r.current_pp_A));
+    if (!(pp > 0.0) || !std::isfinite(pp))  // > 0: the retention is a ratio of strokes
+      throw InputError(fmt::format(
+          "retention current peak-to-peak (--retention-currents) = {} A: must be > 0", pp));
+  // > 0: the errors are given in % of the stroke, which a zero drive does not have (inf, nan)
+  if (!(r.current_pp_A > 0.0) || !std::isfinite(r.current_pp_A))
+    throw InputError(
+        fmt::format("current peak-to-peak (--current-pp) = {} A: must be > 0", r.current_pp_A));
   if (!(r.periods >= 1.0)) throw InputError(fmt::format("periods {}: must be >= 1", r.periods));
   if (static_cast<double>(r.temperatures_C.size()) > kMaxListValues ||
       static_cast<double>(r.retention_currents_pp_A.size()) > kMaxListValues)

@@ -143,6 +143,15 @@ void ModelLoader::store_number(const toml::node& node, const std::string& dotted
     problem(node_line(node), fmt::format("{}: expected a number, got {}", dotted, type_name(node)));
     return;
   }
+  // toml++ gives no double for an integer beyond 2^53 (value<double>() is empty), and the NaN
+  // that stood for it was reported as "NaN is not allowed": quote the integer instead
+  if (node.is_integer() && !node.value<double>()) {
+    problem(node_line(node),
+            fmt::format("{} = {}: an integer beyond 2^53 (9007199254740992) is not exactly a "
+                        "number here; give a smaller value",
+                        dotted, node.as_integer()->get()));
+    return;
+  }
   ParamValue pv;
   pv.value = node.value<double>().value_or(std::numeric_limits<double>::quiet_NaN());
   pv.provenance = comment_of(node);

@@ -3,6 +3,7 @@
 // package gmasim.report_figures from those CSVs).
 #include <fmt/format.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <system_error>
 
@@ -53,8 +54,11 @@ class Figures {
     c.stdout_to_stderr = true;  // our standard output is the command's summary
     const int rc = run_python(c);
     rendered_ = rc == 0;
-    if (!rendered_)
+    if (!rendered_) {
       note_ = fmt::format("(figure rendering failed: `{}` exited with {})", c.text(), rc);
+      std::fprintf(stderr, "gmasim: warning: %s; report.md shows the captions only\n",
+                   note_.substr(1, note_.size() - 2).c_str());
+    }
   }
 
   std::string operator()(const std::string& stem, const std::string& caption) const {

@@ -258,7 +258,7 @@ mkdir -p d12
 check "12 identify: --out is a directory, refused before the search" 2 "--out d12: is a directory; name the file to write" \
   "$B" "${ID[@]}" --data syn/manifest.toml --fit fit.toml --out d12
 check "12 identify: --checkpoint-every 0" 2 "--checkpoint-every 0: must be >= 1" \
-  "$B" "${ID[@]}" --data syn/manifest.toml --fit fit.toml --out o12.toml --checkpoint-every 0
+  "$B" "${ID[@]}" --data syn/manifest.toml --fit fit.toml --out o12.toml --checkpoint c12.ckpt --checkpoint-every 0
 check "12 identify: --fd-step 1e-300 (a Jacobian of rounding)" 2 "--fd-step 1e-300: must be in \[1e-8, 0.1\)" \
   "$B" "${ID[@]}" --data syn/manifest.toml --fit fit.toml --out o12.toml --fd-step 1e-300
 ok "12 ... and no output of the refused fits" test ! -e o12.toml
@@ -269,6 +269,34 @@ check "12 a claim's condition the study cannot hold: file:line" 2 "claims0.toml:
 check "12 reproduce --compare: read before the study" 2 "nonexist.toml" \
   "$B" reproduce --quick --no-figures --compare nonexist.toml --out r12
 ok "12 ... and no report of the refused studies" test ! -e r12
+check "12 reproduce --python that cannot run (was exit 0, a note in report.md)" 2 \
+  "--python /nonexistent: not an executable .* or --no-figures" "$B" reproduce --quick --python /nonexistent --out r12
+check "12 track --seed -1 (wrapped to 2^64 - 1)" 1 "--seed -1: must be >= 0" \
+  "$B" track --temperatures 20 --amplitudes 10 --frequencies 10 --periods 1 --seed -1 --out r12
+check "12 track --seed beyond 64 bits (saturated)" 1 "--seed 99999999999999999999999: out of range" \
+  "$B" track --temperatures 20 --amplitudes 10 --frequencies 10 --periods 1 --seed 99999999999999999999999 --out r12
+check "12 a whole number out of an int flag's range: not 'not a whole number'" 1 \
+  "--threads 2147483648: out of range" "$B" sweep --threads 2147483648 --out r12
+check "12 ablate --current-pp 0 (inf % of no stroke)" 2 "current peak-to-peak \(--current-pp\) = 0 A: must be > 0" \
+  "$B" ablate --frequencies 10 --periods 1 --current-pp 0 --out r12
+check "12 params-vs-temperature --retention-currents 0" 2 \
+  "retention current peak-to-peak \(--retention-currents\) = 0 A: must be > 0" \
+  "$B" params-vs-temperature --retention-currents 0 --out r12
+check "12 --ambient without --self-heating (ignored)" 1 "--ambient: only a self-heating run uses it" \
+  "$B" simulate --ambient 30 --periods 1 --out r12
+check "12 compensate --no-track with a tracking flag (ignored)" 1 "--no-track excludes --track-amplitudes" \
+  "$B" compensate --no-track --track-amplitudes 5 --out r12
+check "12 identify --checkpoint-every without --checkpoint (ignored)" 1 "--checkpoint-every requires --checkpoint" \
+  "$B" "${ID[@]}" --data syn/manifest.toml --fit fit.toml --out o12.toml --checkpoint-every 3
+for f in "--bias 1e308|tracking bias current \(--bias\)" "--current-limit 0|tracking current limit \(--current-limit\) = 0 A" \
+         "--track-amplitudes 0|tracking amplitude \(--track-amplitudes\) = 0 um" \
+         "--track-frequencies 0|tracking frequency \(--track-frequencies\) = 0 Hz"; do
+  check "12 compensate ${f%%|*}: named by its own flag" 2 "${f#*|}" "$B" compensate ${f%%|*} --out r12
+done
+sed 's/^coil_turns = .*/coil_turns = 9007199254740993/' "$SRC/models/single_rod.toml" >big12.toml
+check "12 an integer beyond 2^53 in a model: quoted, not NaN" 2 \
+  "big12.toml:[0-9]+: circuit.branches.coil.coil_turns = 9007199254740993: an integer beyond 2\^53" "$B" model check big12.toml
+ok "12 ... and nothing written by the refused runs" test ! -e r12
 
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]

@@ -161,7 +161,7 @@ struct RequestFields<AblateRequest> {
                All, GMASIM_REF(R, temperature_C)),
       field<R>("frequencies_Hz", "Hz", positive(), "--frequencies",
                "Excitation frequencies [Hz]; list or range", kCliPy, GMASIM_REF(R, frequencies_Hz)),
-      field<R>("current_pp_A", "A", nonnegative(), "--current-pp", "Current peak-to-peak [A]", All,
+      field<R>("current_pp_A", "A", positive(), "--current-pp", "Current peak-to-peak [A]", All,
                GMASIM_REF(R, current_pp_A)),
       current_min_row<R>(),
       field<R>("periods", "-", kPeriods, "--periods", "Periods per run [-]; errors over the last",
@@ -176,12 +176,12 @@ struct RequestFields<ParamsVsTemperatureRequest> {
   static constexpr std::string_view experiment = "params-vs-temperature";
   static constexpr auto rows = std::tuple{
       temperatures_row<R>(),
-      field<R>("current_pp_A", "A", nonnegative(), "--current-pp",
+      field<R>("current_pp_A", "A", positive(), "--current-pp",
                "Current peak-to-peak of the Fig. 19 operating point [A]", All,
                GMASIM_REF(R, current_pp_A)),
       field<R>("frequency_Hz", "Hz", positive(), "--frequency", "Excitation frequency [Hz]", All,
                GMASIM_REF(R, frequency_Hz)),
-      field<R>("retention_currents_pp_A", "A", nonnegative(), "--retention-currents",
+      field<R>("retention_currents_pp_A", "A", positive(), "--retention-currents",
                "Current peak-to-peak values of the retention table [A]; list or range", Cli,
                GMASIM_REF(R, retention_currents_pp_A)),
       current_min_row<R>(),
