@@ -265,7 +265,8 @@ TEST(Validate, SimulationSettingsAreRefusedBeforeAnyWork) {
     return input_error([&] { (void)gmasim::simulate(m, s); });
   };
   using S = gmasim::SimulationSettings;
-  EXPECT_EQ(err([](S& s) { s.periods = 1e300; }), "periods = 1e+300: must be in [1, 1e+06]");
+  EXPECT_EQ(err([](S& s) { s.periods = 1e300; }),
+            "periods (--periods) = 1e+300: must be in [1, 1e+06]");
   EXPECT_THAT(err([](S& s) { s.waveform.frequency_Hz = 1e-300; }), HasSubstr("too many"));
   // Issue 19, item 2: below the smallest step, before it becomes a count.
   EXPECT_THAT(err([](S& s) { s.dt_s = 1e-300; }), HasSubstr("must be in [1e-12, 0.001] s"));

@@ -80,7 +80,7 @@ def test_bad_requests_raise_clear_errors(mdma):
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    (dict(periods=1e300), r"periods = 1e\+300: must be in \[1, 1e\+06\]"),
+    (dict(periods=1e300), r"periods \(--periods\) = 1e\+300: must be in \[1, 1e\+06\]"),
     (dict(periods=float("nan")), "periods"),
     (dict(frequency_Hz=1e-300), "too many"),
     (dict(frequency_Hz=float("inf")), "frequency"),

@@ -365,8 +365,10 @@ void validate(const Waveform& w) {
     require_in(v, -kMaxCurrent_A, kMaxCurrent_A, what, "A");
   };
   auto frequency = [](double v, const char* what) {
-    require_positive(v, what, "Hz");
-    require_in(v, 0.0, kMaxFrequency_Hz, what, "Hz");
+    require_finite(v, what, "Hz");
+    if (!(v > 0.0 && v <= kMaxFrequency_Hz))  // "[0 Hz, ...]" read as if 0 were allowed
+      throw InputError(
+          fmt::format("{} = {:g} Hz: must be in (0 Hz, {:g} Hz]", what, v, kMaxFrequency_Hz));
   };
   switch (w.kind) {
     case WaveformKind::BiasedSine:
@@ -432,7 +434,7 @@ void validate(const SimulationSettings& s) {
     require_finite(s.periods, "periods");
     if (!(s.periods >= 1.0))
       throw InputError(fmt::format("periods = {} (--periods): must be >= 1", s.periods));
-    require_in(s.periods, 1.0, kMaxPeriods, "periods");
+    require_in(s.periods, 1.0, kMaxPeriods, "periods (--periods)");
   }
   require_nonnegative(s.duration_s, "duration", "s");
   const RunLength L = run_length(s);

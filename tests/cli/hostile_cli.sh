@@ -87,7 +87,7 @@ check "4 manifest weight 1e308" 2 "weight = 1e\+308: must be in \[1e-6, 1e6\]" \
   --population 8 --generations 1 --no-plots --quiet
 
 # ---- 5. simulate step counts ---------------------------------------------------------------
-check "5 --periods 1e300" 2 "periods = 1e\+300: must be in \[1, 1e\+06\]" "$B" simulate --periods 1e300 --out s
+check "5 --periods 1e300" 2 "periods \(--periods\) = 1e\+300: must be in \[1, 1e\+06\]" "$B" simulate --periods 1e300 --out s
 check "5 --periods inf" 1 "--periods inf: must be a finite number" "$B" simulate --periods inf --out s
 check "5 --frequency 1e-300" 2 "steps per period = .*too many" "$B" simulate --frequency 1e-300 --out s
 # Issue 19, item 2: a step below 1e-12 s is refused before it becomes a count.

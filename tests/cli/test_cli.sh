@@ -15,7 +15,7 @@ check "quantity stats" 0 "rod2_F_N +rms" "$B" simulate --periods 2 --quantity ro
 check "unknown quantity" 2 "unknown quantity 'nope'" "$B" simulate --periods 2 --quantity nope --out "$T/q2"
 check "curie" 2 "at or above the Curie temperature" "$B" simulate --temperature 400 --out "$T/b"
 check "below absolute zero" 2 "below absolute zero" "$B" simulate --temperature -300 --out "$T/b"
-check "frequency" 2 "frequency = 0 Hz: must be > 0" "$B" simulate --frequency 0 --out "$T/b"
+check "frequency" 2 "frequency = 0 Hz: must be in \(0 Hz, 1e\+06 Hz\]" "$B" simulate --frequency 0 --out "$T/b"
 printf 't_s,current_A\n0,1\n0.001,abc\n' >"$T/w1.csv"
 check "csv non-numeric" 2 "w1.csv:3: non-numeric cell 'abc'" "$B" simulate --waveform "$T/w1.csv" --out "$T/b"
 printf 't_s,current_A\n0,1\n0.002,1\n0.001,2\n' >"$T/w2.csv"
