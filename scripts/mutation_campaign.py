@@ -182,6 +182,8 @@ def case(kind: str, rng: random.Random, s: dict, d: pathlib.Path) -> tuple[list[
         # A sine's flags would contradict the step or chirp (a usage error since issue 19).
         kind = "step" if flag in ("--level", "--step-to", "--step-time") else "chirp"
         args = [flag, value, "--waveform-kind", kind, "--duration", "0.01"]
+        if kind == "step" and flag != "--step-time":  # a step inside the run (0 never steps)
+            args += ["--step-time", "0.002"]
     return [sub, *args, "--out", "o"], ""
 
 

@@ -150,8 +150,9 @@ std::string parse_error_message(const CLI::App& app, const CLI::ParseError& e, i
                          value.find_first_not_of("0123456789", digits) == std::string::npos;
       if (whole)
         return fmt::format("{} {}: out of range ({})", flag, clip_for_message(value, 60),
-                           value.starts_with('-') && is_unsigned
-                               ? "must be >= 0"
+                           value.starts_with('-')
+                               ? (is_unsigned ? "must be >= 0"
+                                              : "too small for the flag; see --help for its range")
                                : "too large for the flag; see --help for its range");
       return fmt::format(
           "{} '{}': not {}{}; e.g. {} {}", flag, clip_for_message(value, 60),

@@ -53,9 +53,21 @@ void check_options(const CLI::App& app) {
         if (is_unsigned && v.starts_with('-'))
           throw InputError(
               fmt::format("{} {}: must be >= 0", o->get_name(), clip_error_message(v)));
+        // CLI11 also reads 0x / 0o / 0b prefixes: the digits after them, in that base
+        const char* digits = b + (*b == '-' ? 1 : 0);
+        int base = 10;
+        if (e - digits > 2 && digits[0] == '0') {
+          const char c = static_cast<char>(digits[1] | 0x20);
+          base = c == 'x' ? 16 : c == 'o' ? 8 : c == 'b' ? 2 : 10;
+        }
         long long sv = 0;
         unsigned long long uv = 0;
-        const auto r = is_unsigned ? std::from_chars(b, e, uv) : std::from_chars(b, e, sv);
+        std::from_chars_result r{};
+        if (base == 10)
+          r = is_unsigned ? std::from_chars(b, e, uv) : std::from_chars(b, e, sv);
+        else if (*b != '-')
+          r = is_unsigned ? std::from_chars(digits + 2, e, uv, base)
+                          : std::from_chars(digits + 2, e, sv, base);
         if (r.ec == std::errc::result_out_of_range)
           throw InputError(fmt::format("{} {}: out of range (a 64-bit whole number)", o->get_name(),
                                        clip_error_message(v)));

@@ -2,6 +2,8 @@
 
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <poll.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -15,14 +17,34 @@
 
 namespace gmasim::io_detail {
 
+namespace {
+constexpr int kFifoWaitSeconds = 10;  // a FIFO's writer must start within this
+}  // namespace
+
 std::string read_text_file(const std::string& path, std::string_view what,
                            OnReadError on_read_error) {
   // Opened without blocking, then read blocking: open(2) of a FIFO that nobody writes waited for
-  // ever (mkfifo ff; gmasim model check ff); now it reads as empty. A pipe with a writer
-  // (--waveform <(...)) is read whole, as before.
+  // ever (mkfifo ff; gmasim model check ff). A FIFO waits for its writer's first bytes (or its
+  // close) at most kFifoWaitSeconds, then is refused; a pipe with a writer (--waveform <(...))
+  // and a writer that opens a moment later (producer > ff &) are read whole.
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   std::FILE* f = nullptr;
   if (fd >= 0) {
+    struct stat st {};
+    if (::fstat(fd, &st) == 0 && S_ISFIFO(st.st_mode)) {
+      pollfd pfd{fd, POLLIN, 0};
+      int rc = 0;
+      do rc = ::poll(&pfd, 1, kFifoWaitSeconds * 1000);
+      while (rc < 0 && errno == EINTR);
+      if (rc == 0) {
+        ::close(fd);
+        throw InputError(located(
+            path, 0,
+            fmt::format("{} is a FIFO that nobody wrote to within {} s: start its writer first, "
+                        "or give a regular file",
+                        what, kFifoWaitSeconds)));
+      }
+    }
     const int flags = ::fcntl(fd, F_GETFL);
     if (flags >= 0) (void)::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
     f = ::fdopen(fd, "rb");

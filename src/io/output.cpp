@@ -268,18 +268,25 @@ void ensure_output_dir(const std::string& dir) {
     throw InputError(located(dir, 0, fmt::format("output directory is not writable ({})", reason)));
   };
   std::error_code ec;
-  std::vector<std::string> missing;  // the directories this call creates, deepest first
-  for (fs::path q = fs::absolute(p, ec); !ec && !q.empty() && !fs::exists(q, ec);
-       q = q.parent_path()) {
-    missing.push_back(q.string());
-    if (q == q.parent_path()) break;
-  }
-  ec.clear();
-  fs::create_directories(p, ec);
+  // Created one component at a time, and recorded (canonical) only where mkdir(2) made it: a
+  // path such as new/../existing/sub must never record `existing` (it exists once `new` does),
+  // nor a directory another process made in between.
+  const fs::path abs = fs::absolute(p, ec);
   if (ec) fail(ec.message());
-  {
-    const std::lock_guard<std::mutex> lock(g_created_mutex);
-    g_created_dirs.insert(g_created_dirs.end(), missing.rbegin(), missing.rend());
+  fs::path cur;
+  for (const fs::path& part : abs) {
+    cur /= part;
+    if (part == "." || part == ".." || cur == cur.root_path()) continue;
+    if (::mkdir(cur.c_str(), 0777) == 0) {
+      const fs::path made = fs::canonical(cur, ec);
+      if (!ec) {
+        const std::lock_guard<std::mutex> lock(g_created_mutex);
+        g_created_dirs.push_back(made.string());
+      }
+      ec.clear();
+    } else if (errno != EEXIST) {
+      fail(std::strerror(errno));
+    }
   }
   if (!fs::is_directory(p, ec)) fail(ec ? ec.message() : "not a directory");
   const fs::path probe = p / fmt::format(".gmasim-write-test.{}", static_cast<long>(::getpid()));

@@ -233,7 +233,16 @@ check "12 synthesize: two records of one name" 2 "two records are both named T20
 check "12 sensitivity: --json and --csv one file" 2 "--csv x.out: the same file as --json x.out" \
   "$B" sensitivity --param thermal_expansion.sleeve_length_m --claim thermal_model --json x.out --csv x.out
 mkfifo fifo
-check "12 a FIFO nobody writes: read as empty, no hang" 2 "fifo:1: missing table" timeout 20 "$B" model check fifo
+check "12 a FIFO nobody writes: refused after 10 s, no hang" 2 "fifo: model file is a FIFO that nobody wrote to within 10 s" \
+  timeout 30 "$B" model check fifo
+mkfifo fifo2
+(sleep 1; cat "$SRC/models/single_rod.toml" >fifo2) &
+check "12 a FIFO whose writer starts a moment later: read whole" 0 "fifo2: OK|fifo2: valid|OK" timeout 30 "$B" model check fifo2
+wait
+mkdir -p pre/existing
+check "12 a refused run through new/../existing/sub" 2 "nonexist.toml" \
+  "$B" reproduce --quick --no-figures --out pre/new/../existing/sub --compare nonexist.toml
+ok "12 ... removes what it made and keeps the directory that existed" test -d pre/existing -a ! -e pre/new
 check "12 track: a PID log of 1e8 rows" 2 "track: 1e\+08 PID samples in the longest run .* \(limit 2e\+07 rows\)" \
   "$B" track --temperatures 20 --amplitudes 10 --frequencies 10 --periods 1 --sample-rate 1e9 --out s12
 check "12 track: --dt above the PID sample period (was clamped)" 2 \
@@ -275,6 +284,10 @@ check "12 track --seed -1 (wrapped to 2^64 - 1)" 1 "--seed -1: must be >= 0" \
   "$B" track --temperatures 20 --amplitudes 10 --frequencies 10 --periods 1 --seed -1 --out r12
 check "12 track --seed beyond 64 bits (saturated)" 1 "--seed 99999999999999999999999: out of range" \
   "$B" track --temperatures 20 --amplitudes 10 --frequencies 10 --periods 1 --seed 99999999999999999999999 --out r12
+check "12 track --seed in hex beyond 64 bits (CLI11 reads 0x)" 1 "--seed 0x1FFFFFFFFFFFFFFFFFFF: out of range" \
+  "$B" track --temperatures 20 --amplitudes 10 --frequencies 10 --periods 1 --seed 0x1FFFFFFFFFFFFFFFFFFF --out r12
+check "12 a whole number below an int flag's range" 1 "--threads -99999999999999999999: out of range \(too small" \
+  "$B" sweep --threads -99999999999999999999 --out r12
 check "12 a whole number out of an int flag's range: not 'not a whole number'" 1 \
   "--threads 2147483648: out of range" "$B" sweep --threads 2147483648 --out r12
 check "12 ablate --current-pp 0 (inf % of no stroke)" 2 "current peak-to-peak \(--current-pp\) = 0 A: must be > 0" \
