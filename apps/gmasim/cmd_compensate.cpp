@@ -94,22 +94,19 @@ int run_compensate_cmd(CompensateArgs& a) {
     // The tracking's numbers under compensate's own flag names, before the schedule's runs
     // (track's checks named --amplitudes, --frequencies; the schedule's --current-min and
     // --max-current, for --bias and --current-limit).
-    for (double A : a.track.amplitudes_um) {
-      require_finite(A, "tracking amplitude (--track-amplitudes)", "um");
-      if (!(A > 0.0 && A <= kMaxTrackAmplitude_um))
-        throw InputError(
-            fmt::format("tracking amplitude (--track-amplitudes) = {:g} um: must be "
-                        "in (0, {:g}] um",
-                        A, kMaxTrackAmplitude_um));
-    }
-    for (double f : a.track.frequencies_Hz) {
-      require_finite(f, "tracking frequency (--track-frequencies)", "Hz");
-      if (!(f > 0.0 && f <= kMaxFrequency_Hz))
-        throw InputError(
-            fmt::format("tracking frequency (--track-frequencies) = {:g} Hz: must be "
-                        "in (0, {:g}] Hz",
-                        f, kMaxFrequency_Hz));
-    }
+    auto in_range = [](const std::vector<double>& values, const char* what, const char* unit,
+                       double max) {  // (0, max]
+      for (double v : values) {
+        require_finite(v, what, unit);
+        if (!(v > 0.0 && v <= max))
+          throw InputError(
+              fmt::format("{} = {:g} {}: must be in (0, {:g}] {}", what, v, unit, max, unit));
+      }
+    };
+    in_range(a.track.amplitudes_um, "tracking amplitude (--track-amplitudes)", "um",
+             kMaxTrackAmplitude_um);
+    in_range(a.track.frequencies_Hz, "tracking frequency (--track-frequencies)", "Hz",
+             kMaxFrequency_Hz);
     require_in(a.track.current_limit_A, 0.0, kMaxCurrent_A,
                "tracking current limit (--current-limit)", "A");
     if (!(a.track.current_limit_A > 0.0))
