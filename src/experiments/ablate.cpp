@@ -129,8 +129,9 @@ AblateResult run_ablate(const Model& m, const AblateRequest& r) {
   AblateResult res;
   for (std::size_t fi = 0; fi < r.frequencies_Hz.size(); ++fi) {
     const AblationRun& full = runs[fi * per_f];
-    if (full.diverged)
-      throw DivergenceError(0.0, "", "full model at the ablation point", 0.0, full.error);
+    if (full.diverged)  // the run's own diagnosis (time, rod, quantity), after the point
+      throw DivergenceError(fmt::format("ablate: the full model at {:g} degC, {:g} Hz diverged: {}",
+                                        r.temperature_C, r.frequencies_Hz[fi], full.error));
     res.full.push_back(full.metrics);
     for (std::size_t li = 0; li < laws.size(); ++li)
       res.rows.push_back(

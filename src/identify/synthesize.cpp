@@ -20,10 +20,15 @@ void check_request(const SyntheticRequest& r) {
   if (r.samples_per_period < 8)
     throw InputError(fmt::format("samples per period {} (--samples-per-period): must be >= 8",
                                  r.samples_per_period));
-  if (r.precycles == 0 && r.initial_state == InitialState::Demagnetised && !(r.periods >= 1.5))
-    throw InputError("periods: must be >= 1.5 (the first is not compared)");
-  if (!(r.periods >= 1.0)) throw InputError("periods: must be >= 1 (one whole loop)");
-  require_in(r.periods, 1.0, kMaxPeriods, "periods");
+  // One range, stated whole: from the demagnetised state the first period is not compared
+  const bool first_skipped = r.precycles == 0 && r.initial_state == InitialState::Demagnetised;
+  const double lowest = first_skipped ? 1.5 : 1.0;
+  if (!(r.periods >= lowest && r.periods <= kMaxPeriods))
+    throw InputError(fmt::format(
+        "periods (--periods) = {:g}: must be in [{:g}, {:g}] ({})", r.periods, lowest, kMaxPeriods,
+        first_skipped ? "a whole loop after the first period, which a "
+                        "record from the demagnetised state does not compare"
+                      : "one whole loop"));
   require_in(r.current_min_A, -kMaxCurrent_A, kMaxCurrent_A, "current minimum", "A");
   require_in(r.noise_pct, 0.0, 100.0, "noise", "%");
   require_in(r.flux_noise_pct, 0.0, 100.0, "flux noise", "%");

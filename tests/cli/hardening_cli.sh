@@ -309,6 +309,13 @@ done
 sed 's/^coil_turns = .*/coil_turns = 9007199254740993/' "$SRC/models/single_rod.toml" >big12.toml
 check "12 an integer beyond 2^53 in a model: quoted, not NaN" 2 \
   "big12.toml:[0-9]+: circuit.branches.coil.coil_turns = 9007199254740993: an integer beyond 2\^53" "$B" model check big12.toml
+check "12 synthesize --periods: one range, stated whole" 2 \
+  "periods \(--periods\) = 1e\+308: must be in \[1.5, 1e\+06\]" \
+  "$B" identify synthesize --out r12 --periods 1e308 --temperatures 20 --currents 8 --frequencies 10
+check "12 ablate: a diverged full model names its point, then its diagnosis" 3 \
+  "ablate: the full model at 70 degC, 10 Hz diverged: diverged at t = .* H \[A/m\]" \
+  "$B" ablate --model "$SRC/models/single_rod.toml" --set circuit.branches.coil.coil_turns=1e20 \
+  --frequencies 10 --periods 1 --out r12
 ok "12 ... and nothing written by the refused runs" test ! -e r12
 
 echo "$pass passed, $fail failed"
