@@ -279,10 +279,12 @@ int run_identify(IdentifyArgs& a) {
   try {
     return run_identify_body(a, *comm);
   } catch (const InputError& e) {
+    remove_created_output_dirs_if_empty();  // as main() does for every other command
     if (root) print_error(e.what());
     if (comm->size() > 1) comm->abort(2);
     return 2;
   } catch (const std::exception& e) {
+    remove_created_output_dirs_if_empty();
     print_error(fmt::format("internal error (rank {}): {}", comm->rank(), e.what()));
     if (comm->size() > 1) comm->abort(4);
     return 4;

@@ -417,6 +417,8 @@ MeasurementCondition make_condition(const KeyMap& keys, const Measurement& m,
   const ConditionKeys k(keys, path, header_line);
   MeasurementCondition c;
   c.temperature_C = read_temperature(k);
+  c.temperature_file = k.at("temperature_C").file;
+  c.temperature_line = k.at("temperature_C").line;
   if (m.condition.quasi_static) check_untimed_keys(k);
   read_periodic_keys(k, m, c);
   read_current_keys(k, c);

@@ -160,8 +160,11 @@ CondData make_cond(const Model& start_model, const Measurement& meas, std::size_
                    const ObjectiveSettings& settings) {
   try {
     (void)make_conditions(start_model, meas.condition.temperature_C);
-  } catch (const InputError& e) {
-    throw InputError(located(meas.path, 0, e.what()));
+  } catch (const InputError& e) {  // at the line that gave the temperature, where known
+    const auto& c = meas.condition;
+    throw InputError(c.temperature_file.empty()
+                         ? located(meas.path, 0, e.what())
+                         : located(c.temperature_file, c.temperature_line, e.what()));
   }
   CondData cd;
   cd.index = k;

@@ -316,6 +316,12 @@ check "12 ablate: a diverged full model names its point, then its diagnosis" 3 \
   "ablate: the full model at 70 degC, 10 Hz diverged: diverged at t = .* H \[A/m\]" \
   "$B" ablate --model "$SRC/models/single_rod.toml" --set circuit.branches.coil.coil_turns=1e20 \
   --frequencies 10 --periods 1 --out r12
+mkdir -p syn400 && cp syn/manifest.toml syn400/ && for f in syn/*.csv; do
+  sed 's/^# temperature_C = .*/# temperature_C = 400/' "$f" >"syn400/$(basename "$f")"; done
+check "12 identify: a record's temperature beyond the computable range, at its line" 2 \
+  "syn400/T20_I8_f10.csv:[0-9]+: temperature 400 degC: outside the range" \
+  "$B" "${ID[@]}" --data syn400/manifest.toml --fit fit.toml --out o12.toml
+ok "12 ... and identify's report directory is not left behind" test ! -e o12_report
 ok "12 ... and nothing written by the refused runs" test ! -e r12
 
 echo "$pass passed, $fail failed"

@@ -58,6 +58,10 @@ inline constexpr long kMaxPrecycles = 100;
 
 struct MeasurementCondition {
   double temperature_C = 0.0;
+  // Where temperature_C was read (the CSV's header or its sidecar, and the line; "" and 0 when
+  // built in memory): an error about the temperature is reported there.
+  std::string temperature_file;
+  long temperature_line = 0;
   // Periodic (biased-sine) excitation when frequency_Hz > 0: then current_pp_A is set.
   double frequency_Hz = 0.0;
   double current_pp_A = 0.0;
