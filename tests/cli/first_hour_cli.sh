@@ -65,10 +65,15 @@ lines="$(grep -c '^simulate: ' "$T/p.err")"
 [[ "$lines" -ge 1 && "$lines" -le 10 ]] && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: $lines progress lines"; }
 
 # --- reproduce on a pipe: a heartbeat line every 3 s, not 15 s of silence (stopped after 8 s;
-# the full study on one thread and two compared models: the study alone now ends in about 4 s,
-# and the heartbeat goes on through the compared models)
+# the full study on one thread and five compared models: on an idle machine a study takes about
+# 1.8 s since the lanes, so with two compared models the run ended at 5.3 s, before the second
+# heartbeat; the heartbeat goes on through the compared models)
 timeout 8 "$B" reproduce --no-figures --threads 1 --compare models/mdma_printed.toml \
-  calibration/models/printed__kelvin__compression_negative.toml --out "$T/r" >/dev/null 2>"$T/r.err"
+  calibration/models/printed__kelvin__compression_negative.toml \
+  calibration/models/printed__kelvin__compression_positive.toml \
+  calibration/models/printed__room_referenced__compression_negative.toml \
+  calibration/models/printed__room_referenced__compression_positive.toml \
+  --out "$T/r" >/dev/null 2>"$T/r.err"
 n="$(grep -cE '^reproduce: (the first stage is running|[0-9]+/[0-9]+ stages done), [0-9]+ s elapsed' "$T/r.err")"
 [[ "$n" -ge 2 ]] && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: $n heartbeat lines in 8 s"; cat "$T/r.err"; }
 
