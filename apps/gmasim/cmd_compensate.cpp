@@ -94,23 +94,14 @@ int run_compensate_cmd(CompensateArgs& a) {
     // The tracking's numbers under compensate's own flag names, before the schedule's runs
     // (track's checks named --amplitudes, --frequencies; the schedule's --current-min and
     // --max-current, for --bias and --current-limit).
-    auto in_range = [](const std::vector<double>& values, const char* what, const char* unit,
-                       double max) {  // (0, max]
-      for (double v : values) {
-        require_finite(v, what, unit);
-        if (!(v > 0.0 && v <= max))
-          throw InputError(
-              fmt::format("{} = {:g} {}: must be in (0, {:g}] {}", what, v, unit, max, unit));
-      }
-    };
-    in_range(a.track.amplitudes_um, "tracking amplitude (--track-amplitudes)", "um",
-             kMaxTrackAmplitude_um);
-    in_range(a.track.frequencies_Hz, "tracking frequency (--track-frequencies)", "Hz",
-             kMaxFrequency_Hz);
-    require_in(a.track.current_limit_A, 0.0, kMaxCurrent_A,
-               "tracking current limit (--current-limit)", "A");
-    if (!(a.track.current_limit_A > 0.0))
-      throw InputError("tracking current limit (--current-limit) = 0 A: must be > 0 A");
+    for (double A : a.track.amplitudes_um)
+      require_positive_at_most(A, kMaxTrackAmplitude_um, "tracking amplitude (--track-amplitudes)",
+                               "um");
+    for (double f : a.track.frequencies_Hz)
+      require_positive_at_most(f, kMaxFrequency_Hz, "tracking frequency (--track-frequencies)",
+                               "Hz");
+    require_positive_at_most(a.track.current_limit_A, kMaxCurrent_A,
+                             "tracking current limit (--current-limit)", "A");
     require_in(a.track.bias_A, -a.track.current_limit_A, a.track.current_limit_A,
                "tracking bias current (--bias)", "A");
   }

@@ -264,6 +264,13 @@ int run_identify_body(IdentifyArgs& a, Communicator& comm) {
   return r.interrupted ? 130 : 0;
 }
 
+// MPI's abort ends every rank without returning to main(), whose cleanup of a failed command's
+// empty output directories therefore runs here first.
+void abort_ranks(Communicator& comm, int code) {
+  remove_created_output_dirs_if_empty();
+  comm.abort(code);
+}
+
 int run_identify(IdentifyArgs& a) {
   const bool launched = launched_by_mpi();
   const bool use_mpi = a.mpi == "on" || (a.mpi == "auto" && launched);
@@ -279,14 +286,12 @@ int run_identify(IdentifyArgs& a) {
   try {
     return run_identify_body(a, *comm);
   } catch (const InputError& e) {
-    remove_created_output_dirs_if_empty();  // as main() does for every other command
     if (root) print_error(e.what());
-    if (comm->size() > 1) comm->abort(2);
-    return 2;
+    if (comm->size() > 1) abort_ranks(*comm, 2);
+    return 2;  // main() removes the empty output directories of a failed command
   } catch (const std::exception& e) {
-    remove_created_output_dirs_if_empty();
     print_error(fmt::format("internal error (rank {}): {}", comm->rank(), e.what()));
-    if (comm->size() > 1) comm->abort(4);
+    if (comm->size() > 1) abort_ranks(*comm, 4);
     return 4;
   }
 }

@@ -3,11 +3,9 @@
 #include <fmt/ranges.h>
 #include <unistd.h>
 
-#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <mutex>
@@ -119,25 +117,6 @@ class StageProgress {
   std::thread beat_;
 };
 
-// What posix_spawnp (run_python) can start: a path with '/' as it is, a bare name on PATH; an
-// executable regular file either way.
-bool runnable(const std::string& exe) {
-  auto ok = [](const std::string& f) {
-    std::error_code ec;
-    return std::filesystem::is_regular_file(f, ec) && ::access(f.c_str(), X_OK) == 0;
-  };
-  if (exe.find('/') != std::string::npos) return ok(exe);
-  const char* path = std::getenv("PATH");
-  std::string dirs = path ? path : "/usr/bin:/bin";
-  for (std::size_t b = 0; b <= dirs.size();) {
-    const std::size_t e = std::min(dirs.find(':', b), dirs.size());
-    const std::string d = dirs.substr(b, e - b);
-    if (ok((d.empty() ? std::string(".") : d) + "/" + exe)) return true;
-    b = e + 1;
-  }
-  return false;
-}
-
 int run_reproduce_cmd(const ReproduceArgs& a) {
   if (a.claim_kinds) {
     fmt::print("{}", claim_kinds_markdown());
@@ -145,7 +124,7 @@ int run_reproduce_cmd(const ReproduceArgs& a) {
   }
   const Model model = load_model_args(a.model);
   // A Python that cannot run ended in exit 0 with a note inside report.md only
-  if (!a.no_figures && !runnable(a.python))
+  if (!a.no_figures && !python_runnable(a.python))
     throw InputError(fmt::format(
         "--python {}: not an executable file{}; the figures need a Python 3 with "
         "numpy and matplotlib: give one, or --no-figures",

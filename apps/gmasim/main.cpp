@@ -88,6 +88,15 @@ void check_options(const CLI::App& app) {
 
 void require_finite_numbers(const CLI::App& app) { check_options(app); }
 
+// A command that fails -- an exception in main(), or a non-zero exit of its own -- leaves no
+// output directory it created empty; one that wrote part of its output keeps it (rmdir only).
+struct EmptyOutputDirs {
+  int rc = 1;  // the command's exit status, once it returned one
+  ~EmptyOutputDirs() {
+    if (rc != 0) remove_created_output_dirs_if_empty();
+  }
+};
+
 CLI::Validator model_path_transform() {
   return CLI::Validator(
       [](std::string& path) {
@@ -265,33 +274,29 @@ int main(int argc, char** argv) {
     gmasim::cli::print_error(e.what());
     return 1;
   }
+  gmasim::cli::EmptyOutputDirs dirs;  // removed unless the command exits 0
   try {
     // Each runner checks whether its subcommand was parsed and returns -1 if not.
     for (auto& run : runners) {
       const int rc = run();
-      if (rc >= 0) return rc;
+      if (rc >= 0) return dirs.rc = rc;
     }
     return 1;
   } catch (const gmasim::cli::UsageError& e) {
-    gmasim::remove_created_output_dirs_if_empty();
     gmasim::cli::print_error(e.what());
     return 1;
   } catch (const gmasim::InputError& e) {
-    gmasim::remove_created_output_dirs_if_empty();
     gmasim::cli::print_error(e.what());
     return 2;
   } catch (const gmasim::DivergenceError& e) {
-    gmasim::remove_created_output_dirs_if_empty();
     gmasim::cli::print_error(e.what());
     return 3;
   } catch (const std::bad_alloc&) {
-    gmasim::remove_created_output_dirs_if_empty();
     gmasim::cli::print_error(
         "out of memory: the run needs more memory than the system gives it (MemAvailable, "
         "ulimit -v); record less often (--record-every), shorten the run or lower --threads");
     return 2;
   } catch (const std::exception& e) {
-    gmasim::remove_created_output_dirs_if_empty();
     gmasim::cli::print_error(fmt::format("internal error: {}", e.what()));
     return 4;
   }

@@ -59,6 +59,14 @@ double require_in(double v, double lo, double hi, std::string_view what, std::st
   return v;
 }
 
+double require_positive_at_most(double v, double hi, std::string_view what, std::string_view unit) {
+  require_finite(v, what, unit);
+  if (!(v > 0.0 && v <= hi))
+    fail(v, what, unit,
+         fmt::format("must be in ({}, {}]", with_unit(0.0, unit), with_unit(hi, unit)));
+  return v;
+}
+
 long checked_count(double x, double max, std::string_view what) {
   if (!std::isfinite(x)) throw InputError(fmt::format("{} = {:g}: not a finite count", what, x));
   if (x < 0.0) throw InputError(fmt::format("{} = {:g}: must be >= 0", what, x));

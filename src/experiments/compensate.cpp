@@ -72,9 +72,7 @@ DriveRun run_drive(const detail::RunFn& run, const CompensateRequest& r, double 
 void validate_request(const Model& m, const CompensateRequest& r) {
   require_finite(r.reference_temperature_C, "reference temperature (--reference-temperature)",
                  "degC");
-  require_in(r.max_current_A, 0.0, kMaxCurrent_A, "maximum current (--max-current)", "A");
-  if (!(r.max_current_A > 0.0))
-    throw InputError("maximum current (--max-current) = 0 A: must be > 0 A");
+  require_positive_at_most(r.max_current_A, kMaxCurrent_A, "maximum current (--max-current)", "A");
   require_in(r.current_min_A, -r.max_current_A, r.max_current_A, "current minimum (--current-min)",
              "A");
   require_in(r.reference_current_pp_A, 0.0, 2.0 * kMaxCurrent_A,

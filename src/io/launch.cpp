@@ -3,10 +3,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <string_view>
+#include <system_error>
 #include <vector>
 
 #include "gmasim/io/io.hpp"
@@ -17,6 +20,23 @@ std::string PythonCommand::text() const {
   std::string t = python + " -m " + module;
   for (const auto& a : args) t += " " + a;
   return t;
+}
+
+bool python_runnable(const std::string& python) {
+  auto ok = [](const std::string& f) {
+    std::error_code ec;
+    return std::filesystem::is_regular_file(f, ec) && ::access(f.c_str(), X_OK) == 0;
+  };
+  if (python.find('/') != std::string::npos) return ok(python);
+  const char* path = std::getenv("PATH");
+  const std::string dirs = path ? path : "/usr/bin:/bin";
+  for (std::size_t b = 0; b <= dirs.size();) {
+    const std::size_t e = std::min(dirs.find(':', b), dirs.size());
+    const std::string d = dirs.substr(b, e - b);
+    if (ok((d.empty() ? std::string(".") : d) + "/" + python)) return true;
+    b = e + 1;
+  }
+  return false;
 }
 
 int run_python(const PythonCommand& c) {

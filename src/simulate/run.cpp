@@ -365,10 +365,7 @@ void validate(const Waveform& w) {
     require_in(v, -kMaxCurrent_A, kMaxCurrent_A, what, "A");
   };
   auto frequency = [](double v, const char* what) {
-    require_finite(v, what, "Hz");
-    if (!(v > 0.0 && v <= kMaxFrequency_Hz))  // "[0 Hz, ...]" read as if 0 were allowed
-      throw InputError(
-          fmt::format("{} = {:g} Hz: must be in (0 Hz, {:g} Hz]", what, v, kMaxFrequency_Hz));
+    require_positive_at_most(v, kMaxFrequency_Hz, what, "Hz");
   };
   switch (w.kind) {
     case WaveformKind::BiasedSine:

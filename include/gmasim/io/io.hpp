@@ -147,5 +147,8 @@ struct PythonCommand {
 // Runs it and waits: the exit status (0: success), 127 if it could not be started, 128 + N
 // if signal N ended it. The child's standard error is ours.
 int run_python(const PythonCommand& c);
+// Whether run_python can start `python`: a path with '/' as it is, a bare name on PATH (as
+// posix_spawnp looks it up); an executable regular file either way.
+bool python_runnable(const std::string& python);
 
 }  // namespace gmasim

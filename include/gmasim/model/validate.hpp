@@ -55,6 +55,9 @@ double require_nonnegative(double v, std::string_view what, std::string_view uni
 // finite and lo <= v <= hi
 double require_in(double v, double lo, double hi, std::string_view what,
                   std::string_view unit = "");
+// finite and 0 < v <= hi ("must be in (0 Hz, 1e+06 Hz]")
+double require_positive_at_most(double v, double hi, std::string_view what,
+                                std::string_view unit = "");
 
 // A count from a double: x finite, 0 <= x <= max, then rounded to the nearest integer.
 // The message names `what`, the value and the limit.
