@@ -17,6 +17,10 @@ for arg in "$@"; do
 done
 
 GMASIM_PRESET="$PRESET" bash scripts/build.sh
+# The machine and the SIMD target the lanes chose on it (run-time dispatch; the sanitizer
+# presets compile fewer targets), so that a failure can be tied to a machine (issue 36).
+bash scripts/cpu_info.sh
+"build/$PRESET/bin/gmasim" --version | sed "s/^/test.sh [$PRESET]: /"
 
 # A fresh build directory has no test timings, so ctest would start the long tests (the CLI
 # scripts, pytest, the reproduction check) last and leave one core idle at the end. Seed the

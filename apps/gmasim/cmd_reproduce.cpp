@@ -4,8 +4,10 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <mutex>
@@ -61,13 +63,29 @@ std::string claim_kinds_markdown() {
   return md;
 }
 
+// The heartbeat's period: 3 s, or GMASIM_HEARTBEAT_S seconds in [0.05, 60] (the test of the
+// heartbeat, tests/cli/first_hour_cli.sh, sets it short so that it sees several beats however
+// fast the CPU runs the study; issue 36). Any other value is refused before the study.
+std::chrono::duration<double> heartbeat_period() {
+  const char* env = std::getenv("GMASIM_HEARTBEAT_S");
+  if (env == nullptr) return std::chrono::seconds(3);
+  char* end = nullptr;
+  const double s = std::strtod(env, &end);
+  if (*env == '\0' || end == nullptr || *end != '\0' || !std::isfinite(s) || s < 0.05 || s > 60.0)
+    throw InputError(fmt::format(
+        "GMASIM_HEARTBEAT_S={}: the heartbeat's period must be a number of seconds in [0.05 s, "
+        "60 s] (unset: 3 s)",
+        env));
+  return std::chrono::duration<double>(s);
+}
+
 // Progress of the stages on stderr. A terminal gets one updating line per stage; a pipe or a
-// file (a CI log) a line every kEverySeconds while the study runs, from a heartbeat thread,
-// so a log never sits silent for the 15 s of a stage, without one line per update.
+// file (a CI log) a line every heartbeat_period() while the study runs, from a heartbeat
+// thread, so a log never sits silent for the 15 s of a stage, without one line per update.
 class StageProgress {
  public:
-  static constexpr auto kEvery = std::chrono::seconds(3);
-  StageProgress() : tty_(isatty(fileno(stderr)) != 0), t0_(std::chrono::steady_clock::now()) {
+  explicit StageProgress(std::chrono::duration<double> every)
+      : every_(every), tty_(isatty(fileno(stderr)) != 0), t0_(std::chrono::steady_clock::now()) {
     if (!tty_) beat_ = std::thread([this] { heartbeat(); });
   }
   ~StageProgress() {
@@ -98,7 +116,7 @@ class StageProgress {
  private:
   void heartbeat() {
     std::unique_lock<std::mutex> lock(mutex_);
-    while (!wake_.wait_for(lock, kEvery, [this] { return stop_; })) {
+    while (!wake_.wait_for(lock, every_, [this] { return stop_; })) {
       const double el =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
       if (total_ == 0)
@@ -108,6 +126,7 @@ class StageProgress {
       std::fflush(stderr);
     }
   }
+  std::chrono::duration<double> every_;
   bool tty_;
   std::chrono::steady_clock::time_point t0_;
   std::mutex mutex_;
@@ -156,11 +175,12 @@ int run_reproduce_cmd(const ReproduceArgs& a) {
   // study's outputs were written
   std::vector<Model> others;
   for (const auto& c : a.compare) others.push_back(load_model(c));
+  const std::chrono::duration<double> heartbeat = heartbeat_period();
   const std::size_t models = 1 + a.compare.size();
   ReproduceResult r;
   std::vector<ComparedModel> compared;
   {
-    StageProgress progress;
+    StageProgress progress(heartbeat);
     r = run_reproduce(model, o, progress.fn(0, models));
     write_reproduce_outputs(model, r, a.out, a.no_figures ? std::string() : a.python,
                             python_package_path());

@@ -15,12 +15,14 @@
 #include <exception>
 #include <filesystem>
 #include <new>
+#include <string>
 #include <vector>
 
 #include "commands.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io/io.hpp"
 #include "gmasim/model/validity.hpp"
+#include "gmasim/simulate/lanes.hpp"
 #include "gmasim/version.h"
 
 namespace gmasim::cli {
@@ -220,6 +222,17 @@ extern "C" void on_fatal_signal(int sig) {
   std::raise(sig);
 }
 
+// "gmasim 0.1.0", plus the git describe of the source tree at configure time if it had one,
+// and the SIMD target the lanes chose on this CPU with its width (run-time dispatch, so a log
+// can be tied to a machine: scripts/test.sh prints it for .ci/run, issue 36).
+std::string version_text() {
+  const std::string git_describe = GMASIM_GIT_DESCRIBE;
+  return std::string("gmasim " GMASIM_VERSION) +
+         (git_describe.empty() ? "" : " (" + git_describe + ")") +
+         fmt::format("\nlanes: SIMD target {}, {} doubles per vector", gmasim::lanes_target(),
+                     gmasim::lanes_width());
+}
+
 }  // namespace
 
 namespace gmasim::cli {
@@ -234,12 +247,8 @@ int main(int argc, char** argv) {
       "model; built-in model: the MDMA prototype). SI units inside; units are named in every "
       "flag and output column."};
   app.require_subcommand(1);
-  // "gmasim 0.1.0", plus the git describe of the source tree at configure time if it had one.
-  const std::string git_describe = GMASIM_GIT_DESCRIBE;
-  app.set_version_flag("--version",
-                       std::string("gmasim " GMASIM_VERSION) +
-                           (git_describe.empty() ? "" : " (" + git_describe + ")"),
-                       "Print the version and exit");
+  app.set_version_flag("--version", version_text,
+                       "Print the version and the SIMD target the lanes use on this CPU, and exit");
   std::vector<gmasim::cli::Runner> runners;
   runners.push_back(gmasim::cli::add_simulate(app));
   runners.push_back(gmasim::cli::add_model(app));

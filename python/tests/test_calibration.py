@@ -155,3 +155,40 @@ def test_undated_ignores_the_date_and_reads_scratch_paths_as_committed(tmp_path)
          "# report: calibration/models/consistent_report\nx = 1\n")
     assert calibrate.undated(a, scratch) == calibrate.undated(b)
     assert calibrate.undated(a, scratch) != calibrate.undated(b.replace("x = 1", "x = 2"))
+
+
+@pytest.mark.parametrize("flag", ["--smoke", "--check"])
+def test_comparisons_skip_with_the_reason_on_another_libm_path(monkeypatch, capsys, tmp_path, flag):
+    # Issue 36: on a CPU whose libm takes another path (no FMA + AVX2) the 1e-14 comparisons
+    # cannot hold; they skip (77, ctest's SKIP_RETURN_CODE) and say why, before any rerun.
+    fake_bin = tmp_path / "gmasim"
+    fake_bin.write_text("")
+
+    def no_rerun(*a, **k):
+        raise AssertionError("a skipped comparison must not rerun anything")
+
+    monkeypatch.setattr(calibrate, "libm_path", lambda: "generic")
+    monkeypatch.setattr(calibrate, "smoke", no_rerun)
+    monkeypatch.setattr(calibrate, "check", no_rerun)
+    assert calibrate.main([flag, "--bin", str(fake_bin)]) == calibrate.SKIP
+    out = capsys.readouterr().out
+    assert f"calibrate.py {flag}: SKIP: this CPU's libm path is 'generic'" in out
+    assert "made on the 'fma' path" in out and "cpu: " in out
+    # On the reference path the comparison runs.
+    monkeypatch.setattr(calibrate, "libm_path", lambda: calibrate.REFERENCE_LIBM_PATH)
+    monkeypatch.setattr(calibrate, "smoke", lambda *a, **k: 0)
+    monkeypatch.setattr(calibrate, "check", lambda *a, **k: 0)
+    assert calibrate.main([flag, "--bin", str(fake_bin)]) == 0
+
+
+def test_cpu_info_names_the_libm_path_of_this_machine():
+    # The predicate the skip uses is the one .ci/run prints (scripts/cpu_info.sh).
+    path = calibrate.libm_path()
+    assert path in {"fma", "fma4", "generic", "unknown"}
+    flags = set()
+    for line in open("/proc/cpuinfo"):
+        if line.startswith("flags"):
+            flags = set(line.split(":", 1)[1].split())
+            break
+    want = "fma" if {"fma", "avx2"} <= flags else "fma4" if "fma4" in flags else "generic"
+    assert path == want
