@@ -202,9 +202,6 @@ int run_reproduce_cmd(const ReproduceArgs& a) {
                fmt::join(failing, ", "),
                a.doc_notes.empty() ? std::string("docs/failing_claims.md") : a.doc_notes,
                a.doc.empty() ? "" : ", and in " + a.doc);
-  for (const auto& t : r.trends)
-    fmt::print("  trend: {} {} ({:+.3g} /A, paper {:+.3g} /A)\n", t.what, t.pass ? "PASS" : "FAIL",
-               t.ours_slope, t.paper_slope);
   if (!a.doc.empty())
     for (const auto& id : unexplained_failures(r.claims, notes))
       fmt::print(stderr, "gmasim reproduce: warning: failing claim {} has no explanation{}\n", id,

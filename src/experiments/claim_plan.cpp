@@ -35,7 +35,18 @@ std::vector<double> keep(const std::vector<double>& grid, const std::vector<doub
 }
 
 // The part of the study each extractor kind reads (claims.cpp, kinds()).
-enum class Part { Sweep, Frf, Params, Track, Ablate, Thermal, None, Unknown };
+enum class Part {
+  Sweep,
+  SweepFamily,
+  Frf,
+  FrfLarge,
+  Params,
+  Track,
+  Ablate,
+  Thermal,
+  None,
+  Unknown
+};
 
 Part part_of(std::string_view kind) {
   static constexpr std::string_view kSweep[] = {"stroke_drop_pct", "hysteresis_drop_pct",
@@ -43,8 +54,12 @@ Part part_of(std::string_view kind) {
                                                 "hysteresis_um",   "B_pp_T"};
   for (auto k : kSweep)
     if (k == kind) return Part::Sweep;
+  if (kind == "stroke_drop_slope_pct_per_A" || kind == "hysteresis_drop_slope_pct_per_A" ||
+      kind == "flux_drop_slope_pct_per_A")
+    return Part::SweepFamily;
   if (kind == "first_resonance_Hz" || kind == "resonance_shift_pct" || kind == "bandwidth_Hz")
     return Part::Frf;
+  if (kind == "resonance_amplitude_change_pct") return Part::FrfLarge;
   if (kind == "stroke_retention_pct" || kind == "EG_rise_pct" || kind == "param_change_pct")
     return Part::Params;
   if (kind == "track_error_growth_pct") return Part::Track;
@@ -57,7 +72,7 @@ Part part_of(std::string_view kind) {
 // What the claims need, condition by condition.
 struct Needs {
   std::vector<std::array<double, 3>> sweep_10Hz, sweep_dynamic;  // (T, I, f)
-  std::vector<double> frf_T, track_T, track_A, ablate_f, params_T, retention_I;
+  std::vector<double> frf_T, frf_large_T, track_T, track_A, ablate_f, params_T, retention_I;
   bool params = false, full = false;
 };
 
@@ -72,6 +87,20 @@ void need_sweep(const StudyRequests& g, const ClaimCondition& c, Needs& n) {
     n.sweep_dynamic.push_back({c.temperature_C, c.current_pp_A, c.frequency_Hz});
 }
 
+// Every current of the grid at the claim's (T, f): the family a slope claim reads.
+void need_family(const StudyRequests& g, const ClaimCondition& c, Needs& n) {
+  for (const SweepRequest* s : {&g.sweep_10Hz, &g.sweep_dynamic}) {
+    if (!has(s->frequencies_Hz, c.frequency_Hz) || !has(s->temperatures_C, c.temperature_C))
+      continue;
+    for (double I : s->currents_pp_A) {
+      ClaimCondition one = c;
+      one.current_pp_A = I;
+      need_sweep(g, one, n);
+    }
+    return;
+  }
+}
+
 void need(const StudyRequests& g, const ClaimSpec& s, Needs& n) {
   if (s.tolerance.kind == ToleranceKind::NotApplicable) return;  // never extracted
   const ClaimCondition& c = s.condition;
@@ -79,9 +108,16 @@ void need(const StudyRequests& g, const ClaimSpec& s, Needs& n) {
     case Part::Sweep:
       need_sweep(g, c, n);
       break;
+    case Part::SweepFamily:
+      need_family(g, c, n);
+      break;
     case Part::Frf:
       n.frf_T.push_back(c.temperature_C);
       if (!std::isnan(c.reference_temperature_C)) n.frf_T.push_back(c.reference_temperature_C);
+      break;
+    case Part::FrfLarge:
+      n.frf_large_T.push_back(c.temperature_C);
+      n.frf_large_T.push_back(c.reference_temperature_C);
       break;
     case Part::Params:
       n.params = true;
@@ -133,6 +169,10 @@ void plan_parts(const Needs& n, ClaimPlan& p) {
   p.frf_request.stepped_sine = false;  // every FRF claim reads the small-signal curve
   p.frf_request.threads = 1;
   p.frf = !p.frf_request.temperatures_C.empty();
+  p.frf_large_request = g.frf_large;
+  p.frf_large_request.temperatures_C = keep(g.frf_large.temperatures_C, n.frf_large_T);
+  p.frf_large_request.threads = 1;
+  p.frf_large = !p.frf_large_request.temperatures_C.empty();
 
   // Tracking: the first temperature (the reference of the growth) and the claims'; the
   // frequencies whole (they set the plant step). With sensor noise the per-point seeds follow
@@ -193,6 +233,12 @@ StudyRequests reproduce_requests(bool quick) {
   g.sweep_dynamic.currents_pp_A = {6, 8};
   g.sweep_dynamic.frequencies_Hz = {100, 200, 400};
   if (quick) g.frf.points = 12;
+  // Section 3.4's resonance amplitude: a stepped sine of +-1 A about the 1 A bias (our reading:
+  // the paper gives no stimulus, and 0.1 mA would move y by under a nanometre), the markers
+  // from the stepped sine (frf --method stepped --amplitude 1).
+  g.frf_large.amplitude_A = 1.0;
+  g.frf_large.small_signal = false;
+  if (quick) g.frf_large.points = 12;
   if (quick) g.track.temperatures_C = {20, 40, 70};
   if (quick) g.params.temperatures_C = {20, 70, 150};
   return g;
@@ -228,6 +274,7 @@ ClaimPlan plan_claims(const ClaimsData& claims, bool quick, std::vector<MetricQu
     p.units.push_back({UnitKind::SweepDynamic, k});
   for (std::size_t k = 0; k < p.metric_points.size(); ++k) p.units.push_back({UnitKind::Metric, k});
   if (p.frf) p.units.push_back({UnitKind::Frf});
+  if (p.frf_large) p.units.push_back({UnitKind::FrfLarge});
   if (!p.functions.empty()) p.units.push_back({UnitKind::Functions});
   return p;
 }
@@ -263,6 +310,8 @@ std::string unit_name(const Unit& u) {
       return "20-150 degC runs";
     case UnitKind::Frf:
       return "FRF";
+    case UnitKind::FrfLarge:
+      return "large-signal FRF";
     case UnitKind::Sweep10Hz:
     case UnitKind::SweepDynamic:
       return "sweep";
@@ -317,6 +366,9 @@ void run_unit_body(const ClaimPlan& p, const Unit& u, const Model& m, PartResult
     case UnitKind::Frf:
       out.frf = run_frf(m, p.frf_request);
       break;
+    case UnitKind::FrfLarge:
+      out.frf_large = run_frf(m, p.frf_large_request);
+      break;
     case UnitKind::Sweep10Hz:
       out.sweeps_10Hz[u.index] = run_sweep(m, p.sweeps_10Hz[u.index]);
       break;
@@ -360,6 +412,8 @@ std::vector<Claim> assemble_claims(const ClaimPlan& p, const Model& m, const Par
                                      s.points.end());
     rr.frf_request = p.frf_request;
     rr.frf = r.frf;
+    rr.frf_large_request = p.frf_large_request;
+    rr.frf_large = r.frf_large;
     rr.track_request = p.track_request;
     rr.track = r.track;
     rr.ablate_request = p.ablate_request;

@@ -20,6 +20,7 @@ namespace gmasim::detail {
 struct StudyRequests {
   SweepRequest sweep_10Hz, sweep_dynamic;
   FrfRequest frf;
+  FrfRequest frf_large;  // +-1 A stepped sine about the bias (the resonance amplitude claim)
   TrackRequest track;
   AblateRequest ablate;
   ParamsVsTemperatureRequest params;
@@ -32,6 +33,7 @@ enum class UnitKind {
   Ablate,
   Params,
   Frf,
+  FrfLarge,
   Sweep10Hz,
   SweepDynamic,
   Metric,
@@ -50,8 +52,8 @@ struct ClaimPlan {
   bool full = false;   // a kind the planner does not know: run the whole study
   bool lanes = true;   // the grids' runs in SIMD lanes (with_lanes)
   std::vector<SweepRequest> sweeps_10Hz, sweeps_dynamic;  // one per (current, frequency)
-  bool frf = false, track = false, ablate = false, params = false;
-  FrfRequest frf_request;
+  bool frf = false, frf_large = false, track = false, ablate = false, params = false;
+  FrfRequest frf_request, frf_large_request;
   TrackRequest track_request;
   AblateRequest ablate_request;
   ParamsVsTemperatureRequest params_request;
@@ -72,7 +74,7 @@ ClaimPlan with_lanes(ClaimPlan p, bool lanes);
 
 struct PartResults {
   std::vector<SweepResult> sweeps_10Hz, sweeps_dynamic;
-  FrfResult frf;
+  FrfResult frf, frf_large;
   TrackResult track;
   AblateResult ablate;
   ParamsVsTemperatureResult params;

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 
+#include "experiments/claim_plan.hpp"
 #include "experiments/lane_runs.hpp"
 #include "gmasim/errors.hpp"
 
@@ -84,9 +85,11 @@ ReproduceResult run_reproduce(const Model& m, const ReproduceOptions& o,
   sd.frequencies_Hz = {100, 200, 400};
   r.sweep_dynamic = run_sweep(m, sd);
   next();
-  FrfRequest& fr = r.frf_request;
-  if (o.quick) fr.points = 12;
-  r.frf = run_frf(m, fr);
+  const detail::StudyRequests g = detail::reproduce_requests(o.quick);
+  r.frf_request = g.frf;
+  r.frf = run_frf(m, r.frf_request);
+  r.frf_large_request = g.frf_large;
+  r.frf_large = run_frf(m, r.frf_large_request);
   next();
   TrackRequest& tr = r.track_request;
   tr.threads = o.threads;
@@ -105,7 +108,6 @@ ReproduceResult run_reproduce(const Model& m, const ReproduceOptions& o,
   r.loops = hysteresis_loops(m, o.threads, o.lanes);
   r.claims = score_claims(r, o.claims ? *o.claims : builtin_claims());
   mark_fitted(r.claims, m.spec);
-  r.trends = trend_checks(r.claims);
   next();
   r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
@@ -172,64 +174,6 @@ void mark_fitted(std::vector<Claim>& claims, const ModelSpec& spec) {
                       spec.source, spec.line_of("calibration.fitted_claims"), id));
     it->fitted = true;
   }
-}
-
-namespace {
-
-double slope(const std::vector<double>& x, const std::vector<double>& y) {
-  const double n = static_cast<double>(x.size());
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    sx += x[i];
-    sy += y[i];
-    sxx += x[i] * x[i];
-    sxy += x[i] * y[i];
-  }
-  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
-}
-
-int sign_of(double v) { return v > 0 ? 1 : (v < 0 ? -1 : 0); }
-
-}  // namespace
-
-std::vector<TrendCheck> trend_checks(const std::vector<Claim>& claims) {
-  std::vector<TrendCheck> out;
-  for (const char* kind : {"stroke_drop_pct", "hysteresis_drop_pct", "flux_drop_pct"}) {
-    TrendCheck t;
-    t.kind = kind;
-    for (const auto& c : claims) {
-      if (c.kind != kind || !c.applicable || !std::isfinite(c.condition.current_pp_A)) continue;
-      if (t.what.empty()) t.what = c.claim.substr(0, c.claim.find(','));
-      t.currents_pp_A.push_back(c.condition.current_pp_A);
-      t.paper.push_back(c.paper);
-      t.ours.push_back(c.ours);
-    }
-    if (t.currents_pp_A.size() < 2) continue;
-    t.paper_slope = slope(t.currents_pp_A, t.paper);
-    t.ours_slope = slope(t.currents_pp_A, t.ours);
-    t.pass = std::isfinite(t.ours_slope) && sign_of(t.paper_slope) == sign_of(t.ours_slope);
-    out.push_back(std::move(t));
-  }
-  return out;
-}
-
-std::string trends_markdown(const std::vector<TrendCheck>& trends) {
-  if (trends.empty()) return "";
-  std::string md =
-      "\n### Trends across current (beside the claims, not counted)\n\n"
-      "The sign of the least-squares slope against current of the paper's four values and of "
-      "ours.\n\n| trend | currents (A) | paper | ours | paper slope | our slope | result |\n"
-      "|---|---|---|---|---|---|---|\n";
-  auto list = [](const std::vector<double>& v) {
-    std::string s;
-    for (double x : v) s += (s.empty() ? "" : " / ") + fmt::format("{:.3g}", x);
-    return s;
-  };
-  for (const auto& t : trends)
-    md += fmt::format("| {} | {} | {} | {} | {:+.3g} /A | {:+.3g} /A | {} |\n", t.what,
-                      list(t.currents_pp_A), list(t.paper), list(t.ours), t.paper_slope,
-                      t.ours_slope, t.pass ? "PASS" : "FAIL");
-  return md;
 }
 
 namespace {

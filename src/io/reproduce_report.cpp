@@ -99,7 +99,6 @@ std::string report_markdown(const ReproduceResult& r, const Figures& fig) {
       "## Claims\n\nOne row per number of the paper that READING-NOTES lists, beside ours "
       "(`claims.csv`, `claims.json`).\n\n";
   md += claims_markdown(r.claims);
-  md += trends_markdown(r.trends);
   md += fig("claims",
             "Every applicable claim: ours / paper, green when it passes, red when it fails");
   md += "\n## Temperature sweep at 10 Hz (Fig. 12-14)\n\n";
@@ -214,7 +213,6 @@ void write_reproduction_doc(const ReproduceResult& r, const std::vector<Compared
       "that decides "
       "pass or fail. Claims that need the paper's measurements are marked n/a.\n\n";
   md += claims_markdown(r.claims);
-  md += trends_markdown(r.trends);
   // Every failing claim with its physical explanation (--doc-notes).
   std::string why;
   for (const auto& c : r.claims) {
