@@ -42,7 +42,9 @@ sed 's/^coil_turns = 720.0 /coil_turns = 7.2e9 /' "$(dirname "$0")/../../models/
 check "divergence" 3 "diverged at t = 0.001000000 s in rod1: H" "$B" simulate --model "$T/coil.toml" --waveform-kind step --level 1e-6 --step-to 1000 --step-time 0.001 --duration 0.002 --out "$T/d"
 grep -q '"status": "diverged"' "$T/d/metrics.json" && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: diverged metrics"; }
 check "reproduce quick" 0 "applicable claims pass" "$B" reproduce --quick --no-figures --out "$T/r"
-[[ -s "$T/r/report.md" && $(grep -c '^stroke_drop_\|^hysteresis_drop_\|^flux_drop_' "$T/r/claims.csv") -eq 12 ]] && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: reproduce outputs"; }
+[[ -s "$T/r/report.md" && $(grep -cE '^(stroke|hysteresis|flux)_drop_[0-9]+A,' "$T/r/claims.csv") -eq 12 &&
+   $(grep -cE '^(stroke|hysteresis|flux)_drop_slope,' "$T/r/claims.csv") -eq 3 &&
+   $(grep -c '^resonance_amplitude,' "$T/r/claims.csv") -eq 1 ]] && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: reproduce outputs"; }
 grep -q '| first resonant frequency |' "$T/r/report.md" && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: claims table in report"; }
 # --set on every command; model save writes what it ran.
 check "set on simulate" 0 "with --set material.Ms_A_per_m=7e5" "$B" simulate --set material.Ms_A_per_m=7e5 --periods 1 --out "$T/set"
