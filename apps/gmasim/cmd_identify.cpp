@@ -393,10 +393,12 @@ void add_refine_options(CLI::App* sub, IdentifyArgs& a) {
 
 // identify: how each candidate is simulated and compared.
 void add_objective_options(CLI::App* sub, ObjectiveSettings& s) {
-  sub->add_option("--dt", s.dt_s, "Simulation time step [s]; 0: period / --steps-per-period")
+  sub->add_option("--dt", s.dt_s,
+                  "Time step of the measured records [s]; 0: period / --steps-per-period (scalar "
+                  "targets take the claims' step of gmasim reproduce: T/2000, at most 25 us)")
       ->capture_default_str();
   sub->add_option("--steps-per-period", s.steps_per_period,
-                  "Time steps per period of periodic conditions and targets")
+                  "Time steps per period of periodic measured records")
       ->capture_default_str();
   sub->add_option("--quasi-static-increments", s.quasi_static_increments,
                   "Quasi-static records: increments of the drive over its whole range")
@@ -405,7 +407,8 @@ void add_objective_options(CLI::App* sub, ObjectiveSettings& s) {
                   "Weight of the flux_T residuals of files that have them (0: ignore flux)")
       ->capture_default_str();
   sub->add_option("--target-periods", s.target_periods,
-                  "Periods simulated for scalar targets (the last is measured)")
+                  "Periods simulated for scalar targets (the last is measured; 3, as gmasim "
+                  "reproduce's sweeps)")
       ->capture_default_str();
 }
 

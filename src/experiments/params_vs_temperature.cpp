@@ -55,12 +55,14 @@ void check_request(const ParamsVsTemperatureRequest& r) {
     SimulationSettings s;
     s.waveform = biased_sine(pp, r.frequency_Hz, r.current_min_A);
     s.periods = r.periods;
+    s.dt_s = r.dt_s;
     validate(s);
   }
   {
     SimulationSettings s;
     s.waveform = biased_sine(r.current_pp_A, r.frequency_Hz, r.current_min_A);
     s.periods = r.periods;
+    s.dt_s = r.dt_s;
     validate(s);
   }
 }
@@ -71,6 +73,7 @@ SimulationSettings point_settings(const ParamsVsTemperatureRequest& r, double T,
   s.temperature_C = T;
   s.waveform = biased_sine(pp, r.frequency_Hz, r.current_min_A);
   s.periods = r.periods;
+  s.dt_s = r.dt_s;
   return s;
 }
 

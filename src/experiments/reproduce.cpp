@@ -70,37 +70,36 @@ ReproduceResult run_reproduce(const Model& m, const ReproduceOptions& o,
   auto next = [&]() {
     if (progress) progress(++stage, stages);
   };
+  // The study's requests, one definition with the claim planner's (claim_plan.cpp).
+  const detail::StudyRequests g = detail::reproduce_requests(o.quick);
   SweepRequest& s10 = r.sweep_10Hz_request;
+  s10 = g.sweep_10Hz;
   s10.threads = o.threads;
   s10.lanes = o.lanes;
-  if (o.quick) s10.temperatures_C = {20, 40, 70};
   r.sweep_10Hz = run_sweep(m, s10);
   next();
   SweepRequest& sd = r.sweep_dynamic_request;
+  sd = g.sweep_dynamic;
   sd.threads = o.threads;
   sd.lanes = o.lanes;
-  sd.temperatures_C =
-      o.quick ? std::vector<double>{20, 70} : std::vector<double>{20, 30, 40, 50, 60, 70};
-  sd.currents_pp_A = {6, 8};
-  sd.frequencies_Hz = {100, 200, 400};
   r.sweep_dynamic = run_sweep(m, sd);
   next();
-  const detail::StudyRequests g = detail::reproduce_requests(o.quick);
   r.frf_request = g.frf;
   r.frf = run_frf(m, r.frf_request);
   r.frf_large_request = g.frf_large;
   r.frf_large = run_frf(m, r.frf_large_request);
   next();
   TrackRequest& tr = r.track_request;
+  tr = g.track;
   tr.threads = o.threads;
-  if (o.quick) tr.temperatures_C = {20, 40, 70};
   r.track = run_track(m, tr);
   next();
+  r.ablate_request = g.ablate;
   r.ablate_request.lanes = o.lanes;
   r.ablate = run_ablate(m, r.ablate_request);
   next();
   ParamsVsTemperatureRequest& pr = r.params_request;
-  if (o.quick) pr.temperatures_C = {20, 70, 150};
+  pr = g.params;
   pr.lanes = o.lanes;
   r.params = run_params_vs_temperature(m, pr);
   next();

@@ -91,10 +91,14 @@ std::vector<std::vector<State>> StartCache::make_in_lanes(
   return extra;
 }
 
+// A scalar target's run takes the claims' time step (claim_dt: the step gmasim reproduce
+// scores the claims with, issue 37's "one numerics"), not the records' --dt or
+// --steps-per-period, and whole steps per period as simulate() makes them.
 SineGrid sine_target_grid(const SineRun& run, const ObjectiveSettings& s) {
   const double per = 1.0 / run.f;
   SineGrid g;
-  g.per_period = steps_to_resolve(per / objective_step(s, per), 8, "steps per period");
+  g.per_period =
+      steps_to_resolve(per / claim_dt(biased_sine(run.pp, run.f, run.min)), 8, "steps per period");
   const long periods = std::max(1L, checked_count(s.target_periods, 1e4, "target periods"));
   g.grid = StepGrid::uniform(0.0, per / static_cast<double>(g.per_period),
                              static_cast<double>(periods) * static_cast<double>(g.per_period),

@@ -59,4 +59,9 @@ double auto_dt(const Waveform& w) {
   }
 }
 
+double claim_dt(const Waveform& w) {
+  if (w.kind != WaveformKind::BiasedSine) return auto_dt(w);
+  return std::min(kClaimMaxDt_s, w.period_s() / kStepsPerPeriod);
+}
+
 }  // namespace gmasim

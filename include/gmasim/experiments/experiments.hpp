@@ -333,6 +333,7 @@ struct ParamsVsTemperatureRequest {
   double current_pp_A = 8.0, frequency_Hz = 10.0;  // the operating point of Fig. 19
   std::vector<double> retention_currents_pp_A{6, 8, 10, 12};
   double periods = 3.0;
+  double dt_s = 0.0;  // 0: auto_dt (gmasim reproduce gives claim_dt's step)
   double current_min_A = -3.0;
   int threads = 0;
   // The runs advance together in SIMD lanes where the model allows (AblateRequest::lanes).

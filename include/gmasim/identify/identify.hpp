@@ -196,10 +196,15 @@ FitSpec parse_fit_spec(const std::string& toml_text, const std::string& source_n
 // Objective
 // =======================================================================================
 struct ObjectiveSettings {
-  double dt_s = 0.0;                // fixed time step; 0: the rules below
-  double steps_per_period = 500.0;  // periodic conditions and targets: dt = period / this
+  // The measured records' step: dt_s if > 0, else period / steps_per_period. The scalar
+  // targets take the claims' step (claim_dt, gmasim/simulate/simulate.hpp) whatever these say,
+  // so that the fit computes each claim as gmasim reproduce scores it (issue 37).
+  double dt_s = 0.0;                // fixed time step of the records; 0: the rule below
+  double steps_per_period = 500.0;  // periodic records: dt = period / this
   double flux_weight = 0.0;         // weight of the flux_T residuals (files that have them)
-  double target_periods = 2.0;      // run length of the scalar-target simulations
+  // Run length of the scalar-target simulations [periods]: 3, the periods of gmasim
+  // reproduce's sweeps and 20-150 degC runs (SweepRequest, ParamsVsTemperatureRequest).
+  double target_periods = 3.0;
   // Quasi-static records: the drive (current or field) moves in at most this many equal
   // increments over its whole range min..max; each sample-to-sample change is split into
   // ceil(|change| / (range / this)) quasi_static_step calls. The loop converges at second
