@@ -29,13 +29,16 @@ double rel(double a, double b, double floor = 1e-300) {
 }
 
 // Compensate: each temperature's root search in lock step, its runs in lanes, against the
-// searches with simulate(). Observed: the same evaluations, drives within 1.5e-15 relative,
-// strokes (the target's reference run included) 2e-14; tolerance 2e-13. The lanes' result does
+// searches with simulate(). Observed: the same evaluations, drives within 1e-13 relative,
+// strokes (the target's reference run included) 5.7e-14 (issue 37's model at 5 A; 1.5e-15 and
+// 2e-14 for issue 18's at 4 A); tolerance 1e-12. The lanes' result does
 // not depend on the thread count (bit for bit).
 TEST(LaneUsers, CompensateSearchesMatchTheScalarSearches) {
   CompensateRequest r;
   r.temperatures_C = {20.0, 90.0, 130.0};
-  r.reference_current_pp_A = 4.0;
+  // 5 A: the model of issue 37's refit needs a 1.40 times larger drive at 90 degC (at 4 A its
+  // stroke hardly changes there, gain 0.98, and a search's last step flips between the paths)
+  r.reference_current_pp_A = 5.0;
   r.periods = 2.0;
   r.dt_s = 4e-5;
   r.threads = 2;
@@ -45,7 +48,7 @@ TEST(LaneUsers, CompensateSearchesMatchTheScalarSearches) {
   r.lanes = false;
   r.threads = 2;
   const CompensateResult b = run_compensate(mdma(), r);
-  EXPECT_LE(rel(a.target_stroke_um, b.target_stroke_um), 2e-13);
+  EXPECT_LE(rel(a.target_stroke_um, b.target_stroke_um), 1e-12);
   ASSERT_EQ(a.points.size(), b.points.size());
   double worst_x = 0.0, worst_s = 0.0;
   for (std::size_t i = 0; i < a.points.size(); ++i) {
@@ -61,8 +64,8 @@ TEST(LaneUsers, CompensateSearchesMatchTheScalarSearches) {
     EXPECT_EQ(p.stroke_um, one.points[i].stroke_um);
     EXPECT_EQ(p.evaluations, one.points[i].evaluations);
   }
-  EXPECT_LE(worst_x, 2e-13);
-  EXPECT_LE(worst_s, 2e-13);
+  EXPECT_LE(worst_x, 1e-12);
+  EXPECT_LE(worst_s, 1e-12);
   EXPECT_GT(a.points[1].gain, 1.02);  // the search moved the hot drive
   std::printf("compensate lanes vs scalar: drive %.3g, strokes %.3g relative\n", worst_x, worst_s);
 }

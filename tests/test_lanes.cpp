@@ -459,8 +459,10 @@ TEST(Lanes, ObjectiveResidualsMatchTheScalarRuns) {
 // (the sine runs' start states, the modulus target's state at rest, the first resonance's bias
 // ramp: make_states; then the bias point's DC settling in the eighth lane beside the seven
 // sines) against one run_sine / make_state / settle_at_bias each, at the start and at a point
-// away from it. Observed: residuals (% of each target's scale) 9.5e-12 % apart, tolerance
-// 1e-10 %; the targets that read nothing but a ramp (modulus: E_G at rest; first resonance: the
+// away from it. Observed: residuals (% of each target's scale) 2.05e-10 % apart, tolerance
+// 2e-9 % (9.5e-12 % before issue 37, whose scales are the claims' tolerances, up to 4.4 times
+// smaller, and whose runs take the claims' step, 25 us for 200 us, over 3 periods for 2: the
+// same relative agreement of the targets in residuals up to 35 times larger); the targets that read nothing but a ramp (modulus: E_G at rest; first resonance: the
 // settled, linearised bias point) 1.6e-15 to 1.1e-14 relative, tolerance 1.2e-13; any target
 // 1.9e-12 to 2.5e-12, tolerance 2e-11.
 TEST(Lanes, TargetRunsAndRampsMatchTheScalarPath) {
@@ -482,7 +484,7 @@ TEST(Lanes, TargetRunsAndRampsMatchTheScalarPath) {
     ASSERT_TRUE(scalar.residuals(u.data(), rb.data()));
     for (std::size_t i = 0; i < ra.size(); ++i) {
       worst = std::max(worst, std::fabs(ra[i] - rb[i]));
-      EXPECT_NEAR(ra[i], rb[i], 1e-10) << "point " << point << ", residual " << i;
+      EXPECT_NEAR(ra[i], rb[i], 2e-9) << "point " << point << ", residual " << i;
       EXPECT_GT(std::fabs(ra[i]), 1e-3) << "residual " << i << " is not a target's error";
     }
     const auto ta = batched.target_fits(u), tb = scalar.target_fits(u);

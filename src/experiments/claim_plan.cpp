@@ -229,7 +229,7 @@ StudyRequests reproduce_requests(bool quick) {
   StudyRequests g;
   if (quick) g.sweep_10Hz.temperatures_C = {20, 40, 70};
   // The claims' time step (claim_dt, issue 37's "one numerics": what gmasim identify's scalar
-  // targets take): 25 us at 10 Hz; from 20 Hz up it is the automatic rule's (dt_s = 0).
+  // targets take): 25 us at 10 Hz; from 50 Hz up it is the automatic rule's (dt_s = 0).
   g.sweep_10Hz.dt_s = claim_dt(biased_sine(1.0, g.sweep_10Hz.frequencies_Hz.front()));
   g.params.dt_s = claim_dt(biased_sine(1.0, g.params.frequency_Hz));
   g.sweep_dynamic.temperatures_C =

@@ -89,7 +89,7 @@ inline constexpr double kMaxDt_s = 10e-6;
 double auto_dt(const Waveform& w);
 
 // The claims' time step (issue 37, "one numerics"): the rule above with its cap at
-// kClaimMaxDt_s instead of kMaxDt_s, so 25 us at 10 Hz and auto_dt()'s step from 20 Hz up.
+// kClaimMaxDt_s instead of kMaxDt_s, so 25 us at 10 Hz and auto_dt()'s step from 50 Hz up.
 // `gmasim reproduce`'s 10 Hz sweep and 20-150 degC runs and `gmasim identify`'s scalar
 // targets take it, so that the fit and the score compute every claim alike. Its error on each
 // claim is below a tenth of the claim's tolerance (docs/model.md, "The claims' time step"),
