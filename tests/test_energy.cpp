@@ -122,7 +122,9 @@ TEST(Energy, EveryTermIsBookedFromItsOwnLaw) {
   const std::vector<std::pair<const char*, EnergyBalance>> windows = {
       {"rising half period", ledger(mdma(), 20.0, 12.0, 100.0, 2L * spp, 2L * spp + spp / 2, spp)},
       {"whole period", ledger(mdma(), 20.0, 12.0, 100.0, 2L * spp, 3L * spp, spp)},
-      {"quarter period at 3 kHz", ledger(mdma(), 20.0, 2.0, 3000.0, 8000, 8500, 2000)}};
+      // 6 kHz: the rods' kinetic energy is 22 % of the mechanical input over the quarter
+      // period on issue 37's model (3 kHz gave 5 %, below the 10 % this test needs to see it)
+      {"quarter period at 6 kHz", ledger(mdma(), 20.0, 2.0, 6000.0, 8000, 8500, 2000)}};
   std::map<std::string, int> checked;
   for (const auto& [where, e] : windows) {
     ASSERT_LT(e.magnetic_residual_rel, 1e-6) << where;

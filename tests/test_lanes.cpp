@@ -462,9 +462,10 @@ TEST(Lanes, ObjectiveResidualsMatchTheScalarRuns) {
 // away from it. Observed: residuals (% of each target's scale) 2.05e-10 % apart, tolerance
 // 2e-9 % (9.5e-12 % before issue 37, whose scales are the claims' tolerances, up to 4.4 times
 // smaller, and whose runs take the claims' step, 25 us for 200 us, over 3 periods for 2: the
-// same relative agreement of the targets in residuals up to 35 times larger); the targets that read nothing but a ramp (modulus: E_G at rest; first resonance: the
-// settled, linearised bias point) 1.6e-15 to 1.1e-14 relative, tolerance 1.2e-13; any target
-// 1.9e-12 to 2.5e-12, tolerance 2e-11.
+// same relative agreement of the targets in residuals up to 35 times larger); the targets that read
+// nothing but a ramp (modulus: E_G at rest; first resonance: the settled, linearised bias
+// point) 1.6e-15 to 1.1e-14 relative, tolerance 1.2e-13; any target 1.9e-12 to 2.5e-12, tolerance
+// 2e-11.
 TEST(Lanes, TargetRunsAndRampsMatchTheScalarPath) {
   const std::string src = GMASIM_SOURCE_DIR;
   const ModelSpec start = load_model_spec(src + "/calibration/start/consistent.toml");

@@ -177,9 +177,9 @@ TEST(Compensate, SolvedDriveRestoresTheTargetStrokeInEveryMode) {
                       gmasim::CompensationAdjust::Scale}) {
     gmasim::CompensateRequest r;
     r.temperatures_C = {20.0, 90.0};
-    // 4 A p-p: below the built-in model's saturation (8 A already gives 95 % of its 12 A
-    // stroke, which no current restores at 90 degC: compensate reports it unreachable).
-    r.reference_current_pp_A = 4.0;
+    // 5 A p-p: below the built-in model's saturation (at 6 A the 90 degC stroke needs 30 A;
+    // at 4 A issue 37's model strokes more when hot, so nothing is lost to restore).
+    r.reference_current_pp_A = 5.0;
     r.adjust = adjust;
     r.periods = 2.0;
     r.tolerance_um = 1e-3;
@@ -190,7 +190,7 @@ TEST(Compensate, SolvedDriveRestoresTheTargetStrokeInEveryMode) {
     ASSERT_TRUE(hot.reachable && !hot.diverged) << hot.error;
     EXPECT_NEAR(hot.stroke_um, res.target_stroke_um, r.tolerance_um);
     EXPECT_LT(hot.uncompensated_stroke_um, res.target_stroke_um - 1.0);  // it was lost
-    EXPECT_GT(hot.gain, 1.02);  // observed 1.038 or more (the built-in model of 2026-11-26)
+    EXPECT_GT(hot.gain, 1.02);  // the drive grew (amplitude: 1.40 on issue 37's model)
     // The drive, rerun independently, gives that stroke.
     gmasim::SimulationSettings s;
     s.temperature_C = 90.0;

@@ -59,7 +59,7 @@ check "saved option" 0 "options.magnetic_state +printed" "$B" model show --model
 check "self-heating" 0 "energy: in .* J = stored .* J \+ to ambient" "$B" simulate --self-heating --set thermal_network.coil_heat_capacity_J_per_K=2 --periods 10 --dt 5e-5 --record-every 50 --out "$T/heat"
 [[ -s "$T/heat/self_heating.csv" ]] && grep -q '"self_heating"' "$T/heat/metrics.json" && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: self-heating outputs"; }
 check "thermal step too long" 2 "fastest time constant" "$B" simulate --self-heating --set thermal_network.coil_heat_capacity_J_per_K=0.01 --periods 2 --out "$T/heat2"
-check "compensate" 0 "70.0 +4\.[0-9]+ +-3.0000" "$B" compensate --temperatures 20,70 --reference-current-pp 4 --no-track --periods 2 --out "$T/comp"
+check "compensate" 0 "70.0 +5\.[0-9]+ +-3.0000" "$B" compensate --temperatures 20,70 --reference-current-pp 5 --no-track --periods 2 --out "$T/comp"
 check "compensate bad list" 2 "temperatures must increase" "$B" compensate --temperatures 70,20 --no-track --out "$T/comp2"
 # Inverse-model feed-forward (issue 20): the evaluation's table and the refused words.
 check "feedforward" 0 "100.0 +20.0 +pid_inverse" "$B" track --feedforward inverse --mismatch none --controllers pid,pid_inverse --temperatures 20 --amplitudes 20 --frequencies 100 --out "$T/ff"
