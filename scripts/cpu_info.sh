@@ -19,7 +19,7 @@ if [[ ! -r $info ]]; then
   echo "cpu: unknown ($info not readable), $(uname -m)"
   exit 0
 fi
-field() { grep -m1 "^$1[[:space:]]*:" "$info" | cut -d: -f2- | sed 's/^ *//'; }
+field() { { grep -m1 "^$1[[:space:]]*:" "$info" || true; } | cut -d: -f2- | sed 's/^ *//'; }
 flags=" $(field flags) "
 has() { [[ $flags == *" $1 "* ]]; }
 if has fma && has avx2; then libm=fma
@@ -30,4 +30,4 @@ if [[ ${1:-} == --libm ]]; then echo "$libm"; exit 0; fi
 simd=""
 for f in avx512f avx2 fma sse4_2; do has "$f" && simd+="$f "; done
 echo "cpu: $(field 'model name') ($(field vendor_id), family $(field 'cpu family') model $(field model)," \
-  "$(grep -c '^processor' "$info") cores, $(uname -m)); SIMD flags: ${simd% }; glibc libm path: $libm"
+  "$(grep -c '^processor' "$info" || true) cores, $(uname -m)); SIMD flags: ${simd% }; glibc libm path: $libm"
