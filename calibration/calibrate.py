@@ -414,19 +414,19 @@ def main(argv=None) -> int:
             raise CalibrationError(f"gmasim not found at {a.bin} (build it, or pass --bin / set GMASIM_BIN)")
         if a.check and (a.smoke or a.write_reference or a.work):
             raise CalibrationError("--check goes alone (not with --smoke, --write-reference or --work)")
-        if (a.smoke and not a.write_reference) or a.check:
+        if a.smoke and a.readings:
+            raise CalibrationError("--smoke runs the [smoke] reading of readings.toml; name no readings")
+        known = {r["name"]: r for r in cfg["reading"]}
+        for n in a.readings:
+            if n not in known:
+                raise CalibrationError(f"unknown reading {n}; readings.toml lists: {', '.join(known)}")
+        if (a.smoke and not a.write_reference) or a.check:  # after the usage checks: 2 before 77
             reason = skip_reason("--smoke" if a.smoke else "--check")
             if reason is not None:
                 print(reason)
                 return SKIP
         if a.smoke:
-            if a.readings:
-                raise CalibrationError("--smoke runs the [smoke] reading of readings.toml; name no readings")
             return smoke(a.bin, cfg, pathlib.Path(a.work) if a.work else None, a.write_reference)
-        known = {r["name"]: r for r in cfg["reading"]}
-        for n in a.readings:
-            if n not in known:
-                raise CalibrationError(f"unknown reading {n}; readings.toml lists: {', '.join(known)}")
         if a.check:
             return check(a.bin, cfg, a.readings)
         todo = [known[n] for n in a.readings] if a.readings else cfg["reading"]

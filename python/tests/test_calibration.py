@@ -222,3 +222,12 @@ def test_fit_and_score_compute_each_fitted_claim_alike():
         assert t["simulated"] == pytest.approx(ours, rel=5e-11, abs=0), cid
         compared += 1
     assert compared == 10
+
+
+def test_a_usage_error_is_reported_before_the_cpu_skip(monkeypatch, tmp_path, capsys):
+    fake_bin = tmp_path / "gmasim"
+    fake_bin.write_text("")
+    monkeypatch.setattr(calibrate, "libm_path", lambda: "generic")
+    assert calibrate.main(["--check", "no_such_reading", "--bin", str(fake_bin)]) == 2
+    assert calibrate.main(["--smoke", "consistent", "--bin", str(fake_bin)]) == 2
+    assert "SKIP" not in capsys.readouterr().out

@@ -211,7 +211,9 @@ void plan_metrics(ClaimPlan& p) {
              same(p.metric_points[k].frequencies_Hz[0], q.frequency_Hz)))
       ++k;
     if (k == p.metric_points.size()) {
-      SweepRequest r = d;  // the sweep's settings at one point, its own reference
+      // the sweep command's default settings at one point (the automatic step, not the
+      // claims' step of the study's 10 Hz sweep), its own reference
+      SweepRequest r = d;
       r.temperatures_C = {q.temperature_C};
       r.currents_pp_A = {q.current_pp_A};
       r.frequencies_Hz = {q.frequency_Hz};

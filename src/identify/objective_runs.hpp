@@ -64,8 +64,9 @@ struct SineMetrics {
   double stroke_um = 0, hysteresis_um = 0, B_pp_T = 0;
 };
 
-// A sine run's grid: steps_per_period steps per period (at least 8; dt_s of the settings
-// if given), target_periods periods. Throws InputError when it is too long.
+// A sine run's grid: the claims' step (claim_dt, as gmasim reproduce scores the claims; the
+// settings' dt_s and steps_per_period are the records'), whole steps per period (at least 8),
+// target_periods periods. Throws InputError when it is too long.
 struct SineGrid {
   StepGrid grid;
   long per_period = 0;
