@@ -187,6 +187,10 @@ struct RequestFields<ParamsVsTemperatureRequest> {
       current_min_row<R>(),
       field<R>("periods", "-", kPeriods, "--periods",
                "Periods per run [-]; statistics over the last", kCliMeta, GMASIM_REF(R, periods)),
+      field<R>("dt_s", "s", nonnegative(), "--dt",
+               "Time step [s]; 0 = automatic rule (T/2000, at most 10 us; gmasim reproduce "
+               "gives the claims' 25 us at 10 Hz)",
+               All, GMASIM_REF(R, dt_s)),
       threads_row<R>(Cli),
   };
 };
