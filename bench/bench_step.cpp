@@ -18,22 +18,20 @@ using bench::mdma;
 
 // One step of the built-in model (consistent magnetic state: a Newton solve on the rods'
 // fields) or, with Arg(1), of the printed reading.
+// Its instructions per step are counted by gmasim_step_count (bench/count: the same run, a fixed
+// 2000 steps, under callgrind; scripts/performance.py --sections callgrind).
 void BM_FullModelStep(benchmark::State& bs) {
-  bench::step_loop(bs, bs.range(0) == 0 ? mdma() : bench::mdma_printed(), 70.0,
-                   biased_sine(8.0, 400.0));
+  const bench::StepRun r = bench::full_model_step_run(bs.range(0) == 1);
+  bench::step_loop(bs, r.m, r.temperature_C, r.w);
 }
 BENCHMARK(BM_FullModelStep)->Arg(0)->Arg(1);
-
-// The same steps, exactly 2000 of them (one 400 Hz period at the automatic dt of 1.25 us) from
-// make_state: a fixed amount of work, for counting the instructions of step() under callgrind
-// (scripts/performance.py --sections callgrind), where the timed loop's iteration count varies.
-BENCHMARK(BM_FullModelStep)->Name("BM_FullModelStepCount")->Arg(0)->Arg(1)->Iterations(2000);
 
 // The same step of the built-in model with the energy ledgers booked (gmasim/model/energy.hpp:
 // every branch of the circuit solved, each rod's dissipation along the step's path and its
 // oscillator's power by Gauss-Legendre), against BM_FullModelStep/0 (issue 18).
 void BM_FullModelStepWithLedger(benchmark::State& bs) {
-  bench::step_loop(bs, mdma(), 70.0, biased_sine(8.0, 400.0), true);
+  const bench::StepRun r = bench::full_model_step_run(false);
+  bench::step_loop(bs, r.m, r.temperature_C, r.w, true);
 }
 BENCHMARK(BM_FullModelStepWithLedger);
 

@@ -51,6 +51,18 @@ class StepSequence {
   long k_ = 0;
 };
 
+// BM_FullModelStep's run, which gmasim_step_count counts: the built-in model (consistent
+// magnetic state) or, printed, the paper-as-printed reading, at 70 degC under the 8 A p-p
+// biased sine at 400 Hz (automatic dt 1.25 us: 2000 steps a period).
+struct StepRun {
+  const Model& m;
+  double temperature_C;
+  Waveform w;
+};
+inline StepRun full_model_step_run(bool printed) {
+  return {printed ? mdma_printed() : mdma(), 70.0, biased_sine(8.0, 400.0)};
+}
+
 // The production step, as step_fn.
 inline void production_step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
   step(m, c, s, in);

@@ -16,7 +16,7 @@ absolute times are printed for reference only. Sections:
   5. growth: rods (models/single_rod.toml, 1 rod, against models/mdma.toml, 3 rods), periods
      of a simulation, conditions (grid points) of a sweep.
   6. callgrind (not in the default --sections): the instructions of step() per step, consistent
-     state (BM_FullModelStepCount/0) against the printed reading (/1), counted by valgrind's
+     state (the run of BM_FullModelStep/0) against the printed reading (/1), counted by valgrind's
      callgrind over a fixed 2000 steps (gmasim_step_count, the same steps without Google
      Benchmark and without libhwy's load-time timer probe, issue 36), and their ratio; beside it the ns per step of
      BM_FullModelStep/0 and /1 from one run, interleaved (issue 22, item 1: /0 <= 500 ns and
@@ -148,7 +148,7 @@ def numpy_section(bindir: pathlib.Path, reps: int) -> str:
 
 
 STEP_SYMBOL = "gmasim::step(*"  # callgrind collects inside step() only (--toggle-collect)
-STEP_COUNTER = "gmasim_step_count"  # bench/count/step_count.cpp: BM_FullModelStepCount's steps
+STEP_COUNTER = "gmasim_step_count"  # bench/count/step_count.cpp: BM_FullModelStep's run, 2000 steps
 SKIP = 77  # the ctest step_instruction_budget's SKIP_RETURN_CODE
 # What valgrind prints when it cannot run a program on the CPU at hand (an instruction its
 # decoder does not know, e.g. valgrind 3.19 and RDTSCP on AMD Zen 5, or AVX-512 anywhere): the
@@ -162,18 +162,14 @@ class CannotCount(Exception):
 
 
 def cpu_model() -> str:
-    try:
-        for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return "unknown CPU"
+    """The machine as scripts/cpu_info.sh names it (model, vendor, SIMD flags, libm path)."""
+    res = subprocess.run(["bash", str(ROOT / "scripts/cpu_info.sh")], capture_output=True, text=True)
+    return res.stdout.strip().removeprefix("cpu: ") if res.returncode == 0 else "unknown CPU"
 
 
 def callgrind_step_instructions(exe: pathlib.Path, arg: int, work: pathlib.Path) -> tuple[float, int]:
     """(instructions per step, steps) inside step() for gmasim_step_count <arg> (the steps of
-    BM_FullModelStepCount/<arg>): the instructions callgrind collected while in step(), over
+    BM_FullModelStep/<arg>): the instructions callgrind collected while in step(), over
     the calls of step() it recorded. Raises CannotCount when valgrind cannot run the program on
     this CPU."""
     out = work / f"callgrind.{arg}.out"

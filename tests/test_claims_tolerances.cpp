@@ -109,6 +109,17 @@ void check_families(std::set<std::string>& covered) {
   }
 }
 
+// Each claim of `rules` has the rule's kind and number (field: the tolerance's bound or value).
+void expect_rules(const std::map<std::string, std::pair<ToleranceKind, double>>& rules,
+                  double ClaimTolerance::*field, std::set<std::string>& covered) {
+  for (const auto& [id, rule] : rules) {
+    const ClaimSpec& c = claim(id);
+    EXPECT_EQ(c.tolerance.kind, rule.first) << id;
+    EXPECT_EQ(c.tolerance.*field, rule.second) << id;
+    covered.insert(id);
+  }
+}
+
 // Rules 1, 4 and 5: the paper's own model errors, its bounds, the other readings.
 void check_errors_bounds_readings(std::set<std::string>& covered) {
   // Rule 1: the paper's own model error, section 4.5 (um, %) and section 4.4.2.
@@ -136,12 +147,7 @@ void check_errors_bounds_readings(std::set<std::string>& covered) {
       {"bandwidth", {ToleranceKind::GreaterThan, 2000.0}},
       {"design_bandwidth", {ToleranceKind::GreaterThan, 1000.0}},
       {"resonance_amplitude", {ToleranceKind::LessThan, 10.0}}};
-  for (const auto& [id, b] : bounds) {
-    const ClaimSpec& c = claim(id);
-    EXPECT_EQ(c.tolerance.kind, b.first) << id;
-    EXPECT_EQ(c.tolerance.bound, b.second) << id;
-    covered.insert(id);
-  }
+  expect_rules(bounds, &ClaimTolerance::bound, covered);
   const ClaimSpec& ra = claim("resonance_amplitude");
   EXPECT_EQ(ra.condition.current_pp_A, 2.0);  // +-1 A
   EXPECT_EQ(ra.condition.temperature_C, 70.0);
@@ -152,12 +158,7 @@ void check_errors_bounds_readings(std::set<std::string>& covered) {
       {"EG_rise_150C", {ToleranceKind::Absolute, 50.0}},
       {"design_stroke", {ToleranceKind::Relative, 0.30}},
       {"thermal_model", {ToleranceKind::Relative, 0.01}}};
-  for (const auto& [id, r] : readings) {
-    const ClaimSpec& c = claim(id);
-    EXPECT_EQ(c.tolerance.kind, r.first) << id;
-    EXPECT_EQ(c.tolerance.value, r.second) << id;
-    covered.insert(id);
-  }
+  expect_rules(readings, &ClaimTolerance::value, covered);
   for (const ClaimSpec* c : of_kind("track_error_growth_pct")) {
     EXPECT_EQ(c->tolerance.kind, ToleranceKind::Absolute) << c->id;
     EXPECT_EQ(c->tolerance.value, 10.0) << c->id;

@@ -1,6 +1,6 @@
-// gmasim_step_count: the steps of BM_FullModelStepCount/<0|1> (bench/bench_step.cpp), a fixed
-// 2000 of them, for counting the instructions of step() under valgrind's callgrind
-// (scripts/performance.py --step-budget, the ctest step_instruction_budget).
+// gmasim_step_count: the run of BM_FullModelStep/<0|1> (bench/bench_step.cpp), a fixed 2000
+// steps of it (one 400 Hz period), for counting the instructions of step() under valgrind's
+// callgrind (scripts/performance.py --step-budget, the ctest step_instruction_budget).
 //
 //   gmasim_step_count 0   the built-in model, consistent magnetic state
 //   gmasim_step_count 1   the paper-as-printed reading (models/mdma_printed.toml)
@@ -14,8 +14,9 @@
 // the constructor stores a resolution that only Highway's nanobenchmark reads, which nothing
 // here calls, and neither step() nor this program runs any Highway code. The test
 // step_count_replaces_highway_timer_probe checks that the dynamic linker binds the probe here.
-// The steps are the same StepSequence (bench/step_fixture.hpp) as BM_FullModelStepCount, and
-// callgrind collects inside step() only, so the count is the benchmark's.
+// The steps are the same StepSequence of full_model_step_run (bench/step_fixture.hpp) as
+// BM_FullModelStep's, and callgrind collects inside step() only, so the count is the
+// benchmark's.
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -34,10 +35,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: gmasim_step_count 0|1 (0: built-in model, 1: printed reading)\n");
     return 2;
   }
-  const bool printed = argv[1][0] == '1';
   try {
-    bench::StepSequence run(printed ? bench::mdma_printed() : bench::mdma(), 70.0,
-                            biased_sine(8.0, 400.0), false);
+    const bench::StepRun r = bench::full_model_step_run(argv[1][0] == '1');
+    bench::StepSequence run(r.m, r.temperature_C, r.w, false);
     auto step_fn = bench::production_step;
     constexpr int kSteps = 2000;  // one 400 Hz period at the automatic dt of 1.25 us
     for (int k = 0; k < kSteps; ++k) run.next(step_fn);
