@@ -97,6 +97,12 @@ def load_readings(path: pathlib.Path) -> dict:
         for key in ("start", "fit"):
             if not (HERE / r[key]).is_file():
                 raise CalibrationError(f"{path}: reading {r['name']}: {key} {HERE / r[key]} does not exist")
+        for key in ("set", "drop"):
+            if key in r and not (isinstance(r[key], list) and all(isinstance(v, str) for v in r[key])):
+                raise CalibrationError(f"{path}: reading {r['name']}: {key} must be a list of strings")
+        for v in r.get("set", []):
+            if "=" not in v:
+                raise CalibrationError(f"{path}: reading {r['name']}: set entry {v!r} is not name=value")
     if not names:
         raise CalibrationError(f"{path}: no [[reading]]")
     return cfg
@@ -135,8 +141,10 @@ def read_claims(path: pathlib.Path) -> dict:
         doc = json.load(f)
     rows = doc["tables"]["claims"]["rows"]
     applicable = [r for r in rows if r["result"] != "n/a"]
+    predicted = [r for r in applicable if not r["fitted"]]
     return {"pass": sum(1 for r in applicable if r["pass"] is True),
-            "applicable": len(applicable), "total": len(rows), "rows": rows}
+            "applicable": len(applicable), "total": len(rows), "rows": rows,
+            "predicted_pass": sum(1 for r in predicted if r["pass"] is True), "predicted": len(predicted)}
 
 
 def read_fit(path: pathlib.Path) -> dict:
@@ -146,11 +154,39 @@ def read_fit(path: pathlib.Path) -> dict:
             "parameters": {p["name"]: p["value"] for p in doc["parameters"]}}
 
 
+# A reading's own keys (not identify settings): `set`, the model changes of the reading applied
+# to its start model (gmasim identify --set, so the fitted model file carries them); `drop`, the
+# fit spec's [[parameter]] blocks it does not fit (they keep their start values).
+READING_KEYS = ("name", "start", "fit", "install", "set", "drop")
+
+
+def fit_spec_without(fit: pathlib.Path, drop: list[str], dest: pathlib.Path) -> pathlib.Path:
+    """The fit spec with the [[parameter]] blocks named in `drop` removed (a block runs from its
+    [[...]] line to the next one); every name must be a parameter of the spec."""
+    blocks, cur = [[]], None
+    for line in fit.read_text().splitlines(keepends=True):
+        if line.startswith("[["):
+            blocks.append([])
+        blocks[-1].append(line)
+    kept, dropped = [], set()
+    for b in blocks:
+        m = re.search(r'^name\s*=\s*"([^"]+)"', "".join(b), re.M) if b and b[0].startswith("[[parameter]]") else None
+        if m and m.group(1) in drop:
+            dropped.add(m.group(1))
+            continue
+        kept.append("".join(b))
+    missing = sorted(set(drop) - dropped)
+    if missing:
+        raise CalibrationError(f"{rel(fit)} has no [[parameter]] {', '.join(missing)} to drop")
+    dest.write_text(f"# {rel(fit)} without {', '.join(drop)} (calibrate.py, a reading's `drop`)\n" + "".join(kept))
+    return dest
+
+
 def calibrate(bin_: str, reading: dict, search: dict, out: pathlib.Path, quick: bool = False) -> dict:
     """identify + reproduce for one reading into out/<name>*; returns its scores."""
     name = reading["name"]
     settings = dict(search)
-    settings.update({k: v for k, v in reading.items() if k not in ("name", "start", "fit", "install")})
+    settings.update({k: v for k, v in reading.items() if k not in READING_KEYS})
     model = out / f"{name}.toml"
     report = out / f"{name}_report"
     scored = out / f"{name}_reproduce"
@@ -158,7 +194,11 @@ def calibrate(bin_: str, reading: dict, search: dict, out: pathlib.Path, quick: 
         fresh_dir(d)
     out.mkdir(parents=True, exist_ok=True)
     print(f"== {name}", file=sys.stderr)
-    run([bin_, "identify", "--model", rel(HERE / reading["start"]), "--fit", rel(HERE / reading["fit"]),
+    fit = HERE / reading["fit"]
+    if reading.get("drop"):
+        fit = fit_spec_without(fit, reading["drop"], report.parent / f"{name}_fit.toml")
+    sets = [a for v in reading.get("set", []) for a in ("--set", v)]
+    run([bin_, "identify", "--model", rel(HERE / reading["start"]), "--fit", rel(fit), *sets,
          "--out", rel(model), "--report", rel(report), *identify_flags(settings), "--no-plots", "--quiet"])
     run([bin_, "reproduce", "--model", rel(model), "--out", rel(scored), "--no-figures",
          *(["--quick", "--threads", "1"] if quick else [])], quiet=True)
@@ -188,7 +228,8 @@ def scores_of(out: pathlib.Path, name: str) -> dict | None:
         return None
     c, f = read_claims(claims), read_fit(fit)
     return {"reading": name, "claims_pass": c["pass"], "claims_applicable": c["applicable"],
-            "claims_total": c["total"], "fit_rms_pct": f["rms_pct"], "parameters": f["parameters"]}
+            "claims_total": c["total"], "predicted_pass": c["predicted_pass"], "predicted": c["predicted"],
+            "fit_rms_pct": f["rms_pct"], "parameters": f["parameters"]}
 
 
 def write_scores(cfg: dict, out: pathlib.Path, path: pathlib.Path) -> list[dict]:
@@ -196,9 +237,10 @@ def write_scores(cfg: dict, out: pathlib.Path, path: pathlib.Path) -> list[dict]
     rows = [s for s in (scores_of(out, r["name"]) for r in cfg["reading"]) if s]
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["reading", "claims_pass", "claims_applicable", "fit_rms_pct"])
+    w.writerow(["reading", "claims_pass", "claims_applicable", "predicted_pass", "predicted", "fit_rms_pct"])
     for s in rows:
-        w.writerow([s["reading"], s["claims_pass"], s["claims_applicable"], f"{s['fit_rms_pct']:.4g}"])
+        w.writerow([s["reading"], s["claims_pass"], s["claims_applicable"], s["predicted_pass"], s["predicted"],
+                    f"{s['fit_rms_pct']:.4g}"])
     tmp = path.with_suffix(".csv.tmp")
     tmp.write_text(buf.getvalue())
     os.replace(tmp, path)
@@ -433,13 +475,16 @@ def main(argv=None) -> int:
         out = HERE / "models"
         for r in todo:
             s = calibrate(a.bin, r, cfg.get("search", {}), out)
-            print(f"   {s['claims_pass']} of {s['claims_applicable']} applicable claims pass; "
+            print(f"   {s['claims_pass']} of {s['claims_applicable']} applicable claims pass "
+                  f"({s['predicted_pass']} of {s['predicted']} predicted); "
                   f"fit RMS {s['fit_rms_pct']:.4g} %", file=sys.stderr)
         rows = write_scores(cfg, out, HERE / "scores.csv")
-        print("ranking (most claims passed, then lowest fit RMS):")
-        for s in sorted(rows, key=lambda s: (-s["claims_pass"], s["fit_rms_pct"])):
-            print(f"  {s['reading']}: {s['claims_pass']} of {s['claims_applicable']}, "
-                  f"fit RMS {s['fit_rms_pct']:.4g} %")
+        # Readings are chosen by the claims they predict, not by those they were fitted to
+        # (issue 37): most predicted claims passed, then most claims, then the lowest fit RMS.
+        print("ranking (most predicted claims passed, then most claims, then lowest fit RMS):")
+        for s in sorted(rows, key=lambda s: (-s["predicted_pass"], -s["claims_pass"], s["fit_rms_pct"])):
+            print(f"  {s['reading']}: predicted {s['predicted_pass']} of {s['predicted']}, all "
+                  f"{s['claims_pass']} of {s['claims_applicable']}, fit RMS {s['fit_rms_pct']:.4g} %")
         return 0
     except (CalibrationError, OSError, KeyError, tomllib.TOMLDecodeError) as e:
         print(f"calibrate.py: {e}", file=sys.stderr)

@@ -116,10 +116,13 @@ void write_outputs(const IdentifyArgs& a, const IdentifyResult& r, const ModelSp
   p.report_dir = a.report;
   p.fitted_claims = fitted_claims(load_fit_spec(a.fit));
   // The start's own text: the file as read, with any --set values written into it.
-  const std::string start_text = a.model.sets.empty() ? start.text : model_toml(start, "--set");
+  // A --set of an option the file omits adds a line, so the lines are those of that text.
+  const bool set = !a.model.sets.empty();
+  const std::string start_text = set ? model_toml(start, "--set") : start.text;
+  const ModelSpec start_as_written = set ? parse_model_spec(start_text, start.source) : start;
   const fs::path out(a.out);
   if (out.has_parent_path()) ensure_output_dir(out.parent_path().string());
-  write_file_atomic(a.out, fitted_model_toml(start_text, start, r, p));
+  write_file_atomic(a.out, fitted_model_toml(start_text, start_as_written, r, p));
   ensure_output_dir(a.report);
   const fs::path dir(a.report);
   write_file_atomic((dir / "fit_report.json").string(), fit_report_json(r, p));

@@ -68,13 +68,14 @@ def test_committed_scores_agree_with_the_committed_outputs():
     with open(SOURCE_DIR / "calibration" / "scores.csv") as f:
         next(f)
         for line in f:
-            name, npass, napp, rms = line.strip().split(",")
-            rows[name] = (int(npass), int(napp), float(rms))
+            name, npass, napp, ppass, npred, rms = line.strip().split(",")
+            rows[name] = (int(npass), int(napp), int(ppass), int(npred), float(rms))
     assert rows, "scores.csv is empty"
-    for name, (npass, napp, rms) in rows.items():
+    for name, (npass, napp, ppass, npred, rms) in rows.items():
         s = calibrate.scores_of(out, name)
         assert s is not None, f"{name}: scores.csv lists it but its outputs are missing"
         assert (s["claims_pass"], s["claims_applicable"]) == (npass, napp)
+        assert (s["predicted_pass"], s["predicted"]) == (ppass, npred)
         assert s["fit_rms_pct"] == pytest.approx(rms, rel=1e-3)
     assert set(rows) <= {r["name"] for r in cfg["reading"]}
 

@@ -155,7 +155,9 @@ void rod_material(const Model& m, const RodModel& rod, const Conditions& c, cons
     throw InputError(fmt::format("{}: eq. (8) gives a non-positive resistivity {} ohm m at {} degC",
                                  src, rc.rho_ohm_m, T));
   rc.eddy_geometry_s_m_per_H =
-      eddy_time_constant(1.0, rc.r_outer_m, rc.r_inner_m, rod.k_j, rc.rho_ohm_m);
+      m.options.eddy_law == EddyLaw::Classical
+          ? classical_eddy_coefficient(rc.r_outer_m, rc.r_inner_m, rc.rho_ohm_m)
+          : eddy_time_constant(1.0, rc.r_outer_m, rc.r_inner_m, rod.k_j, rc.rho_ohm_m);  // eq. (7)
   rc.series_reluctance_per_H = m.options.magnetic_state == MagneticState::Consistent
                                    ? joint_reluctance(rod.joint_gap_m, rc.area_m2)
                                    : 0.0;

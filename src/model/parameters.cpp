@@ -376,6 +376,13 @@ constexpr OptionChoice kEq11Saturation[] = {
     {"reference", static_cast<int>(Eq11Saturation::Reference),
      "M normalised by M_s at T_ref: the strain follows the magnetisation"},
 };
+constexpr OptionChoice kEddyLaw[] = {
+    {"table4", static_cast<int>(EddyLaw::Table4),
+     "kappa = (r1^2 - r2^2)/(4 k_j rho) with Table 4's k_j, as printed"},
+    {"classical", static_cast<int>(EddyLaw::Classical),
+     "the classical quasi-static eddy field of a tube, section-averaged (r^2/(8 rho) for a solid "
+     "rod); k_j unused"},
+};
 
 const OptionDef kOptions[] = {
     {"stress_sign", false, kStressSign, OPTION(stress_sign),
@@ -394,6 +401,10 @@ const OptionDef kOptions[] = {
     {"magnetisation_law", false, kMagnetisationLaw, OPTION(magnetisation_law),
      "the hysteresis law of the rods (docs/model.md, \"Magnetisation laws\"); may be omitted",
      "jiles_atherton"},
+    {"eddy_law", false, kEddyLaw, OPTION(eddy_law),
+     "the eddy-current coefficient kappa of eq. (7) (docs/model.md, \"The eddy law\"); may be "
+     "omitted",
+     "table4"},
 };
 
 #undef OPTION

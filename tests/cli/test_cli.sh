@@ -83,6 +83,16 @@ if compgen -G "$(dirname "$B")/../python/gmasim/_gmasim*.so" >/dev/null; then
 else
   echo "skip: --plot (no Python module in this build)"
 fi
+# identify --set of an option the start file omits (it adds a line to the start's text): the
+# fitted model is written with the fitted values on their lines and carries the option.
+"$B" identify synthesize --out "$T/iddata2" --temperatures 20 --currents 8 --frequencies 10 \
+  --steps-per-period 100 --samples-per-period 50 >/dev/null
+check "identify --set of an omitted option" 0 "weighted RMS" "$B" identify --data "$T/iddata2/manifest.toml" \
+  --set options.eddy_law=classical --fit material.chi_m:8:50:log --out "$T/idset/m.toml" --islands 1 \
+  --population 8 --generations 1 --migrate-every 1 --no-refine --no-profile --steps-per-period 100 \
+  --threads 1 --no-plots
+ok "identify --set: option and fitted value in the model" grep -q '^eddy_law = "classical"' "$T/idset/m.toml"
+ok "identify --set: the fitted value on its line" grep -q '^chi_m = .*# identified' "$T/idset/m.toml"
 # The Freeze switches by their one set of names (kFreezeSwitches).
 check "simulate --freeze" 0 "stroke" "$B" simulate --periods 2 --temperature 70 --freeze mu_G,E_t --out "$T/fz"
 grep -q '"frozen": \["mu_G", "E_t"\]' "$T/fz/metrics.json" && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: frozen in metrics.json"; }

@@ -39,6 +39,12 @@ enum class MagneticState { Printed, Consistent };
 //   Reference:   M_s at T_r, i.e. lambda_s^T = lambda_s (M_s^T/M_s)^2: the strain is a function
 //                of the magnetisation alone (classical magnetoelastic scaling, docs/model.md).
 enum class Eq11Saturation { Temperature, Reference };
+// The eddy-current coefficient kappa of eq. (7), H_c - H = kappa dB/dt (docs/model.md, "The
+// eddy law"):
+//   Table4:    kappa = (r1^2 - r2^2)/(4 k_j rho) with Table 4's factor k_j, as printed;
+//   Classical: the quasi-static field of azimuthal eddy currents in a long tube of radii
+//              r2 < r1, averaged over its section (r1^2/(8 rho) for a solid rod); k_j unused.
+enum class EddyLaw { Table4, Classical };
 
 // Parsed once, by the loader or ModelSpec::set_options, from the words of the option table
 // (gmasim/model/parameters.hpp). The defaults are the built-in model's readings (a test holds them
@@ -53,6 +59,7 @@ struct Options {
   bool thermal_expansion_in_output = false;
   bool geometry_thermal_expansion = true;
   MagnetisationLaw magnetisation_law = MagnetisationLaw::JilesAtherton;
+  EddyLaw eddy_law = EddyLaw::Table4;
   bool operator==(const Options&) const = default;
 };
 

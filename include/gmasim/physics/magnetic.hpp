@@ -113,6 +113,25 @@ inline double eddy_time_constant(double mu_H_per_m, double r_outer_m, double r_i
   return mu_H_per_m * (r_outer_m * r_outer_m - r_inner_m * r_inner_m) / (4.0 * k_j * rho_ohm_m);
 }
 
+// Eq. (7)'s kappa by the classical eddy law (options.eddy_law = "classical"; not in the paper,
+// docs/model.md "The eddy law"). A long tube of radii r2 < r1 and resistivity rho in a uniform
+// axial dB/dt (flux in the bore neglected): Faraday gives E(r) = -(r^2 - r2^2)/(2 r) dB/dt, the
+// azimuthal current J = E/rho, and Ampere dH/dr = -J, so the field inside lags the surface field
+// by (dB/dt / rho) f(r), f(r) = (r1^2 - r^2)/4 - (r2^2/2) ln(r1/r). Its mean over the section:
+//   kappa = [ (r1^2 - r2^2)/8 - r2^2/4 + r2^4 ln(r1/r2) / (2 (r1^2 - r2^2)) ] / rho   [s m/H]
+// which is r1^2/(8 rho) for a solid rod (r2 = 0): the classical first-order eddy lag of a
+// cylinder, tau = mu r^2/(8 rho) (derived here; tests/test_eddy_law.cpp integrates f(r)).
+inline double classical_eddy_coefficient(double r_outer_m, double r_inner_m, double rho_ohm_m) {
+  const double a2 = r_outer_m * r_outer_m, b2 = r_inner_m * r_inner_m;
+  double k = 0.125 * (a2 - b2);
+  // The three terms cancel for a thin wall t: about (r/t)^2 ulp are lost (6e-11 relative at
+  // r/t = 100, tests/test_eddy_law.cpp); log1p keeps the logarithm exact.
+  if (b2 > 0.0)
+    k += -0.25 * b2 +
+         b2 * b2 * std::log1p((r_outer_m - r_inner_m) / r_inner_m) / (2.0 * (a2 - b2));
+  return k / rho_ohm_m;
+}
+
 // Eq. (7), consistent reading: the field the circuit applies to a rod, H_c = U/(k_f l), is
 // the material's field H plus the eddy-current field, which opposes the change of flux:
 //   H_c = H + kappa dB/dt,   kappa = (r1^2 - r2^2)/(4 k_j rho)   [s m/H]
