@@ -62,9 +62,14 @@ ReproduceResult run_reproduce(const Model& m, const ReproduceOptions& o,
   auto opt = [&](const char* k) {
     return std::string(option_word(*find_option_def(k), m.options));
   };
-  r.model_readings =
-      fmt::format("eq. 10: shape law {}, temperature scale {}; stress sign {}",
-                  opt("eq10_shape_law"), opt("eq10_temperature_scale"), opt("stress_sign"));
+  std::string gaps;
+  for (const auto& rod : m.rods)
+    gaps += fmt::format("{}{:.4g}", gaps.empty() ? "" : " / ", rod.joint_gap_m * 1e6);
+  r.model_readings = fmt::format(
+      "magnetic state {}; eq. 10: shape law {}, temperature scale {}; eq. 11: M_s {}; stress sign "
+      "{}; eddy law {}; joint gaps {} um",
+      opt("magnetic_state"), opt("eq10_shape_law"), opt("eq10_temperature_scale"),
+      opt("eq11_saturation"), opt("stress_sign"), opt("eddy_law"), gaps);
   std::size_t stage = 0;
   const std::size_t stages = 7;
   auto next = [&]() {
@@ -233,10 +238,21 @@ std::string comparison_markdown(const std::vector<ComparedModel>& models) {
           fmt::format(" {} {} |", md_number(m.claims[k].ours), m.claims[k].pass ? "PASS" : "FAIL");
     md += "\n";
   }
+  // Readings are chosen by the claims they predict (issue 37): each count on its own row.
   md += "| **claims met** | |";
   for (const auto& m : models) {
     const ClaimCount n = count_claims(m.claims);
     md += fmt::format(" **{} of {}** |", n.pass, n.applicable);
+  }
+  md += "\n| **predicted claims met** | |";
+  for (const auto& m : models) {
+    const ClaimCount n = count_claims(m.claims);
+    md += fmt::format(" **{} of {}** |", n.predicted_pass, n.predicted);
+  }
+  md += "\n| fitted claims met | |";
+  for (const auto& m : models) {
+    const ClaimCount n = count_claims(m.claims);
+    md += fmt::format(" {} of {} |", n.fitted_pass, n.fitted);
   }
   md += "\n\nReadings: ";
   for (const auto& m : models) md += fmt::format("`{}` = {}; ", m.name, m.readings);
