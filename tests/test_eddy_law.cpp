@@ -81,9 +81,9 @@ TEST(EddyLaw, OptionSelectsKappaInTheConditionsAndLeavesTheRestAlone) {
   for (std::size_t i = 0; i < a.rods.size(); ++i) {
     const auto& ra = a.rods[i];
     const auto& rb = b.rods[i];
-    EXPECT_DOUBLE_EQ(ra.eddy_geometry_s_m_per_H,
-                     eddy_time_constant(1.0, ra.r_outer_m, ra.r_inner_m, table4.rods[i].k_j,
-                                        ra.rho_ohm_m));
+    EXPECT_DOUBLE_EQ(
+        ra.eddy_geometry_s_m_per_H,
+        eddy_time_constant(1.0, ra.r_outer_m, ra.r_inner_m, table4.rods[i].k_j, ra.rho_ohm_m));
     EXPECT_DOUBLE_EQ(rb.eddy_geometry_s_m_per_H,
                      classical_eddy_coefficient(rb.r_outer_m, rb.r_inner_m, rb.rho_ohm_m));
     EXPECT_NEAR(ra.eddy_geometry_s_m_per_H / rb.eddy_geometry_s_m_per_H, ratio[i], 0.01) << i;

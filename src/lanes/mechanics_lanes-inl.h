@@ -9,7 +9,7 @@
 #define GMASIM_LANES_MECHANICS_INL_H_
 #endif
 
-#include "gmasim/mechanics/oscillator.hpp"
+#include "gmasim/physics/oscillator.hpp"
 #include "hwy/contrib/math/math-inl.h"
 #include "hwy/highway.h"
 #include "lanes/ja_lanes-inl.h"

@@ -1,5 +1,5 @@
 // The mechanics module (docs/layers.md, "The mechanics module"): the actuator's mechanics
-// apart from any experiment. The oscillator update of eq. (15) (gmasim/mechanics/oscillator.hpp,
+// apart from any experiment. The oscillator update of eq. (15) (gmasim/physics/oscillator.hpp,
 // called by step()), the modes of the chain of eq. (15) with the sensor mount
 // (src/mechanics/modal.cpp), and the small-signal linearisation of the whole actuator (circuit,
 // eddy lag, magnetisation law, forces, oscillators) about a settled bias point
@@ -9,7 +9,7 @@
 #include <complex>
 #include <vector>
 
-#include "gmasim/mechanics/oscillator.hpp"
+#include "gmasim/physics/oscillator.hpp"
 #include "gmasim/model/model.hpp"
 
 namespace gmasim {

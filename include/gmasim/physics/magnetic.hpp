@@ -127,8 +127,7 @@ inline double classical_eddy_coefficient(double r_outer_m, double r_inner_m, dou
   // The three terms cancel for a thin wall t: about (r/t)^2 ulp are lost (6e-11 relative at
   // r/t = 100, tests/test_eddy_law.cpp); log1p keeps the logarithm exact.
   if (b2 > 0.0)
-    k += -0.25 * b2 +
-         b2 * b2 * std::log1p((r_outer_m - r_inner_m) / r_inner_m) / (2.0 * (a2 - b2));
+    k += -0.25 * b2 + b2 * b2 * std::log1p((r_outer_m - r_inner_m) / r_inner_m) / (2.0 * (a2 - b2));
   return k / rho_ohm_m;
 }
 

@@ -5,8 +5,8 @@
 #include <cmath>
 #include <span>
 
-// The oscillator update of eq. (15) lives in the mechanics module (gmasim/mechanics/).
-#include "gmasim/mechanics/oscillator.hpp"
+// The oscillator update of eq. (15), one law per header.
+#include "gmasim/physics/oscillator.hpp"
 
 namespace gmasim::physics {
 

@@ -1,7 +1,7 @@
-// The mechanics module: the static stiffness of a rod's oscillator
-// (gmasim/mechanics/stiffness.hpp).
-#include "gmasim/mechanics/stiffness.hpp"
-
+// Eq. (16)-(18): the static stiffness of a rod's oscillator (gmasim/model/model.hpp,
+// oscillator_stiffness). In the model layer: the mechanics analysis above it (modes,
+// linearisation) and the identify objective use it (docs/layers.md).
+#include "gmasim/model/model.hpp"
 #include "gmasim/model/rod_laws.hpp"
 
 namespace gmasim {
