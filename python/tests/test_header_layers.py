@@ -41,3 +41,21 @@ def test_an_upward_include_is_reported_with_file_line_and_layers(tmp_path, capsy
     assert ('src/lanes/kernel.h:1: a simulate header includes "experiments/plan.hpp", of the '
             'higher layer experiments') in out
     assert "2 upward include(s)" in out  # mechanics -> model and experiments -> model are downward
+
+
+def test_the_law_is_dispatched_in_one_place():
+    """Issue 38, item 2: `with_magnetisation_law` (gmasim/magnetisation/laws.hpp) is the one
+    place that turns the model's law into code; no other file of the library, the CLI, the
+    Python module or the benchmarks compares the option with a law. The lanes' structure flag (src/lanes/pack.cpp, `st.preisach`) is the one left, until the lanes take
+    their law from the same seam."""
+    import re
+    allowed = {"src/lanes/pack.cpp": 1}
+    found = {}
+    for folder in ("src", "include", "apps", "python/src", "bench"):
+        for p in (SOURCE_DIR / folder).rglob("*"):
+            if p.suffix not in (".cpp", ".hpp", ".h") or not p.is_file():
+                continue
+            n = len(re.findall(r"magnetisation_law\s*[!=]=\s*MagnetisationLaw::", p.read_text()))
+            if n:
+                found[str(p.relative_to(SOURCE_DIR))] = n
+    assert found == allowed

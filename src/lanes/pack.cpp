@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/model/validity.hpp"
 #include "gmasim/simulate/lanes.hpp"
 #include "lanes/lane_data.hpp"
@@ -20,9 +21,9 @@ bool lanes_supported(const Model& m, std::string* why) {
     if (why) *why = reason;
     return false;
   };
-  if (m.options.magnetisation_law != MagnetisationLaw::JilesAtherton &&
-      m.options.magnetisation_law != MagnetisationLaw::Preisach)
-    return no("the lanes have the Jiles-Atherton and Preisach laws only");
+  if (!with_magnetisation_law(m.options.magnetisation_law,
+                              [](auto law) { return decltype(law)::has_lanes; }))
+    return no("the model's magnetisation law has no lane kernel");
   if (m.options.magnetic_state != MagneticState::Consistent)
     return no("the lanes run the consistent magnetic state only");
   if (!m.circuit.lowrank.enabled) return no("the circuit is not on the low-rank path");

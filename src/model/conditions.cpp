@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/model/model.hpp"
 #include "gmasim/model/validity.hpp"
 #include "gmasim/physics/magnetic.hpp"
@@ -145,10 +146,8 @@ void rod_material(const Model& m, const RodModel& rod, const Conditions& c, cons
   rc.alpha_sigma = magnetoelastic_coupling(rc.S_mu_J_per_m3, rc.MsT_mu);
   // The magnetisation law's temperature laws (src/model/magnetisation/).
   const double T_law = fz.magnetisation ? m.T_ref_C : T;
-  if (m.options.magnetisation_law == MagnetisationLaw::Preisach)
-    model_detail::preisach_conditions(m, rod, T_law, T, rc);
-  else
-    model_detail::jiles_atherton_conditions(m, rod, T_law, T, rc);
+  with_magnetisation_law(m.options.magnetisation_law,
+                         [&](auto law) { decltype(law)::temperature_laws(m, rod, T_law, T, rc); });
   rc.rho_ohm_m =
       resistivity(mat.rho0_ohm_m, mat.drho_dT_ohm_m_per_K, d.of(fz.resistivity));  // eq. (8)
   if (!(rc.rho_ohm_m > 0))

@@ -12,15 +12,4 @@ Conditions conditions_at(const Model& m, double temperature_C, const Freeze& fre
 
 }  // namespace gmasim::model_detail
 
-namespace gmasim::model_detail {
-
-// The magnetisation laws' temperature laws (src/model/magnetisation/<law>.cpp): the law's
-// constants of rod `rod` at temperature T_law_C (T_ref when frozen) into rc, given rc's
-// M_s^T (MsT_mag) and eq. (3)'s coupling (alpha_sigma); InputError naming the rod and the
-// operating temperature T_C where the law is not defined.
-void jiles_atherton_conditions(const Model& m, const RodModel& rod, double T_law_C, double T_C,
-                               RodConditions& rc);
-void preisach_conditions(const Model& m, const RodModel& rod, double T_law_C, double T_C,
-                         RodConditions& rc);
-
-}  // namespace gmasim::model_detail
+namespace gmasim::model_detail {}  // namespace gmasim::model_detail

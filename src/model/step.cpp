@@ -472,10 +472,8 @@ void stage_ledger(const Model& m, const Conditions& c, State& s, const StepInput
 }
 
 void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
-  if (m.options.magnetisation_law == MagnetisationLaw::Preisach)
-    step_law<PreisachLaw>(m, c, s, in);
-  else
-    step_law<JilesAthertonLaw>(m, c, s, in);
+  with_magnetisation_law(m.options.magnetisation_law,
+                         [&](auto law) { step_law<decltype(law)>(m, c, s, in); });
 }
 
 // The step: the stages in order (gmasim/model/step_stages.hpp).

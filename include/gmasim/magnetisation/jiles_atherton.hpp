@@ -17,6 +17,15 @@ namespace gmasim {
 struct JilesAthertonLaw {
   static constexpr MagnetisationLaw id = MagnetisationLaw::JilesAtherton;
 
+  // Its temperature laws (src/model/magnetisation/jiles_atherton.cpp): the law's constants of rod
+  // `rod` at T_law_C (T_ref when frozen) into rc, given rc's M_s^T (MsT_mag) and eq. (3)'s coupling
+  // (alpha_sigma); InputError naming the rod and the operating temperature T_C where the law
+  // is not defined.
+  static void temperature_laws(const Model& m, const RodModel& rod, double T_law_C, double T_C,
+                               RodConditions& rc);
+  // It has a lane kernel (src/lanes/): gmasim::lanes_supported asks the law, not a list.
+  static constexpr bool has_lanes = true;
+
   // make_state: demagnetised, M_irr = 0 (RodState's default).
   static void init_state(const RodConditions&, RodState&) {}
 

@@ -30,6 +30,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/model/model.hpp"
 #include "gmasim/model/validity.hpp"
 
@@ -176,10 +177,9 @@ void run_grid(const Model& m, const Conditions& c, State& st, const StepGrid& g,
 template <StepDrive D, StepRecorder R>
 void run_loop(const Model& m, const Conditions& c, State& st, const StepGrid& g, D&& drive,
               R&& record) {
-  if (m.options.magnetisation_law == MagnetisationLaw::Preisach)
-    run_loop_detail::run_grid<PreisachLaw>(m, c, st, g, drive, record);
-  else
-    run_loop_detail::run_grid<JilesAthertonLaw>(m, c, st, g, drive, record);
+  with_magnetisation_law(m.options.magnetisation_law, [&](auto law) {
+    run_loop_detail::run_grid<decltype(law)>(m, c, st, g, drive, record);
+  });
 }
 
 template <class Law, class D, class R>
@@ -250,10 +250,9 @@ inline void run_loop_step(const Model& m, const Conditions& c, State& st, long k
   p.dt_s = dt_s;
   HeldCurrent drive{current_A};
   NoRecorder record;
-  if (m.options.magnetisation_law == MagnetisationLaw::Preisach)
-    run_loop_detail::advance<PreisachLaw, false>(m, c, st, p, drive, record);
-  else
-    run_loop_detail::advance<JilesAthertonLaw, false>(m, c, st, p, drive, record);
+  with_magnetisation_law(m.options.magnetisation_law, [&](auto law) {
+    run_loop_detail::advance<decltype(law), false>(m, c, st, p, drive, record);
+  });
 }
 
 // run_loop without a recorder.

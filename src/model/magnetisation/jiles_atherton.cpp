@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/magnetisation/jiles_atherton.hpp"
 #include "gmasim/model/model.hpp"
 #include "model/conditions_detail.hpp"
 #include "model/parameter_rows.hpp"
@@ -86,8 +87,13 @@ const LawTables& jiles_atherton_tables() {
   return t;
 }
 
-void jiles_atherton_conditions(const Model& m, const RodModel& rod, double T_law_C, double T_C,
-                               RodConditions& rc) {
+}  // namespace gmasim::model_detail
+
+namespace gmasim {
+
+void JilesAthertonLaw::temperature_laws(const Model& m, const RodModel& rod, double T_law_C,
+                                        double T_C, RodConditions& rc) {
+  using model_detail::ja_at;
   rc.ja = ja_at(m, rod.ja, T_law_C);  // eq. (10)
   if (m.options.magnetic_state == MagneticState::Consistent) rc.ja.alpha += rc.alpha_sigma;
   rc.ja_inv_a_m_per_A = 1.0 / rc.ja.a_A_per_m;
@@ -100,4 +106,4 @@ void jiles_atherton_conditions(const Model& m, const RodModel& rod, double T_law
         m.spec.source, T_C, rod.name, rc.ja.a_A_per_m, rc.ja.k_A_per_m, rc.ja.c, rc.ja.alpha));
 }
 
-}  // namespace gmasim::model_detail
+}  // namespace gmasim

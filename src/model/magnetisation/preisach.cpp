@@ -14,6 +14,7 @@
 #include <cmath>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/magnetisation/preisach.hpp"
 #include "gmasim/model/model.hpp"
 #include "model/conditions_detail.hpp"
 #include "model/parameter_rows.hpp"
@@ -70,8 +71,13 @@ const LawTables& preisach_tables() {
   return t;
 }
 
-void preisach_conditions(const Model& m, const RodModel& rod, double T_law_C, double T_C,
-                         RodConditions& rc) {
+}  // namespace gmasim::model_detail
+
+namespace gmasim {
+
+void PreisachLaw::temperature_laws(const Model& m, const RodModel& rod, double T_law_C, double T_C,
+                                   RodConditions& rc) {
+  using namespace physics;
   const PreisachReference& p = rod.preisach;
   PreisachCoefficients& q = rc.preisach;
   q.Hc_A_per_m = p.Hc0_A_per_m * std::pow(rc.MsT_mag / m.material.Ms_A_per_m, p.n_c);
@@ -89,4 +95,4 @@ void preisach_conditions(const Model& m, const RodModel& rod, double T_law_C, do
         m.spec.source, T_C, rod.name, q.Hc_A_per_m, q.a_A_per_m, q.c, q.alpha));
 }
 
-}  // namespace gmasim::model_detail
+}  // namespace gmasim
