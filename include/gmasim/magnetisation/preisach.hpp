@@ -46,17 +46,18 @@ struct PreisachLaw {
   struct Trial {
     double M, dM_dH, x1;
     bool moved;
+    physics::PreisachPoint point;  // the up-switched measure at x1, committed as it is
   };
   static MoveStart begin_move(const RodConditions&, const RodState&) { return {}; }
   static Trial trial_from(const RodConditions& rc, const RodState& r, const MoveStart&, double H1,
                           double M_guess) {
-    Trial t{r.M_A_per_m, 0.0, 0.0, H1 != r.H_A_per_m};
+    Trial t{r.M_A_per_m, 0.0, 0.0, H1 != r.H_A_per_m, {}};
     if (!t.moved) {
       t.dM_dH = reversible_susceptibility(rc, r);
       return t;
     }
     t.M = physics::preisach_magnetisation(H1, rc.MsT_mag, rc.preisach, r.preisach, M_guess,
-                                          &t.dM_dH, &t.x1);
+                                          &t.dM_dH, &t.x1, &t.point);
     return t;
   }
   // The consistent state's joint Newton solve (as JilesAthertonLaw's): the law's own inner
@@ -78,7 +79,7 @@ struct PreisachLaw {
       return;
     }
     r.M_A_per_m = t.M;
-    physics::preisach_commit(rc.preisach.dist, r.preisach, t.x1);
+    physics::preisach_commit_point(r.preisach, t.x1, t.point);
     r.Mirr_A_per_m = rc.MsT_mag * (1.0 - rc.preisach.c) * (2.0 * r.preisach.mu_now - 1.0);
   }
 
@@ -90,9 +91,10 @@ struct PreisachLaw {
       return;
     }
     double x1 = 0.0;
+    physics::PreisachPoint point;
     r.M_A_per_m = physics::preisach_magnetisation(H1, rc.MsT_mag, rc.preisach, r.preisach, M_guess,
-                                                  dM_dH, &x1);
-    physics::preisach_commit(rc.preisach.dist, r.preisach, x1);
+                                                  dM_dH, &x1, &point);
+    physics::preisach_commit_point(r.preisach, x1, point);
     r.Mirr_A_per_m = rc.MsT_mag * (1.0 - rc.preisach.c) * (2.0 * r.preisach.mu_now - 1.0);
   }
 
@@ -119,9 +121,10 @@ struct PreisachLaw {
   static double ode_rate(const RodConditions&, double, double, double, double) { return 0.0; }
   static void ode_commit(const RodConditions& rc, RodState& r, double, double M_guess) {
     double x1 = 0.0;
+    physics::PreisachPoint point;
     r.M_A_per_m = physics::preisach_magnetisation(r.H_A_per_m, rc.MsT_mag, rc.preisach, r.preisach,
-                                                  M_guess, nullptr, &x1);
-    physics::preisach_commit(rc.preisach.dist, r.preisach, x1);
+                                                  M_guess, nullptr, &x1, &point);
+    physics::preisach_commit_point(r.preisach, x1, point);
   }
 
   // The field excursion about a reversal that switches no hysteron [A/m]: a move of dx from a

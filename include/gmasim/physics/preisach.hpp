@@ -68,33 +68,47 @@ struct Everett {
 };
 
 // One side of the triangle: the integrals over h in [p, q] of F(a - h) (side a) or F(b + h)
-// (side b), of h times it, and of the density f there.
+// (side b), of h times it, and of the density f there, from the Gaussian terms at the two ends
+// (gp at p, gq at q: gauss_terms(a - p) and gauss_terms(a - q) on side a, gauss_terms(b + p)
+// and gauss_terms(b + q) on side b).
 struct SideIntegrals {
   double I0 = 0, I1 = 0, J = 0;
 };
-inline SideIntegrals side_a(double a, double p, double q, double s) {
-  if (std::isinf(a)) return {q - p, 0.5 * (q * q - p * p), 0.0};
-  const GaussTerms gp = gauss_terms(a - p, s), gq = gauss_terms(a - q, s);
+inline SideIntegrals side_a(double a, const GaussTerms& gp, const GaussTerms& gq) {
   return {gp.A - gq.A, a * (gp.A - gq.A) - (gp.Y - gq.Y), gp.F - gq.F};
 }
-inline SideIntegrals side_b(double b, double p, double q, double s) {
-  if (std::isinf(b)) return {};
-  const GaussTerms gp = gauss_terms(b + p, s), gq = gauss_terms(b + q, s);
+inline SideIntegrals side_b(double b, const GaussTerms& gp, const GaussTerms& gq) {
   return {gq.A - gp.A, (gq.Y - gp.Y) - b * (gq.A - gp.A), gq.F - gp.F};
 }
 
 // E(a, b) = int_0^D f_c(h) [F(a - h) - F(b + h)] dh, D = (a - b)/2; Ec with h f_c(h) in place
 // of f_c; Eu = int_0^D f_c(h) s^2 [f(b + h) - f(a - h)] dh (int u f(u) du = -s^2 f(u)).
-// The upper limit D (where a - h = b + h) adds nothing to the derivatives.
+// The upper limit D (where a - h = b + h) adds nothing to the derivatives. A bin's Gaussian terms
+// at its upper edge are the next bin's at its lower edge, so each edge is evaluated once (as the
+// lanes do, src/lanes/preisach_lanes-inl.h); a = +inf makes side a {q - p, (q^2 - p^2)/2, 0},
+// b = -inf side b nothing.
 inline Everett everett(const PreisachDistribution& d, double a, double b) {
   Everett e;
   if (!(a > b)) return e;
-  const double D =
-      (std::isinf(a) || std::isinf(b)) ? std::numeric_limits<double>::infinity() : 0.5 * (a - b);
+  const bool a_inf = std::isinf(a), b_inf = std::isinf(b);
+  const double D = (a_inf || b_inf) ? std::numeric_limits<double>::infinity() : 0.5 * (a - b);
   const double s = d.sigma_u;
+  GaussTerms ga_p{}, gb_p{}, ga_q{}, gb_q{};
+  if (!a_inf) ga_p = gauss_terms(a - d.edge[0], s);
+  if (!b_inf) gb_p = gauss_terms(b + d.edge[0], s);
   for (int j = 0; j < kPreisachBins && d.edge[j] < D; ++j) {
     const double p = d.edge[j], q = std::min(d.edge[j + 1], D), w = d.density[j];
-    const SideIntegrals A = side_a(a, p, q, s), B = side_b(b, p, q, s);
+    SideIntegrals A{q - p, 0.5 * (q * q - p * p), 0.0}, B{};
+    if (!a_inf) {
+      ga_q = gauss_terms(a - q, s);
+      A = side_a(a, ga_p, ga_q);
+      ga_p = ga_q;
+    }
+    if (!b_inf) {
+      gb_q = gauss_terms(b + q, s);
+      B = side_b(b, gb_p, gb_q);
+      gb_p = gb_q;
+    }
     e.E += w * (A.I0 - B.I0);
     e.Ec += w * (A.I1 - B.I1);
     e.Eu += w * s * s * (B.J - A.J);
@@ -283,10 +297,12 @@ struct PreisachCoefficients {  // at one temperature
 //   g(M) = M - M_s^T [(1 - c)(2 mu(x) - 1) + c L(H_e/a)] = 0 with its exact derivative
 // (H_e and x depend on M through alpha), from M_guess. dM_dH (if given) receives
 // chi_e / (1 - alpha chi_e), chi_e = M_s [(1 - c) 2 mu'(x) / H_c + c L'(H_e/a) / a]; x1 (if
-// given) the reduced input the move ends at.
+// given) the reduced input the move ends at; point (if given) the up-switched measure there
+// (preisach_point at x1), which preisach_commit_point commits without evaluating the
+// distribution again.
 inline double preisach_magnetisation(double H1, double MsT_A_per_m, const PreisachCoefficients& p,
                                      const PreisachHistory& h, double M_guess, double* dM_dH,
-                                     double* x1) {
+                                     double* x1, PreisachPoint* point = nullptr) {
   const double inv_a = 1.0 / p.a_A_per_m, inv_hc = 1.0 / p.Hc_A_per_m;
   const double tol = 1e-12 * MsT_A_per_m;
   double M = M_guess;
@@ -302,6 +318,7 @@ inline double preisach_magnetisation(double H1, double MsT_A_per_m, const Preisa
     if (std::fabs(g) <= tol || it == 59) {
       if (dM_dH) *dM_dH = chi_e / (1.0 - p.alpha * chi_e);
       if (x1) *x1 = x;
+      if (point) *point = pt;
       return Mnew;
     }
     double dg = 1.0 - p.alpha * chi_e;
