@@ -120,7 +120,11 @@ class SingleRodPrinted:
         el = d["mechanics"]["elements"]
         chain = d["mechanics"]["chains"]["rod"]
         m_load = sum(el[e]["mass_kg"] for e in chain)
-        self.m = rod["mass_kg"] / 3 + m_load  # eq. 15
+        # The rod's mass: the file's, else derived from the cold geometry (gmasim/model/derived.hpp).
+        r0o, r0i = 0.5 * rod["outer_diameter_m"], 0.5 * rod["inner_diameter_m"]
+        m_rod = rod.get("mass_kg", mat.get("density_kg_per_m3", 9250.0) * math.pi
+                        * (r0o * r0o - r0i * r0i) * rod["length_m"])
+        self.m = m_rod / 3 + m_load  # eq. 15
         self.cd = rod["damping_N_s_per_m"] + 1 / sum(1 / el[e]["damping_N_s_per_m"] for e in chain)
         self.k_load = 1 / sum(1 / el[e]["stiffness_N_per_m"] for e in chain)  # eq. 18
 

@@ -32,7 +32,7 @@ int run_show(const ModelArgs& a, bool doc) {
   fmt::print("# temperatures: {}\n", ranges_text(m));
   fmt::print("{:<48} {:>14}  {:<10} {}\n", "parameter", "value", "unit",
              doc ? "meaning" : "provenance");
-  for (const auto& row : describe_model(spec))
+  for (const auto& row : describe_model(m.spec))  // with the derived quantities
     fmt::print("{:<48} {:>14}  {:<10} {}\n", row.name, row.value, row.unit,
                doc ? row.doc : row.provenance);
   return 0;

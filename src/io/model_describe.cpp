@@ -3,10 +3,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <map>
 
 #include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io/io.hpp"
+#include "gmasim/model/derived.hpp"
 #include "io/model_loader.hpp"
 #include "io/schema.hpp"
 
@@ -77,9 +79,17 @@ class Describer {
         lines_(io_detail::split_lines(text_, io_detail::StripCR::Yes)) {}
 
   std::vector<ParamRow> rows() {
+    std::map<std::string, DerivedQuantity> derived;
+    for (auto& d : derived_quantities(spec_)) derived.emplace(d.name, std::move(d));
     for (const auto& [name, pv] : spec_.params) {
       const ParamDef* def = spec_.def_of(name);
-      rows_.push_back({name, fmt::format("{:g}", pv.value), spec_.unit_of(name), pv.provenance,
+      std::string provenance = pv.provenance;
+      // A value given where the geometry derives one: the derived value beside it.
+      if (const auto d = derived.find(name); d != derived.end() && d->second.overridden)
+        provenance +=
+            fmt::format("{}[override; derived {:.4g} {}: {}]", provenance.empty() ? "" : " ",
+                        d->second.derived, spec_.unit_of(name), d->second.formula);
+      rows_.push_back({name, fmt::format("{:g}", pv.value), spec_.unit_of(name), provenance,
                        pv.line, def ? std::string(def->doc) : std::string()});
     }
     for (const auto& [name, value] : spec_.meta)

@@ -14,6 +14,7 @@
 #include "common/toml_io.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io/io.hpp"
+#include "gmasim/model/derived.hpp"
 #include "io/schema.hpp"
 
 namespace gmasim {
@@ -75,8 +76,11 @@ ModelLoader::ModelLoader(std::string_view text, const std::string& source)
 ModelSpec ModelLoader::run() {
   const toml::table root = parse_toml(text_, spec_.source);
   read_root(root);
-  for (const auto& [name, pv] : spec_.params)
+  const std::vector<std::string> derived = apply_derivations(spec_);  // gmasim/model/derived.hpp
+  for (const auto& [name, pv] : spec_.params) {
+    if (std::find(derived.begin(), derived.end(), name) != derived.end()) continue;
     if (auto p = schema::check_value(spec_, name, pv.value)) problem(pv.line, *p);
+  }
   if (!problems_.empty()) {
     std::stable_sort(problems_.begin(), problems_.end(),
                      [](const auto& a, const auto& b) { return a.first < b.first; });

@@ -13,6 +13,7 @@
 #include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/io/io.hpp"
+#include "gmasim/model/derived.hpp"
 #include "gmasim/model/validate.hpp"
 #include "io/schema.hpp"
 
@@ -190,10 +191,60 @@ ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assi
       throw InputError(fmt::format("{} '{}': {}", flag, shown, e.what()));
     }
   }
+  apply_derivations(spec);  // a --set of the geometry moves what it derives
   return spec;
 }
 
-std::string model_toml(const ModelSpec& spec, const std::string& why) {
+namespace {
+
+// Defaulted keys and omitted options: below their table's header if the file has one, else
+// in a new table at the end (returned). Bottom-up, so earlier line numbers stay valid.
+std::string insert_added(std::vector<std::string>& lines, const ModelSpec& original,
+                         const std::map<std::string, std::vector<std::string>>& added,
+                         const std::string& why) {
+  std::vector<std::pair<long, std::string>> inserts;
+  std::string appended;
+  // The line of a table's header: recorded for the optional tables, else found in the text
+  // ([<rod>] of a key the file leaves to its derivation); 0 if the file has none.
+  auto header_line = [&](const std::string& table) -> long {
+    const auto it = original.option_lines.find("[" + table + "]");
+    if (it != original.option_lines.end() && it->second > 0) return it->second;
+    const std::string header = "[" + table + "]";
+    for (std::size_t i = 0; i < lines.size(); ++i) {
+      const std::string_view l = io_detail::trim(lines[i]);
+      if (l.starts_with(header) &&
+          (l.size() == header.size() || l[header.size()] == ' ' || l[header.size()] == '#'))
+        return static_cast<long>(i) + 1;
+    }
+    return 0;
+  };
+  for (const auto& [table, keys] : added) {
+    const long at = header_line(table);
+    std::string block;
+    for (const auto& k : keys) block += (block.empty() ? "" : "\n") + k;
+    if (at > 0) {
+      inserts.emplace_back(at, block);
+    } else {
+      appended += fmt::format("\n[{}]  # added by: {}\n{}\n", table, why, block);
+    }
+  }
+  std::sort(inserts.begin(), inserts.end(),
+            [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (const auto& [line_no, block] : inserts)
+    lines.insert(lines.begin() + std::min<long>(line_no, static_cast<long>(lines.size())), block);
+  return appended;
+}
+
+}  // namespace
+
+std::string model_toml(const ModelSpec& given, const std::string& why) {
+  // The derived quantities at the spec's current geometry (gmasim/model/derived.hpp): they are
+  // not written (the file derives them again), an override is.
+  ModelSpec spec = given;
+  const std::vector<std::string> derived = apply_derivations(spec);
+  auto is_derived = [&](const std::string& name) {
+    return std::find(derived.begin(), derived.end(), name) != derived.end();
+  };
   if (spec.text.empty())
     throw InputError(fmt::format("{}: the model has no source text to save from", spec.source));
   if (auto missing = schema::unset_message(spec))
@@ -206,6 +257,7 @@ std::string model_toml(const ModelSpec& spec, const std::string& why) {
   auto leaf_of = [](const std::string& dotted) { return dotted.substr(dotted.rfind('.') + 1); };
   std::map<std::string, std::vector<std::string>> added;  // table -> new "key = value" lines
   for (const auto& [name, pv] : spec.params) {
+    if (is_derived(name)) continue;
     const auto it = original.params.find(name);
     const std::string table = name.substr(0, name.rfind('.'));
     if (it == original.params.end() && law_changed &&
@@ -235,24 +287,7 @@ std::string model_toml(const ModelSpec& spec, const std::string& why) {
     comment_out_law_tables(
         lines, original,
         std::string(option_word(*find_option_def("options.magnetisation_law"), spec.options)), why);
-  // Defaulted keys and omitted options: below their table's header if the file has one, else
-  // in a new table at the end (bottom-up, so earlier line numbers stay valid).
-  std::vector<std::pair<long, std::string>> inserts;
-  std::string appended;
-  for (const auto& [table, keys] : added) {
-    const auto it = original.option_lines.find("[" + table + "]");
-    std::string block;
-    for (const auto& k : keys) block += (block.empty() ? "" : "\n") + k;
-    if (it != original.option_lines.end() && it->second > 0) {
-      inserts.emplace_back(it->second, block);
-    } else {
-      appended += fmt::format("\n[{}]  # added by: {}\n{}\n", table, why, block);
-    }
-  }
-  std::sort(inserts.begin(), inserts.end(),
-            [](const auto& a, const auto& b) { return a.first > b.first; });
-  for (const auto& [line_no, block] : inserts)
-    lines.insert(lines.begin() + std::min<long>(line_no, static_cast<long>(lines.size())), block);
+  const std::string appended = insert_added(lines, original, added, why);
   std::string text;
   for (const auto& l : lines) text += l + "\n";
   text += appended;

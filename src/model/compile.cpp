@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/model/derived.hpp"
 #include "gmasim/model/model.hpp"
 #include "gmasim/model/validity.hpp"
 #include "model/schema.hpp"
@@ -25,10 +26,12 @@ namespace {
 
 // The rules of every number and of the options, as the loader applies them: a spec built or
 // edited in code is held to the same rules as a file.
-void check_spec(const ModelSpec& spec) {
+void check_spec(const ModelSpec& spec, const std::vector<std::string>& derived) {
   if (auto missing = schema::unset_message(spec)) fail(spec, 0, *missing);
-  for (const auto& [name, pv] : spec.params)
+  for (const auto& [name, pv] : spec.params) {
+    if (std::find(derived.begin(), derived.end(), name) != derived.end()) continue;
     if (auto problem = schema::check_value(spec, name, pv.value)) fail(spec, pv.line, *problem);
+  }
   if (auto problem = check_options(spec.options))
     fail(spec, spec.line_of(problem->key), problem->message);
 }
@@ -212,8 +215,8 @@ void derive(const ModelSpec& spec, Model& m) {
 
 // Everything of compile() but the Model's copy of the spec and the validity check, which reads
 // it (m.spec).
-Model build_model(const ModelSpec& spec) {
-  check_spec(spec);
+Model build_model(const ModelSpec& spec, const std::vector<std::string>& derived) {
+  check_spec(spec, derived);
   Model m;
   m.options = spec.options;
   size_instances(spec, m);
@@ -250,15 +253,12 @@ double preload_force_N(const ModelSpec& spec) {
   return it->second.value * 1e6 * preload_area_m2(spec);
 }
 
-Model compile(const ModelSpec& spec) {
-  Model m = build_model(spec);
-  m.spec = spec;
-  check_model_validity(m);  // gmasim/model/validity.hpp: no rod under a crushing prestress
-  return m;
-}
+Model compile(const ModelSpec& spec) { return compile(ModelSpec(spec)); }
 
 Model compile(ModelSpec&& spec) {
-  Model m = build_model(spec);
+  // gmasim/model/derived.hpp: what follows from the geometry (its inputs are checked).
+  const std::vector<std::string> derived = apply_derivations(spec);
+  Model m = build_model(spec, derived);
   m.spec = std::move(spec);
   check_model_validity(m);
   return m;

@@ -149,6 +149,10 @@ const ParamDef kParams[] = {
     {G::Material, "alpha_thermal_per_K", "1/K", R::NonNegative,
      "thermal expansion coefficient of the rods, eq. (21) and l^T, A^T",
      LAND(in_material, Material, alpha_thermal_per_K)},
+    {G::Material, "density_kg_per_m3", "kg/m^3", R::Positive,
+     "density of the rods' material: their derived mass (gmasim/model/derived.hpp)",
+     LAND(in_material, Material, density_kg_per_m3), 9250.0,
+     "default: Terfenol-D, 9.2-9.25 g/cm^3 (manufacturers' data sheets)"},
     // [preload]
     {G::Preload,
      "force_N",
@@ -193,7 +197,10 @@ const ParamDef kParams[] = {
      Cross{Cross::Below, "outer_diameter_m"}},
     {G::Rod, "length_m", "m", R::Positive, "length l_i, eq. (2), (17)",
      LAND(in_rod, RodModel, length_m)},
-    {G::Rod, "mass_kg", "kg", R::Positive, "mass m_i, eq. (24)", LAND(in_rod, RodModel, mass_kg)},
+    {G::Rod, "mass_kg", "kg", R::Positive,
+     "mass m_i, eq. (24); derived from the geometry when the file omits it",
+     LAND(in_rod, RodModel, mass_kg), 0.0,
+     "derived: material.density_kg_per_m3 x pi (r_o^2 - r_i^2) x length_m"},
     {G::Rod, "k_f", "-", R::Positive,
      "flux-leakage factor k_f of eq. (7) (the printed reading; the consistent reading uses "
      "joint_gap_m)",

@@ -292,7 +292,12 @@ void ModelSpec::set(const std::string& dotted, double value) {
   const std::string key = resolve(*this, dotted);
   ParamValue& pv = params.at(key);
   const double old = pv.value;
+  const bool was_assigned = pv.assigned;
   pv.value = value;
+  pv.assigned = true;  // a value set is the user's: never replaced by a derivation
+  const std::string was_provenance = pv.provenance;
+  if (!was_assigned && pv.line == 0 && pv.provenance.starts_with("derived:"))
+    pv.provenance = "set in place of the derived value";
   // The value itself, and the cross-field rules that depend on it.
   std::vector<std::string> to_check = {key};
   for (auto& d : schema::dependents(*this, key)) to_check.push_back(std::move(d));
@@ -301,6 +306,8 @@ void ModelSpec::set(const std::string& dotted, double value) {
     if (it == params.end() || schema::is_unset(it->second)) continue;
     if (auto problem = schema::check_value(*this, k, it->second.value)) {
       pv.value = old;
+      pv.assigned = was_assigned;
+      pv.provenance = was_provenance;
       throw InputError(
           located(source, pv.line, fmt::format("cannot set {} = {:g}: {}", key, value, *problem)));
     }

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/model/derived.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "model/conditions_detail.hpp"
 
@@ -102,6 +103,18 @@ std::vector<std::string> model_warnings(const Model& m) {
         spec.source, it->second.line,
         fmt::format("{} = {:g}{}: far outside {}, [{:g}, {:g}]{}; the results may mean nothing",
                     k.key, v, u, k.what, k.lo, k.hi, u)));
+  }
+  // A value the file gives in place of one the geometry derives (gmasim/model/derived.hpp).
+  for (const auto& d : derived_quantities(spec)) {
+    if (!d.overridden || !(d.derived > 0)) continue;
+    const double off = d.value / d.derived - 1.0;
+    if (std::fabs(off) <= kDerivedWarnFraction) continue;
+    out.push_back(located(
+        spec.source, spec.line_of(d.name),
+        fmt::format("{} = {:g} {} overrides the {:.4g} {} its geometry gives ({}), {:+.0f} %: "
+                    "remove it to use the derived value, or check the geometry",
+                    d.name, d.value, spec.unit_of(d.name), d.derived, spec.unit_of(d.name),
+                    d.formula, 100.0 * off)));
   }
   double worst = 0.0;  // the largest prestress over the rods, and where
   std::string where;

@@ -72,6 +72,7 @@ struct ParamValue {
   double value = 0.0;
   std::string provenance;  // the trailing comment of the TOML line ("Table 4", ...)
   long line = 0;           // source line in the model file (0: a default of its row)
+  bool assigned = false;   // set after loading (ModelSpec::set, --set): never re-derived
 };
 
 struct SpecBranch {
@@ -204,6 +205,7 @@ struct RodModel {
 struct Material {  // Terfenol-D, shared by the rods
   double Ms_A_per_m, lambda_s, sigma_lambda_Pa, Es_Pa, Tc_C, rho0_ohm_m, drho_dT_ohm_m_per_K;
   double beta_per_K, chi_m, x_exponent, alpha_thermal_per_K;
+  double density_kg_per_m3;  // the rods' mass (derived quantities, gmasim/model/derived.hpp)
 };
 
 struct ChainElementModel {  // a magnetizer, output rod or disk spring: constant m, k, c

@@ -1,0 +1,37 @@
+// Quantities that follow from a model's geometry and material (issue 39, item 1): derived when
+// the model is compiled, so that a user who changes a rod's diameter or length gets the mass
+// that goes with it, never the stale one of another design. A value the file gives (or a --set)
+// overrides the derivation; it is reported with the derived value beside it, and a warning is
+// given when the two differ by more than kDerivedWarnFraction (gmasim/model/validity.hpp,
+// model_warnings). The derivations:
+//   <rod>.mass_kg = material.density_kg_per_m3 x pi (r_o^2 - r_i^2) x <rod>.length_m
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "gmasim/model/model.hpp"
+
+namespace gmasim {
+
+inline constexpr double kDerivedWarnFraction = 0.10;
+
+struct DerivedQuantity {
+  std::string name;  // the parameter, "rod1.mass_kg"
+  double derived;    // its value by the formula
+  std::string
+      formula;      // "material.density_kg_per_m3 9250 x pi (r_o^2 - r_i^2) 1.374e-04 m^2 x ..."
+  bool overridden;  // the spec gives its own value (file or --set)
+  double value;     // the spec's value (the derived one unless overridden)
+};
+
+// Every derivable parameter of the spec with its derived value; the spec is not changed.
+std::vector<DerivedQuantity> derived_quantities(const ModelSpec& spec);
+
+// Writes the derived value into each derivable parameter the spec does not give (line 0, not
+// assigned), with the provenance "derived: <formula> = <value>"; the loader and compile() call
+// it. Returns the names it derived: their rules are not checked on their own (line 0 would
+// name no line), their inputs' are.
+std::vector<std::string> apply_derivations(ModelSpec& spec);
+
+}  // namespace gmasim

@@ -1,0 +1,53 @@
+// Quantities derived from geometry and material (gmasim/model/derived.hpp).
+#include "gmasim/model/derived.hpp"
+
+#include <fmt/format.h>
+
+#include <numbers>
+
+namespace gmasim {
+
+namespace {
+
+bool overridden(const ParamValue& pv) { return pv.line > 0 || pv.assigned; }
+
+}  // namespace
+
+std::vector<DerivedQuantity> derived_quantities(const ModelSpec& spec) {
+  std::vector<DerivedQuantity> out;
+  const auto density = spec.params.find("material.density_kg_per_m3");
+  if (density == spec.params.end()) return out;
+  const double rho = density->second.value;
+  for (const auto& rod : spec.rods) {
+    const auto mass = spec.params.find(rod + ".mass_kg");
+    const auto od = spec.params.find(rod + ".outer_diameter_m");
+    const auto id = spec.params.find(rod + ".inner_diameter_m");
+    const auto len = spec.params.find(rod + ".length_m");
+    if (mass == spec.params.end() || od == spec.params.end() || id == spec.params.end() ||
+        len == spec.params.end())
+      continue;
+    const double ro = 0.5 * od->second.value, ri = 0.5 * id->second.value;
+    const double area = std::numbers::pi * (ro * ro - ri * ri);
+    const double m = rho * area * len->second.value;
+    out.push_back({mass->first, m,
+                   fmt::format("material.density_kg_per_m3 {:g} kg/m^3 x pi (r_o^2 - r_i^2) "
+                               "{:.4g} m^2 x {}.length_m {:g} m",
+                               rho, area, rod, len->second.value),
+                   overridden(mass->second), mass->second.value});
+  }
+  return out;
+}
+
+std::vector<std::string> apply_derivations(ModelSpec& spec) {
+  std::vector<std::string> names;
+  for (const auto& d : derived_quantities(spec)) {
+    if (d.overridden) continue;
+    ParamValue& pv = spec.params.at(d.name);
+    pv.value = d.derived;
+    pv.provenance = fmt::format("derived: {} = {:.6g}", d.formula, d.derived);
+    names.push_back(d.name);
+  }
+  return names;
+}
+
+}  // namespace gmasim
