@@ -132,7 +132,9 @@ std::string resolve_model_path(const std::string& path) {
   const bool bare = !p.has_parent_path() || p.parent_path() == "models";
   const std::string dir = shipped_models_dir();
   if (!bare || dir.empty()) return path;
-  const fs::path shipped = fs::path(dir) / p.filename();
+  fs::path shipped = fs::path(dir) / p.filename();
+  // A bare name without its extension ("single_rod_preisach"): the shipped file of that name.
+  if (!fs::is_regular_file(shipped, ec) && !p.has_extension()) shipped += ".toml";
   return fs::is_regular_file(shipped, ec) ? shipped.string() : path;
 }
 

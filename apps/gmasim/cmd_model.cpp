@@ -1,7 +1,12 @@
 // gmasim model show / params / save / check.
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <array>
+#include <filesystem>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "commands.hpp"
 #include "gmasim/errors.hpp"
@@ -118,6 +123,39 @@ int run_check(ModelArgs args, const std::string& file, bool dt_table) {
   }
 }
 
+// The shipped models (shipped_models_dir()): each file's bare name, [meta] name and description.
+int run_list() {
+  namespace fs = std::filesystem;
+  const std::string dir = shipped_models_dir();
+  if (dir.empty())
+    throw InputError(
+        "no shipped models directory: neither $GMASIM_MODELS_DIR nor "
+        "<prefix>/share/gmasim/models beside this executable exists");
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.is_regular_file() && e.path().extension() == ".toml") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  fmt::print("# shipped models in {} (use the name with --model, e.g. --model {})\n", dir,
+             files.empty() ? "mdma_printed" : files.front().stem().string());
+  std::vector<std::array<std::string, 3>> rows = {{"name", "meta.name", "meta.description"}};
+  for (const auto& f : files) {
+    const ModelSpec spec = load_model_spec(f.string());
+    auto meta = [&](const char* key) {
+      const auto it = spec.meta.find(key);
+      return it == spec.meta.end() ? std::string() : it->second;
+    };
+    rows.push_back({f.stem().string(), meta("meta.name"), meta("meta.description")});
+  }
+  std::size_t w0 = 0, w1 = 0;
+  for (const auto& r : rows) {
+    w0 = std::max(w0, r[0].size());
+    w1 = std::max(w1, r[1].size());
+  }
+  for (const auto& r : rows) fmt::print("{:<{}}  {:<{}}  {}\n", r[0], w0, r[1], w1, r[2]);
+  fmt::print("(no --model: the built-in MDMA model, models/mdma.toml compiled in)\n");
+  return 0;
+}
+
 }  // namespace
 
 Runner add_model(CLI::App& app) {
@@ -153,12 +191,15 @@ Runner add_model(CLI::App& app) {
   check->add_option("file", *check_path, "Model file (TOML); same as --model")
       ->transform(model_path_transform());
   add_model_options(check, *check_model);
+  auto* list = sub->add_subcommand(
+      "list", "List the shipped model files by the name --model takes, with their [meta]");
   auto dt_table = std::make_shared<bool>(false);
   check->add_flag("--dt-table", *dt_table,
                   "Print only the time-step table of docs/model.md (convergence as dt halves, "
                   "observed order, the eddy field's ringing threshold), as Markdown");
   return [=]() -> int {
     if (show->parsed()) return run_show(*show_model, *show_doc);
+    if (list->parsed()) return run_list();
     if (params->parsed()) return run_params(*params_markdown);
     if (save->parsed()) {
       const ModelSpec spec = load_model_spec_args(*save_model_args);
