@@ -111,3 +111,22 @@ TEST(Derived, ABadGeometryIsReportedAtItsOwnLineNotAtTheDerivedMass) {
     EXPECT_EQ(msg.find("mass_kg"), std::string::npos) << msg;
   }
 }
+
+TEST(Derived, CoilResistanceFollowsTheTurnsWhenTheWindingIsGiven) {
+  // The user: 800 turns instead of the template's 500, the same winding.
+  const ModelSpec base = load_model_spec(template_path("single_rod.toml"));
+  const auto R = [](const ModelSpec& s) { return compile(s).thermal_network.coil_resistance_ohm; };
+  const double per_turn = 1.7241e-8 * 0.08 / (std::numbers::pi * 0.0006 * 0.0006 / 4.0);
+  EXPECT_NEAR(R(base), 500 * per_turn, 1e-12);
+  EXPECT_NEAR(R(apply_assignments(base, {"circuit.branches.coil.coil_turns=800"})), 800 * per_turn,
+              1e-12);
+  // A thinner wire: R ~ 1/d^2.
+  EXPECT_NEAR(R(apply_assignments(base, {"thermal_network.coil_wire_diameter_m=0.0003"})),
+              4 * 500 * per_turn, 1e-11);
+  // Without the winding (the MDMA, which gives no [thermal_network]) the resistance is an
+  // input: its default, not derived.
+  const Model mdma = load_model("");
+  EXPECT_EQ(mdma.thermal_network.coil_resistance_ohm, 1.5);
+  for (const auto& d : derived_quantities(mdma.spec))
+    EXPECT_NE(d.name, "thermal_network.coil_resistance_ohm");
+}

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -319,15 +320,20 @@ TEST(ModelWriter, DefaultedKeysAreWrittenIntoTheirTable) {
 TEST(ModelFile, SingleRodTemplateNeedsNoDummyTables) {
   const std::string path = std::string(GMASIM_SOURCE_DIR) + "/models/single_rod.toml";
   const gmasim::ModelSpec spec = gmasim::load_model_spec(path);
-  for (const char* table : {"[magnet]", "[thermal_expansion]", "[mechanics.sleeves",
-                            "[mechanics.sleeve_modulus]", "[thermal_network]"})
+  for (const char* table :
+       {"[magnet]", "[thermal_expansion]", "[mechanics.sleeves", "[mechanics.sleeve_modulus]"})
     EXPECT_EQ(spec.text.find(std::string("\n") + table), std::string::npos) << table;
-  for (const char* key :
-       {"magnet.alpha_pm1_per_K", "thermal_expansion.rod_length_m",
-        "mechanics.sleeve_modulus.Et_Pa", "thermal_network.coil_resistance_ohm"}) {
+  for (const char* key : {"magnet.alpha_pm1_per_K", "thermal_expansion.rod_length_m",
+                          "mechanics.sleeve_modulus.Et_Pa", "thermal_network.coil_alpha_per_K"}) {
     EXPECT_EQ(spec.params.at(key).line, 0) << key;
     EXPECT_THAT(spec.params.at(key).provenance, StartsWith("default:")) << key;
   }
+  // Its [thermal_network] holds only the winding, from which the coil resistance is derived
+  // (gmasim/model/derived.hpp): 1.7241e-8 ohm m x 500 turns x 0.08 m / (pi (0.6 mm)^2 / 4).
+  EXPECT_THAT(spec.params.at("thermal_network.coil_resistance_ohm").provenance,
+              StartsWith("derived:"));
+  EXPECT_NEAR(spec.params.at("thermal_network.coil_resistance_ohm").value,
+              1.7241e-8 * 500 * 0.08 / (std::numbers::pi * 0.0006 * 0.0006 / 4), 1e-12);
   const gmasim::Model m = gmasim::compile(spec);
   EXPECT_EQ(m.rod_count(), 1);
   EXPECT_TRUE(m.sleeves.empty());

@@ -11,6 +11,31 @@ namespace {
 
 bool overridden(const ParamValue& pv) { return pv.line > 0 || pv.assigned; }
 
+double value_or(const ModelSpec& spec, const std::string& name, double fallback) {
+  const auto it = spec.params.find(name);
+  return it == spec.params.end() ? fallback : it->second.value;
+}
+
+// The winding's resistance at T_ref, when its wire diameter and mean turn length are given.
+void coil_resistance(const ModelSpec& spec, std::vector<DerivedQuantity>& out) {
+  const auto R = spec.params.find("thermal_network.coil_resistance_ohm");
+  const double d = value_or(spec, "thermal_network.coil_wire_diameter_m", 0.0);
+  const double l = value_or(spec, "thermal_network.coil_mean_turn_length_m", 0.0);
+  const double rho = value_or(spec, "thermal_network.coil_resistivity_ohm_m", 0.0);
+  if (R == spec.params.end() || !(d > 0) || !(l > 0) || !(rho > 0)) return;
+  double turns = 0.0;
+  for (const auto& [name, pv] : spec.params)
+    if (name.starts_with("circuit.branches.") && name.ends_with(".coil_turns")) turns += pv.value;
+  if (!(turns > 0)) return;
+  const double area = std::numbers::pi * d * d / 4.0;
+  out.push_back({R->first, rho * turns * l / area,
+                 fmt::format("thermal_network.coil_resistivity_ohm_m {:g} ohm m x {:g} turns x "
+                             "coil_mean_turn_length_m {:g} m / (pi coil_wire_diameter_m^2 / 4) "
+                             "{:.4g} m^2",
+                             rho, turns, l, area),
+                 overridden(R->second), R->second.value});
+}
+
 }  // namespace
 
 std::vector<DerivedQuantity> derived_quantities(const ModelSpec& spec) {
@@ -35,6 +60,7 @@ std::vector<DerivedQuantity> derived_quantities(const ModelSpec& spec) {
                                rho, area, rod, len->second.value),
                    overridden(mass->second), mass->second.value});
   }
+  coil_resistance(spec, out);
   return out;
 }
 

@@ -5,6 +5,9 @@
 // given when the two differ by more than kDerivedWarnFraction (gmasim/model/validity.hpp,
 // model_warnings). The derivations:
 //   <rod>.mass_kg = material.density_kg_per_m3 x pi (r_o^2 - r_i^2) x <rod>.length_m
+//   thermal_network.coil_resistance_ohm = coil_resistivity_ohm_m x N x coil_mean_turn_length_m
+//       / (pi coil_wire_diameter_m^2 / 4), N the turns of every branch that carries a coil (in
+//       series: one current), when the winding's wire diameter and mean turn length are given
 #pragma once
 
 #include <string>

@@ -239,6 +239,8 @@ struct SensorMountModel {
 struct ThermalNetworkModel {
   double coil_resistance_ohm = 0;  // at T_ref_C
   double coil_alpha_per_K = 0;     // R(T) = R (1 + alpha (T - T_ref))
+  // The winding, for the derived resistance (gmasim/model/derived.hpp); 0: not given.
+  double coil_wire_diameter_m = 0, coil_mean_turn_length_m = 0, coil_resistivity_ohm_m = 0;
   double coil_C_J_per_K = 0, rods_C_J_per_K = 0, housing_C_J_per_K = 0;  // heat capacities
   double rod_specific_heat_J_per_kg_K = 0;  // rods_C_J_per_K = this x the rods' mass (compile)
   double G_coil_rods_W_per_K = 0, G_coil_housing_W_per_K = 0, G_rods_housing_W_per_K = 0,
