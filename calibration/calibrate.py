@@ -163,7 +163,7 @@ READING_KEYS = ("name", "start", "fit", "install", "set", "drop")
 def fit_spec_without(fit: pathlib.Path, drop: list[str], dest: pathlib.Path) -> pathlib.Path:
     """The fit spec with the [[parameter]] blocks named in `drop` removed (a block runs from its
     [[...]] line to the next one); every name must be a parameter of the spec."""
-    blocks, cur = [[]], None
+    blocks = [[]]
     for line in fit.read_text().splitlines(keepends=True):
         if line.startswith("[["):
             blocks.append([])

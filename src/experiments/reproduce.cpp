@@ -239,21 +239,14 @@ std::string comparison_markdown(const std::vector<ComparedModel>& models) {
     md += "\n";
   }
   // Readings are chosen by the claims they predict (issue 37): each count on its own row.
+  std::vector<ClaimCount> counts;
+  for (const auto& m : models) counts.push_back(count_claims(m.claims));
   md += "| **claims met** | |";
-  for (const auto& m : models) {
-    const ClaimCount n = count_claims(m.claims);
-    md += fmt::format(" **{} of {}** |", n.pass, n.applicable);
-  }
+  for (const auto& n : counts) md += fmt::format(" **{} of {}** |", n.pass, n.applicable);
   md += "\n| **predicted claims met** | |";
-  for (const auto& m : models) {
-    const ClaimCount n = count_claims(m.claims);
-    md += fmt::format(" **{} of {}** |", n.predicted_pass, n.predicted);
-  }
+  for (const auto& n : counts) md += fmt::format(" **{} of {}** |", n.predicted_pass, n.predicted);
   md += "\n| fitted claims met | |";
-  for (const auto& m : models) {
-    const ClaimCount n = count_claims(m.claims);
-    md += fmt::format(" {} of {} |", n.fitted_pass, n.fitted);
-  }
+  for (const auto& n : counts) md += fmt::format(" {} of {} |", n.fitted_pass, n.fitted);
   md += "\n\nReadings: ";
   for (const auto& m : models) md += fmt::format("`{}` = {}; ", m.name, m.readings);
   md += "\n";

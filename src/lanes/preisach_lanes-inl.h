@@ -319,7 +319,8 @@ struct PreisachLanes {
 
 // The kernel's hooks (step_kernel-inl.h, step_lanes.cpp): the rod's constants and state at the
 // step's start, the trial a lane keeps (take_trial), and the commit of the stacks of the lanes
-// that keep the step (PreisachLaw::commit_trial: preisach_commit at x1; nothing moved: no loss).
+// that keep the step (PreisachLaw::commit_trial: the trial's measure committed at x1 with
+// preisach_commit_point, the distribution not evaluated again; nothing moved: no loss).
 template <class D>
 HWY_INLINE void law_rod(const Chunk<D>& c, const RodStates<D>& s, int i,
                         PreisachLaneConstants<D>& k, PreisachLanes::Rod<D>& r) {

@@ -36,12 +36,11 @@ void coil_resistance(const ModelSpec& spec, std::vector<DerivedQuantity>& out) {
                  overridden(R->second), R->second.value});
 }
 
-}  // namespace
-
-std::vector<DerivedQuantity> derived_quantities(const ModelSpec& spec) {
-  std::vector<DerivedQuantity> out;
+// Each rod's mass: density x its volume. Keys a spec lacks (a file with problems still being
+// collected by the loader) skip the rod rather than throw.
+void rod_masses(const ModelSpec& spec, std::vector<DerivedQuantity>& out) {
   const auto density = spec.params.find("material.density_kg_per_m3");
-  if (density == spec.params.end()) return out;
+  if (density == spec.params.end()) return;
   const double rho = density->second.value;
   for (const auto& rod : spec.rods) {
     const auto mass = spec.params.find(rod + ".mass_kg");
@@ -60,6 +59,13 @@ std::vector<DerivedQuantity> derived_quantities(const ModelSpec& spec) {
                                rho, area, rod, len->second.value),
                    overridden(mass->second), mass->second.value});
   }
+}
+
+}  // namespace
+
+std::vector<DerivedQuantity> derived_quantities(const ModelSpec& spec) {
+  std::vector<DerivedQuantity> out;
+  rod_masses(spec, out);
   coil_resistance(spec, out);
   return out;
 }
