@@ -141,12 +141,14 @@ TEST(Lanes, FallbackTargetsAgree) {
 
 // The lanes against the scalar step(): the same Newton path (stepfast2's joint Newton in
 // (H, M): quadratic first guess, one law evaluation per solve, the last iterate committed,
-// L D L^T rod solve), so they differ in Highway's exp/cos/sin/tanh against libm's (a few ulp)
-// and where that rounding moves a Newton convergence decision. Observed after 3000 steps,
-// relative to the scales below: y 5.8e-13 (of 1 um), B 2.4e-15, H 1.4e-13 (of 1e4 A/m),
-// M 8.3e-15 (3.9e-13, 2.6e-15, 1.4e-13, 5.8e-15 before the lanes mirrored the skipped confirming
-// solve, the oscillator's series and M_an carried; 4.2e-9 when the lanes mirrored the step of
-// c77ea92); tolerance 7e-12.
+// L D L^T rod solve), so they differ in Highway's exp against libm's in the magnetic laws' lanes
+// (a few ulp; the mechanics laws are the scalar's own: tests/test_laws_lanes.cpp) and where that
+// rounding moves a Newton convergence decision. Observed after 3000 steps, relative to the
+// scales below: y 6.0e-13 (of 1 um), B 2.8e-15, H 1.3e-13 (of 1e4 A/m), M 6.2e-15 (5.8e-13,
+// 2.4e-15, 1.4e-13, 8.3e-15 while the mechanics had its own lane
+// copy; 3.9e-13, 2.6e-15, 1.4e-13, 5.8e-15 before the lanes mirrored the skipped confirming solve,
+// the oscillator's series and M_an carried; 4.2e-9 when the lanes mirrored the step of c77ea92);
+// tolerance 7e-12.
 TEST(Lanes, FollowTheScalarStep) {
   const Runs runs(9);
   LaneBatch b = runs.batch();

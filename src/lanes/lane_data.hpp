@@ -17,95 +17,120 @@ inline constexpr int kMaxRods = 8;
 // repeats the last lane and is never read back.
 inline constexpr std::size_t kPad = 8;
 
-// Per rod and lane: the step's state (RodState's numbers), then the constants it reads
-// (RodConditions, Material, the circuit's rod branch).
+// The fields, each in one table: its name and where pack.cpp reads it (LaneBatch::unpack writes
+// a state field back to the same place). The enums below and pack/unpack are generated from
+// these tables, so a field is added in one line. A state field is what the step changes (loaded
+// into registers for the step, stored after it), a constant what it only reads.
+//
+// Per rod and lane: the step's state (RodState's numbers, r), ...
+#define GMASIM_LANE_ROD_STATE(X)                                                           \
+  X(kH, r.H_A_per_m)                                                                       \
+  X(kMirr, r.Mirr_A_per_m)                                                                 \
+  X(kM, r.M_A_per_m)                                                                       \
+  X(kHc, r.Hc_A_per_m)                                                                     \
+  X(kHprev, r.H_prev_A_per_m)                                                              \
+  X(kMprev, r.M_prev_A_per_m)                                                              \
+  X(kHprev2, r.H_prev2_A_per_m)                                                            \
+  X(kMprev2, r.M_prev2_A_per_m)                                                            \
+  X(kX, r.x_m)                                                                             \
+  X(kV, r.v_m_per_s)                                                                       \
+  X(kF, r.F_N)                                                                             \
+  X(kMuR, r.mu_r)                                                                          \
+  X(kE, r.E_Pa)                                                                            \
+  X(kLambda, r.lambda)                                                                     \
+  X(kTau, r.tau_s)                                                                         \
+  X(kPhi, r.phi_Wb)                                                                        \
+  X(kKRod, r.k_rod_N_per_m)                                                                \
+  X(kKLoad, r.k_load_N_per_m)                                                              \
+  X(kKOsc, r.K_osc_N_per_m)                                                                \
+  X(kB, r.B_T)                                                                             \
+  X(kAnX, r.an_x)                   /* the law's last evaluation, H_e / a (NaN: none) */   \
+  X(kAnL, r.an_L)                   /* L there */                                          \
+  X(kAnDL, r.an_dL)                 /* L' there */                                         \
+  X(kPrestressY, r.prestress_exp.y) /* eq. (11)'s tanh anchor (physics::exp_near) */       \
+  X(kPrestressE, r.prestress_exp.e)                                                        \
+  X(kOscDecayY, r.osc_decay.y) /* the oscillator's last e^(tau/2) (physics::exp_cached) */ \
+  X(kOscDecayE, r.osc_decay.e)
+// ... then the constants it reads (RodConditions rc, Material m.material, the circuit's rod
+// branch br; q = M_s^T / M_s of the strain guard).
+#define GMASIM_LANE_ROD_CONSTANTS(X)                                                              \
+  X(kLength, rc.length_m)                                                                         \
+  X(kArea, rc.area_m2)                                                                            \
+  X(kMsTMag, rc.MsT_mag)                                                                          \
+  X(kInvEs, rc.dE.inverse_Es_per_Pa)                                                              \
+  X(kRot, rc.dE.rotation_compliance_per_Pa)                                                       \
+  X(kCoupling, rc.dE.coupling)                                                                    \
+  X(kMu0Ms2, rc.dE.mu0_Ms2_over_chi_m_J_per_m3)                                                   \
+  X(kSdE, rc.dE.S_J_per_m3)                                                                       \
+  X(kJaA, rc.ja.a_A_per_m)                                                                        \
+  X(kJaAlpha, rc.ja.alpha)                                                                        \
+  X(kJaC, rc.ja.c)                                                                                \
+  X(kJaK, rc.ja.k_A_per_m)                                                                        \
+  X(kKappa, rc.eddy_geometry_s_m_per_H)                                                           \
+  X(kRs, rc.series_reluctance_per_H)                                                              \
+  X(kMassOsc, rc.mass_osc_kg)                                                                     \
+  X(kMomMass, rc.momentum_mass_kg)                                                                \
+  X(kDampOsc, rc.damping_osc_N_s_per_m)                                                           \
+  X(kFixedCompl, rc.fixed_compliance_m_per_N)                                                     \
+  X(kSigmaP, rc.sigma_p_Pa)                                                                       \
+  X(kCoilTurns, br.coil_turns)                                                                    \
+  X(kPmMmf, br.pm_mmf_At)                                                                         \
+  X(kStrainBound, kStrainGuardFactor* m.material.lambda_s* q* q)                                  \
+  X(kFluxMs, std::max(m.material.Ms_A_per_m, rc.MsT_mag))                                         \
+  X(kJaInvA, 1.0 / rc.ja.a_A_per_m)            /* the scalar law's inv_a */                       \
+  X(kLengthPerArea, rc.length_over_area_per_m) /* l / A (the consistent step's l_A) */            \
+  X(kInvArea, 1.0 / rc.area_m2)                                                                   \
+  X(kInvMassOsc, rc.inv_mass_osc_per_kg)                      /* 1 / m of the rod's oscillator */ \
+  X(kJaInvK, 1.0 / rc.ja.k_A_per_m)                           /* JaMoveStart::inv_k */            \
+  X(kInvMsTE, rc.inv_MsT_E_m_per_A)                           /* 1 / M_s^T of eq. (13) */         \
+  X(kInvMsStrain, rc.inv_Ms_strain_m_per_A)                   /* 1 / M_s of eq. (11) */           \
+  X(kAreaOverLength, rc.area_over_length_m)                   /* A / l (eq. 17) */                \
+  X(kFourSpOverLs, 4.0 * rc.sigma_p_Pa / m.material.lambda_s) /* eq. (11)'s 4 sigma_p / lambda_s  \
+                                                               */
+
+// Per lane: the State's scalars (s), ...
+#define GMASIM_LANE_GLOBAL_STATE(X)                                        \
+  X(kT, s.t_s)                                                             \
+  X(kCurrent, s.current_A)                                                 \
+  X(kY, s.y_m)                                                             \
+  X(kYStack, s.y_stack_m)                                                  \
+  X(kQ, s.q_m)                                                             \
+  X(kZ, s.z_m)                                                             \
+  X(kZv, s.z_v_m_per_s)                                                    \
+  X(kBSensor, s.B_T)                                                       \
+  X(kMountDecayY, s.mount_decay.y) /* the sensor mount's, as kOscDecayY */ \
+  X(kMountDecayE, s.mount_decay.e)
+// ... and the constants (Conditions c, Model m; the flux sensor's area).
+#define GMASIM_LANE_GLOBAL_CONSTANTS(X)        \
+  X(kPmScale, c.pm_scale)                      \
+  X(kXT, c.thermal_expansion_m)                \
+  X(kMountMass, m.sensor_mount.mass_kg)        \
+  X(kMountK, m.sensor_mount.stiffness_N_per_m) \
+  X(kMountC, m.sensor_mount.damping_N_s_per_m) \
+  X(kActMass, m.sensor_mount.actuator_mass_kg) \
+  X(kLambdaS, m.material.lambda_s)             \
+  X(kSensorArea, sensor_area)                  \
+  X(kMountInvMass, m.sensor_mount.enabled ? 1.0 / m.sensor_mount.mass_kg : 0.0)
+
+#define GMASIM_LANE_FIELD_NAME(name, source) name,
 enum RodField : int {
-  kH,
-  kMirr,
-  kM,
-  kHc,
-  kHprev,
-  kMprev,
-  kHprev2,
-  kMprev2,
-  kX,
-  kV,
-  kF,
-  kMuR,
-  kE,
-  kLambda,
-  kTau,
-  kPhi,
-  kKRod,
-  kKLoad,
-  kKOsc,
-  kB,
-  kAnX,   // the law's last evaluation, H_e / a (RodState::an_x; NaN: none)
-  kAnL,   // L there (RodState::an_L)
-  kAnDL,  // L' there (RodState::an_dL)
-  kRodStateCount,
-  kLength = kRodStateCount,
-  kArea,
-  kMsTMag,
-  kInvEs,
-  kRot,
-  kCoupling,
-  kMu0Ms2,
-  kSdE,
-  kJaA,
-  kJaAlpha,
-  kJaC,
-  kJaK,
-  kKappa,
-  kRs,
-  kMassOsc,
-  kMomMass,
-  kDampOsc,
-  kFixedCompl,
-  kSigmaP,
-  kCoilTurns,
-  kPmMmf,
-  kStrainBound,
-  kFluxMs,
-  kJaInvA,          // 1 / a (the scalar law's inv_a)
-  kLengthPerArea,   // l / A (the consistent step's l_A)
-  kInvArea,         // 1 / A
-  kInvMassOsc,      // 1 / m of the rod's oscillator (oscillator_step's inv_m)
-  kJaInvK,          // 1 / k (JaMoveStart::inv_k)
-  kInvMsTE,         // 1 / M_s^T of eq. (13) (RodConditions::inv_MsT_E_m_per_A)
-  kInvMsStrain,     // 1 / M_s of eq. (11) (RodConditions::inv_Ms_strain_m_per_A)
-  kAreaOverLength,  // A / l (eq. 17)
-  kFourSpOverLs,    // 4 sigma_p / lambda_s (eq. 11's 2 sigma_p / sigma_s times E)
-  kRodFieldCount
+  GMASIM_LANE_ROD_STATE(GMASIM_LANE_FIELD_NAME) kRodStateCount,
+  kRodConstantsBefore = kRodStateCount - 1,
+  GMASIM_LANE_ROD_CONSTANTS(GMASIM_LANE_FIELD_NAME) kRodFieldCount
 };
 
 // Per lane: the State's scalars, the constants, and the diagnosis of a diverged lane.
 enum GlobalField : int {
-  kT,
-  kCurrent,
-  kY,
-  kYStack,
-  kQ,
-  kZ,
-  kZv,
-  kBSensor,
-  kGlobalStateCount,
-  kPmScale = kGlobalStateCount,
-  kXT,
-  kMountMass,
-  kMountK,
-  kMountC,
-  kActMass,
-  kLambdaS,
-  kSensorArea,
-  kMountInvMass,  // 1 / m of the sensor mount's oscillator
-  kFail,
+  GMASIM_LANE_GLOBAL_STATE(GMASIM_LANE_FIELD_NAME) kGlobalStateCount,
+  kGlobalConstantsBefore = kGlobalStateCount - 1,
+  GMASIM_LANE_GLOBAL_CONSTANTS(GMASIM_LANE_FIELD_NAME) kFail,
   kFailValue,
   kFailRod,
   kFailT,
   kFailBound,
   kGlobalFieldCount
 };
+#undef GMASIM_LANE_FIELD_NAME
 
 // What stopped a lane (kFail), in the order step() and run_loop() check (first one wins).
 enum FailCode : int {
@@ -183,6 +208,64 @@ struct StepInputs {
 // The kernel, dispatched to the best target of this CPU (src/lanes/step_lanes.cpp); width_one
 // runs the width-1 instance of the same code (the reference each lane is compared with).
 void step_dispatch(LaneData& d, const StepInputs& in, bool width_one);
+// The mechanics laws alone (rod_mechanics, chain_stiffness, mid_step_stiffness, oscillator_step,
+// base_excited_step) over n lanes (a multiple of 8), on the best target: for the test that each
+// lane equals the scalar instance bit for bit (tests/test_laws_lanes.cpp). in[f * n + j] is
+// field f (LawProbeIn) of lane j, out[f * n + j] field f of LawProbeOut.
+enum LawProbeIn : int {
+  kPiM,
+  kPiInvMsTE,
+  kPiInvEs,
+  kPiRot,
+  kPiCoupling,
+  kPiMu0Ms2,
+  kPiS,
+  kPiInvMsStrain,
+  kPiLambdaS,
+  kPiSigmaP,
+  kPiArea,
+  kPiAreaOverLength,
+  kPiLengthOverArea,
+  kPiPrestressY,
+  kPiPrestressE,
+  kPiFixedCompliance,
+  kPiK0,
+  kPiMass,
+  kPiInvMass,
+  kPiDamping,
+  kPiF0,
+  kPiX,
+  kPiV,
+  kPiDecayY,
+  kPiDecayE,
+  kPiH,
+  kPiQ0,
+  kPiQ1,
+  kPiZ,
+  kPiZv,
+  kLawProbeInCount
+};
+enum LawProbeOut : int {
+  kPoE,
+  kPoLambda,
+  kPoF,
+  kPoKRod,
+  kPoCompliance,
+  kPoPrestressY,
+  kPoPrestressE,
+  kPoKLoad,
+  kPoK,
+  kPoX,
+  kPoV,
+  kPoDecayY,
+  kPoDecayE,
+  kPoZ,
+  kPoZv,
+  kPoMountDecayY,
+  kPoMountDecayE,
+  kLawProbeOutCount
+};
+void mechanics_laws_dispatch(const double* in, double* out, std::size_t n);
 // The target the dispatcher chose and its vector width in doubles.
 const char* dispatch_target_name();
 int dispatch_lanes();

@@ -72,24 +72,10 @@ void pack_globals(LaneData& L, std::size_t j, const Model& m, const Conditions& 
         c.rods[static_cast<std::size_t>(m.circuit.branches[static_cast<std::size_t>(b)].rod)]
             .area_m2;
   auto glob = [&](int f) -> double& { return L.glob(f)[j]; };
-  const double globals[] = {s.t_s,
-                            s.current_A,
-                            s.y_m,
-                            s.y_stack_m,
-                            s.q_m,
-                            s.z_m,
-                            s.z_v_m_per_s,
-                            s.B_T,
-                            c.pm_scale,
-                            c.thermal_expansion_m,
-                            m.sensor_mount.mass_kg,
-                            m.sensor_mount.stiffness_N_per_m,
-                            m.sensor_mount.damping_N_s_per_m,
-                            m.sensor_mount.actuator_mass_kg,
-                            m.material.lambda_s,
-                            sensor_area,
-                            m.sensor_mount.enabled ? 1.0 / m.sensor_mount.mass_kg : 0.0};
-  for (int f = 0; f <= kMountInvMass; ++f) glob(f) = globals[f];
+#define GMASIM_PACK(name, source) glob(name) = source;
+  GMASIM_LANE_GLOBAL_STATE(GMASIM_PACK)
+  GMASIM_LANE_GLOBAL_CONSTANTS(GMASIM_PACK)
+#undef GMASIM_PACK
   for (int f = kFail; f < kGlobalFieldCount; ++f) glob(f) = 0.0;
 }
 
@@ -123,68 +109,14 @@ void pack_lane(LaneData& L, std::size_t j, const Model& m, const Conditions& c, 
   for (int i = 0; i < n; ++i) {
     const RodState& r = s.rods[static_cast<std::size_t>(i)];
     const RodConditions& rc = c.rods[static_cast<std::size_t>(i)];
-    const double state[kRodStateCount] = {r.H_A_per_m,
-                                          r.Mirr_A_per_m,
-                                          r.M_A_per_m,
-                                          r.Hc_A_per_m,
-                                          r.H_prev_A_per_m,
-                                          r.M_prev_A_per_m,
-                                          r.H_prev2_A_per_m,
-                                          r.M_prev2_A_per_m,
-                                          r.x_m,
-                                          r.v_m_per_s,
-                                          r.F_N,
-                                          r.mu_r,
-                                          r.E_Pa,
-                                          r.lambda,
-                                          r.tau_s,
-                                          r.phi_Wb,
-                                          r.k_rod_N_per_m,
-                                          r.k_load_N_per_m,
-                                          r.K_osc_N_per_m,
-                                          r.B_T,
-                                          r.an_x,
-                                          r.an_L,
-                                          r.an_dL};
-    for (int f = 0; f < kRodStateCount; ++f) rod(f, i) = state[f];
     const auto& br =
         m.circuit
             .branches[static_cast<std::size_t>(m.circuit.rod_branch[static_cast<std::size_t>(i)])];
     const double q = rc.MsT_mag / rc.Ms_strain_A_per_m;
-    const double constants[kRodFieldCount - kRodStateCount] = {
-        rc.length_m,
-        rc.area_m2,
-        rc.MsT_mag,
-        rc.dE.inverse_Es_per_Pa,
-        rc.dE.rotation_compliance_per_Pa,
-        rc.dE.coupling,
-        rc.dE.mu0_Ms2_over_chi_m_J_per_m3,
-        rc.dE.S_J_per_m3,
-        rc.ja.a_A_per_m,
-        rc.ja.alpha,
-        rc.ja.c,
-        rc.ja.k_A_per_m,
-        rc.eddy_geometry_s_m_per_H,
-        rc.series_reluctance_per_H,
-        rc.mass_osc_kg,
-        rc.momentum_mass_kg,
-        rc.damping_osc_N_s_per_m,
-        rc.fixed_compliance_m_per_N,
-        rc.sigma_p_Pa,
-        br.coil_turns,
-        br.pm_mmf_At,
-        kStrainGuardFactor * m.material.lambda_s * q * q,
-        std::max(m.material.Ms_A_per_m, rc.MsT_mag),
-        1.0 / rc.ja.a_A_per_m,
-        rc.length_m / rc.area_m2,
-        1.0 / rc.area_m2,
-        1.0 / rc.mass_osc_kg,
-        1.0 / rc.ja.k_A_per_m,
-        rc.inv_MsT_E_m_per_A,
-        rc.inv_Ms_strain_m_per_A,
-        rc.area_over_length_m,
-        4.0 * rc.sigma_p_Pa / m.material.lambda_s};
-    for (int f = kRodStateCount; f < kRodFieldCount; ++f) rod(f, i) = constants[f - kRodStateCount];
+#define GMASIM_PACK(name, source) rod(name, i) = source;
+    GMASIM_LANE_ROD_STATE(GMASIM_PACK)
+    GMASIM_LANE_ROD_CONSTANTS(GMASIM_PACK)
+#undef GMASIM_PACK
     for (int b = 0; b < n; ++b) L.S(i, b)[j] = lr.S8[static_cast<std::size_t>(8 * i + b)];
     L.bt_coil(i)[j] = lr.bt_coil8[i];
     L.bt_pm(i)[j] = lr.bt_pm8[i];
@@ -279,35 +211,14 @@ void LaneBatch::unpack(std::size_t j, State& s) const {
   LaneData& L = *d_;
   for (int i = 0; i < L.st.rods; ++i) {
     RodState& r = s.rods[static_cast<std::size_t>(i)];
-    double* const fields[kRodStateCount] = {&r.H_A_per_m,
-                                            &r.Mirr_A_per_m,
-                                            &r.M_A_per_m,
-                                            &r.Hc_A_per_m,
-                                            &r.H_prev_A_per_m,
-                                            &r.M_prev_A_per_m,
-                                            &r.H_prev2_A_per_m,
-                                            &r.M_prev2_A_per_m,
-                                            &r.x_m,
-                                            &r.v_m_per_s,
-                                            &r.F_N,
-                                            &r.mu_r,
-                                            &r.E_Pa,
-                                            &r.lambda,
-                                            &r.tau_s,
-                                            &r.phi_Wb,
-                                            &r.k_rod_N_per_m,
-                                            &r.k_load_N_per_m,
-                                            &r.K_osc_N_per_m,
-                                            &r.B_T,
-                                            &r.an_x,
-                                            &r.an_L,
-                                            &r.an_dL};
-    for (int f = 0; f < kRodStateCount; ++f) *fields[f] = L.rod(f, i)[j];
+#define GMASIM_UNPACK(name, target) target = L.rod(name, i)[j];
+    GMASIM_LANE_ROD_STATE(GMASIM_UNPACK)
     if (L.st.preisach) r.preisach = L.pre.history(i)[j];
   }
-  double* const globals[kGlobalStateCount] = {&s.t_s, &s.current_A, &s.y_m,         &s.y_stack_m,
-                                              &s.q_m, &s.z_m,       &s.z_v_m_per_s, &s.B_T};
-  for (int f = 0; f < kGlobalStateCount; ++f) *globals[f] = L.glob(f)[j];
+#undef GMASIM_UNPACK
+#define GMASIM_UNPACK(name, target) target = L.glob(name)[j];
+  GMASIM_LANE_GLOBAL_STATE(GMASIM_UNPACK)
+#undef GMASIM_UNPACK
 }
 
 std::size_t LaneBatch::record_width() const {

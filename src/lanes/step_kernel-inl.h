@@ -12,10 +12,12 @@
 
 #include "gmasim/model/validity.hpp"
 #include "gmasim/physics/magnetic.hpp"
+#include "gmasim/physics/magnetostriction.hpp"
+#include "gmasim/physics/mechanics.hpp"
 #include "hwy/highway.h"
 #include "lanes/ja_lanes-inl.h"
 #include "lanes/lane_data.hpp"
-#include "lanes/mechanics_lanes-inl.h"
+#include "lanes/number_lanes-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace gmasim::lanes::HWY_NAMESPACE {

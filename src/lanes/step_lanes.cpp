@@ -8,50 +8,59 @@
 
 #include "hwy/foreach_target.h"  // IWYU pragma: keep
 #include "hwy/highway.h"
+#include "lanes/number_lanes-inl.h"
 #include "lanes/preisach_lanes-inl.h"
 #include "lanes/step_kernel-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace gmasim::lanes::HWY_NAMESPACE {
 
-// Stage 3 (model/step.cpp, step_law): each rod's Delta-E modulus, strain, force and stiffness
-// (eq. 11-14, 17), its load stiffness (eq. 18) and its oscillator over the step (eq. 15-16,
-// stiffness at mid-step); then the sensor mount's probe (model.hpp, SensorMountModel).
+// Stage 3 (model/step.cpp, stage_strain and stage_mechanics): each rod's Delta-E modulus,
+// strain, force and stiffness (eq. 11-14, 17: laws::rod_mechanics), its load stiffness
+// (eq. 18: chain_stiffness) and its oscillator over the step (eq. 15-16, stiffness at mid-step:
+// mid_step_stiffness, oscillator_step); then the sensor mount's probe (base_excited_step). The
+// laws are gmasim/physics's own, instantiated over the lanes' number type (Lanes<D>).
 template <class D>
 HWY_INLINE void mechanics(const Chunk<D>& c, RodStates<D>& s, V<D> h, V<D> t1, Fails<D>& fails) {
+  using N = Lanes<D>;
   const D d = c.d;
   const int n = c.n;
   const Structure& st = c.L.st;
-  V<D> F0[kMaxRods], K0[kMaxRods];
-  const V<D> lambda_s = c.glob(kLambdaS);
+  N F0[kMaxRods], K0[kMaxRods], compliance[kMaxRods];
+  const N lambda_s = c.glob(kLambdaS);
   for (int i = 0; i < n; ++i) {
     F0[i] = s.f[kF][i];
-    K0[i] = hn::Add(s.f[kKRod][i], s.f[kKLoad][i]);
-    // rod_laws.hpp, update_rod_mechanics: the reciprocals are the conditions'
-    const V<D> M = s.f[kM][i], A = c.rod(kArea, i);
-    const V<D> inv_E =
-        delta_e_compliance(d, hn::Mul(M, c.rod(kInvMsTE, i)), c.rod(kInvEs, i), c.rod(kRot, i),
-                           c.rod(kCoupling, i), c.rod(kMu0Ms2, i), c.rod(kSdE, i));
-    const V<D> E = hn::Div(C(d, 1.0), inv_E);
-    s.f[kE][i] = E;
-    s.f[kLambda][i] =
-        magnetostriction(d, hn::Mul(M, c.rod(kInvMsStrain, i)), lambda_s, c.rod(kSigmaP, i), E,
-                         hn::Mul(c.rod(kFourSpOverLs, i), inv_E));
-    s.f[kF][i] = hn::Mul(hn::Mul(s.f[kLambda][i], E), A);
-    s.f[kKRod][i] = hn::Mul(E, c.rod(kAreaOverLength, i));
+    K0[i] = N(s.f[kKRod][i]) + N(s.f[kKLoad][i]);
+    const laws::DeltaETermsT<N> dE{c.rod(kInvEs, i), c.rod(kRot, i), c.rod(kCoupling, i),
+                                   c.rod(kMu0Ms2, i), c.rod(kSdE, i)};
+    laws::ExpPointT<N> prestress{s.f[kPrestressY][i], s.f[kPrestressE][i]};
+    const laws::RodMechanicsT<N> k =
+        laws::rod_mechanics<N>(s.f[kM][i], c.rod(kInvMsTE, i), dE, c.rod(kInvMsStrain, i), lambda_s,
+                               c.rod(kSigmaP, i), c.rod(kFourSpOverLs, i), c.rod(kArea, i),
+                               c.rod(kAreaOverLength, i), c.rod(kLengthPerArea, i), prestress);
+    s.f[kPrestressY][i] = prestress.y.v;
+    s.f[kPrestressE][i] = prestress.e.v;
+    s.f[kE][i] = k.E_Pa.v;
+    s.f[kLambda][i] = k.lambda.v;
+    s.f[kF][i] = k.F_N.v;
+    s.f[kKRod][i] = k.k_rod_N_per_m.v;
+    compliance[i] = k.compliance_m_per_N;
   }
-  V<D> compliance[kMaxRods];  // 1 / k_rod, each rod's once (the chains share them)
-  for (int i = 0; i < n; ++i) compliance[i] = hn::Div(C(d, 1.0), s.f[kKRod][i]);
   for (int i = 0; i < n; ++i) {
-    V<D> inv_k = c.rod(kFixedCompl, i);
-    for (int k = 0; k < st.chain_count[static_cast<std::size_t>(i)]; ++k)
-      inv_k = hn::Add(
-          inv_k, compliance[st.chain[static_cast<std::size_t>(i)][static_cast<std::size_t>(k)]]);
-    s.f[kKLoad][i] = hn::Div(C(d, 1.0), inv_k);
-    const V<D> K = hn::Mul(C(d, 0.5), hn::Add(hn::Add(K0[i], s.f[kKRod][i]), s.f[kKLoad][i]));
-    s.f[kKOsc][i] = K;
-    oscillator_step(d, c.rod(kMassOsc, i), c.rod(kInvMassOsc, i), c.rod(kDampOsc, i), K, F0[i],
-                    s.f[kF][i], h, s.f[kX][i], s.f[kV][i]);
+    const auto u = static_cast<std::size_t>(i);
+    const N k_load = laws::chain_stiffness<N>(c.rod(kFixedCompl, i), compliance, st.chain[u].data(),
+                                              st.chain_count[u]);
+    s.f[kKLoad][i] = k_load.v;
+    const N K = laws::mid_step_stiffness<N>(K0[i], s.f[kKRod][i], k_load);
+    s.f[kKOsc][i] = K.v;
+    N x = s.f[kX][i], v = s.f[kV][i];
+    laws::ExpPointT<N> decay{s.f[kOscDecayY][i], s.f[kOscDecayE][i]};
+    laws::oscillator_step<N>(c.rod(kMassOsc, i), c.rod(kInvMassOsc, i), c.rod(kDampOsc, i), K,
+                             F0[i], s.f[kF][i], h, x, v, decay);
+    s.f[kX][i] = x.v;
+    s.f[kV][i] = v.v;
+    s.f[kOscDecayY][i] = decay.y.v;
+    s.f[kOscDecayE][i] = decay.e.v;
     fails.check(d, s.f[kX][i], C(d, 1.0), kFailX, i, t1);
   }
 }
@@ -61,18 +70,21 @@ HWY_INLINE void mechanics(const Chunk<D>& c, RodStates<D>& s, V<D> h, V<D> t1, F
 template <class D>
 HWY_INLINE void mount_and_outputs(const Chunk<D>& c, RodStates<D>& s, V<D>* g, V<D> h, V<D> t1,
                                   Fails<D>& fails) {
+  using N = Lanes<D>;
   const D d = c.d;
   const Structure& st = c.L.st;
   if (st.mount) {
     V<D> p = hn::Zero(d);
     for (int i = 0; i < c.n; ++i) p = hn::Add(p, hn::Mul(c.rod(kMomMass, i), s.f[kX][i]));
     const V<D> q1 = hn::Div(p, c.glob(kActMass));
-    const V<D> q0 = g[kQ];
-    const V<D> qdot = hn::Div(hn::Sub(q1, q0), h);
-    const V<D> cm = c.glob(kMountC), km = c.glob(kMountK);
-    oscillator_step(d, c.glob(kMountMass), c.glob(kMountInvMass), cm, km,
-                    hn::Add(hn::Mul(cm, qdot), hn::Mul(km, q0)),
-                    hn::Add(hn::Mul(cm, qdot), hn::Mul(km, q1)), h, g[kZ], g[kZv]);
+    N z = g[kZ], zv = g[kZv];
+    laws::ExpPointT<N> decay{g[kMountDecayY], g[kMountDecayE]};
+    laws::base_excited_step<N>(c.glob(kMountMass), c.glob(kMountInvMass), c.glob(kMountC),
+                               c.glob(kMountK), g[kQ], q1, h, z, zv, decay);
+    g[kZ] = z.v;
+    g[kZv] = zv.v;
+    g[kMountDecayY] = decay.y.v;
+    g[kMountDecayE] = decay.e.v;
     g[kQ] = q1;
     fails.check(d, g[kZ], C(d, 1.0), kFailZ, -1, t1);
   }
@@ -246,6 +258,52 @@ void StepAll(LaneData& L, const StepInputs& in, bool width_one) {
     step_law<JilesAthertonLanes>(L, in, width_one);
 }
 
+// lane_data.hpp, mechanics_laws_dispatch: the laws of mechanics() and mount_and_outputs() on
+// given inputs (a rod whose chain is itself; the mount's decay starts where the rod's does).
+void MechanicsLaws(const double* in, double* out, std::size_t n) {
+  using N = Lanes<hn::ScalableTag<double>>;
+  const hn::ScalableTag<double> d;
+  for (std::size_t j = 0; j < n; j += hn::Lanes(d)) {
+    auto at = [&](int f) -> N { return hn::LoadU(d, in + static_cast<std::size_t>(f) * n + j); };
+    auto put = [&](int f, N v) { hn::StoreU(v.v, d, out + static_cast<std::size_t>(f) * n + j); };
+    const laws::DeltaETermsT<N> dE{at(kPiInvEs), at(kPiRot), at(kPiCoupling), at(kPiMu0Ms2),
+                                   at(kPiS)};
+    laws::ExpPointT<N> prestress{at(kPiPrestressY), at(kPiPrestressE)};
+    const laws::RodMechanicsT<N> k =
+        laws::rod_mechanics<N>(at(kPiM), at(kPiInvMsTE), dE, at(kPiInvMsStrain), at(kPiLambdaS),
+                               at(kPiSigmaP), N(4.0) * at(kPiSigmaP) / at(kPiLambdaS), at(kPiArea),
+                               at(kPiAreaOverLength), at(kPiLengthOverArea), prestress);
+    const N compliance[1] = {k.compliance_m_per_N};
+    const int self[1] = {0};
+    const N k_load = laws::chain_stiffness<N>(at(kPiFixedCompliance), compliance, self, 1);
+    const N K = laws::mid_step_stiffness<N>(at(kPiK0), k.k_rod_N_per_m, k_load);
+    N x = at(kPiX), v = at(kPiV), z = at(kPiZ), zv = at(kPiZv);
+    laws::ExpPointT<N> decay{at(kPiDecayY), at(kPiDecayE)}, mount = decay;
+    laws::oscillator_step<N>(at(kPiMass), at(kPiInvMass), at(kPiDamping), K, at(kPiF0), k.F_N,
+                             at(kPiH), x, v, decay);
+    laws::base_excited_step<N>(at(kPiMass), at(kPiInvMass), at(kPiDamping), K, at(kPiQ0), at(kPiQ1),
+                               at(kPiH), z, zv, mount);
+    const N values[kLawProbeOutCount] = {k.E_Pa,
+                                         k.lambda,
+                                         k.F_N,
+                                         k.k_rod_N_per_m,
+                                         k.compliance_m_per_N,
+                                         prestress.y,
+                                         prestress.e,
+                                         k_load,
+                                         K,
+                                         x,
+                                         v,
+                                         decay.y,
+                                         decay.e,
+                                         z,
+                                         zv,
+                                         mount.y,
+                                         mount.e};
+    for (int f = 0; f < kLawProbeOutCount; ++f) put(f, values[f]);
+  }
+}
+
 int WidthOf() { return static_cast<int>(hn::Lanes(hn::ScalableTag<double>())); }
 
 }  // namespace gmasim::lanes::HWY_NAMESPACE
@@ -256,6 +314,11 @@ namespace gmasim::lanes {
 
 HWY_EXPORT(StepAll);
 HWY_EXPORT(WidthOf);
+HWY_EXPORT(MechanicsLaws);
+
+void mechanics_laws_dispatch(const double* in, double* out, std::size_t n) {
+  HWY_DYNAMIC_DISPATCH(MechanicsLaws)(in, out, n);
+}
 
 void step_dispatch(LaneData& d, const StepInputs& in, bool width_one) {
   HWY_DYNAMIC_DISPATCH(StepAll)(d, in, width_one);

@@ -69,10 +69,8 @@ double recoil_m(const Model& m, const Conditions& c, const State& s) {
 // the step: linear forcing, and oscillator_step is exact.
 void advance_sensor_mount(const SensorMountModel& o, double q0_m, double q1_m, double h_s,
                           State& s) {
-  const double qdot = (q1_m - q0_m) / h_s;
-  const double c = o.damping_N_s_per_m, k = o.stiffness_N_per_m;
-  oscillator_step(o.mass_kg, 1.0 / o.mass_kg, c, k, c * qdot + k * q0_m, c * qdot + k * q1_m, h_s,
-                  s.z_m, s.z_v_m_per_s, s.mount_decay);
+  base_excited_step(o.mass_kg, 1.0 / o.mass_kg, o.damping_N_s_per_m, o.stiffness_N_per_m, q0_m,
+                    q1_m, h_s, s.z_m, s.z_v_m_per_s, s.mount_decay);
   s.q_m = q1_m;
 }
 
@@ -449,7 +447,7 @@ void stage_mechanics(const Model& m, const Conditions& c, State& s, const StepIn
     const auto& rc = c.rods[i];
     auto& r = s.rods[i];
     r.k_load_N_per_m = load_stiffness_from_compliances(rc, w.inv_k_rod.data());
-    const double K = 0.5 * (w.K0_N_per_m[i] + r.k_rod_N_per_m + r.k_load_N_per_m);
+    const double K = mid_step_stiffness(w.K0_N_per_m[i], r.k_rod_N_per_m, r.k_load_N_per_m);
     r.K_osc_N_per_m = K;
     oscillator_step(rc.mass_osc_kg, rc.inv_mass_osc_per_kg, rc.damping_osc_N_s_per_m, K, w.F0_N[i],
                     r.F_N, in.dt_s, r.x_m, r.v_m_per_s, r.osc_decay);

@@ -43,14 +43,15 @@ inline double rod_static_field(const Model& m, std::size_t i, const RodCondition
 // The reciprocals are RodConditions' (divided once); 1/E is eq. (13)'s bracket. Returns the
 // rod's compliance 1/k_rod = (1/E) l / A (eq. 17), for the load stiffness of eq. (18).
 inline double update_rod_mechanics(const Material& mat, const RodConditions& rc, RodState& r) {
-  const double inv_E = physics::delta_e_compliance(r.M_A_per_m * rc.inv_MsT_E_m_per_A, rc.dE);
-  r.E_Pa = 1.0 / inv_E;  // eq. (13)
-  r.lambda = physics::magnetostriction_near(r.M_A_per_m * rc.inv_Ms_strain_m_per_A, mat.lambda_s,
-                                            rc.sigma_p_Pa, r.E_Pa, inv_E,
-                                            r.prestress_exp);  // eq. (11)-(12)
-  r.F_N = physics::rod_force(r.lambda, r.E_Pa, rc.area_m2);    // eq. (14)
-  r.k_rod_N_per_m = r.E_Pa * rc.area_over_length_m;            // eq. (17): E A / l
-  return inv_E * rc.length_over_area_per_m;
+  const physics::RodMechanics k = physics::rod_mechanics(
+      r.M_A_per_m, rc.inv_MsT_E_m_per_A, rc.dE, rc.inv_Ms_strain_m_per_A, mat.lambda_s,
+      rc.sigma_p_Pa, 4.0 * rc.sigma_p_Pa / mat.lambda_s, rc.area_m2, rc.area_over_length_m,
+      rc.length_over_area_per_m, r.prestress_exp);
+  r.E_Pa = k.E_Pa;
+  r.lambda = k.lambda;
+  r.F_N = k.F_N;
+  r.k_rod_N_per_m = k.k_rod_N_per_m;
+  return k.compliance_m_per_N;
 }
 
 // Load stiffness of a rod (eq. 18): its fixed members plus the rods in its chain, whose
@@ -64,10 +65,8 @@ double load_stiffness(const RodConditions& rc, KRod k_rod) {
 }
 // The same from the rods' compliances 1/k_rod (inv_k_rod[j], divided once per rod and step).
 inline double load_stiffness_from_compliances(const RodConditions& rc, const double* inv_k_rod) {
-  double inv_k = rc.fixed_compliance_m_per_N;
-  for (int j = 0; j < rc.chain_rod_count; ++j)
-    inv_k += inv_k_rod[rc.chain_rods[static_cast<std::size_t>(j)]];
-  return 1.0 / inv_k;
+  return physics::chain_stiffness(rc.fixed_compliance_m_per_N, inv_k_rod, rc.chain_rods.data(),
+                                  rc.chain_rod_count);
 }
 inline double load_stiffness(const RodConditions& rc, const State& s) {
   return load_stiffness(rc,

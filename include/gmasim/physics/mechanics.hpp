@@ -5,6 +5,8 @@
 #include <cmath>
 #include <span>
 
+#include "gmasim/physics/laws.hpp"
+
 // The oscillator update of eq. (15), one law per header.
 #include "gmasim/physics/oscillator.hpp"
 
