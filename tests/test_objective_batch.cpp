@@ -151,8 +151,9 @@ TEST(ObjectiveBatch, TargetsEqualThePointsBitForBit) {
 }
 
 // The batch's lanes follow the scalar objective (lanes = false) as residuals() does in lanes:
-// to the lanes' rounding: observed 1.8e-15 % of RMS apart (AVX-512), tolerance 1e-13 % (the
-// rounding differs between SIMD targets).
+// bit for bit since the laws are written once (issue 38: gmasim/physics/laws-inl.h, ja_law-inl.h)
+// (observed 1.8e-15 % of RMS apart on AVX-512 before, tolerance 1e-13 % (the rounding differs
+// between SIMD targets).
 TEST(ObjectiveBatch, FollowsTheScalarObjective) {
   const Objective& lanes = batch_objective(true);
   const Objective& scalar = batch_objective(false);
@@ -161,7 +162,7 @@ TEST(ObjectiveBatch, FollowsTheScalarObjective) {
   double worst = 0.0;
   for (std::size_t i = 0; i < u.size(); ++i) {
     worst = std::max(worst, std::fabs(a[i] - b[i]));
-    EXPECT_NEAR(a[i], b[i], 1e-13) << "point " << i;  // observed 1.8e-15 %
+    EXPECT_EQ(a[i], b[i]) << "point " << i;  // 0 (1.8e-15 % before issue 38)
   }
   std::printf("objective batch in lanes vs scalar: largest RMS difference %.3g %%\n", worst);
 }

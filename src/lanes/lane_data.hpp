@@ -50,7 +50,11 @@ inline constexpr std::size_t kPad = 8;
   X(kPrestressY, r.prestress_exp.y) /* eq. (11)'s tanh anchor (physics::exp_near) */       \
   X(kPrestressE, r.prestress_exp.e)                                                        \
   X(kOscDecayY, r.osc_decay.y) /* the oscillator's last e^(tau/2) (physics::exp_cached) */ \
-  X(kOscDecayE, r.osc_decay.e)
+  X(kOscDecayE, r.osc_decay.e)                                                             \
+  X(kJaLangevinY, r.ja_exp.langevin.y) /* the JA law's anchors (RodState::ja_exp) */       \
+  X(kJaLangevinE, r.ja_exp.langevin.e)                                                     \
+  X(kJaLagY, r.ja_exp.lag.y)                                                               \
+  X(kJaLagE, r.ja_exp.lag.e)
 // ... then the constants it reads (RodConditions rc, Material m.material, the circuit's rod
 // branch br; q = M_s^T / M_s of the strain guard).
 #define GMASIM_LANE_ROD_CONSTANTS(X)                                                              \

@@ -53,6 +53,7 @@ struct Lanes {
   friend HWY_INLINE M operator>=(Lanes a, Lanes b) { return {hn::Ge(a.v, b.v)}; }
   friend HWY_INLINE M operator==(Lanes a, Lanes b) { return {hn::Eq(a.v, b.v)}; }
   friend HWY_INLINE Lanes select(M m, Lanes a, Lanes b) { return hn::IfThenElse(m.m, a.v, b.v); }
+  friend HWY_INLINE M true_mask(Lanes) { return {hn::FirstN(D(), hn::Lanes(D()))}; }
   friend HWY_INLINE Lanes abs(Lanes a) { return hn::Abs(a.v); }
   friend HWY_INLINE Lanes sqrt(Lanes a) { return hn::Sqrt(a.v); }
   // The scalar function f in each lane where m holds, x kept elsewhere (libm: the scalar step's
@@ -101,7 +102,12 @@ HWY_NOINLINE void oscillator_free_closed_form_where(LaneMask<D> where, Lanes<D> 
 // this target: physics laws over Lanes<D> (rod_mechanics, oscillator_step, ...).
 namespace laws {
 using ::gmasim::lanes::HWY_NAMESPACE::oscillator_free_closed_form_where;
-#include "gmasim/physics/laws-inl.h"  // NOLINT(build/include): once per target, by design
+#define GMASIM_LAW_INLINE HWY_INLINE
+#define GMASIM_LAW_RARE HWY_NOINLINE
+#include "gmasim/physics/laws-inl.h"    // NOLINT(build/include): once per target, by design
+#include "gmasim/physics/ja_law-inl.h"  // NOLINT(build/include): likewise
+#undef GMASIM_LAW_INLINE
+#undef GMASIM_LAW_RARE
 }  // namespace laws
 
 }  // namespace gmasim::lanes::HWY_NAMESPACE

@@ -288,7 +288,7 @@ struct PreisachLanes {
   }
   template <class D>
   static HWY_INLINE Trial<D> joint_trial(D d, const Constants<D>& k, const Rod<D>& r,
-                                         const Start<D>&, V<D> H1, V<D> M_iter) {
+                                         const Start<D>&, V<D> H1, V<D> M_iter, Mk<D>) {
     const V<D> one = C(d, 1.0);
     Trial<D> t;
     t.moved = hn::Not(hn::Eq(H1, r.H));
@@ -351,6 +351,8 @@ HWY_INLINE void take_trial(D, M done, M /*real*/, const PreisachLaneTrial<D>& t,
   tr.moved = hn::Or(hn::And(done, tr.moved), hn::AndNot(done, t.moved));
 }
 
+template <class D>
+HWY_INLINE void commit_law_state(const Magnetic<PreisachLanes, D>&, RodStates<D>&, int) {}
 template <class D>
 HWY_INLINE void law_commit(const Chunk<D>& c, const Magnetic<PreisachLanes, D>& mg, Mk<D> keep) {
   const D d = c.d;

@@ -181,7 +181,13 @@ template <class D>
 HWY_INLINE void law_rod(const Chunk<D>& c, const RodStates<D>& s, int i, JaLaneConstants<D>& k,
                         typename JilesAthertonLanes::template Rod<D>& r) {
   k = ja_constants(c, i);
-  r = {s.f[kH][i], s.f[kMirr][i], s.f[kM][i], s.f[kAnX][i], s.f[kAnL][i], s.f[kAnDL][i]};
+  r = {s.f[kH][i],
+       s.f[kMirr][i],
+       s.f[kM][i],
+       s.f[kAnX][i],
+       s.f[kAnL][i],
+       s.f[kAnDL][i],
+       {{s.f[kJaLangevinY][i], s.f[kJaLangevinE][i]}, {s.f[kJaLagY][i], s.f[kJaLagE][i]}}};
 }
 
 // The fields every law's trial has (the Jiles-Atherton law's are all of them): a lane that has
@@ -217,10 +223,23 @@ HWY_INLINE void take_trial(D d, M done, M real, const T& t, T& tr, std::size_t& 
 template <class Law, class D>
 struct Magnetic {
   V<D> H[kMaxRods], Mg[kMaxRods], B0[kMaxRods], Bs[kMaxRods], g[kMaxRods];
+  typename Law::template Start<D> start[kMaxRods];  // each rod's move (its anchors, JA)
   typename Law::template Trial<D> trial[kMaxRods];
 };
 template <class D>
 HWY_INLINE void law_commit(const Chunk<D>&, const Magnetic<JilesAthertonLanes, D>&, Mk<D>) {}
+// The law's state the step commits beside M and M_irr, into the rods' state (stored with it):
+// the JA law's anchors as its last evaluation left them (JilesAthertonLaw::commit_trial's
+// r.ja_exp = *t.near).
+template <class D>
+HWY_INLINE void commit_law_state(const Magnetic<JilesAthertonLanes, D>& mg, RodStates<D>& s,
+                                 int i) {
+  const auto& near = mg.start[i].near;
+  s.f[kJaLangevinY][i] = near.langevin.y.v;
+  s.f[kJaLangevinE][i] = near.langevin.e.v;
+  s.f[kJaLagY][i] = near.lag.y.v;
+  s.f[kJaLagE][i] = near.lag.e.v;
+}
 
 // model/step.cpp's next_correction_within_tolerance per lane: after an undamped correction the
 // next one is bounded by 2 law_steps (the sum of the laws' own steps |M_next - M*|); true where
@@ -307,7 +326,7 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
   V<D> e0[kMaxRods], inv_mud[kMaxRods];
   const V<D>* g = mg.g;
   const V<D> two_over_h = hn::Div(C(d, 2.0), h);
-  typename Law::template Start<D> start[kMaxRods];
+  auto& start = mg.start;
   typename Law::template Rod<D> rod[kMaxRods];
   typename Law::template Constants<D> k[kMaxRods];
   for (int i = 0; i < n; ++i) {
@@ -322,7 +341,7 @@ HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, 
     V<D> law_steps = hn::Zero(d);  // sum over the rods of |M_next - M*|
     Mk<D> laws_hold = hn::FirstN(d, hn::Lanes(d));
     for (int i = 0; i < n; ++i) {
-      const auto t = Law::joint_trial(d, k[i], rod[i], start[i], mg.H[i], mg.Mg[i]);
+      const auto t = Law::joint_trial(d, k[i], rod[i], start[i], mg.H[i], mg.Mg[i], hn::Not(done));
       auto& tr = mg.trial[i];
       take_trial(d, done, real, t, tr, c.L.full_solves);
       laws_hold = hn::And(laws_hold, tr.converged);
@@ -397,6 +416,7 @@ HWY_INLINE void commit_fields(const Chunk<D>& c, RodStates<D>& s, bool quasi_sta
     s.f[kMuR][i] = hn::Add(C(d, 1.0), tr.dM_dH);
     s.f[kTau][i] = hn::Mul(hn::Mul(C(d, kMu0), s.f[kMuR][i]), kappa);
     s.f[kPhi][i] = hn::Mul(B1, c.rod(kArea, i));
+    commit_law_state(mg, s, i);
     s.f[kAnX][i] = tr.an_x;
     s.f[kAnL][i] = tr.an_L;
     s.f[kAnDL][i] = tr.an_dL;

@@ -59,7 +59,7 @@ struct JilesAthertonLaw {
     return {physics::ja_move_start_near(r.H_A_per_m, r.M_A_per_m, rc.MsT_mag, rc.ja,
                                         rc.ja_inv_a_m_per_A, rc.ja_inv_k_m_per_A, r.an_x,
                                         {r.an_L, r.an_dL}),
-            r.ja_exp, physics::JaExpPoints{}};
+            r.ja_exp, physics::no_ja_exp_points<double>()};
   }
   static Trial trial_from(const RodConditions& rc, const RodState& r, const MoveStart& st,
                           double H1, double M_guess) {
@@ -88,38 +88,18 @@ struct JilesAthertonLaw {
   };
   static void joint_trial(const RodConditions& rc, const RodState& r, MoveStart& st, double H1,
                           double M_iter, JointTrial& t) {
-    double chi_e = 0.0;
-    double g = 0.0;
+    const physics::JaJointTrialT<double> j = physics::ja_joint_trial(
+        r.H_A_per_m, r.Mirr_A_per_m, r.M_A_per_m, r.an_x, {r.an_L, r.an_dL}, rc.MsT_mag, rc.ja,
+        static_cast<const physics::JaMoveStart&>(st), st.near, st.recent, H1, M_iter, true);
+    t.M = j.M;
+    t.dM_dH = j.dM_dH;
+    t.Mirr = j.Mirr;
+    t.inv_mu_r = j.inv_mu_r;
+    t.M_next = j.M_next;
+    t.an_x = j.an_x;
+    t.an_lv = j.an_lv;
     t.near = &st.near;
-    if (H1 == r.H_A_per_m) {
-      physics::ja_step_from(r.H_A_per_m, st, H1, rc.MsT_mag, rc.ja, r.Mirr_A_per_m, r.M_A_per_m,
-                            M_iter, t.Mirr, t.M, chi_e);
-      M_iter = t.M;
-      t.an_x = r.an_x;  // nothing evaluated: the rod's own point stays
-      t.an_lv = {r.an_L, r.an_dL};
-    } else {
-      const physics::JaEvaluation e = physics::ja_evaluate(
-          st, H1, M_iter, rc.MsT_mag, rc.ja, r.Mirr_A_per_m, st.inv_a, st.near, &st.recent);
-      t.an_x = e.x1;
-      t.an_lv = e.lv;
-      t.Mirr = e.Mirr1;
-      t.M = e.M;
-      chi_e = e.chi_e;
-      g = M_iter - e.M;
-      const bool far = std::fabs(g) > physics::ja_safeguard_residual(rc.MsT_mag);
-      if (far) {  // far from eq. (9): solve it (ja_step_from)
-        physics::ja_step_from(r.H_A_per_m, st, H1, rc.MsT_mag, rc.ja, r.Mirr_A_per_m, r.M_A_per_m,
-                              M_iter - g / std::max(1.0 - rc.ja.alpha * chi_e, 0.2), t.Mirr, t.M,
-                              chi_e);
-        M_iter = t.M;
-        g = 0.0;
-      }
-    }
-    const physics::JaSlopeTerms sl = physics::ja_slope_terms(chi_e, rc.ja);
-    t.dM_dH = sl.dM_dH;
-    t.inv_mu_r = sl.inv_mu_r;
-    t.M_next = M_iter - g * sl.inv_dg;
-    t.converged = std::fabs(g) <= physics::ja_magnetisation_tolerance(rc.MsT_mag);
+    t.converged = j.converged;
   }
   static void commit_trial(const RodConditions&, RodState& r, const Trial& t) {
     r.Mirr_A_per_m = t.Mirr;

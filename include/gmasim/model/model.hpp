@@ -394,7 +394,7 @@ struct RodState {
   // The anchors of the law's exponentials (physics::JaExpPoints, exp_near) where the consistent
   // state's evaluations left them: the next step's evaluations start from them. Stage 2,
   // consistent state, Jiles-Atherton only; none (NaN) after make_state.
-  physics::JaExpPoints ja_exp{};
+  physics::JaExpPoints ja_exp = physics::no_ja_exp_points<double>();
   // reported
   double mu_r = 1;    // eq. (3) at the extrapolated M, stage 1 (printed); the JA differential
                       // permeability 1 + dM/dH, stage 2 (consistent)

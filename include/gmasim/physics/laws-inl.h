@@ -6,11 +6,14 @@
 // Before it, the namespace must declare the primitives of T (select, any, all, none, abs, sqrt,
 // each; for double gmasim/physics/number.hpp) and oscillator_free_closed_form_where; the scalar
 // helpers it names with ::gmasim::physics:: (gmasim/physics/laws.hpp) must be declared.
+// GMASIM_LAW_INLINE marks a law's function, GMASIM_LAW_RARE one on a rare path (the instance
+// defines them: `inline` for double; always and never inlined in the lanes, where a vector
+// argument of an out-of-line call goes through memory).
 // Each function is one law and cites its equation; the scalar and the lane instances are the
 // same text, so a lane computes what the scalar step computes, bit for bit.
 // c0 + c1 x + ... + c7 x^7 by Estrin's scheme (short dependency chains).
 template <class T>
-inline T polynomial7(T x, const double (&c)[8]) {
+GMASIM_LAW_INLINE T polynomial7(T x, const double (&c)[8]) {
   const T x2 = x * x, x4 = x2 * x2;
   return (c[0] + c[1] * x) + x2 * (c[2] + c[3] * x) +
          x4 * ((c[4] + c[5] * x) + x2 * (c[6] + c[7] * x));
@@ -18,7 +21,7 @@ inline T polynomial7(T x, const double (&c)[8]) {
 
 // e^x to (x^8 / 8!): below 1e-19 relative where |x| <= 1/64.
 template <class T>
-inline T exp_series7(T x) {
+GMASIM_LAW_INLINE T exp_series7(T x) {
   constexpr double kExp[8] = {1.0,      1.0,       1.0 / 2,   1.0 / 6,
                               1.0 / 24, 1.0 / 120, 1.0 / 720, 1.0 / 5040};
   return polynomial7(x, kExp);
@@ -26,7 +29,7 @@ inline T exp_series7(T x) {
 
 // e^x - 1 to (x^11 / 11!): below 3e-18 relative to e^x where |x| <= 1/8.
 template <class T>
-inline T expm1_series10(T x) {
+GMASIM_LAW_INLINE T expm1_series10(T x) {
   const T x2 = x * x, x4 = x2 * x2, x8 = x4 * x4;
   return x * (((1.0 + x * (1.0 / 2)) + x2 * (1.0 / 6 + x * (1.0 / 24))) +
               x4 * ((1.0 / 120 + x * (1.0 / 720)) + x2 * (1.0 / 5040 + x * (1.0 / 40320))) +
@@ -37,7 +40,7 @@ inline T expm1_series10(T x) {
 // absolute; rounding a few 1e-16 absolute, where std::cos(0.5 * pi * m) is itself 6e-17 off at
 // m = 1 through the rounding of pi/2): no range reduction. std::cos elsewhere.
 template <class T>
-inline T cos_half_pi(T m) {
+GMASIM_LAW_INLINE T cos_half_pi(T m) {
   const ::gmasim::physics::Mask<T> in = abs(m) <= 1.0;
   if (none(in)) return each(::gmasim::physics::CosHalfPiLibm{}, m, !in);
   const T t = m * m, t2 = t * t, t4 = t2 * t2, t8 = t4 * t4;
@@ -62,19 +65,46 @@ struct ExpPointT {
 // and two roundings away from a std::exp value (within 2 units in the last place of std::exp(y),
 // test Series.ExpNearIsWithinAFewUlp), however long the anchor is kept: over a Newton solve's
 // iterates and from step to step (RodState::ja_exp, prestress_exp).
+// Only where `where` holds (the lanes that evaluate this exponential: a moves exactly where the
+// scalar step moves it; the value elsewhere is not used).
 template <class T>
-inline T exp_near(T y, ExpPointT<T>& a) {
+GMASIM_LAW_INLINE T exp_near(T y, ExpPointT<T>& a, ::gmasim::physics::Mask<T> where) {
   const T d = y - a.y;
-  const ::gmasim::physics::Mask<T> near = abs(d) <= 1.0 / 8;
-  if (all(near)) return a.e + a.e * expm1_series10(d);
-  const T fresh = each(::gmasim::physics::LibmExp{}, y, !near);
-  if (none(near)) {
+  const ::gmasim::physics::Mask<T> moves = where && !(abs(d) <= 1.0 / 8);
+  if (none(moves)) return a.e + a.e * expm1_series10(d);
+  const T fresh = each(::gmasim::physics::LibmExp{}, y, moves);
+  if (all(moves)) {
     a = {y, fresh};
     return a.e;
   }
   const T series = a.e + a.e * expm1_series10(d);  // a lane whose anchor is near
-  a = {select(near, a.y, y), select(near, a.e, fresh)};
-  return select(near, series, fresh);
+  a = {select(moves, y, a.y), select(moves, fresh, a.e)};
+  return select(moves, fresh, series);
+}
+template <class T>
+GMASIM_LAW_INLINE T exp_near(T y, ExpPointT<T>& a) {
+  return exp_near(y, a, true_mask(y));
+}
+
+// e^y near the last value of the same Newton solve: from `recent` (y_r, e^{y_r}), a value
+// exp_near(y_r, a) returned, as e^{y_r} (1 + d + d^2/2 + d^3/6), d = y - y_r, where |d| <= 2^-13
+// (truncation below 1e-17 relative; the consistent state's iterates after the first move the
+// law's exponents by 1e-5 at most); otherwise exp_near(y, a), and recent becomes (y, that value).
+// recent holds only exp_near's values and lives for one solve (JilesAthertonLaw::MoveStart), so
+// every value is at most two short series and four roundings from a std::exp value.
+template <class T>
+GMASIM_LAW_INLINE T exp_near(T y, ExpPointT<T>& a, ExpPointT<T>& recent, ::gmasim::physics::Mask<T> where) {
+  const T d = y - recent.y;
+  const ::gmasim::physics::Mask<T> go = where && !(abs(d) <= 1.0 / 8192);
+  if (none(go)) return recent.e + recent.e * (d * (1.0 + d * (1.0 / 2 + d * (1.0 / 6))));
+  const T v = exp_near(y, a, go);
+  if (all(go)) {
+    recent = {y, v};
+    return recent.e;
+  }
+  const T series = recent.e + recent.e * (d * (1.0 + d * (1.0 / 2 + d * (1.0 / 6))));
+  recent = {select(go, y, recent.y), select(go, v, recent.e)};
+  return select(go, v, series);
 }
 
 // e^y where the last call with this p may have had the same y (a step's fixed decay over a run
@@ -82,7 +112,7 @@ inline T exp_near(T y, ExpPointT<T>& a) {
 // Only where `where` holds (the lanes that take this exponential; elsewhere p is kept and the
 // value is not used): p then changes exactly where the scalar step changes it.
 template <class T>
-inline T exp_cached(T y, ExpPointT<T>& p, ::gmasim::physics::Mask<T> where) {
+GMASIM_LAW_INLINE T exp_cached(T y, ExpPointT<T>& p, ::gmasim::physics::Mask<T> where) {
   const ::gmasim::physics::Mask<T> update = where && !(y == p.y);
   if (any(update))
     p = {select(update, y, p.y),
@@ -118,7 +148,7 @@ struct OscillatorPropagatorT {
 // One doubling where `at` holds: (C, S) of exp(N / 2), whose (N / 2)^2 = u_half I, to those of
 // exp(N) = exp(N / 2)^2 = (C^2 + u_half S^2) I + (C S) N.
 template <class T>
-inline void oscillator_series_doubled(T u_half, ::gmasim::physics::Mask<T> at, T& C, T& S) {
+GMASIM_LAW_INLINE void oscillator_series_doubled(T u_half, ::gmasim::physics::Mask<T> at, T& C, T& S) {
   const T c = C;
   C = select(at, c * c + u_half * (S * S), c);
   S = select(at, c * S, S);
@@ -126,7 +156,7 @@ inline void oscillator_series_doubled(T u_half, ::gmasim::physics::Mask<T> at, T
 // decay: the last e^(tau/2) taken by std::exp (physics::exp_cached; a run's step repeats it).
 // valid is false (f0, f1 unset) beyond the series' caps.
 template <class T>
-inline OscillatorPropagatorT<T> oscillator_propagator(T tau, T delta, ExpPointT<T>& decay) {
+GMASIM_LAW_INLINE OscillatorPropagatorT<T> oscillator_propagator(T tau, T delta, ExpPointT<T>& decay) {
   const T half_tau = 0.5 * tau;
   const T u = half_tau * half_tau - delta;
   const T au = abs(u);
@@ -175,7 +205,7 @@ inline OscillatorPropagatorT<T> oscillator_propagator(T tau, T delta, ExpPointT<
 // modes. Updates x [m] and v [m/s].
 // inv_m = 1/m; decay: oscillator_propagator's (the row's last e^(tau/2)).
 template <class T>
-inline void oscillator_step(T m, T inv_m, T c, T k, T F0, T F1, T h, T& x, T& v,
+GMASIM_LAW_INLINE void oscillator_step(T m, T inv_m, T c, T k, T F0, T F1, T h, T& x, T& v,
                             ExpPointT<T>& decay) {
   const T g = (F1 - F0) / h;  // force rate [N/s]
   // Particular solution x_p(s) = (F0 + g s)/k - g c / k^2, v_p = g / k.
@@ -201,7 +231,7 @@ inline void oscillator_step(T m, T inv_m, T c, T k, T F0, T F1, T h, T& x, T& v,
 // q0 to q1 over h (the sensor mount: model.hpp, SensorMountModel): the forcing c q' + k q is
 // linear over the step, so oscillator_step is exact.
 template <class T>
-inline void base_excited_step(T m, T inv_m, T c, T k, T q0, T q1, T h, T& z, T& zv,
+GMASIM_LAW_INLINE void base_excited_step(T m, T inv_m, T c, T k, T q0, T q1, T h, T& z, T& zv,
                               ExpPointT<T>& decay) {
   const T qdot = (q1 - q0) / h;
   oscillator_step(m, inv_m, c, k, c * qdot + k * q0, c * qdot + k * q1, h, z, zv, decay);
@@ -230,7 +260,7 @@ struct DeltaETermsT {
 // delta_e_compliance is 1/E, the bracket itself (the step multiplies by it where eq. 11-12 and
 // 17 divide by E).
 template <class T>
-inline T delta_e_compliance(T m, const DeltaETermsT<T>& d) {
+GMASIM_LAW_INLINE T delta_e_compliance(T m, const DeltaETermsT<T>& d) {
   const T c = cos_half_pi(m);
   const T c2 = c * c;
   const T m2 = m * m;
@@ -241,11 +271,11 @@ inline T delta_e_compliance(T m, const DeltaETermsT<T>& d) {
 
 // Eq. (12): saturation and maximum magnetostrictive stress [Pa].
 template <class T>
-inline T saturation_stress(T lambda_s, T E_Pa) {
+GMASIM_LAW_INLINE T saturation_stress(T lambda_s, T E_Pa) {
   return 0.5 * lambda_s * E_Pa;
 }
 template <class T>
-inline T maximum_stress(T lambda_s, T E_Pa) {
+GMASIM_LAW_INLINE T maximum_stress(T lambda_s, T E_Pa) {
   return 1.5 * lambda_s * E_Pa;
 }
 
@@ -257,21 +287,21 @@ inline T maximum_stress(T lambda_s, T E_Pa) {
 // a few 1e-16 (not its relative error near u = 0), all eq. (11) needs beside 1 (std::tanh goes
 // through expm1, about three times the cost of exp).
 template <class T>
-inline T tanh_from_exp(T u, T e) {  // e = exp(-2|u|)
+GMASIM_LAW_INLINE T tanh_from_exp(T u, T e) {  // e = exp(-2|u|)
   const T t = (1.0 - e) / (1.0 + e);
   return select(u < 0.0, -t, t);
 }
 
 // The same with its exponential from an anchor nearby (p, exp_near: the step's last one).
 template <class T>
-inline T tanh_absolute_near(T u, ExpPointT<T>& p) {
-  return tanh_from_exp(u, exp_near(-2.0 * abs(u), p));
+GMASIM_LAW_INLINE T tanh_absolute_near(T u, ExpPointT<T>& p) {
+  return tanh_from_exp(u, exp_near(-2.0 * abs(u), p));  // every lane evaluates it
 }
 
 // The factor at 2 sigma_p / sigma_s = two_sp_over_ss (given: the step forms it from 1/E).
 // tanh_2sp_ss: tanh(2 sigma_p / sigma_s) (tanh_absolute).
 template <class T>
-inline T prestress_factor_from_tanh(T tanh_2sp_ss, T sigma_p_Pa, T sigma_s_Pa, T sigma_max_Pa) {
+GMASIM_LAW_INLINE T prestress_factor_from_tanh(T tanh_2sp_ss, T sigma_p_Pa, T sigma_s_Pa, T sigma_max_Pa) {
   const T base = 1.0 + 0.5 * tanh_2sp_ss;
   const ::gmasim::physics::Mask<T> below = sigma_p_Pa <= sigma_s_Pa;
   if (all(below)) return base;
@@ -285,7 +315,7 @@ inline T prestress_factor_from_tanh(T tanh_2sp_ss, T sigma_p_Pa, T sigma_s_Pa, T
 // The step's: tanh's exponential from the anchor `near` (tanh_absolute_near; RodState::
 // prestress_exp), a few units in the last place from magnetostriction's.
 template <class T>
-inline T magnetostriction_near(T m, T lambda_s, T sigma_p_Pa, T four_sp_over_ls, T E_Pa,
+GMASIM_LAW_INLINE T magnetostriction_near(T m, T lambda_s, T sigma_p_Pa, T four_sp_over_ls, T E_Pa,
                                T inv_E_per_Pa, ExpPointT<T>& near) {
   const T f = prestress_factor_from_tanh(tanh_absolute_near(four_sp_over_ls * inv_E_per_Pa, near),
                                          sigma_p_Pa, saturation_stress(lambda_s, E_Pa),
@@ -295,7 +325,7 @@ inline T magnetostriction_near(T m, T lambda_s, T sigma_p_Pa, T four_sp_over_ls,
 
 // Eq. (14): magnetostrictive force of one rod [N].  F = lambda E A.
 template <class T>
-inline T rod_force(T lambda, T E_Pa, T area_m2) {
+GMASIM_LAW_INLINE T rod_force(T lambda, T E_Pa, T area_m2) {
   return lambda * E_Pa * area_m2;
 }
 
@@ -309,7 +339,7 @@ struct RodMechanicsT {
   T E_Pa, lambda, F_N, k_rod_N_per_m, compliance_m_per_N;
 };
 template <class T>
-inline RodMechanicsT<T> rod_mechanics(T M_A_per_m, T inv_MsT_E, const DeltaETermsT<T>& dE,
+GMASIM_LAW_INLINE RodMechanicsT<T> rod_mechanics(T M_A_per_m, T inv_MsT_E, const DeltaETermsT<T>& dE,
                                       T inv_Ms_strain, T lambda_s, T sigma_p_Pa, T four_sp_over_ls,
                                       T area_m2, T area_over_length_m, T length_over_area_per_m,
                                       ExpPointT<T>& prestress) {
@@ -328,7 +358,7 @@ inline RodMechanicsT<T> rod_mechanics(T M_A_per_m, T inv_MsT_E, const DeltaETerm
 // compliance of its chain's fixed members and those of the rods in its chain (compliances[j],
 // 1/k_rod of rod j; members: the chain's rod indices).
 template <class T>
-inline T chain_stiffness(T fixed_compliance_m_per_N, const T* compliances_m_per_N,
+GMASIM_LAW_INLINE T chain_stiffness(T fixed_compliance_m_per_N, const T* compliances_m_per_N,
                          const int* members, int count) {
   T inv_k = fixed_compliance_m_per_N;
   for (int j = 0; j < count; ++j) inv_k = inv_k + compliances_m_per_N[members[j]];
@@ -338,6 +368,7 @@ inline T chain_stiffness(T fixed_compliance_m_per_N, const T* compliances_m_per_
 // Eq. (16): the oscillator's stiffness over a step, the mean of its values at the ends (the
 // Delta-E effect varies it; the mean keeps the update second order in h).
 template <class T>
-inline T mid_step_stiffness(T K0_N_per_m, T k_rod1_N_per_m, T k_load1_N_per_m) {
+GMASIM_LAW_INLINE T mid_step_stiffness(T K0_N_per_m, T k_rod1_N_per_m, T k_load1_N_per_m) {
   return 0.5 * (K0_N_per_m + k_rod1_N_per_m + k_load1_N_per_m);
 }
+

@@ -22,12 +22,24 @@ inline void oscillator_free_closed_form_where(bool where, double m, double c, do
   if (where) oscillator_free_closed_form(m, c, k, h, e0, ed0, e1, ed1);
 }
 
-#include "gmasim/physics/laws-inl.h"  // IWYU pragma: export
+#define GMASIM_LAW_INLINE [[gnu::always_inline]] inline
+#define GMASIM_LAW_RARE inline
+#include "gmasim/physics/laws-inl.h"    // IWYU pragma: export
+#include "gmasim/physics/ja_law-inl.h"  // IWYU pragma: export
+#undef GMASIM_LAW_INLINE
+#undef GMASIM_LAW_RARE
 
 using ExpPoint = ExpPointT<double>;
 inline constexpr ExpPoint kNoExpPoint{__builtin_nan(""), 0.0};
 using OscillatorPropagator = OscillatorPropagatorT<double>;
 using DeltaETerms = DeltaETermsT<double>;
 using RodMechanics = RodMechanicsT<double>;
+using LangevinValue = LangevinValueT<double>;
+using LagWeightsSlope = LagWeightsSlopeT<double>;
+using JaCoefficients = JaCoefficientsT<double>;
+using JaMoveStart = JaMoveStartT<double>;
+using JaExpPoints = JaExpPointsT<double>;
+using JaEvaluation = JaEvaluationT<double>;
+using JaSlopeTerms = JaSlopeTermsT<double>;
 
 }  // namespace gmasim::physics

@@ -164,30 +164,6 @@ inline LagWeights lag_weights(double r) {
   return {E, (1.0 - E) / r};
 }
 
-// lag_weights with dq/dr = (E - q) / r beside them (ja_irreversible_update), from one
-// reciprocal of r; dq/dr = -1/2 at r <= 1e-12.
-struct LagWeightsSlope {
-  double E, q, dq_dr;
-};
-inline LagWeightsSlope lag_weights_and_slope_from(double r, double E) {
-  if (r < 1e-2) {
-    const double q =
-        1.0 - r * (1.0 / 2 - r * (1.0 / 6 - r * (1.0 / 24 - r * (1.0 / 120 - r * (1.0 / 720)))));
-    return {E, q, r > 1e-12 ? (E - q) / r : -0.5};
-  }
-  const double inv_r = 1.0 / r;
-  const double q = (1.0 - E) * inv_r;
-  return {E, q, (E - q) * inv_r};
-}
-// The same with exp(-r) from an anchor nearby (p, physics::exp_near; moved where it is not).
-inline LagWeightsSlope lag_weights_and_slope_near(double r, ExpPoint& p) {
-  return lag_weights_and_slope_from(r, exp_near(-r, p));
-}
-// The same with the solve's last value beside the anchor (exp_near(y, p, recent)).
-inline LagWeightsSlope lag_weights_and_slope_near(double r, ExpPoint& p, ExpPoint& recent) {
-  return lag_weights_and_slope_from(r, exp_near(-r, p, recent));
-}
-
 // Exact update of the first-order lag  tau dH/dt = u(t) - H  over one step h with u
 // linear from u0 to u1 (first-order hold):
 //   H1 = u1 + (H0 - u0) E - (u1 - u0) q,   E = exp(-h/tau), q = (1 - E) tau/h.

@@ -9,7 +9,7 @@
 // primitives, which this header gives for double and number_lanes-inl.h for the lanes:
 //   Mask<T>            what a comparison gives (bool for double)
 //   select(m, a, b)    a where m holds, b elsewhere (a branch becomes a select)
-//   any(m), all(m), none(m)
+//   any(m), all(m), none(m), true_mask(x) (every lane)
 //   abs(x), sqrt(x)    exact in IEEE arithmetic
 //   each(f, x, m)      a scalar function f (libm's std::exp, std::cos) applied to each lane
 //                      where m holds (x kept elsewhere):
@@ -35,6 +35,7 @@ inline double select(bool m, double a, double b) { return m ? a : b; }
 inline bool any(bool m) { return m; }
 inline bool all(bool m) { return m; }
 inline bool none(bool m) { return !m; }
+inline bool true_mask(double) { return true; }  // every lane (the one)
 inline double abs(double x) { return std::fabs(x); }
 inline double sqrt(double x) { return std::sqrt(x); }
 template <class F>
