@@ -67,9 +67,10 @@ ReproduceResult run_reproduce(const Model& m, const ReproduceOptions& o,
     gaps += fmt::format("{}{:.4g}", gaps.empty() ? "" : " / ", rod.joint_gap_m * 1e6);
   r.model_readings = fmt::format(
       "magnetic state {}; eq. 10: shape law {}, temperature scale {}; eq. 11: M_s {}; stress sign "
-      "{}; eddy law {}; joint gaps {} um",
+      "{}; eddy law {}; joint gaps {} um; sensor mount base {}",
       opt("magnetic_state"), opt("eq10_shape_law"), opt("eq10_temperature_scale"),
-      opt("eq11_saturation"), opt("stress_sign"), opt("eddy_law"), gaps);
+      opt("eq11_saturation"), opt("stress_sign"), opt("eddy_law"), gaps,
+      m.sensor_mount.enabled ? opt("sensor_mount_base") : std::string("none"));
   std::size_t stage = 0;
   const std::size_t stages = 7;
   auto next = [&]() {

@@ -157,6 +157,7 @@ struct Structure {
   int rods = 0;
   bool preisach = false;  // the Preisach law (LaneData::pre); the Jiles-Atherton law otherwise
   bool mount = false, xT_in_output = false;
+  bool mount_on_output = false;  // options.sensor_mount_base = output
   int sensor_count = 0;
   std::array<int, kMaxRods> sensor_rods{};  // rods whose branches the flux sensor reads
   std::array<std::array<int, kMaxRods>, kMaxRods> chain{};  // eq. (18): rods in rod i's chain

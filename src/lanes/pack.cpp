@@ -45,6 +45,7 @@ lanes::Structure structure_of(const Model& m, const Conditions& c) {
   st.rods = m.rod_count();
   st.preisach = m.options.magnetisation_law == MagnetisationLaw::Preisach;
   st.mount = m.sensor_mount.enabled;
+  st.mount_on_output = m.options.sensor_mount_base == SensorMountBase::Output;
   st.xT_in_output = m.options.thermal_expansion_in_output;
   for (int b : m.flux_sensor_branches)
     st.sensor_rods[static_cast<std::size_t>(st.sensor_count++)] =
@@ -59,8 +60,9 @@ lanes::Structure structure_of(const Model& m, const Conditions& c) {
 
 bool same_structure(const lanes::Structure& a, const lanes::Structure& b) {
   return a.rods == b.rods && a.preisach == b.preisach && a.mount == b.mount &&
-         a.xT_in_output == b.xT_in_output && a.sensor_count == b.sensor_count &&
-         a.sensor_rods == b.sensor_rods && a.chain == b.chain && a.chain_count == b.chain_count;
+         a.xT_in_output == b.xT_in_output && a.mount_on_output == b.mount_on_output &&
+         a.sensor_count == b.sensor_count && a.sensor_rods == b.sensor_rods && a.chain == b.chain &&
+         a.chain_count == b.chain_count;
 }
 
 // Lane j's State scalars and constants (the GlobalField numbers), its failure record cleared.

@@ -74,9 +74,15 @@ HWY_INLINE void mount_and_outputs(const Chunk<D>& c, RodStates<D>& s, V<D>* g, V
   const D d = c.d;
   const Structure& st = c.L.st;
   if (st.mount) {
-    V<D> p = hn::Zero(d);
-    for (int i = 0; i < c.n; ++i) p = hn::Add(p, hn::Mul(c.rod(kMomMass, i), s.f[kX][i]));
-    const V<D> q1 = hn::Div(p, c.glob(kActMass));
+    // the bracket's base (model/step.cpp, mount_base_m): the recoil p / M or the output sum x
+    V<D> p = hn::Zero(d), q1;
+    if (st.mount_on_output) {
+      for (int i = 0; i < c.n; ++i) p = hn::Add(p, s.f[kX][i]);
+      q1 = p;
+    } else {
+      for (int i = 0; i < c.n; ++i) p = hn::Add(p, hn::Mul(c.rod(kMomMass, i), s.f[kX][i]));
+      q1 = hn::Div(p, c.glob(kActMass));
+    }
     N z = g[kZ], zv = g[kZv];
     laws::ExpPointT<N> decay{g[kMountDecayY], g[kMountDecayE]};
     laws::base_excited_step<N>(c.glob(kMountMass), c.glob(kMountInvMass), c.glob(kMountC),
@@ -91,7 +97,7 @@ HWY_INLINE void mount_and_outputs(const Chunk<D>& c, RodStates<D>& s, V<D>* g, V
   V<D> y = hn::Zero(d);
   for (int i = 0; i < c.n; ++i) y = hn::Add(y, s.f[kX][i]);
   g[kYStack] = y;
-  if (st.mount) y = hn::Add(y, hn::Sub(g[kZ], g[kQ]));
+  if (st.mount) y = st.mount_on_output ? g[kZ] : hn::Add(y, hn::Sub(g[kZ], g[kQ]));
   if (st.xT_in_output) y = hn::Add(y, c.glob(kXT));
   g[kY] = y;
   V<D> phi = hn::Zero(d);

@@ -184,6 +184,7 @@ SmallSignalModel linearise(const Model& m, const Conditions& c, const State& s) 
     L.sm_mass_kg = m.sensor_mount.mass_kg;
     L.sm_stiffness_N_per_m = m.sensor_mount.stiffness_N_per_m;
     L.sm_damping_N_s_per_m = m.sensor_mount.damping_N_s_per_m;
+    L.sm_on_output = m.options.sensor_mount_base == SensorMountBase::Output;
     for (std::size_t i = 0; i < n; ++i)
       L.recoil_per_x.push_back(c.rods[i].momentum_mass_kg / m.sensor_mount.actuator_mass_kg);
   }
@@ -268,6 +269,10 @@ std::complex<double> SmallSignalModel::response(double f_Hz) const {
     Y += X;
     if (sensor_mount) Q += recoil_per_x[i] * X;
   }
+  // On the output: the probe follows Y through its bracket, z = Y (c s + k)/(m s^2 + c s + k).
+  if (sensor_mount && sm_on_output)
+    return Y * (sm_damping_N_s_per_m * sj + sm_stiffness_N_per_m) /
+           (sm_mass_kg * sj * sj + sm_damping_N_s_per_m * sj + sm_stiffness_N_per_m);
   // The probe's deflection u = Q s^2 / (s^2 + (c/m) s + k/m) (model.hpp, SensorMountModel).
   if (sensor_mount)
     Y -= Q * sj * sj * sm_mass_kg /

@@ -348,87 +348,6 @@ const ParamDef kParams[] = {
 
 #undef LAND
 
-// ---- options ----------------------------------------------------------------------------
-template <auto P>
-void set_option(Options& o, int v) {
-  using T = std::remove_reference_t<decltype(o.*P)>;
-  o.*P = static_cast<T>(v);
-}
-template <auto P>
-int get_option(const Options& o) {
-  return static_cast<int>(o.*P);
-}
-#define OPTION(field) &set_option<&Options::field>, &get_option<&Options::field>, "Options::" #field
-
-constexpr OptionChoice kBoolean[] = {{"false", 0, "off"}, {"true", 1, "on"}};
-constexpr OptionChoice kStressSign[] = {
-    {"compression_negative", static_cast<int>(StressSign::CompressionNegative),
-     "the Zheng/Zhou form of eq. (6): compression is negative"},
-    {"compression_positive", static_cast<int>(StressSign::CompressionPositive),
-     "sigma in eq. (3), (6), (13) is the compressive magnitude, as eq. (11)-(12) use sigma_p"},
-};
-constexpr OptionChoice kEq10Scale[] = {
-    {"room_referenced", static_cast<int>(Eq10Scale::RoomReferenced),
-     "p(T) = p0 f(T)/f(T_ref), T and T_c in K: Table 4 holds at T_ref for every law"},
-    {"kelvin", static_cast<int>(Eq10Scale::Kelvin), "T/T_c in K: Table 4 holds at 0 K"},
-    {"celsius", static_cast<int>(Eq10Scale::Celsius), "T/T_c in degC, the literal print"},
-};
-constexpr OptionChoice kShapeLaw[] = {
-    {"printed", static_cast<int>(ShapeLaw::Printed), "a^T = a0 exp(-T/(beta3 T_c)), as printed"},
-    {"mean_field", static_cast<int>(ShapeLaw::MeanField),
-     "a^T = a0 T/T_ref (kelvin), mean-field theory; needs room_referenced"},
-};
-constexpr OptionChoice kMagneticState[] = {
-    {"printed", static_cast<int>(MagneticState::Printed), "eq. (2), (3), (7) as printed"},
-    {"consistent", static_cast<int>(MagneticState::Consistent),
-     "each rod carries the flux of its own state, B = mu0 (H + M)"},
-};
-constexpr OptionChoice kMagnetisationLaw[] = {
-    {"jiles_atherton", static_cast<int>(MagnetisationLaw::JilesAtherton),
-     "Jiles-Atherton, eq. (9)-(10): the [<rod>.ja] tables"},
-    {"preisach", static_cast<int>(MagnetisationLaw::Preisach),
-     "Preisach, log-normal coercive and Gaussian interaction fields: the [<rod>.preisach] "
-     "tables"},
-};
-constexpr OptionChoice kEq11Saturation[] = {
-    {"temperature", static_cast<int>(Eq11Saturation::Temperature),
-     "M normalised by M_s^T, as printed"},
-    {"reference", static_cast<int>(Eq11Saturation::Reference),
-     "M normalised by M_s at T_ref: the strain follows the magnetisation"},
-};
-constexpr OptionChoice kEddyLaw[] = {
-    {"table4", static_cast<int>(EddyLaw::Table4),
-     "kappa = (r1^2 - r2^2)/(4 k_j rho) with Table 4's k_j, as printed"},
-    {"classical", static_cast<int>(EddyLaw::Classical),
-     "the classical quasi-static eddy field of a tube, section-averaged (r^2/(8 rho) for a solid "
-     "rod); k_j unused"},
-};
-
-const OptionDef kOptions[] = {
-    {"stress_sign", false, kStressSign, OPTION(stress_sign),
-     "the sign convention of the prestress in eq. (3), (6), (13)"},
-    {"eq10_temperature_scale", false, kEq10Scale, OPTION(eq10_scale),
-     "the temperature scale of T/T_c in eq. (10) and where Table 4 holds"},
-    {"eq10_shape_law", false, kShapeLaw, OPTION(shape_law), "the law of the JA shape a^T"},
-    {"magnetic_state", false, kMagneticState, OPTION(magnetic_state),
-     "how a rod's flux, field and magnetisation relate (docs/model.md, \"Magnetic state\")"},
-    {"eq11_saturation", false, kEq11Saturation, OPTION(eq11_saturation),
-     "the M_s that normalises M in eq. (11)"},
-    {"thermal_expansion_in_output", true, kBoolean, OPTION(thermal_expansion_in_output),
-     "add the thermal expansion x_T of eq. (21) to the output (section 4.4.2 removes it)"},
-    {"geometry_thermal_expansion", true, kBoolean, OPTION(geometry_thermal_expansion),
-     "use l^T, A^T, r^T in eq. (2), (7), (17), (19)"},
-    {"magnetisation_law", false, kMagnetisationLaw, OPTION(magnetisation_law),
-     "the hysteresis law of the rods (docs/model.md, \"Magnetisation laws\"); may be omitted",
-     "jiles_atherton"},
-    {"eddy_law", false, kEddyLaw, OPTION(eddy_law),
-     "the eddy-current coefficient kappa of eq. (7) (docs/model.md, \"The eddy law\"); may be "
-     "omitted",
-     "table4"},
-};
-
-#undef OPTION
-
 }  // namespace
 
 std::string_view rule_text(Rule r) {
@@ -504,7 +423,7 @@ std::span<const ParamDef> parameter_table() {
       [](auto law) { return law.rows; });
   return rows;
 }
-std::span<const OptionDef> option_table() { return kOptions; }
+// option_table, the options' words: src/model/option_table.cpp.
 
 const GroupDef& group_def(Group g) {
   for (const auto& d : parameter_groups())
@@ -516,7 +435,7 @@ const GroupDef& group_def(Group g) {
 
 const OptionDef* find_option_def(std::string_view key) {
   if (key.starts_with("options.")) key.remove_prefix(8);
-  for (const auto& o : kOptions)
+  for (const auto& o : option_table())
     if (o.key == key) return &o;
   return nullptr;
 }
@@ -583,7 +502,7 @@ std::string parameters_markdown() {
       "\n## [options]\n\nEvery option is required: a model file states its reading (an option "
       "with a default may be omitted).\n\n";
   md += "| key | values | meaning | lands in |\n|---|---|---|---|\n";
-  for (const auto& o : kOptions) {
+  for (const auto& o : option_table()) {
     std::string values;
     for (const auto& c : o.choices)
       values += fmt::format("{}`{}`{}", values.empty() ? "" : "; ", c.word,

@@ -42,8 +42,9 @@ inline void check(double value, double t, std::string_view rod, const char* quan
 void finish_outputs(const Model& m, const Conditions& c, State& s) {
   double y = 0.0;
   for (const auto& r : s.rods) y += r.x_m;
-  s.y_stack_m = y;                                 // eq. (20)
-  if (m.sensor_mount.enabled) y += s.z_m - s.q_m;  // the probe's deflection u = q - z
+  s.y_stack_m = y;             // eq. (20)
+  if (m.sensor_mount.enabled)  // the probe: its deflection u = q - z, or itself on the output
+    y = m.options.sensor_mount_base == SensorMountBase::Output ? s.z_m : y + (s.z_m - s.q_m);
   if (m.options.thermal_expansion_in_output) y += c.thermal_expansion_m;
   s.y_m = y;
   double phi = 0.0, area = 0.0;
@@ -62,6 +63,15 @@ double recoil_m(const Model& m, const Conditions& c, const State& s) {
   double p = 0.0;
   for (std::size_t i = 0; i < s.rods.size(); ++i) p += c.rods[i].momentum_mass_kg * s.rods[i].x_m;
   return p / m.sensor_mount.actuator_mass_kg;
+}
+
+// The base of the sensor mount's bracket (options.sensor_mount_base): the housing's recoil, or
+// the output y_stack = sum x (eq. 20).
+double mount_base_m(const Model& m, const Conditions& c, const State& s) {
+  if (m.options.sensor_mount_base == SensorMountBase::Recoil) return recoil_m(m, c, s);
+  double y = 0.0;
+  for (const auto& r : s.rods) y += r.x_m;
+  return y;
 }
 
 // The sensor mount (model.hpp, SensorMountModel): with w = u - q, m w'' + c w' + k w =
@@ -273,7 +283,7 @@ void settle_at_rest(const Model& m, const Conditions& c, State& s) {
     r.v_m_per_s = 0.0;
   }
   if (m.sensor_mount.enabled) {  // the probe at rest on its bracket: u = 0
-    s.q_m = s.z_m = recoil_m(m, c, s);
+    s.q_m = s.z_m = mount_base_m(m, c, s);
     s.z_v_m_per_s = 0.0;
   }
   finish_outputs(m, c, s);
@@ -454,7 +464,7 @@ void stage_mechanics(const Model& m, const Conditions& c, State& s, const StepIn
     check(r.x_m, w.t1_s, m.rods[i].name, "x [m]", 1.0);
   }
   if (m.sensor_mount.enabled) {
-    advance_sensor_mount(m.sensor_mount, s.q_m, recoil_m(m, c, s), in.dt_s, s);
+    advance_sensor_mount(m.sensor_mount, s.q_m, mount_base_m(m, c, s), in.dt_s, s);
     check(s.z_m, w.t1_s, "sensor mount", "z [m]", 1.0);
   }
 }

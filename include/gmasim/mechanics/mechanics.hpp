@@ -9,8 +9,8 @@
 #include <complex>
 #include <vector>
 
-#include "gmasim/physics/oscillator.hpp"
 #include "gmasim/model/model.hpp"
+#include "gmasim/physics/oscillator.hpp"
 
 namespace gmasim {
 
@@ -42,6 +42,7 @@ struct SmallSignalModel {
   // deflection u = Q m s^2 / (m s^2 + c s + k), Q = sum recoil_per_x_i X_i the housing's recoil.
   bool sensor_mount = false;
   double sm_mass_kg = 0, sm_stiffness_N_per_m = 0, sm_damping_N_s_per_m = 0;
+  bool sm_on_output = false;  // options.sensor_mount_base = output: Y x (c s + k)/(m s^2 + c s + k)
   std::vector<double> recoil_per_x;  // (m_i/2 + m_lr,i) / M_actuator per rod [-]
   // Y(j 2 pi f)/I [m/A].
   std::complex<double> response(double f_Hz) const;

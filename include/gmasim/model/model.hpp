@@ -45,6 +45,13 @@ enum class Eq11Saturation { Temperature, Reference };
 //   Classical: the quasi-static field of azimuthal eddy currents in a long tube of radii
 //              r2 < r1, averaged over its section (r1^2/(8 rho) for a solid rod); k_j unused.
 enum class EddyLaw { Table4, Classical };
+// What moves the base of the sensor mount's bracket (docs/model.md, "The sensor mount"):
+//   Recoil: the housing's recoil q = p / M; the probe sits on a bracket of the shell and the
+//           sensor reads y_stack + (z - q): the bracket's resonance with an antiresonance above it;
+//   Output: the actuator's output q = y_stack; the probe's tip rides on the output through the
+//           bracket's spring and the sensor reads the probe, y = z: base excitation, the
+//           resonance and no antiresonance (issue 37's mount reading).
+enum class SensorMountBase { Recoil, Output };
 
 // Parsed once, by the loader or ModelSpec::set_options, from the words of the option table
 // (gmasim/model/parameters.hpp). The defaults are the built-in model's readings (a test holds them
@@ -60,6 +67,7 @@ struct Options {
   bool geometry_thermal_expansion = true;
   MagnetisationLaw magnetisation_law = MagnetisationLaw::JilesAtherton;
   EddyLaw eddy_law = EddyLaw::Table4;
+  SensorMountBase sensor_mount_base = SensorMountBase::Recoil;
   bool operator==(const Options&) const = default;
 };
 
