@@ -57,40 +57,40 @@ inline constexpr std::size_t kPad = 8;
   X(kJaLagE, r.ja_exp.lag.e)
 // ... then the constants it reads (RodConditions rc, Material m.material, the circuit's rod
 // branch br; q = M_s^T / M_s of the strain guard).
-#define GMASIM_LANE_ROD_CONSTANTS(X)                                                              \
-  X(kLength, rc.length_m)                                                                         \
-  X(kArea, rc.area_m2)                                                                            \
-  X(kMsTMag, rc.MsT_mag)                                                                          \
-  X(kInvEs, rc.dE.inverse_Es_per_Pa)                                                              \
-  X(kRot, rc.dE.rotation_compliance_per_Pa)                                                       \
-  X(kCoupling, rc.dE.coupling)                                                                    \
-  X(kMu0Ms2, rc.dE.mu0_Ms2_over_chi_m_J_per_m3)                                                   \
-  X(kSdE, rc.dE.S_J_per_m3)                                                                       \
-  X(kJaA, rc.ja.a_A_per_m)                                                                        \
-  X(kJaAlpha, rc.ja.alpha)                                                                        \
-  X(kJaC, rc.ja.c)                                                                                \
-  X(kJaK, rc.ja.k_A_per_m)                                                                        \
-  X(kKappa, rc.eddy_geometry_s_m_per_H)                                                           \
-  X(kRs, rc.series_reluctance_per_H)                                                              \
-  X(kMassOsc, rc.mass_osc_kg)                                                                     \
-  X(kMomMass, rc.momentum_mass_kg)                                                                \
-  X(kDampOsc, rc.damping_osc_N_s_per_m)                                                           \
-  X(kFixedCompl, rc.fixed_compliance_m_per_N)                                                     \
-  X(kSigmaP, rc.sigma_p_Pa)                                                                       \
-  X(kCoilTurns, br.coil_turns)                                                                    \
-  X(kPmMmf, br.pm_mmf_At)                                                                         \
-  X(kStrainBound, kStrainGuardFactor* m.material.lambda_s* q* q)                                  \
-  X(kFluxMs, std::max(m.material.Ms_A_per_m, rc.MsT_mag))                                         \
-  X(kJaInvA, 1.0 / rc.ja.a_A_per_m)            /* the scalar law's inv_a */                       \
-  X(kLengthPerArea, rc.length_over_area_per_m) /* l / A (the consistent step's l_A) */            \
-  X(kInvArea, 1.0 / rc.area_m2)                                                                   \
-  X(kInvMassOsc, rc.inv_mass_osc_per_kg)                      /* 1 / m of the rod's oscillator */ \
-  X(kJaInvK, 1.0 / rc.ja.k_A_per_m)                           /* JaMoveStart::inv_k */            \
-  X(kInvMsTE, rc.inv_MsT_E_m_per_A)                           /* 1 / M_s^T of eq. (13) */         \
-  X(kInvMsStrain, rc.inv_Ms_strain_m_per_A)                   /* 1 / M_s of eq. (11) */           \
-  X(kAreaOverLength, rc.area_over_length_m)                   /* A / l (eq. 17) */                \
-  X(kFourSpOverLs, 4.0 * rc.sigma_p_Pa / m.material.lambda_s) /* eq. (11)'s 4 sigma_p / lambda_s  \
-                                                               */
+#define GMASIM_LANE_ROD_CONSTANTS(X)                                                     \
+  X(kLength, rc.length_m)                                                                \
+  X(kArea, rc.area_m2)                                                                   \
+  X(kMsTMag, rc.MsT_mag)                                                                 \
+  X(kInvEs, rc.dE.inverse_Es_per_Pa)                                                     \
+  X(kRot, rc.dE.rotation_compliance_per_Pa)                                              \
+  X(kCoupling, rc.dE.coupling)                                                           \
+  X(kMu0Ms2, rc.dE.mu0_Ms2_over_chi_m_J_per_m3)                                          \
+  X(kSdE, rc.dE.S_J_per_m3)                                                              \
+  X(kJaA, rc.ja.a_A_per_m)                                                               \
+  X(kJaAlpha, rc.ja.alpha)                                                               \
+  X(kJaC, rc.ja.c)                                                                       \
+  X(kJaK, rc.ja.k_A_per_m)                                                               \
+  X(kKappa, rc.eddy_geometry_s_m_per_H)                                                  \
+  X(kRs, rc.series_reluctance_per_H)                                                     \
+  X(kMassOsc, rc.mass_osc_kg)                                                            \
+  X(kMomMass, rc.momentum_mass_kg)                                                       \
+  X(kDampOsc, rc.damping_osc_N_s_per_m)                                                  \
+  X(kFixedCompl, rc.fixed_compliance_m_per_N)                                            \
+  X(kSigmaP, rc.sigma_p_Pa)                                                              \
+  X(kCoilTurns, br.coil_turns)                                                           \
+  X(kPmMmf, br.pm_mmf_At)                                                                \
+  X(kStrainBound, kStrainGuardFactor* m.material.lambda_s* q* q)                         \
+  X(kFluxMs, std::max(m.material.Ms_A_per_m, rc.MsT_mag))                                \
+  X(kJaInvA, 1.0 / rc.ja.a_A_per_m)            /* the scalar law's inv_a */              \
+  X(kLengthPerArea, rc.length_over_area_per_m) /* l / A (the consistent step's l_A) */   \
+  X(kInvArea, 1.0 / rc.area_m2)                                                          \
+  X(kInvMassOsc, rc.inv_mass_osc_per_kg)             /* 1 / m of the rod's oscillator */ \
+  X(kJaInvK, 1.0 / rc.ja.k_A_per_m)                  /* JaMoveStart::inv_k */            \
+  X(kInvMsTE, rc.inv_MsT_E_m_per_A)                  /* 1 / M_s^T of eq. (13) */         \
+  X(kInvMsStrain, rc.inv_Ms_strain_m_per_A)          /* 1 / M_s of eq. (11) */           \
+  X(kAreaOverLength, rc.area_over_length_m)          /* A / l (eq. 17) */                \
+  X(kFourSpOverLs, rc.four_sigma_p_over_lambda_s_Pa) /* eq. (11)'s 4 sigma_p / lambda_s  \
+                                                      */
 
 // Per lane: the State's scalars (s), ...
 #define GMASIM_LANE_GLOBAL_STATE(X)                                        \

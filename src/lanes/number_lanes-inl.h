@@ -104,7 +104,8 @@ namespace laws {
 using ::gmasim::lanes::HWY_NAMESPACE::oscillator_free_closed_form_where;
 #define GMASIM_LAW_INLINE HWY_INLINE
 #define GMASIM_LAW_RARE HWY_NOINLINE
-#include "gmasim/physics/laws-inl.h"    // NOLINT(build/include): once per target, by design
+#include "gmasim/physics/laws-inl.h"  // NOLINT(build/include): once per target, by design
+// after laws-inl.h, whose series and anchors it uses (a block of its own: clang-format keeps it)
 #include "gmasim/physics/ja_law-inl.h"  // NOLINT(build/include): likewise
 #undef GMASIM_LAW_INLINE
 #undef GMASIM_LAW_RARE

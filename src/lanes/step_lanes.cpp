@@ -73,13 +73,14 @@ HWY_INLINE void mount_and_outputs(const Chunk<D>& c, RodStates<D>& s, V<D>* g, V
   using N = Lanes<D>;
   const D d = c.d;
   const Structure& st = c.L.st;
+  V<D> y = hn::Zero(d);  // eq. (20): y_stack = sum x
+  for (int i = 0; i < c.n; ++i) y = hn::Add(y, s.f[kX][i]);
+  g[kYStack] = y;
   if (st.mount) {
-    // the bracket's base (model/step.cpp, mount_base_m): the recoil p / M or the output sum x
-    V<D> p = hn::Zero(d), q1;
-    if (st.mount_on_output) {
-      for (int i = 0; i < c.n; ++i) p = hn::Add(p, s.f[kX][i]);
-      q1 = p;
-    } else {
+    // the bracket's base (model/step.cpp, mount_base_m): the recoil p / M or the output y_stack
+    V<D> q1 = y;
+    if (!st.mount_on_output) {
+      V<D> p = hn::Zero(d);
       for (int i = 0; i < c.n; ++i) p = hn::Add(p, hn::Mul(c.rod(kMomMass, i), s.f[kX][i]));
       q1 = hn::Div(p, c.glob(kActMass));
     }
@@ -94,9 +95,6 @@ HWY_INLINE void mount_and_outputs(const Chunk<D>& c, RodStates<D>& s, V<D>* g, V
     g[kQ] = q1;
     fails.check(d, g[kZ], C(d, 1.0), kFailZ, -1, t1);
   }
-  V<D> y = hn::Zero(d);
-  for (int i = 0; i < c.n; ++i) y = hn::Add(y, s.f[kX][i]);
-  g[kYStack] = y;
   if (st.mount) y = st.mount_on_output ? g[kZ] : hn::Add(y, hn::Sub(g[kZ], g[kQ]));
   if (st.xT_in_output) y = hn::Add(y, c.glob(kXT));
   g[kY] = y;

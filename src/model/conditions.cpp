@@ -228,6 +228,7 @@ Conditions conditions_at(const Model& m, double temperature_C, const Freeze& fz)
     rc.inv_MsT_E_m_per_A = 1.0 / rc.MsT_E;
     rc.inv_Ms_strain_m_per_A = 1.0 / rc.Ms_strain_A_per_m;
     rc.inv_mass_osc_per_kg = 1.0 / rc.mass_osc_kg;
+    rc.four_sigma_p_over_lambda_s_Pa = 4.0 * rc.sigma_p_Pa / m.material.lambda_s;
     c.rods.push_back(rc);
   }
   return c;

@@ -39,9 +39,15 @@ inline void check(double value, double t, std::string_view rod, const char* quan
   diverged(value, t, rod, quantity, limit);
 }
 
-void finish_outputs(const Model& m, const Conditions& c, State& s) {
+// Eq. (20): the stack's displacement, the sum of the rods' x.
+double stack_displacement_m(const State& s) {
   double y = 0.0;
   for (const auto& r : s.rods) y += r.x_m;
+  return y;
+}
+
+void finish_outputs(const Model& m, const Conditions& c, State& s) {
+  double y = stack_displacement_m(s);
   s.y_stack_m = y;             // eq. (20)
   if (m.sensor_mount.enabled)  // the probe: its deflection u = q - z, or itself on the output
     y = m.options.sensor_mount_base == SensorMountBase::Output ? s.z_m : y + (s.z_m - s.q_m);
@@ -68,10 +74,8 @@ double recoil_m(const Model& m, const Conditions& c, const State& s) {
 // The base of the sensor mount's bracket (options.sensor_mount_base): the housing's recoil, or
 // the output y_stack = sum x (eq. 20).
 double mount_base_m(const Model& m, const Conditions& c, const State& s) {
-  if (m.options.sensor_mount_base == SensorMountBase::Recoil) return recoil_m(m, c, s);
-  double y = 0.0;
-  for (const auto& r : s.rods) y += r.x_m;
-  return y;
+  return m.options.sensor_mount_base == SensorMountBase::Recoil ? recoil_m(m, c, s)
+                                                                : stack_displacement_m(s);
 }
 
 // The sensor mount (model.hpp, SensorMountModel): with w = u - q, m w'' + c w' + k w =

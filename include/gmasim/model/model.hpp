@@ -337,14 +337,15 @@ struct RodConditions {
   int chain_rod_count;
   // Reciprocals and ratios of the fields above that every step uses, divided once here
   // (make_conditions sets them with the fields they come from; the step multiplies).
-  double inv_area_per_m2;         // 1 / A^T
-  double length_over_area_per_m;  // l^T / A^T (eq. 2)
-  double area_over_length_m;      // A^T / l^T (eq. 17)
-  double inv_MsT_E_m_per_A;       // 1 / MsT_E (eq. 13)
-  double inv_Ms_strain_m_per_A;   // 1 / Ms_strain_A_per_m (eq. 11)
-  double inv_mass_osc_per_kg;     // 1 / mass_osc_kg (eq. 15)
-  double ja_inv_a_m_per_A;        // 1 / ja.a_A_per_m (eq. 9; Jiles-Atherton law only)
-  double ja_inv_k_m_per_A;        // 1 / ja.k_A_per_m (eq. 9; Jiles-Atherton law only)
+  double inv_area_per_m2;                // 1 / A^T
+  double length_over_area_per_m;         // l^T / A^T (eq. 2)
+  double area_over_length_m;             // A^T / l^T (eq. 17)
+  double inv_MsT_E_m_per_A;              // 1 / MsT_E (eq. 13)
+  double inv_Ms_strain_m_per_A;          // 1 / Ms_strain_A_per_m (eq. 11)
+  double inv_mass_osc_per_kg;            // 1 / mass_osc_kg (eq. 15)
+  double four_sigma_p_over_lambda_s_Pa;  // 4 sigma_p / lambda_s (eq. 11-12's 2 sigma_p/sigma_s x E)
+  double ja_inv_a_m_per_A;               // 1 / ja.a_A_per_m (eq. 9; Jiles-Atherton law only)
+  double ja_inv_k_m_per_A;               // 1 / ja.k_A_per_m (eq. 9; Jiles-Atherton law only)
 };
 
 struct Conditions {

@@ -45,7 +45,7 @@ inline double rod_static_field(const Model& m, std::size_t i, const RodCondition
 inline double update_rod_mechanics(const Material& mat, const RodConditions& rc, RodState& r) {
   const physics::RodMechanics k = physics::rod_mechanics(
       r.M_A_per_m, rc.inv_MsT_E_m_per_A, rc.dE, rc.inv_Ms_strain_m_per_A, mat.lambda_s,
-      rc.sigma_p_Pa, 4.0 * rc.sigma_p_Pa / mat.lambda_s, rc.area_m2, rc.area_over_length_m,
+      rc.sigma_p_Pa, rc.four_sigma_p_over_lambda_s_Pa, rc.area_m2, rc.area_over_length_m,
       rc.length_over_area_per_m, r.prestress_exp);
   r.E_Pa = k.E_Pa;
   r.lambda = k.lambda;

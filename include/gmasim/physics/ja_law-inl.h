@@ -47,7 +47,7 @@ GMASIM_LAW_INLINE ::gmasim::physics::Mask<T> langevin_closed(T x) {
 template <class T>
 GMASIM_LAW_INLINE LangevinValueT<T> langevin_regimes(T x, T e) {
   const T ax = abs(x);
-  const ::gmasim::physics::Mask<T> small = ax < 0.1, big = ax > 40.0;
+  const ::gmasim::physics::Mask<T> small = ax<0.1, big = ax> 40.0;
   if (all(small)) return langevin_series(x);
   if (all(big)) return langevin_asymptote(x);
   LangevinValueT<T> v = langevin_pair_from_exp(x, e);
@@ -69,22 +69,17 @@ GMASIM_LAW_INLINE LangevinValueT<T> langevin_pair(T x) {
   return langevin_regimes(x, e);
 }
 // langevin_pair with its exponential exp(-2|x|) from an anchor nearby (p, exp_near: a few units
-// in the last place from langevin_pair; p moves where it is not near), in the lanes of where.
+// in the last place from langevin_pair; p moves where it is not near), and from the solve's last
+// value `recent` beside it where given (exp_near(y, p, recent)), in the lanes of where.
 template <class T>
-GMASIM_LAW_INLINE LangevinValueT<T> langevin_pair_near(T x, ExpPointT<T>& p,
+GMASIM_LAW_INLINE LangevinValueT<T> langevin_pair_near(T x, ExpPointT<T>& p, ExpPointT<T>* recent,
                                                        ::gmasim::physics::Mask<T> where) {
   const ::gmasim::physics::Mask<T> closed = langevin_closed(x);
   T e = 0.0;
-  if (any(closed)) e = exp_near(-2.0 * abs(x), p, where && closed);
-  return langevin_regimes(x, e);
-}
-// The same with the solve's last value beside the anchor (exp_near(y, p, recent)).
-template <class T>
-GMASIM_LAW_INLINE LangevinValueT<T> langevin_pair_near(T x, ExpPointT<T>& p, ExpPointT<T>& recent,
-                                                       ::gmasim::physics::Mask<T> where) {
-  const ::gmasim::physics::Mask<T> closed = langevin_closed(x);
-  T e = 0.0;
-  if (any(closed)) e = exp_near(-2.0 * abs(x), p, recent, where && closed);
+  if (any(closed)) {
+    const T y = -2.0 * abs(x);
+    e = recent ? exp_near(y, p, *recent, where && closed) : exp_near(y, p, where && closed);
+  }
   return langevin_regimes(x, e);
 }
 
@@ -112,17 +107,14 @@ GMASIM_LAW_INLINE LagWeightsSlopeT<T> lag_weights_and_slope_from(T r, T E) {
   }
   return w;
 }
-// With exp(-r) from an anchor nearby (p, exp_near; moved where it is not), in the lanes of where.
+// With exp(-r) from an anchor nearby (p, exp_near; moved where it is not), and from the solve's
+// last value `recent` beside it where given (exp_near(y, p, recent)), in the lanes of where.
 template <class T>
 GMASIM_LAW_INLINE LagWeightsSlopeT<T> lag_weights_and_slope_near(T r, ExpPointT<T>& p,
-                                                      ::gmasim::physics::Mask<T> where) {
-  return lag_weights_and_slope_from(r, exp_near(-r, p, where));
-}
-// The same with the solve's last value beside the anchor (exp_near(y, p, recent)).
-template <class T>
-GMASIM_LAW_INLINE LagWeightsSlopeT<T> lag_weights_and_slope_near(T r, ExpPointT<T>& p, ExpPointT<T>& recent,
-                                                      ::gmasim::physics::Mask<T> where) {
-  return lag_weights_and_slope_from(r, exp_near(-r, p, recent, where));
+                                                                 ExpPointT<T>* recent,
+                                                                 ::gmasim::physics::Mask<T> where) {
+  return lag_weights_and_slope_from(
+      r, recent ? exp_near(-r, p, *recent, where) : exp_near(-r, p, where));
 }
 
 // The four JA coefficients at one temperature (eq. 10 evaluated).
@@ -147,9 +139,10 @@ struct JaCoefficientsT {
 // anchor `lag` where it is near, or from the solve's last value lag_recent (exp_near; lag moves
 // where neither is near), in the lanes of where.
 template <class T>
-GMASIM_LAW_INLINE T ja_irreversible_update(T Mirr0, T Man0, T Man1, T dMan1, T dHe, T inv_k, T& dMirr_dHe1,
-                                ExpPointT<T>& lag, ExpPointT<T>* lag_recent,
-                                ::gmasim::physics::Mask<T> where) {
+GMASIM_LAW_INLINE T ja_irreversible_update(T Mirr0, T Man0, T Man1, T dMan1, T dHe, T inv_k,
+                                           T& dMirr_dHe1, ExpPointT<T>& lag,
+                                           ExpPointT<T>* lag_recent,
+                                           ::gmasim::physics::Mask<T> where) {
   const T delta = select(dHe > 0.0, T(1.0), T(-1.0));
   const T d0 = (Man0 - Mirr0) * delta, d1 = (Man1 - Mirr0) * delta;
   // dHe == 0: nothing moves; d0, d1 <= 0: pinned for the whole step
@@ -173,8 +166,7 @@ GMASIM_LAW_INLINE T ja_irreversible_update(T Mirr0, T Man0, T Man1, T dMan1, T d
   // d/dHe1 through M_an1 (weight 1 - q) and through r = s/k (dq/dr = (E - q)/r): one
   // reciprocal of r for q and dq/dr (lag_weights_and_slope_from).
   const ::gmasim::physics::Mask<T> moves = where && !still;
-  const LagWeightsSlopeT<T> w = lag_recent ? lag_weights_and_slope_near(r, lag, *lag_recent, moves)
-                                           : lag_weights_and_slope_near(r, lag, moves);
+  const LagWeightsSlopeT<T> w = lag_weights_and_slope_near(r, lag, lag_recent, moves);
   const T dq_dr = w.dq_dr;
   const T dm = (1.0 - w.q) * dMan1 + ds_dHe1 * inv_k * (-(Mirr0 - u0) * w.E - (Man1 - u0) * dq_dr);
   const T m1 = Man1 + (Mirr0 - u0) * w.E - (Man1 - u0) * w.q;
@@ -198,8 +190,9 @@ struct JaMoveStartT {
 // 1e-12 M_s^T / a of it: one exponential less per rod and step.) inv_a = 1/a and inv_k = 1/k,
 // divided once with the coefficients (RodConditions).
 template <class T>
-GMASIM_LAW_INLINE JaMoveStartT<T> ja_move_start_near(T H0, T M0, T MsT_A_per_m, const JaCoefficientsT<T>& p,
-                                          T inv_a, T inv_k, T x_at, const LangevinValueT<T>& lv) {
+GMASIM_LAW_INLINE JaMoveStartT<T> ja_move_start_near(T H0, T M0, T MsT_A_per_m,
+                                                     const JaCoefficientsT<T>& p, T inv_a, T inv_k,
+                                                     T x_at, const LangevinValueT<T>& lv) {
   const T He0 = H0 + p.alpha * M0;
   const T x0 = He0 * inv_a;
   const ::gmasim::physics::Mask<T> near = abs(x0 - x_at) <= 1e-7;
@@ -241,8 +234,7 @@ template <class T>
     T inv_a, JaExpPointsT<T>& near, JaExpPointsT<T>* recent, ::gmasim::physics::Mask<T> where) {
   const T He1 = H1 + p.alpha * M1;
   const LangevinValueT<T> lv =
-      recent ? langevin_pair_near(He1 * inv_a, near.langevin, recent->langevin, where)
-             : langevin_pair_near(He1 * inv_a, near.langevin, where);
+      langevin_pair_near(He1 * inv_a, near.langevin, recent ? &recent->langevin : nullptr, where);
   const T Man1 = MsT_A_per_m * lv.L;
   const T dMan = MsT_A_per_m * inv_a * lv.dL;
   T dMirr = 0.0;
@@ -282,8 +274,9 @@ GMASIM_LAW_INLINE T ja_safeguard_residual(T MsT_A_per_m) {
 // = M_irr0, M1 = M0 and chi_e is the reversible c dM_an/dH_e. Outside where the outputs are kept.
 template <class T>
 GMASIM_LAW_RARE void ja_step_from(T H0, const JaMoveStartT<T>& st, T H1, T MsT_A_per_m,
-                         const JaCoefficientsT<T>& p, T Mirr0, T M0, T M_guess, T& Mirr1_out,
-                         T& M1_out, T& chi_e_out, ::gmasim::physics::Mask<T> where) {
+                                  const JaCoefficientsT<T>& p, T Mirr0, T M0, T M_guess,
+                                  T& Mirr1_out, T& M1_out, T& chi_e_out,
+                                  ::gmasim::physics::Mask<T> where) {
   const T inv_a = 1.0 / p.a_A_per_m;
   const ::gmasim::physics::Mask<T> same = where && H1 == H0;
   if (any(same)) {
@@ -349,11 +342,12 @@ struct JaJointTrialT {
   ::gmasim::physics::Mask<T> converged, solved;
 };
 template <class T>
-GMASIM_LAW_INLINE JaJointTrialT<T> ja_joint_trial(T H0, T Mirr0, T M0, T an_x, const LangevinValueT<T>& an_lv,
-                                       T MsT_A_per_m, const JaCoefficientsT<T>& p,
-                                       const JaMoveStartT<T>& st, JaExpPointsT<T>& near,
-                                       JaExpPointsT<T>& recent, T H1, T M_iter,
-                                       ::gmasim::physics::Mask<T> live) {
+GMASIM_LAW_INLINE JaJointTrialT<T> ja_joint_trial(T H0, T Mirr0, T M0, T an_x,
+                                                  const LangevinValueT<T>& an_lv, T MsT_A_per_m,
+                                                  const JaCoefficientsT<T>& p,
+                                                  const JaMoveStartT<T>& st, JaExpPointsT<T>& near,
+                                                  JaExpPointsT<T>& recent, T H1, T M_iter,
+                                                  ::gmasim::physics::Mask<T> live) {
   JaJointTrialT<T> t;
   const ::gmasim::physics::Mask<T> same = H1 == H0, moves = live && !same;
   T chi_e = 0.0, g = 0.0;
@@ -363,7 +357,7 @@ GMASIM_LAW_INLINE JaJointTrialT<T> ja_joint_trial(T H0, T Mirr0, T M0, T an_x, c
     ja_step_from(H0, st, H1, MsT_A_per_m, p, Mirr0, M0, M_iter, t.Mirr, t.M, chi_e, same);
   t.an_x = an_x;  // nothing evaluated: the rod's own point stays
   t.an_lv = an_lv;
-  t.solved = same && !same;
+  t.solved = !true_mask(H1);  // no lane yet
   if (!all(same)) {
     const JaEvaluationT<T> e =
         ja_evaluate(st, H1, M_iter, MsT_A_per_m, p, Mirr0, st.inv_a, near, &recent, moves);

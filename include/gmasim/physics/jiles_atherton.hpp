@@ -87,13 +87,6 @@ inline JaMoveStart ja_move_start(double H0, double M0, double MsT_A_per_m,
   const double inv_a = 1.0 / p.a_A_per_m;
   return {He0, MsT_A_per_m * langevin(He0 * inv_a), inv_a, 1.0 / p.k_A_per_m};
 }
-// ja_evaluate without anchors (every exponential by libm).
-inline JaEvaluation ja_evaluate(const JaMoveStart& st, double H1, double M1, double MsT_A_per_m,
-                                const JaCoefficients& p, double Mirr0, double inv_a) {
-  JaExpPoints none = no_ja_exp_points<double>();
-  return ja_evaluate(st, H1, M1, MsT_A_per_m, p, Mirr0, inv_a, none,
-                     static_cast<JaExpPoints*>(nullptr), true);
-}
 // ja_step_from for one rod (every lane: where = true).
 inline void ja_step_from(double H0, const JaMoveStart& st, double H1, double MsT_A_per_m,
                          const JaCoefficients& p, double Mirr0, double M0, double M_guess,

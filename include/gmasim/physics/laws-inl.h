@@ -93,7 +93,8 @@ GMASIM_LAW_INLINE T exp_near(T y, ExpPointT<T>& a) {
 // recent holds only exp_near's values and lives for one solve (JilesAthertonLaw::MoveStart), so
 // every value is at most two short series and four roundings from a std::exp value.
 template <class T>
-GMASIM_LAW_INLINE T exp_near(T y, ExpPointT<T>& a, ExpPointT<T>& recent, ::gmasim::physics::Mask<T> where) {
+GMASIM_LAW_INLINE T exp_near(T y, ExpPointT<T>& a, ExpPointT<T>& recent,
+                             ::gmasim::physics::Mask<T> where) {
   const T d = y - recent.y;
   const ::gmasim::physics::Mask<T> go = where && !(abs(d) <= 1.0 / 8192);
   if (none(go)) return recent.e + recent.e * (d * (1.0 + d * (1.0 / 2 + d * (1.0 / 6))));
@@ -148,7 +149,8 @@ struct OscillatorPropagatorT {
 // One doubling where `at` holds: (C, S) of exp(N / 2), whose (N / 2)^2 = u_half I, to those of
 // exp(N) = exp(N / 2)^2 = (C^2 + u_half S^2) I + (C S) N.
 template <class T>
-GMASIM_LAW_INLINE void oscillator_series_doubled(T u_half, ::gmasim::physics::Mask<T> at, T& C, T& S) {
+GMASIM_LAW_INLINE void oscillator_series_doubled(T u_half, ::gmasim::physics::Mask<T> at, T& C,
+                                                 T& S) {
   const T c = C;
   C = select(at, c * c + u_half * (S * S), c);
   S = select(at, c * S, S);
@@ -156,7 +158,8 @@ GMASIM_LAW_INLINE void oscillator_series_doubled(T u_half, ::gmasim::physics::Ma
 // decay: the last e^(tau/2) taken by std::exp (physics::exp_cached; a run's step repeats it).
 // valid is false (f0, f1 unset) beyond the series' caps.
 template <class T>
-GMASIM_LAW_INLINE OscillatorPropagatorT<T> oscillator_propagator(T tau, T delta, ExpPointT<T>& decay) {
+GMASIM_LAW_INLINE OscillatorPropagatorT<T> oscillator_propagator(T tau, T delta,
+                                                                 ExpPointT<T>& decay) {
   const T half_tau = 0.5 * tau;
   const T u = half_tau * half_tau - delta;
   const T au = abs(u);
@@ -206,7 +209,7 @@ GMASIM_LAW_INLINE OscillatorPropagatorT<T> oscillator_propagator(T tau, T delta,
 // inv_m = 1/m; decay: oscillator_propagator's (the row's last e^(tau/2)).
 template <class T>
 GMASIM_LAW_INLINE void oscillator_step(T m, T inv_m, T c, T k, T F0, T F1, T h, T& x, T& v,
-                            ExpPointT<T>& decay) {
+                                       ExpPointT<T>& decay) {
   const T g = (F1 - F0) / h;  // force rate [N/s]
   // Particular solution x_p(s) = (F0 + g s)/k - g c / k^2, v_p = g / k.
   const T inv_k = 1.0 / k;
@@ -232,7 +235,7 @@ GMASIM_LAW_INLINE void oscillator_step(T m, T inv_m, T c, T k, T F0, T F1, T h, 
 // linear over the step, so oscillator_step is exact.
 template <class T>
 GMASIM_LAW_INLINE void base_excited_step(T m, T inv_m, T c, T k, T q0, T q1, T h, T& z, T& zv,
-                              ExpPointT<T>& decay) {
+                                         ExpPointT<T>& decay) {
   const T qdot = (q1 - q0) / h;
   oscillator_step(m, inv_m, c, k, c * qdot + k * q0, c * qdot + k * q1, h, z, zv, decay);
 }
@@ -301,7 +304,8 @@ GMASIM_LAW_INLINE T tanh_absolute_near(T u, ExpPointT<T>& p) {
 // The factor at 2 sigma_p / sigma_s = two_sp_over_ss (given: the step forms it from 1/E).
 // tanh_2sp_ss: tanh(2 sigma_p / sigma_s) (tanh_absolute).
 template <class T>
-GMASIM_LAW_INLINE T prestress_factor_from_tanh(T tanh_2sp_ss, T sigma_p_Pa, T sigma_s_Pa, T sigma_max_Pa) {
+GMASIM_LAW_INLINE T prestress_factor_from_tanh(T tanh_2sp_ss, T sigma_p_Pa, T sigma_s_Pa,
+                                               T sigma_max_Pa) {
   const T base = 1.0 + 0.5 * tanh_2sp_ss;
   const ::gmasim::physics::Mask<T> below = sigma_p_Pa <= sigma_s_Pa;
   if (all(below)) return base;
@@ -316,7 +320,7 @@ GMASIM_LAW_INLINE T prestress_factor_from_tanh(T tanh_2sp_ss, T sigma_p_Pa, T si
 // prestress_exp), a few units in the last place from magnetostriction's.
 template <class T>
 GMASIM_LAW_INLINE T magnetostriction_near(T m, T lambda_s, T sigma_p_Pa, T four_sp_over_ls, T E_Pa,
-                               T inv_E_per_Pa, ExpPointT<T>& near) {
+                                          T inv_E_per_Pa, ExpPointT<T>& near) {
   const T f = prestress_factor_from_tanh(tanh_absolute_near(four_sp_over_ls * inv_E_per_Pa, near),
                                          sigma_p_Pa, saturation_stress(lambda_s, E_Pa),
                                          maximum_stress(lambda_s, E_Pa));
@@ -339,10 +343,12 @@ struct RodMechanicsT {
   T E_Pa, lambda, F_N, k_rod_N_per_m, compliance_m_per_N;
 };
 template <class T>
-GMASIM_LAW_INLINE RodMechanicsT<T> rod_mechanics(T M_A_per_m, T inv_MsT_E, const DeltaETermsT<T>& dE,
-                                      T inv_Ms_strain, T lambda_s, T sigma_p_Pa, T four_sp_over_ls,
-                                      T area_m2, T area_over_length_m, T length_over_area_per_m,
-                                      ExpPointT<T>& prestress) {
+GMASIM_LAW_INLINE RodMechanicsT<T> rod_mechanics(T M_A_per_m, T inv_MsT_E,
+                                                 const DeltaETermsT<T>& dE, T inv_Ms_strain,
+                                                 T lambda_s, T sigma_p_Pa, T four_sp_over_ls,
+                                                 T area_m2, T area_over_length_m,
+                                                 T length_over_area_per_m,
+                                                 ExpPointT<T>& prestress) {
   const T inv_E = delta_e_compliance(M_A_per_m * inv_MsT_E, dE);
   RodMechanicsT<T> r;
   r.E_Pa = 1.0 / inv_E;  // eq. (13)
@@ -359,7 +365,7 @@ GMASIM_LAW_INLINE RodMechanicsT<T> rod_mechanics(T M_A_per_m, T inv_MsT_E, const
 // 1/k_rod of rod j; members: the chain's rod indices).
 template <class T>
 GMASIM_LAW_INLINE T chain_stiffness(T fixed_compliance_m_per_N, const T* compliances_m_per_N,
-                         const int* members, int count) {
+                                    const int* members, int count) {
   T inv_k = fixed_compliance_m_per_N;
   for (int j = 0; j < count; ++j) inv_k = inv_k + compliances_m_per_N[members[j]];
   return 1.0 / inv_k;
@@ -371,4 +377,3 @@ template <class T>
 GMASIM_LAW_INLINE T mid_step_stiffness(T K0_N_per_m, T k_rod1_N_per_m, T k_load1_N_per_m) {
   return 0.5 * (K0_N_per_m + k_rod1_N_per_m + k_load1_N_per_m);
 }
-

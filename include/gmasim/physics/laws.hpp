@@ -24,7 +24,8 @@ inline void oscillator_free_closed_form_where(bool where, double m, double c, do
 
 #define GMASIM_LAW_INLINE [[gnu::always_inline]] inline
 #define GMASIM_LAW_RARE inline
-#include "gmasim/physics/laws-inl.h"    // IWYU pragma: export
+#include "gmasim/physics/laws-inl.h"  // IWYU pragma: export
+// after laws-inl.h, whose series and anchors it uses (a block of its own: clang-format keeps it)
 #include "gmasim/physics/ja_law-inl.h"  // IWYU pragma: export
 #undef GMASIM_LAW_INLINE
 #undef GMASIM_LAW_RARE

@@ -1,12 +1,6 @@
-// Short power series shared by the step's laws: a degree-7 polynomial by Estrin's scheme, e^x
-// from its Taylor series where |x| <= 1/64 (truncation below 1e-19 relative) or, to degree 10,
-// where |x| <= 1/8 (below 3e-18), and e^y from a known anchor value e^{y_a} (exp_near: one
-// exponential less where a law is evaluated again close to an earlier point, within a Newton
-// solve and from one step to the next).
+// Forwarding header: the short power series shared by the step's laws (polynomial7,
+// exp_series7, expm1_series10, cos_half_pi, exp_near, exp_cached) are written once over the
+// number type in gmasim/physics/laws-inl.h (issue 38), instantiated for double by laws.hpp.
 #pragma once
 
-#include <cmath>
-
 #include "gmasim/physics/laws.hpp"
-
-namespace gmasim::physics {}  // namespace gmasim::physics
