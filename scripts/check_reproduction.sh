@@ -18,7 +18,7 @@ CMP=(models/mdma_printed.toml)
 # The consistent reading (the built-in model) beside its structural readings (issue 37), then
 # the printed magnetic state's readings.
 for r in consistent consistent__classical_eddy consistent__no_joint_gaps \
-         consistent__classical_eddy__no_joint_gaps consistent__mount_on_output \
+         consistent__classical_eddy__no_joint_gaps consistent__mount_on_output consistent__bonded_joints \
          printed__kelvin__compression_negative printed__kelvin__compression_positive \
          printed__room_referenced__compression_negative printed__room_referenced__compression_positive \
          mean_field__room_referenced__compression_negative mean_field__room_referenced__compression_positive; do

@@ -130,3 +130,24 @@ TEST(Derived, CoilResistanceFollowsTheTurnsWhenTheWindingIsGiven) {
   for (const auto& d : derived_quantities(mdma.spec))
     EXPECT_NE(d.name, "thermal_network.coil_resistance_ohm");
 }
+
+TEST(Derived, CoilHeatCapacityIsTheWindingsCopper) {
+  // models/single_rod.toml: 500 turns of 0.6 mm wire, 80 mm mean turn; copper 8890 kg/m^3, 385
+  // J/(kg K): 500 x 0.08 m x 2.827e-7 m^2 = 1.131e-5 m^3, 0.1005 kg, 38.71 J/K.
+  const ModelSpec base = load_model_spec(template_path("single_rod.toml"));
+  const auto C = [](const ModelSpec& s) { return compile(s).thermal_network.coil_C_J_per_K; };
+  const double per_turn = 8890.0 * 0.08 * std::numbers::pi * 0.0006 * 0.0006 / 4.0 * 385.0;
+  EXPECT_NEAR(C(base), 500 * per_turn, 1e-12);
+  EXPECT_NEAR(C(base), 38.709, 1e-3);
+  // It follows the turns and the wire, as the resistance does; a value given is an override.
+  EXPECT_NEAR(C(apply_assignments(base, {"circuit.branches.coil.coil_turns=800"})), 800 * per_turn,
+              1e-12);
+  EXPECT_NEAR(C(apply_assignments(base, {"thermal_network.coil_wire_diameter_m=0.0012"})),
+              4 * 500 * per_turn, 1e-11);
+  const Model given =
+      compile(apply_assignments(base, {"thermal_network.coil_heat_capacity_J_per_K=60"}));
+  EXPECT_EQ(given.thermal_network.coil_C_J_per_K, 60.0);
+  EXPECT_TRUE(has_warning_about(given, "coil_heat_capacity_J_per_K"));  // 60 vs 38.7: > 10 %
+  // The MDMA gives no winding: its capacity stays the input (default 80 J/K).
+  EXPECT_EQ(load_model("").thermal_network.coil_C_J_per_K, 80.0);
+}

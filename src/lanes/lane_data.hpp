@@ -76,6 +76,7 @@ inline constexpr std::size_t kPad = 8;
   X(kMomMass, rc.momentum_mass_kg)                                                       \
   X(kDampOsc, rc.damping_osc_N_s_per_m)                                                  \
   X(kFixedCompl, rc.fixed_compliance_m_per_N)                                            \
+  X(kJointCompl, rc.joint_compliance_m_per_N)                                            \
   X(kSigmaP, rc.sigma_p_Pa)                                                              \
   X(kCoilTurns, br.coil_turns)                                                           \
   X(kPmMmf, br.pm_mmf_At)                                                                \
@@ -234,6 +235,7 @@ enum LawProbeIn : int {
   kPiPrestressY,
   kPiPrestressE,
   kPiFixedCompliance,
+  kPiJointCompliance,
   kPiK0,
   kPiMass,
   kPiInvMass,

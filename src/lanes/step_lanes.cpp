@@ -34,10 +34,10 @@ HWY_INLINE void mechanics(const Chunk<D>& c, RodStates<D>& s, V<D> h, V<D> t1, F
     const laws::DeltaETermsT<N> dE{c.rod(kInvEs, i), c.rod(kRot, i), c.rod(kCoupling, i),
                                    c.rod(kMu0Ms2, i), c.rod(kSdE, i)};
     laws::ExpPointT<N> prestress{s.f[kPrestressY][i], s.f[kPrestressE][i]};
-    const laws::RodMechanicsT<N> k =
-        laws::rod_mechanics<N>(s.f[kM][i], c.rod(kInvMsTE, i), dE, c.rod(kInvMsStrain, i), lambda_s,
-                               c.rod(kSigmaP, i), c.rod(kFourSpOverLs, i), c.rod(kArea, i),
-                               c.rod(kAreaOverLength, i), c.rod(kLengthPerArea, i), prestress);
+    const laws::RodMechanicsT<N> k = laws::rod_mechanics<N>(
+        s.f[kM][i], c.rod(kInvMsTE, i), dE, c.rod(kInvMsStrain, i), lambda_s, c.rod(kSigmaP, i),
+        c.rod(kFourSpOverLs, i), c.rod(kArea, i), c.rod(kAreaOverLength, i),
+        c.rod(kLengthPerArea, i), c.rod(kJointCompl, i), prestress);
     s.f[kPrestressY][i] = prestress.y.v;
     s.f[kPrestressE][i] = prestress.e.v;
     s.f[kE][i] = k.E_Pa.v;
@@ -273,10 +273,10 @@ void MechanicsLaws(const double* in, double* out, std::size_t n) {
     const laws::DeltaETermsT<N> dE{at(kPiInvEs), at(kPiRot), at(kPiCoupling), at(kPiMu0Ms2),
                                    at(kPiS)};
     laws::ExpPointT<N> prestress{at(kPiPrestressY), at(kPiPrestressE)};
-    const laws::RodMechanicsT<N> k =
-        laws::rod_mechanics<N>(at(kPiM), at(kPiInvMsTE), dE, at(kPiInvMsStrain), at(kPiLambdaS),
-                               at(kPiSigmaP), N(4.0) * at(kPiSigmaP) / at(kPiLambdaS), at(kPiArea),
-                               at(kPiAreaOverLength), at(kPiLengthOverArea), prestress);
+    const laws::RodMechanicsT<N> k = laws::rod_mechanics<N>(
+        at(kPiM), at(kPiInvMsTE), dE, at(kPiInvMsStrain), at(kPiLambdaS), at(kPiSigmaP),
+        N(4.0) * at(kPiSigmaP) / at(kPiLambdaS), at(kPiArea), at(kPiAreaOverLength),
+        at(kPiLengthOverArea), at(kPiJointCompliance), prestress);
     const N compliance[1] = {k.compliance_m_per_N};
     const int self[1] = {0};
     const N k_load = laws::chain_stiffness<N>(at(kPiFixedCompliance), compliance, self, 1);

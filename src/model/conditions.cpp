@@ -160,6 +160,10 @@ void rod_material(const Model& m, const RodModel& rod, const Conditions& c, cons
   rc.series_reluctance_per_H = m.options.magnetic_state == MagneticState::Consistent
                                    ? joint_reluctance(rod.joint_gap_m, rc.area_m2)
                                    : 0.0;
+  rc.joint_compliance_m_per_N =
+      m.options.joint_mechanics == JointMechanics::Bonded
+          ? joint_compliance(rod.joint_gap_m, rod.joint_modulus_Pa, rc.area_m2)
+          : 0.0;
 }
 
 // Eq. (24)-(28): rod i's oscillator mass, damping and the fixed part of its load compliance,

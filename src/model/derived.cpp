@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <numbers>
+#include <optional>
 
 namespace gmasim {
 
@@ -16,24 +17,49 @@ double value_or(const ModelSpec& spec, const std::string& name, double fallback)
   return it == spec.params.end() ? fallback : it->second.value;
 }
 
-// The winding's resistance at T_ref, when its wire diameter and mean turn length are given.
-void coil_resistance(const ModelSpec& spec, std::vector<DerivedQuantity>& out) {
-  const auto R = spec.params.find("thermal_network.coil_resistance_ohm");
+// The winding of every branch that carries a coil (in series: one current), when its wire
+// diameter and mean turn length are given: N, l_turn and the wire's section.
+struct Winding {
+  double turns = 0, turn_length_m = 0, wire_area_m2 = 0;
+};
+std::optional<Winding> winding(const ModelSpec& spec) {
   const double d = value_or(spec, "thermal_network.coil_wire_diameter_m", 0.0);
   const double l = value_or(spec, "thermal_network.coil_mean_turn_length_m", 0.0);
-  const double rho = value_or(spec, "thermal_network.coil_resistivity_ohm_m", 0.0);
-  if (R == spec.params.end() || !(d > 0) || !(l > 0) || !(rho > 0)) return;
+  if (!(d > 0) || !(l > 0)) return std::nullopt;
   double turns = 0.0;
   for (const auto& [name, pv] : spec.params)
     if (name.starts_with("circuit.branches.") && name.ends_with(".coil_turns")) turns += pv.value;
-  if (!(turns > 0)) return;
-  const double area = std::numbers::pi * d * d / 4.0;
-  out.push_back({R->first, rho * turns * l / area,
-                 fmt::format("thermal_network.coil_resistivity_ohm_m {:g} ohm m x {:g} turns x "
-                             "coil_mean_turn_length_m {:g} m / (pi coil_wire_diameter_m^2 / 4) "
-                             "{:.4g} m^2",
-                             rho, turns, l, area),
-                 overridden(R->second), R->second.value});
+  if (!(turns > 0)) return std::nullopt;
+  return Winding{turns, l, std::numbers::pi * d * d / 4.0};
+}
+
+void push(std::vector<DerivedQuantity>& out, const std::pair<const std::string, ParamValue>& p,
+          double derived, std::string formula) {
+  out.push_back({p.first, derived, std::move(formula), overridden(p.second), p.second.value});
+}
+
+// The winding's resistance at T_ref and the coil node's heat capacity (its copper's mass x
+// specific heat), when the winding is given.
+void coil_quantities(const ModelSpec& spec, std::vector<DerivedQuantity>& out) {
+  const std::optional<Winding> w = winding(spec);
+  if (!w) return;
+  const double copper_m3 = w->turns * w->turn_length_m * w->wire_area_m2;
+  const auto R = spec.params.find("thermal_network.coil_resistance_ohm");
+  const double rho = value_or(spec, "thermal_network.coil_resistivity_ohm_m", 0.0);
+  if (R != spec.params.end() && rho > 0)
+    push(out, *R, rho * w->turns * w->turn_length_m / w->wire_area_m2,
+         fmt::format("thermal_network.coil_resistivity_ohm_m {:g} ohm m x {:g} turns x "
+                     "coil_mean_turn_length_m {:g} m / (pi coil_wire_diameter_m^2 / 4) {:.4g} m^2",
+                     rho, w->turns, w->turn_length_m, w->wire_area_m2));
+  const auto C = spec.params.find("thermal_network.coil_heat_capacity_J_per_K");
+  const double density = value_or(spec, "thermal_network.coil_density_kg_per_m3", 0.0);
+  const double cp = value_or(spec, "thermal_network.coil_specific_heat_J_per_kg_K", 0.0);
+  if (C != spec.params.end() && density > 0 && cp > 0)
+    push(out, *C, density * copper_m3 * cp,
+         fmt::format("thermal_network.coil_density_kg_per_m3 {:g} kg/m^3 x copper {:.4g} m^3 "
+                     "({:g} turns x {:g} m x {:.4g} m^2) x coil_specific_heat_J_per_kg_K {:g} "
+                     "J/(kg K)",
+                     density, copper_m3, w->turns, w->turn_length_m, w->wire_area_m2, cp));
 }
 
 // Each rod's mass: density x its volume. Keys a spec lacks (a file with problems still being
@@ -66,7 +92,7 @@ void rod_masses(const ModelSpec& spec, std::vector<DerivedQuantity>& out) {
 std::vector<DerivedQuantity> derived_quantities(const ModelSpec& spec) {
   std::vector<DerivedQuantity> out;
   rod_masses(spec, out);
-  coil_resistance(spec, out);
+  coil_quantities(spec, out);
   return out;
 }
 

@@ -73,6 +73,14 @@ constexpr OptionChoice kSensorMountBase[] = {
      "the actuator's output moves the bracket (the probe rides on it); the sensor reads z"},
 };
 
+constexpr OptionChoice kJointMechanics[] = {
+    {"rigid", static_cast<int>(JointMechanics::Rigid),
+     "the joints carry no compliance: the gap is magnetic only (eq. 15-18 as printed)"},
+    {"bonded", static_cast<int>(JointMechanics::Bonded),
+     "each rod's joints are a bond line of thickness joint_gap_m and modulus joint_modulus_Pa, a "
+     "compliance in series with the rod (eq. 17)"},
+};
+
 const OptionDef kOptions[] = {
     {"stress_sign", false, kStressSign, OPTION(stress_sign),
      "the sign convention of the prestress in eq. (3), (6), (13)"},
@@ -98,6 +106,8 @@ const OptionDef kOptions[] = {
      "what moves the sensor mount's bracket (docs/model.md, \"The sensor mount\"); may be "
      "omitted",
      "recoil"},
+    {"joint_mechanics", false, kJointMechanics, OPTION(joint_mechanics),
+     "the mechanics of the rods' joints (docs/model.md, \"The joints\"); may be omitted", "rigid"},
 };
 
 #undef OPTION

@@ -211,6 +211,12 @@ const ParamDef kParams[] = {
      "consistent reading: the equivalent air gap of the rod's joints (between its short rods and "
      "against the magnetizers), a lossless series reluctance g / (mu0 A) in its branch",
      LAND(in_rod, RodModel, joint_gap_m), 0.0, "default: no joints (one solid rod)"},
+    {G::Rod, "joint_modulus_Pa", "Pa", R::Positive,
+     "Young's modulus of the joints' bond line: their compliance joint_gap_m / (E_j A) in series "
+     "with the rod when options.joint_mechanics = bonded (unused when rigid)",
+     LAND(in_rod, RodModel, joint_modulus_Pa), 3.0e9,
+     "default: a cured structural epoxy, ~3 GPa at room temperature (da Silva and Adams, J. "
+     "Adhesion Sci. Technol. 19 (2005) 109; Anasiewicz et al., Materials 15 (2022) 8060)"},
     {G::Rod, "damping_N_s_per_m", "N s/m", R::Positive, "damping c_i, eq. (25)",
      LAND(in_rod, RodModel, damping_N_s_per_m)},
     // [circuit.reluctances_per_H]
@@ -312,8 +318,18 @@ const ParamDef kParams[] = {
      LAND(in_network, ThermalNetworkModel, coil_alpha_per_K), 3.93e-3,
      "default: copper, handbook value"},
     {G::ThermalNetwork, "coil_heat_capacity_J_per_K", "J/K", R::Positive,
-     "heat capacity of the coil node", LAND(in_network, ThermalNetworkModel, coil_C_J_per_K), 80.0,
+     "heat capacity of the coil node; derived from the winding's copper when it is given "
+     "(gmasim/model/derived.hpp)",
+     LAND(in_network, ThermalNetworkModel, coil_C_J_per_K), 80.0,
      "default: estimate, ~0.2 kg of copper x 385 J/(kg K)"},
+    {G::ThermalNetwork, "coil_density_kg_per_m3", "kg/m^3", R::Positive,
+     "density of the winding's conductor (the derived coil heat capacity)",
+     LAND(in_network, ThermalNetworkModel, coil_density_kg_per_m3), 8890.0,
+     "default: annealed copper, 8890 kg/m^3 (IEC 60028)"},
+    {G::ThermalNetwork, "coil_specific_heat_J_per_kg_K", "J/(kg K)", R::Positive,
+     "specific heat of the winding's conductor (the derived coil heat capacity)",
+     LAND(in_network, ThermalNetworkModel, coil_specific_heat_J_per_kg_K), 385.0,
+     "default: copper at 20 degC, 385 J/(kg K) (handbook value)"},
     {G::ThermalNetwork, "rod_specific_heat_J_per_kg_K", "J/(kg K)", R::Positive,
      "specific heat of Terfenol-D; times the rods' mass, the rods node's heat capacity",
      LAND(in_network, ThermalNetworkModel, rod_specific_heat_J_per_kg_K), 350.0,

@@ -24,7 +24,7 @@ ok "saved line names the key it replaced" grep -Eq '^prestress_MPa = 12.0  # set
 check "template force via --set, stale comment dropped" 0 "wrote" \
   "$B" model save --model "$M/single_rod.toml" --set preload.force_N=600 --out "$T/f600.toml"
 ok "no stale comment" grep -q '^force_N = 600.0  # set: gmasim model save --set; was prestress_MPa = 6.4$' "$T/f600.toml"
-check "the printed-reading twin" 0 "OK \(64 parameters, 1 rods" "$B" model check "$M/single_rod_printed.toml"
+check "the printed-reading twin" 0 "OK \(67 parameters, 1 rods" "$B" model check "$M/single_rod_printed.toml"
 
 # --- the template's drive: a 0-6 A intent with the default -3 A minimum crosses 0 A --------
 check "zero-crossing drive warned" 0 "warning: the drive -3 \.\. 3 A crosses 0 A .*no bias magnet.*--current-min defaults to -3 A" \

@@ -98,11 +98,11 @@ check "simulate --freeze" 0 "stroke" "$B" simulate --periods 2 --temperature 70 
 grep -q '"frozen": \["mu_G", "E_t"\]' "$T/fz/metrics.json" && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: frozen in metrics.json"; }
 check "unknown law to freeze" 2 "unknown law 'mu' to freeze; known: mu_G, rho_G, M, E_G, E_t, F_pm, geometry" "$B" simulate --freeze mu --out "$T/fz2"
 check "progress eta" 0 "simulate: 100000/100000 \(100 %\), .* s elapsed, ETA" "$B" simulate --periods 10 --progress --out "$T/prog"
-check "single-rod template" 0 "OK \(64 parameters, 1 rods" "$B" model check "$(dirname "$0")/../../models/single_rod.toml"
-check "single-rod Preisach template" 0 "OK \(64 parameters, 1 rods" "$B" model check "$(dirname "$0")/../../models/single_rod_preisach.toml"
+check "single-rod template" 0 "OK \(67 parameters, 1 rods" "$B" model check "$(dirname "$0")/../../models/single_rod.toml"
+check "single-rod Preisach template" 0 "OK \(67 parameters, 1 rods" "$B" model check "$(dirname "$0")/../../models/single_rod_preisach.toml"
 # Shipped models by their bare name, and the list of them (issue 41).
 check "model list" 0 "single_rod_preisach +single rod \(Preisach\)" "$B" model list
-check "bare model name" 0 "OK \(64 parameters, 1 rods" "$B" model check single_rod_preisach
+check "bare model name" 0 "OK \(67 parameters, 1 rods" "$B" model check single_rod_preisach
 check "bare --model name" 0 "stroke" "$B" simulate --model single_rod --current-min 0 --periods 1 --out "$T/bare"
 check "help has units" 0 "Operating temperature \[degC\]" "$B" simulate --help
 echo "$pass passed, $fail failed"

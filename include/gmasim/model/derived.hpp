@@ -8,6 +8,9 @@
 //   thermal_network.coil_resistance_ohm = coil_resistivity_ohm_m x N x coil_mean_turn_length_m
 //       / (pi coil_wire_diameter_m^2 / 4), N the turns of every branch that carries a coil (in
 //       series: one current), when the winding's wire diameter and mean turn length are given
+//   thermal_network.coil_heat_capacity_J_per_K = coil_density_kg_per_m3 x N x
+//       coil_mean_turn_length_m x (pi coil_wire_diameter_m^2 / 4) x coil_specific_heat_J_per_kg_K
+//       (the winding's copper), under the same condition
 #pragma once
 
 #include <string>

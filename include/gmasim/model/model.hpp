@@ -52,6 +52,12 @@ enum class EddyLaw { Table4, Classical };
 //           bracket's spring and the sensor reads the probe, y = z: base excitation, the
 //           resonance and no antiresonance (issue 37's mount reading).
 enum class SensorMountBase { Recoil, Output };
+// The mechanics of the rods' joints (docs/model.md, "The joints"), each of thickness joint_gap_m:
+//   Rigid:  the joints carry no compliance (eq. 15-18 as printed: the gap is magnetic only);
+//   Bonded: each joint is a bond line of modulus joint_modulus_Pa, a compliance
+//           g / (E_j A) in series with the rod's own l / (E A) (eq. 17): the rod's free stroke
+//           lambda l holds, its stiffness and blocked force fall by 1 / (1 + k_rod g / (E_j A)).
+enum class JointMechanics { Rigid, Bonded };
 
 // Parsed once, by the loader or ModelSpec::set_options, from the words of the option table
 // (gmasim/model/parameters.hpp). The defaults are the built-in model's readings (a test holds them
@@ -68,6 +74,7 @@ struct Options {
   MagnetisationLaw magnetisation_law = MagnetisationLaw::JilesAtherton;
   EddyLaw eddy_law = EddyLaw::Table4;
   SensorMountBase sensor_mount_base = SensorMountBase::Recoil;
+  JointMechanics joint_mechanics = JointMechanics::Rigid;
   bool operator==(const Options&) const = default;
 };
 
@@ -205,6 +212,7 @@ struct RodModel {
   double length_m, outer_diameter_m, inner_diameter_m, mass_kg;  // at T_ref
   double k_f, k_j;               // eq. (7) flux-leakage and eddy-current factors
   double joint_gap_m;            // consistent reading: equivalent air gap of the rod's joints
+  double joint_modulus_Pa;       // their bond's modulus (options.joint_mechanics = bonded)
   double damping_N_s_per_m;      // c_i of eq. (25)
   JaReference ja;                // the Jiles-Atherton law's constants (options.magnetisation_law)
   PreisachReference preisach{};  // the Preisach law's
@@ -250,6 +258,7 @@ struct ThermalNetworkModel {
   // The winding, for the derived resistance (gmasim/model/derived.hpp); 0: not given.
   double coil_wire_diameter_m = 0, coil_mean_turn_length_m = 0, coil_resistivity_ohm_m = 0;
   double coil_C_J_per_K = 0, rods_C_J_per_K = 0, housing_C_J_per_K = 0;  // heat capacities
+  double coil_density_kg_per_m3 = 0, coil_specific_heat_J_per_kg_K = 0;  // the derived coil_C
   double rod_specific_heat_J_per_kg_K = 0;  // rods_C_J_per_K = this x the rods' mass (compile)
   double G_coil_rods_W_per_K = 0, G_coil_housing_W_per_K = 0, G_rods_housing_W_per_K = 0,
          G_housing_ambient_W_per_K = 0;  // thermal conductances
@@ -329,6 +338,9 @@ struct RodConditions {
   // Terfenol-D, g / (mu0 A^T) (physics::joint_reluctance; docs/model.md, "The magnetic
   // state"). 0 in the printed reading.
   double series_reluctance_per_H;
+  // The joints' compliance g / (E_j A^T) in series with the rod (options.joint_mechanics =
+  // bonded; physics::joint_compliance); 0 for rigid joints.
+  double joint_compliance_m_per_N;
   double mass_osc_kg;               // eq. (24) + (27)
   double momentum_mass_kg;          // m/2 + m_lr (eq. 27): the stack's momentum per unit x
   double damping_osc_N_s_per_m;     // eq. (25) + (28)

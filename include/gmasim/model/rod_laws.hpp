@@ -46,7 +46,7 @@ inline double update_rod_mechanics(const Material& mat, const RodConditions& rc,
   const physics::RodMechanics k = physics::rod_mechanics(
       r.M_A_per_m, rc.inv_MsT_E_m_per_A, rc.dE, rc.inv_Ms_strain_m_per_A, mat.lambda_s,
       rc.sigma_p_Pa, rc.four_sigma_p_over_lambda_s_Pa, rc.area_m2, rc.area_over_length_m,
-      rc.length_over_area_per_m, r.prestress_exp);
+      rc.length_over_area_per_m, rc.joint_compliance_m_per_N, r.prestress_exp);
   r.E_Pa = k.E_Pa;
   r.lambda = k.lambda;
   r.F_N = k.F_N;

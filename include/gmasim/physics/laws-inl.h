@@ -338,25 +338,29 @@ GMASIM_LAW_INLINE T rod_force(T lambda, T E_Pa, T area_m2) {
 // axial stiffness E A / l and the compliance 1/k_rod = (1/E)(l / A) the load chains sum
 // (eq. 18). four_sp_over_ls = 4 sigma_p / lambda_s (magnetostriction_near). inv_MsT_E = 1/M_s^T of
 // eq. (13), inv_Ms_strain = 1/M_s of eq. (11).
+// joint_compliance_m_per_N = c_j, the rod's bonded joints in series with it (options.
+// joint_mechanics; 0: rigid, and every result is eq. 14 and 17's bit for bit): the rod and its
+// joints are one element of free stroke lambda l, compliance l / (E A) + c_j, so its stiffness
+// and its blocked force are eq. (17)'s and eq. (14)'s times s = 1 / (1 + k_rod c_j).
 template <class T>
 struct RodMechanicsT {
   T E_Pa, lambda, F_N, k_rod_N_per_m, compliance_m_per_N;
 };
 template <class T>
-GMASIM_LAW_INLINE RodMechanicsT<T> rod_mechanics(T M_A_per_m, T inv_MsT_E,
-                                                 const DeltaETermsT<T>& dE, T inv_Ms_strain,
-                                                 T lambda_s, T sigma_p_Pa, T four_sp_over_ls,
-                                                 T area_m2, T area_over_length_m,
-                                                 T length_over_area_per_m,
-                                                 ExpPointT<T>& prestress) {
+GMASIM_LAW_INLINE RodMechanicsT<T> rod_mechanics(
+    T M_A_per_m, T inv_MsT_E, const DeltaETermsT<T>& dE, T inv_Ms_strain, T lambda_s, T sigma_p_Pa,
+    T four_sp_over_ls, T area_m2, T area_over_length_m, T length_over_area_per_m,
+    T joint_compliance_m_per_N, ExpPointT<T>& prestress) {
   const T inv_E = delta_e_compliance(M_A_per_m * inv_MsT_E, dE);
   RodMechanicsT<T> r;
   r.E_Pa = 1.0 / inv_E;  // eq. (13)
   r.lambda = magnetostriction_near(M_A_per_m * inv_Ms_strain, lambda_s, sigma_p_Pa, four_sp_over_ls,
                                    r.E_Pa, inv_E, prestress);  // eq. (11)-(12)
-  r.F_N = rod_force(r.lambda, r.E_Pa, area_m2);                // eq. (14)
-  r.k_rod_N_per_m = r.E_Pa * area_over_length_m;               // eq. (17): E A / l
-  r.compliance_m_per_N = inv_E * length_over_area_per_m;
+  const T k_rod = r.E_Pa * area_over_length_m;                 // eq. (17): E A / l
+  const T s = 1.0 / (1.0 + k_rod * joint_compliance_m_per_N);  // the joints' share (1 if rigid)
+  r.F_N = rod_force(r.lambda, r.E_Pa, area_m2) * s;            // eq. (14)
+  r.k_rod_N_per_m = k_rod * s;
+  r.compliance_m_per_N = inv_E * length_over_area_per_m + joint_compliance_m_per_N;
   return r;
 }
 

@@ -17,6 +17,13 @@ inline double axial_stiffness(double E_Pa, double area_m2, double length_m) {
   return E_Pa * area_m2 / length_m;
 }
 
+// Not in the paper (issue 37's joint reading, docs/model.md "The joints"): the compliance of a
+// rod's bonded joints, a bond line of total thickness g and modulus E_j over the rod's section
+// A, in series with the rod's l / (E A) [m/N].  c_j = g / (E_j A).
+inline double joint_compliance(double gap_m, double modulus_Pa, double area_m2) {
+  return gap_m / (modulus_Pa * area_m2);
+}
+
 // Eq. (18) and eq. (28): springs or dampers in series: (sum 1/k_i)^-1.
 inline double series_combination(std::span<const double> values) {
   double s = 0.0;
