@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <numbers>
 #include <string>
 
@@ -11,6 +13,7 @@
 #include "gmasim/model/derived.hpp"
 #include "gmasim/model/model.hpp"
 #include "gmasim/model/validity.hpp"
+#include "gmasim/physics/magnetic.hpp"
 
 using namespace gmasim;
 
@@ -150,4 +153,89 @@ TEST(Derived, CoilHeatCapacityIsTheWindingsCopper) {
   EXPECT_TRUE(has_warning_about(given, "coil_heat_capacity_J_per_K"));  // 60 vs 38.7: > 10 %
   // The MDMA gives no winding: its capacity stays the input (default 80 J/K).
   EXPECT_EQ(load_model("").thermal_network.coil_C_J_per_K, 80.0);
+}
+
+namespace {
+
+// models/single_rod.toml with its leakage reluctance given by a geometry instead of a number:
+// an air path of 20 mm over 3.183e-4 m^2 (R = l / (mu0 A) = 5.0e7 /H, the template's R_leak).
+std::string single_rod_with_leak_geometry(const std::string& leak_table) {
+  std::ifstream in(template_path("single_rod.toml"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string leak = "R_leak = 5.0e7";
+  const auto at = text.find(leak);
+  EXPECT_NE(at, std::string::npos);
+  text.erase(at, text.find('\n', at) - at + 1);  // the number goes; the geometry derives it
+  const auto branches = text.find("[[circuit.branches]]");
+  text.insert(branches, leak_table + "\n");
+  return text;
+}
+
+const char* kLeakGeometry =
+    "[circuit.reluctance_geometry.R_leak]  # the air around the rod\n"
+    "length_m = 0.02  # test\n"
+    "area_m2 = 3.183098861837907e-4  # test: 0.02 / (mu0 x 5e7 x 3.1831e-4) = 1\n"
+    "relative_permeability = 1.0  # air\n";
+
+}  // namespace
+
+// A fixed reluctance by its geometry: derived as l / (mu0 mu_r A), in the branch that names it,
+// followed by a --set of its length, an explicit value kept as an override, and saved as geometry.
+TEST(Derived, AReluctanceFollowsItsGeometry) {
+  const std::string text = single_rod_with_leak_geometry(kLeakGeometry);
+  const ModelSpec spec = parse_model_spec(text, "leak_geometry.toml");
+  const double by_hand = 0.02 / (physics::kMu0 * 1.0 * 3.183098861837907e-4);  // CODATA mu0
+  EXPECT_NEAR(by_hand / 5.0e7, 1.0, 1e-9);  // the template's R_leak (CODATA mu0 vs 4 pi 1e-7)
+  EXPECT_DOUBLE_EQ(spec.params.at("circuit.reluctances_per_H.R_leak").value, by_hand);
+  EXPECT_TRUE(
+      spec.params.at("circuit.reluctances_per_H.R_leak")
+          .provenance.starts_with("derived: circuit.reluctance_geometry.R_leak.length_m 0.02 m"));
+  const Model m = compile(spec);
+  const Model original = load_model(template_path("single_rod.toml"));
+  for (std::size_t b = 0; b < m.circuit.branches.size(); ++b)
+    EXPECT_NEAR(m.circuit.branches[b].fixed_reluctance_per_H,
+                original.circuit.branches[b].fixed_reluctance_per_H,
+                1e-9 * original.circuit.branches[b].fixed_reluctance_per_H + 1e-12);
+  // A longer path: the reluctance follows, and with it the compiled branch.
+  const Model longer =
+      compile(apply_assignments(spec, {"circuit.reluctance_geometry.R_leak.length_m=0.05"}));
+  EXPECT_DOUBLE_EQ(longer.circuit.branches[2].fixed_reluctance_per_H, 2.5 * by_hand);
+  // A value given beside the geometry overrides it and is warned about beyond 10 %.
+  const Model given = compile(apply_assignments(spec, {"circuit.reluctances_per_H.R_leak=8e7"}));
+  EXPECT_EQ(given.circuit.branches[2].fixed_reluctance_per_H, 8e7);
+  EXPECT_TRUE(has_warning_about(given, "circuit.reluctances_per_H.R_leak"));
+  // Saved after a --set of the length: the geometry is written, the reluctance derived again.
+  const std::string saved = model_toml(
+      apply_assignments(spec, {"circuit.reluctance_geometry.R_leak.length_m=0.05"}), "test");
+  EXPECT_EQ(saved.find("R_leak ="), std::string::npos);
+  EXPECT_DOUBLE_EQ(
+      compile(parse_model_spec(saved, "saved")).circuit.branches[2].fixed_reluctance_per_H,
+      2.5 * by_hand);
+}
+
+// A bad or missing geometry is reported at its own line, naming the key and the rule.
+TEST(Derived, ABadReluctanceGeometryIsReportedAtItsLine) {
+  const auto message = [](const std::string& table) {
+    try {
+      (void)parse_model_spec(single_rod_with_leak_geometry(table), "leak_geometry.toml");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string negative = message(
+      "[circuit.reluctance_geometry.R_leak]\nlength_m = -0.02\narea_m2 = 3e-4\n"
+      "relative_permeability = 1.0\n");
+  EXPECT_NE(negative.find("circuit.reluctance_geometry.R_leak.length_m = -0.02 m: must be > 0"),
+            std::string::npos)
+      << negative;
+  EXPECT_NE(negative.find("leak_geometry.toml:"), std::string::npos) << negative;
+  EXPECT_EQ(negative.find("reluctances_per_H"), std::string::npos) << negative;
+  const std::string missing =
+      message("[circuit.reluctance_geometry.R_leak]\nlength_m = 0.02\narea_m2 = 3e-4\n");
+  EXPECT_NE(missing.find("relative_permeability"), std::string::npos) << missing;
+  const std::string unknown = message(
+      "[circuit.reluctance_geometry.R_leak]\nlength_m = 0.02\narea_m2 = 3e-4\n"
+      "relative_permeability = 1.0\nmu = 2\n");
+  EXPECT_NE(unknown.find("mu"), std::string::npos) << unknown;
 }

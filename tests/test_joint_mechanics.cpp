@@ -101,7 +101,7 @@ TEST(JointMechanics, MechanicalLedgerCloses) {
   }
   const EnergyBalance e = energy_balance(a, energy_snapshot(m, c, s));
   EXPECT_LT(e.mechanical_residual_rel, 1e-8);  // observed 1.3e-9
-  EXPECT_LT(e.magnetic_residual_rel, 1e-9);  // observed 3.2e-11
+  EXPECT_LT(e.magnetic_residual_rel, 1e-9);    // observed 3.2e-11
   std::printf("bonded joints: ledger residuals mechanical %.3g, magnetic %.3g\n",
               e.mechanical_residual_rel, e.magnetic_residual_rel);
 }

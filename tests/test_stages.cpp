@@ -8,8 +8,8 @@
 #include "gmasim/io.hpp"
 #include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/model.hpp"
-#include "gmasim/simulate.hpp"
 #include "gmasim/model/step_stages.hpp"
+#include "gmasim/simulate.hpp"
 
 using namespace gmasim;
 

@@ -10,6 +10,7 @@
 
 #include "commands.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/experiments/experiments.hpp"
 #include "gmasim/io/io.hpp"
 #include "gmasim/model/parameters.hpp"
 #include "gmasim/model/validity.hpp"
@@ -29,12 +30,28 @@ std::string ranges_text(const Model& m) {
       range_text(validated_range(m)));
 }
 
+// The coil's incremental inductance at T_ref, at 0 A and at the FRF's default bias of 1 A (issue
+// 39 item 1: reported, not used by the step).
+std::string inductance_text(const Model& m) {
+  try {
+    const CoilInductance a = coil_inductance(m, m.T_ref_C, 0.0);
+    const CoilInductance b = coil_inductance(m, m.T_ref_C, 1.0);
+    return fmt::format(
+        "coil: incremental inductance {:.4g} mH at 0 A, {:.4g} mH at 1 A (dPsi/dI on the minor "
+        "loop at the bias, {} degC; reported, not used by the step)",
+        1e3 * a.inductance_H, 1e3 * b.inductance_H, m.T_ref_C);
+  } catch (const DivergenceError& e) {
+    return fmt::format("coil: incremental inductance not computed ({})", e.what());
+  }
+}
+
 int run_show(const ModelArgs& a, bool doc) {
   const ModelSpec spec = load_model_spec_args(a);
   const Model m = compile(spec);  // show only valid models
   print_model_warnings(m);
   fmt::print("# {}\n", model_label(a));
   fmt::print("# temperatures: {}\n", ranges_text(m));
+  fmt::print("# {}\n", inductance_text(m));
   fmt::print("{:<48} {:>14}  {:<10} {}\n", "parameter", "value", "unit",
              doc ? "meaning" : "provenance");
   for (const auto& row : describe_model(m.spec))  // with the derived quantities

@@ -32,6 +32,7 @@ Runner add_reproduce(CLI::App& app);
 Runner add_identify(CLI::App& app);     // cmd_identify.cpp: identify, identify synthesize
 Runner add_sweep(CLI::App& app);        // cmd_sweep.cpp
 Runner add_frf(CLI::App& app);          // cmd_frf.cpp
+Runner add_linearize(CLI::App& app);    // cmd_linearize.cpp
 Runner add_track(CLI::App& app);        // cmd_track.cpp
 Runner add_ablate(CLI::App& app);       // cmd_ablate.cpp
 Runner add_params(CLI::App& app);       // cmd_params.cpp: params-vs-temperature

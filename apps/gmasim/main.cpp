@@ -49,6 +49,7 @@ int main(int argc, char** argv) {
   runners.push_back(gmasim::cli::add_identify(app));
   runners.push_back(gmasim::cli::add_sweep(app));
   runners.push_back(gmasim::cli::add_frf(app));
+  runners.push_back(gmasim::cli::add_linearize(app));
   runners.push_back(gmasim::cli::add_track(app));
   runners.push_back(gmasim::cli::add_ablate(app));
   runners.push_back(gmasim::cli::add_params(app));

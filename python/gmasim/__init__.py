@@ -16,6 +16,7 @@ adds plotting helpers (``gmasim.plots``). Units are SI and named in every key
     y_um = st.step(1.5)
     s = gmasim.sensitivity(m, params=["material.Ms_A_per_m"], claims=["stroke_drop_8A"])
     s["derivative"]   # (quantities x parameters): d claim / d ln parameter
+    sys = gmasim.linearize(m, temperature_C=70)    # scipy.signal.StateSpace, current -> y [m]
 
 Errors: gmasim.InputError (a ValueError: a value out of range, with the rule), TypeError (an
 argument of the wrong type, named), gmasim.DivergenceError (an ArithmeticError: the run
@@ -30,6 +31,7 @@ from ._gmasim import (FREEZE_LAWS, DivergenceError, InputError, Model, Stepper, 
 from ._gmasim import __git_describe__, __version__  # noqa: F401
 from . import plots  # noqa: F401
 from ._sensitivity import fit_parameters, sensitivity  # noqa: F401
+from ._linearize import linearize  # noqa: F401
 from ._arguments import checked as _checked
 from ._results import SimulationResult, as_result as _as_result  # noqa: F401
 
@@ -42,5 +44,5 @@ simulate = _as_result(simulate)
 
 __all__ = ["Model", "Stepper", "simulate", "sweep", "frf", "track", "compensate", "ablate",
            "params_vs_temperature", "parameter_table",
-           "thermal_expansion", "claims", "sensitivity", "fit_parameters", "plots", "InputError",
+           "thermal_expansion", "claims", "sensitivity", "fit_parameters", "linearize", "plots", "InputError",
            "DivergenceError", "FREEZE_LAWS", "SimulationResult"]

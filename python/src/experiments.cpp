@@ -2,7 +2,12 @@
 // CLI writes as CSV) as {"meta": {...}, "<table>": {column: ndarray or list of str}}.
 #include "gmasim/experiments/experiments.hpp"
 
+#include <pybind11/complex.h>
+#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
+
+#include <algorithm>
+#include <complex>
 
 #include "bindings.hpp"
 #include "gmasim/errors.hpp"
@@ -178,6 +183,47 @@ void bind_temperature_laws(py::module_& mod) {
       py::arg("model"), "Eq. (21): the stack's thermal expansion in um/degC");
 }
 
+// _linearize(): the plant as a state space (gmasim.linearize wraps it in a scipy StateSpace).
+py::array matrix(const std::vector<double>& v, int rows, int cols) {
+  py::array_t<double> a({rows, cols});
+  std::copy(v.begin(), v.end(), a.mutable_data());
+  return a;
+}
+py::list complex_list(const std::vector<std::complex<double>>& z) {
+  py::list l;
+  for (const auto& x : z) l.append(py::cast(x));
+  return l;
+}
+void bind_linearize(py::module_& mod) {
+  mod.def(
+      "_linearize",
+      [](const Model& m, double temperature_C, double bias_A) {
+        const StateSpace ss =
+            without_gil([&] { return linearize_plant(m, temperature_C, bias_A); });
+        py::dict d;
+        d["A"] = matrix(ss.A, ss.n_states, ss.n_states);
+        d["B"] = matrix(ss.B, ss.n_states, 1);
+        d["C"] = matrix(ss.C, ss.n_outputs, ss.n_states);
+        d["D"] = matrix(ss.D, ss.n_outputs, 1);
+        d["states"] = ss.states;
+        d["state_units"] = ss.state_units;
+        d["outputs"] = ss.outputs;
+        d["output_units"] = ss.output_units;
+        d["temperature_C"] = ss.temperature_C;
+        d["bias_A"] = ss.bias_A;
+        d["poles"] = complex_list(ss.poles());
+        d["zeros_y"] = complex_list(ss.zeros(0));
+        std::vector<double> dc;
+        for (int k = 0; k < ss.n_outputs; ++k) dc.push_back(ss.dc_gain(k));
+        d["dc_gain"] = dc;
+        return d;
+      },
+      py::arg("model"), py::arg("temperature_C") = 20.0, py::arg("bias_A") = 1.0,
+      "The plant as a state space: {'A', 'B', 'C', 'D', 'states', 'state_units', 'outputs', "
+      "'output_units', 'poles', 'zeros_y', 'dc_gain', ...}; gmasim.linearize returns it as a "
+      "scipy.signal.StateSpace");
+}
+
 // claims(): the whole study scored on the paper's claims.
 void bind_claims(py::module_& mod) {
   mod.def(
@@ -196,6 +242,7 @@ void bind_claims(py::module_& mod) {
 
 void bind_experiments(py::module_& mod) {
   bind_sweep(mod);
+  bind_linearize(mod);
   bind_frf(mod);
   bind_track(mod);
   bind_compensate(mod);

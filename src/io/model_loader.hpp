@@ -66,6 +66,7 @@ class ModelLoader {
   // The numbers of group `g` in table `t` named `table_name`; `extra` are further keys the
   // table may hold (sub-tables, structure), read elsewhere.
   void read_alternative(const toml::table& t, const ParamDef& row, const std::string& table_name);
+  void read_reluctance_geometry(const toml::table& circuit, long line);
   void read_group(const toml::table& t, Group g, const std::string& table_name,
                   const std::vector<std::string>& extra = {});
   // The table of group `g` (its path in parameter_groups(), for `instance`; `parent` holds

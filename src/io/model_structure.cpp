@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <limits>
 #include <set>
 
 #include "io/model_loader.hpp"
@@ -119,23 +120,51 @@ void ModelLoader::read_circuit(const toml::table& root) {
   const auto* t = table_at(root, "circuit", "circuit", 1);
   if (!t) return;
   const long tl = node_line(*t);
-  check_keys(*t, "[circuit]", {"reference_node", "nodes", "reluctances_per_H", "branches"});
+  check_keys(*t, "[circuit]",
+             {"reference_node", "nodes", "reluctances_per_H", "reluctance_geometry", "branches"});
   if (auto s = read_string(*t, "reference_node", "circuit")) {
     spec_.reference_node = *s;
     spec_.option_lines["circuit.reference_node"] = node_line(*t->get("reference_node"));
   }
   read_nodes(*t, tl);
+  read_reluctance_geometry(*t, tl);
   const auto reluctances = read_reluctances(*t, tl);
   read_branches(*t, tl, reluctances);
+}
+
+// [circuit.reluctance_geometry.<name>] (optional): a fixed reluctance by its geometry, each a
+// table of the ReluctanceGeometry rows; the reluctance itself is derived
+// (gmasim/model/derived.hpp).
+void ModelLoader::read_reluctance_geometry(const toml::table& circuit, long line) {
+  if (!circuit.get("reluctance_geometry")) return;
+  const std::string dotted = "circuit.reluctance_geometry";
+  const auto* t = table_at(circuit, "reluctance_geometry", dotted, line);
+  if (!t) return;
+  for (const auto& [name, sub] : named_tables(*t, dotted)) {
+    spec_.reluctance_geometry_names.push_back(name);
+    read_group(*sub, Group::ReluctanceGeometry, dotted + "." + name);
+  }
 }
 
 // [circuit.reluctances_per_H]: free names, each a number of the Reluctance row. The names,
 // or nullopt if the table could not be read.
 std::optional<std::vector<std::string>> ModelLoader::read_reluctances(const toml::table& circuit,
                                                                       long line) {
-  const auto* rt = table_at(circuit, "reluctances_per_H", "circuit.reluctances_per_H", line);
-  if (!rt) return std::nullopt;
+  // A reluctance given only by its geometry: its key, unset (line 0), for the derivation. The
+  // table may then be absent.
+  const auto& by_geometry = spec_.reluctance_geometry_names;
   std::vector<std::string> names;
+  const toml::table empty;
+  const toml::table* rt = &empty;
+  if (circuit.get("reluctances_per_H") || by_geometry.empty())
+    rt = table_at(circuit, "reluctances_per_H", "circuit.reluctances_per_H", line);
+  if (!rt) return std::nullopt;
+  for (const auto& name : by_geometry)
+    if (!rt->get(name)) {
+      names.push_back(name);
+      spec_.params["circuit.reluctances_per_H." + name] =
+          ParamValue{std::numeric_limits<double>::quiet_NaN(), "", 0, false};
+    }
   for (const auto& [key, node] : *rt) {
     const std::string name(key.str());
     if (!valid_name(name)) {

@@ -6,6 +6,8 @@
 #include <numbers>
 #include <optional>
 
+#include "gmasim/physics/magnetic.hpp"
+
 namespace gmasim {
 
 namespace {
@@ -87,12 +89,31 @@ void rod_masses(const ModelSpec& spec, std::vector<DerivedQuantity>& out) {
   }
 }
 
+// Each reluctance of [circuit.reluctance_geometry.<name>]: l / (mu0 mu_r A) (eq. 2's law for a
+// part of constant permeability). Keys a spec lacks skip it (the loader reports them).
+void reluctances(const ModelSpec& spec, std::vector<DerivedQuantity>& out) {
+  for (const auto& name : spec.reluctance_geometry_names) {
+    const std::string g = "circuit.reluctance_geometry." + name + ".";
+    const auto R = spec.params.find("circuit.reluctances_per_H." + name);
+    const auto l = spec.params.find(g + "length_m");
+    const auto A = spec.params.find(g + "area_m2");
+    const auto mu_r = spec.params.find(g + "relative_permeability");
+    if (R == spec.params.end() || l == spec.params.end() || A == spec.params.end() ||
+        mu_r == spec.params.end())
+      continue;
+    push(out, *R, physics::fixed_reluctance(l->second.value, mu_r->second.value, A->second.value),
+         fmt::format("{}length_m {:g} m / (mu0 x relative_permeability {:g} x area_m2 {:g} m^2)", g,
+                     l->second.value, mu_r->second.value, A->second.value));
+  }
+}
+
 }  // namespace
 
 std::vector<DerivedQuantity> derived_quantities(const ModelSpec& spec) {
   std::vector<DerivedQuantity> out;
   rod_masses(spec, out);
   coil_quantities(spec, out);
+  reluctances(spec, out);
   return out;
 }
 

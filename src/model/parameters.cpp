@@ -82,6 +82,10 @@ constexpr GroupDef kGroups[] = {
     {G::Rod, "<rod>", TableRule::Required, "One Terfenol-D rod of stack.rods"},
     {G::Reluctance, "circuit.reluctances_per_H", TableRule::Required,
      "Named fixed reluctances; a branch's `series` sums them"},
+    {G::ReluctanceGeometry, "circuit.reluctance_geometry.<name>", TableRule::Required,
+     "A fixed reluctance of [circuit.reluctances_per_H] given by its geometry: the reluctance "
+     "circuit.reluctances_per_H.<name> = l / (mu0 mu_r A) is derived from it "
+     "(gmasim/model/derived.hpp)"},
     {G::Branch, "circuit.branches.<name>", TableRule::KeysOptional,
      "The sources of a branch of [[circuit.branches]] (absent: 0)"},
     {G::Element, "mechanics.elements.<name>", TableRule::Required,
@@ -223,6 +227,16 @@ const ParamDef kParams[] = {
     {G::Reluctance, "*", "1/H", R::Positive,
      "a fixed reluctance of Table 1 (any name); summed over a branch's series, eq. (23)", nullptr,
      "CircuitBranch::fixed_reluctance_per_H (the sum over `series`)"},
+    // [circuit.reluctance_geometry.<name>]: inputs of a derived reluctance (not landed)
+    {G::ReluctanceGeometry, "length_m", "m", R::Positive,
+     "the flux path's length l through the part", nullptr,
+     "derives circuit.reluctances_per_H.<name> = l / (mu0 mu_r A)"},
+    {G::ReluctanceGeometry, "area_m2", "m^2", R::Positive, "the flux path's cross-section A",
+     nullptr, "derives circuit.reluctances_per_H.<name> = l / (mu0 mu_r A)"},
+    {G::ReluctanceGeometry, "relative_permeability", "-", R::Positive,
+     "the part's relative permeability mu_r (1 for air, epoxy and the magnets' recoil ~1.05; "
+     "a steel's at its working flux)",
+     nullptr, "derives circuit.reluctances_per_H.<name> = l / (mu0 mu_r A)"},
     // [[circuit.branches]]
     {G::Branch, "coil_turns", "turns", R::NonNegative,
      "turns N of the coil in the branch: MMF N I, eq. (22)-(23)",

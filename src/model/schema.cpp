@@ -70,6 +70,8 @@ std::vector<std::string> group_instances(const ModelSpec& spec, Group g) {
     }
     case Group::Reluctance:
       return {};
+    case Group::ReluctanceGeometry:
+      return spec.reluctance_geometry_names;
     case Group::SensorMount: {  // present when the spec holds any of its numbers
       const std::string prefix = table_path(Group::SensorMount, "") + ".";
       const auto it = spec.params.lower_bound(prefix);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "gmasim/mechanics/mechanics.hpp"
+#include "gmasim/mechanics/state_space.hpp"
 #include "gmasim/model/model.hpp"
 #include "gmasim/simulate/simulate.hpp"
 
@@ -102,6 +103,21 @@ struct FrfRequest {
 // Settles the actuator at a DC bias current (make_state, then `bias_state`, then DC steps
 // until H, M and x are at rest). Returns the state; throws DivergenceError.
 State settle_at_bias(const Model& m, const Conditions& c, double bias_A, BiasState bias_state);
+
+// The coil's incremental inductance at a DC bias (issue 39 item 1; src/experiments/
+// inductance.cpp): L = dPsi/dI, Psi = sum_b N_b phi_b the coil's flux linkage, on the minor loop
+// at the bias -- from the anhysteretic state there (settle_at_bias), the current steps to bias
+// +- delta_A (and +- 2 delta_A) and is held until the eddy lag has died out; central differences,
+// Richardson-combined. Reported (gmasim
+// model show), not used by the step. Throws DivergenceError, InputError (delta_A <= 0).
+struct CoilInductance {
+  double temperature_C = 0, bias_A = 0, delta_A = 0;
+  double inductance_H = 0;   // dPsi/dI [H], 2 L(delta) - L(2 delta) (Richardson)
+  double first_order_H = 0;  // the plain central difference over +-delta [H]
+  double linkage_Wb = 0;     // Psi at the bias [Wb-turns]
+};
+CoilInductance coil_inductance(const Model& m, double temperature_C, double bias_A,
+                               double delta_A = 1e-5);
 
 struct FrfCurve {
   double temperature_C = 0;
@@ -418,5 +434,12 @@ Report ablate_report(const Model& m, const AblateRequest& req, const AblateResul
 Report params_report(const Model& m, const ParamsVsTemperatureRequest& req,
                      const ParamsVsTemperatureResult& res);
 Report thermal_report(const Model& m, const ThermalExpansionResult& res);
+
+// gmasim linearize (src/experiments/linearize.cpp): the plant settled at the bias
+// (settle_at_bias, anhysteretic), linearised (linearise) and written as a state space
+// (gmasim/mechanics/state_space.hpp); its report: the states with their units, A, B, C, D, the
+// poles and the zeros of y.
+StateSpace linearize_plant(const Model& m, double temperature_C, double bias_A);
+Report linearize_report(const Model& m, const StateSpace& ss);
 
 }  // namespace gmasim

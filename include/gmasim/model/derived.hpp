@@ -11,6 +11,8 @@
 //   thermal_network.coil_heat_capacity_J_per_K = coil_density_kg_per_m3 x N x
 //       coil_mean_turn_length_m x (pi coil_wire_diameter_m^2 / 4) x coil_specific_heat_J_per_kg_K
 //       (the winding's copper), under the same condition
+//   circuit.reluctances_per_H.<name> = length_m / (mu0 relative_permeability area_m2) of
+//       [circuit.reluctance_geometry.<name>], for each such table
 #pragma once
 
 #include <string>

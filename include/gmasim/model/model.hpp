@@ -115,6 +115,7 @@ struct ModelSpec {
   std::vector<std::string> flux_sensor_branches;           // sensor.flux_branches
   std::vector<std::string> element_names;                  // mechanics.elements.*
   std::vector<std::string> sleeve_names;                   // mechanics.sleeves.*
+  std::vector<std::string> reluctance_geometry_names;      // circuit.reluctance_geometry.*
   std::map<std::string, std::vector<std::string>> chains;  // rod -> load chain (eq. 18/27/28)
   // [calibration] fitted_claims: the claims this model was fitted to (gmasim identify writes
   // them); gmasim reproduce counts the other claims as predictions.

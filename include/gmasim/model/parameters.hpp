@@ -45,22 +45,23 @@ std::string rule_message(Rule r);       // "must be > 0", "must be in [0, 1)", .
 
 // The tables of a model file that hold numbers.
 enum class Group {
-  Reference,         // [reference]
-  Material,          // [material]: Terfenol-D, shared by the rods
-  Preload,           // [preload]
-  Magnet,            // [magnet] (optional, every key defaulted)
-  Rod,               // [<rod>] for each rod of stack.rods
-  RodJa,             // [<rod>.ja] (the Jiles-Atherton law)
-  RodPreisach,       // [<rod>.preisach] (the Preisach law)
-  Element,           // [mechanics.elements.<name>]
-  SensorMount,       // [mechanics.sensor_mount] (optional)
-  SleeveModulus,     // [mechanics.sleeve_modulus] (optional, every key defaulted)
-  Sleeve,            // [mechanics.sleeves.<name>]
-  Branch,            // [[circuit.branches]] (numbers optional, absent = 0)
-  Reluctance,        // [circuit.reluctances_per_H] (free names)
-  ThermalExpansion,  // [thermal_expansion] (optional, every key defaulted)
-  ThermalNetwork,    // [thermal_network] (optional, every key defaulted)
-  Validity           // [validity] (optional, every key defaulted)
+  Reference,           // [reference]
+  Material,            // [material]: Terfenol-D, shared by the rods
+  Preload,             // [preload]
+  Magnet,              // [magnet] (optional, every key defaulted)
+  Rod,                 // [<rod>] for each rod of stack.rods
+  RodJa,               // [<rod>.ja] (the Jiles-Atherton law)
+  RodPreisach,         // [<rod>.preisach] (the Preisach law)
+  Element,             // [mechanics.elements.<name>]
+  SensorMount,         // [mechanics.sensor_mount] (optional)
+  SleeveModulus,       // [mechanics.sleeve_modulus] (optional, every key defaulted)
+  Sleeve,              // [mechanics.sleeves.<name>]
+  Branch,              // [[circuit.branches]] (numbers optional, absent = 0)
+  Reluctance,          // [circuit.reluctances_per_H] (free names)
+  ReluctanceGeometry,  // [circuit.reluctance_geometry.<name>]: derives a fixed reluctance
+  ThermalExpansion,    // [thermal_expansion] (optional, every key defaulted)
+  ThermalNetwork,      // [thermal_network] (optional, every key defaulted)
+  Validity             // [validity] (optional, every key defaulted)
 };
 
 // Whether a group's table must be in the file.

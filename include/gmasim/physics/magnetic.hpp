@@ -105,6 +105,12 @@ inline double static_field(double phi_Wb, double k_f, double mu_H_per_m, double 
 // printed circuit and has no place here.)
 inline double joint_reluctance(double gap_m, double area_m2) { return gap_m / (kMu0 * area_m2); }
 
+// A part of constant relative permeability mu_r as a fixed reluctance of the netlist (eq. 2's law
+// R = l / (mu A) with mu = mu0 mu_r) [1/H]: [circuit.reluctance_geometry.<name>].
+inline double fixed_reluctance(double length_m, double relative_permeability, double area_m2) {
+  return length_m / (kMu0 * relative_permeability * area_m2);
+}
+
 // Eq. (7), second line: time constant of the first-order eddy-current lag [s].
 //   H(s) = H_c(s) / (1 + tau s),  tau = mu (r1^2 - r2^2) / (4 k_j rho)
 // (the second "k_f" of the printed eq. 7 is Table 4's k_j: READING-NOTES).

@@ -1,0 +1,56 @@
+"""gmasim.linearize (issue 40 item 1): the plant as a scipy.signal.StateSpace, equal to the FRF's
+small-signal curve, and the CLI's MATLAB v5 file read back by scipy.io.loadmat (an independent
+reader of what matio wrote)."""
+import subprocess
+
+import numpy as np
+import pytest
+import scipy.io
+from scipy import signal
+
+import gmasim
+
+
+def test_statespace_is_the_frf_small_signal_curve(mdma):
+    for T in (20.0, 70.0):
+        sys = gmasim.linearize(mdma, temperature_C=T, bias_A=1.0)
+        assert isinstance(sys, signal.StateSpace)
+        assert sys.A.shape == (11, 11) and sys.B.shape == (11, 1) and sys.C.shape == (1, 11)
+        assert sys.states[:3] == ["rod1_H", "rod2_H", "rod3_H"] and sys.state_units[3] == "m"
+        assert sys.outputs == ["y"] and sys.output_units == ["m"]
+        f = np.array([1.0, 100.0, 900.0, 1270.0, 1500.0, 3000.0])
+        r = gmasim.frf(mdma, temperatures_C=[T], f_min_Hz=1.0, f_max_Hz=3000.0, points=2,
+                       stepped_sine=False, peak_refinements=0)
+        fr = r["response"]["frequency_Hz"]
+        # The transfer function by hand, C (jwI - A)^-1 B, against the FRF's small-signal curve
+        # (observed ~1e-15), and scipy's freqresp, which goes through a transfer function's
+        # polynomials (s^11 against poles of 1e5 1/s: it warns BadCoefficients; observed 1.5e-9).
+        def by_hand(fk):
+            return (sys.C @ np.linalg.solve(2j * np.pi * fk * np.eye(11) - sys.A, sys.B))[0, 0]
+        mag = np.abs([by_hand(fk) for fk in fr]) * 1e6
+        assert mag == pytest.approx(r["response"]["linear_mag_um_per_A"], rel=1e-12)
+        with pytest.warns(signal.BadCoefficients):
+            _, hs = signal.freqresp(sys, w=2 * np.pi * f)
+        assert np.abs(hs) == pytest.approx(np.abs([by_hand(fk) for fk in f]), rel=1e-7)
+        assert sys.dc_gain[0] == pytest.approx(-(sys.C @ np.linalg.solve(sys.A, sys.B))[0, 0], rel=1e-12)
+
+
+def test_flux_density_output_and_bad_output(mdma):
+    both = gmasim.linearize(mdma, output="all")
+    assert both.outputs == ["y", "B"] and both.output_units == ["m", "T"]
+    B = gmasim.linearize(mdma, output="B")
+    assert B.C.shape == (1, 11)
+    assert B.dc_gain[0] == pytest.approx(both.dc_gain[1], rel=0)
+    with pytest.raises(gmasim.InputError, match="output must be one of"):
+        gmasim.linearize(mdma, output="z")
+
+
+def test_cli_mat_file_is_the_python_statespace(mdma, gmasim_bin, tmp_path):
+    subprocess.run([gmasim_bin, "linearize", "--temperature", "70", "--bias", "1", "--out",
+                    str(tmp_path)], check=True, capture_output=True)
+    d = scipy.io.loadmat(tmp_path / "linearize.mat")
+    sys = gmasim.linearize(mdma, temperature_C=70, bias_A=1, output="all")
+    for k in "ABCD":
+        assert d[k] == pytest.approx(getattr(sys, k), rel=0, abs=0), k
+    assert d["temperature_C"][0, 0] == 70 and d["bias_A"][0, 0] == 1
+    assert (tmp_path / "linearize_A.csv").read_text().splitlines()[0].startswith("row,unit,rod1_H")

@@ -1,0 +1,70 @@
+// gmasim linearize (gmasim/experiments/experiments.hpp, linearize_plant, linearize_report): the
+// plant at a temperature and bias as a state space, and its report.
+#include <cmath>
+#include <complex>
+
+#include "gmasim/experiments/experiments.hpp"
+
+namespace gmasim {
+namespace {
+
+// A matrix of the state space as a table: one row per row of the matrix, named by its state or
+// output and its unit; one column per state (or the input).
+Table matrix_table(const std::string& name, const std::vector<double>& v,
+                   const std::vector<std::string>& row_names,
+                   const std::vector<std::string>& row_units,
+                   const std::vector<std::string>& col_names) {
+  Table t{name, {"row", "unit"}, {}};
+  t.columns.insert(t.columns.end(), col_names.begin(), col_names.end());
+  const std::size_t cols = col_names.size();
+  for (std::size_t i = 0; i < row_names.size(); ++i) {
+    std::vector<Cell> row{row_names[i], row_units[i]};
+    for (std::size_t j = 0; j < cols; ++j) row.emplace_back(v[i * cols + j]);
+    t.rows.push_back(std::move(row));
+  }
+  return t;
+}
+
+// Eigenvalues as rows: real and imaginary parts [1/s], |s| / 2 pi [Hz] and -Re / |s|.
+Table roots_table(const std::string& name, const std::vector<std::complex<double>>& roots) {
+  Table t{name, {"real_per_s", "imag_per_s", "frequency_Hz", "damping_ratio"}, {}};
+  for (const auto& z : roots) {
+    const double mag = std::abs(z);
+    t.rows.push_back({z.real(), z.imag(), mag / (2.0 * M_PI), mag > 0 ? -z.real() / mag : 1.0});
+  }
+  return t;
+}
+
+}  // namespace
+
+StateSpace linearize_plant(const Model& m, double temperature_C, double bias_A) {
+  const Conditions c = make_conditions(m, temperature_C);
+  return state_space(m, linearise(m, c, settle_at_bias(m, c, bias_A, BiasState::Anhysteretic)));
+}
+
+Report linearize_report(const Model& m, const StateSpace& ss) {
+  Report r;
+  r.experiment = "linearize";
+  r.meta.emplace_back("model", m.spec.source);
+  r.meta.emplace_back("temperature_C", ss.temperature_C);
+  r.meta.emplace_back("bias_A", ss.bias_A);
+  r.meta.emplace_back("states", ss.n_states);
+  r.meta.emplace_back("input", ss.input + " [" + ss.input_unit + "]");
+  r.meta.emplace_back("magnetic_states", ss.magnetic_state);
+  r.meta.emplace_back("dc_gain_y_um_per_A", 1e6 * ss.dc_gain(0));
+  if (ss.n_outputs > 1) r.meta.emplace_back("dc_gain_B_mT_per_A", 1e3 * ss.dc_gain(1));
+  Table states{"states", {"index", "state", "unit"}, {}};
+  for (std::size_t i = 0; i < ss.states.size(); ++i)
+    states.rows.push_back({static_cast<int>(i), ss.states[i], ss.state_units[i]});
+  const std::vector<std::string> input{ss.input};
+  r.tables = {states,
+              matrix_table("A", ss.A, ss.states, ss.state_units, ss.states),
+              matrix_table("B", ss.B, ss.states, ss.state_units, input),
+              matrix_table("C", ss.C, ss.outputs, ss.output_units, ss.states),
+              matrix_table("D", ss.D, ss.outputs, ss.output_units, input),
+              roots_table("poles", ss.poles()),
+              roots_table("zeros", ss.zeros(0))};
+  return r;
+}
+
+}  // namespace gmasim
