@@ -23,4 +23,11 @@ inline const gmasim::Model& mdma_printed() {
   return m;
 }
 
+// The built-in model with one option changed (a reading of docs/model.md), compiled.
+inline gmasim::Model mdma_with_option(const char* key, const char* word) {
+  gmasim::ModelSpec spec = gmasim::builtin_model_spec();
+  spec.set_option(key, word);
+  return gmasim::compile(spec);
+}
+
 }  // namespace gmasim_test

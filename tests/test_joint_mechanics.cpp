@@ -21,11 +21,7 @@ namespace {
 
 using namespace gmasim;
 
-Model bonded() {
-  ModelSpec spec = builtin_model_spec();
-  spec.set_option("options.joint_mechanics", "bonded");
-  return compile(spec);
-}
+Model bonded() { return gmasim_test::mdma_with_option("options.joint_mechanics", "bonded"); }
 
 physics::RodMechanics mechanics_at(double M, double joint_compliance) {
   const physics::DeltaETerms dE{1.0 / 88e9, 1.5e-11, 2e-3, 5e5, 1e5};

@@ -21,9 +21,7 @@ namespace {
 using namespace gmasim;
 
 Model mount_on_output() {
-  ModelSpec spec = builtin_model_spec();
-  spec.set_option("options.sensor_mount_base", "output");
-  return compile(spec);
+  return gmasim_test::mdma_with_option("options.sensor_mount_base", "output");
 }
 
 // The linearisation: Y_sensor = Y_stack (c s + k)/(m s^2 + c s + k), Y_stack the same bias

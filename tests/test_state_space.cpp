@@ -32,12 +32,6 @@ Plant plant(const Model& m, double T_C, double bias_A) {
   return {lin, state_space(m, lin)};
 }
 
-Model with_option(const char* key, const char* word) {
-  ModelSpec spec = builtin_model_spec();
-  spec.set_option(key, word);
-  return compile(spec);
-}
-
 // |ss.response - lin.response| / |lin.response| over 1 Hz - 20 kHz.
 double worst_mismatch(const Plant& p) {
   double worst = 0.0;
@@ -57,7 +51,7 @@ TEST(StateSpace, TransferFunctionIsTheLinearisations) {
   };
   const Case cases[] = {
       {"built-in (consistent, recoil mount)", compile(builtin_model_spec())},
-      {"mount on the output", with_option("options.sensor_mount_base", "output")},
+      {"mount on the output", gmasim_test::mdma_with_option("options.sensor_mount_base", "output")},
       {"printed magnetic state",
        load_model(std::string(GMASIM_SOURCE_DIR) + "/models/mdma_printed.toml")},
   };
