@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <cmath>
 #include <filesystem>
 #include <memory>
 
@@ -17,6 +18,8 @@
 
 namespace gmasim::cli {
 namespace {
+
+constexpr double kLowGainMargin_dB = 6.0, kLowPhaseMargin_deg = 30.0;
 
 struct TrackArgs : ExperimentArgs<TrackRequest> {
   // --feedforward inverse: the evaluation against mismatched plants
@@ -80,6 +83,37 @@ int run_feedforward_cmd(TrackArgs& a, const Model& model) {
   return 0;
 }
 
+// The PID loop's margins at each temperature (pid_loop_margins), flagged below the classic
+// 6 dB / 30 deg, or where the linear closed loop is unstable (a limit cycle or divergence at its
+// dominant pole's frequency).
+void print_margins(const TrackResult& res) {
+  if (res.margins.empty()) return;
+  fmt::print(
+      "  PID loop about the bias (linearised plant, sampled controller; flagged below {} dB "
+      "or {} deg):\n  {:>6} {:>9} {:>9} {:>9} {:>9} {:>14}\n",
+      kLowGainMargin_dB, kLowPhaseMargin_deg, "T degC", "GM dB", "at Hz", "PM deg", "at Hz",
+      "closed loop");
+  for (const auto& k : res.margins) {
+    std::string flag;
+    if (!k.stable)
+      flag = fmt::format("  UNSTABLE: a pole at |z| = {:.4f}, {:.0f} Hz", k.spectral_radius,
+                         k.dominant_Hz);
+    else if (k.gain_margin_dB < kLowGainMargin_dB)
+      flag = fmt::format("  low gain margin: a larger loop gain rings at {:.0f} Hz",
+                         k.phase_crossover_Hz);
+    else if (k.phase_margin_deg < kLowPhaseMargin_deg)
+      flag = fmt::format("  low phase margin: rings near {:.0f} Hz", k.gain_crossover_Hz);
+    auto pair = [](double margin, double f, int decimals) {
+      return std::isfinite(margin) ? fmt::format("{:9.{}f} {:9.0f}", margin, decimals, f)
+                                   : fmt::format("{:>9} {:>9}", "none", "-");
+    };
+    fmt::print("  {:6.1f} {} {} {:>14}{}\n", k.temperature_C,
+               pair(k.gain_margin_dB, k.phase_crossover_Hz, 2),
+               pair(k.phase_margin_deg, k.gain_crossover_Hz, 1),
+               fmt::format("|z| {:.4f}", k.spectral_radius), flag);
+  }
+}
+
 int run_track_cmd(TrackArgs& a) {
   const Model model = load_model_args(a.model);
   a.options.apply();
@@ -121,8 +155,13 @@ int run_track_cmd(TrackArgs& a) {
     fmt::print("  {:6.1f} {:7.2f} {:7.2f} {:11.4f} {:11.4f} {:8.2f} {:+9.1f} {:6.2f}..{:<6.2f}{}\n",
                p.temperature_C, p.amplitude_um, p.frequency_Hz, p.error_rms_um, p.error_peak_um,
                p.error_rms_pct, p.error_change_pct, p.current_min_A, p.current_max_A,
-               p.saturated ? " saturated" : "");
+               std::string(p.saturated ? " saturated" : "") +
+                   (p.limit_cycle ? fmt::format(" LIMIT CYCLE: the error flips sign at {:.0f} % "
+                                                "of the samples (~{:.0f} Hz)",
+                                                100.0 * p.error_alternation, p.error_oscillation_Hz)
+                                  : std::string()));
   }
+  print_margins(res);
   if (a.plot) files.push_back(render_plot("track", a.out));
   fmt::print("  {} points on {} threads in {:.2f} s\n  wrote {}\n", res.points.size(), res.threads,
              res.wall_time_s, fmt::join(files, ", "));

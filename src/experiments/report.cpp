@@ -118,13 +118,24 @@ Report track_report(const Model& m, const TrackRequest& req, const TrackResult& 
   Table t{"points",
           {"temperature_C", "amplitude_um", "frequency_Hz", "error_rms_um", "error_peak_um",
            "error_rms_pct_of_amplitude", "error_change_pct", "y_bias_um", "current_min_A",
-           "current_max_A", "saturated", "status", "error"},
+           "current_max_A", "saturated", "error_alternation", "error_oscillation_Hz", "limit_cycle",
+           "status", "error"},
           {}};
   for (const auto& p : res.points)
     t.rows.push_back({p.temperature_C, p.amplitude_um, p.frequency_Hz, p.error_rms_um,
                       p.error_peak_um, p.error_rms_pct, p.error_change_pct, p.y_bias_um,
-                      p.current_min_A, p.current_max_A, p.saturated, status(p.diverged), p.error});
+                      p.current_min_A, p.current_max_A, p.saturated, p.error_alternation,
+                      p.error_oscillation_Hz, p.limit_cycle, status(p.diverged), p.error});
   r.tables.push_back(t);
+  Table margins{"margins",
+                {"temperature_C", "gain_margin_dB", "phase_crossover_Hz", "phase_margin_deg",
+                 "gain_crossover_Hz", "closed_loop_pole_radius", "closed_loop_pole_Hz", "stable"},
+                {}};
+  for (const auto& k : res.margins)
+    margins.rows.push_back({k.temperature_C, k.gain_margin_dB, k.phase_crossover_Hz,
+                            k.phase_margin_deg, k.gain_crossover_Hz, k.spectral_radius,
+                            k.dominant_Hz, k.stable});
+  r.tables.push_back(margins);
   return r;
 }
 

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <random>
 
@@ -228,6 +229,17 @@ struct SampledController {
   InverseFeedforward* inverse;
   std::normal_distribution<double> noise{0.0, 1.0};
   double I = 0.0, ff_min = 0.0, ff_max = 0.0;
+  // The sampled error's sign changes over the last period (from after_s): a loop that rings at
+  // the sampling's Nyquist frequency flips it every sample (TrackPoint::error_alternation).
+  double after_s = std::numeric_limits<double>::infinity(), e_last = 0.0;
+  long pairs = -1, flips = 0;
+
+  void count_sign(double tk, double e) {
+    if (!(tk > after_s)) return;
+    if (pairs >= 0 && e * e_last < 0.0) ++flips;
+    ++pairs;
+    e_last = e;
+  }
 
   // With the inverse feed-forward: i = clip(i_ff + a u); the PID's limits follow i_ff.
   double with_inverse(double tk, double e) {
@@ -244,6 +256,7 @@ struct SampledController {
     const double tk = grid.sample_time(p.sample);
     const double y_meas =
         s.y_m * 1e6 + r.sensor_noise_um * (r.sensor_noise_um > 0.0 ? noise(rng) : 0.0);
+    count_sign(tk, ref.at(tk) - y_meas);
     if (inverse != nullptr) {
       I = with_inverse(tk, ref.at(tk) - y_meas);
       log(s, tk);
@@ -323,7 +336,13 @@ void detail::track_run(const TrackPlant& plant, const TrackRequest& r, const Tra
                             plant.inverse};
     if (plant.inverse != nullptr) plant.inverse->reset();
     ErrorOverLastPeriod err{ref, (t_end - period) + 1e-12 * period};
+    drive.after_s = err.after_s;
     run_loop(m, c, s, grid, drive, err);
+    if (drive.pairs > 0) {
+      p.error_alternation = static_cast<double>(drive.flips) / static_cast<double>(drive.pairs);
+      p.error_oscillation_Hz = 0.5 * p.error_alternation * r.sample_rate_Hz;
+      p.limit_cycle = p.error_alternation > kLimitCycleAlternation;
+    }
     p.error_rms_um = std::sqrt(err.ss / static_cast<double>(std::max(err.n, 1L)));
     p.error_peak_um = err.peak;
     p.error_rms_pct = p.error_rms_um / j.A * 100.0;
@@ -377,6 +396,10 @@ TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& p
         if (idx == 0) res.example = std::move(ex);
       },
       progress);
+  for (double T : r.temperatures_C)
+    res.margins.push_back(pid_loop_margins(linearize_plant(m, T, r.bias_A), r.gains,
+                                           r.sample_rate_Hz, res.plant_dt_s,
+                                           r.amplifier_A_per_unit * r.feedforward.gain_at(T)));
   res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   for (std::size_t i = 0; i < res.points.size(); ++i)
     res.points[i].error_change_pct =

@@ -6,6 +6,7 @@
 #include <complex>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -227,6 +228,24 @@ class Pid {
   bool first_ = true;
 };
 
+// The PID loop's stability margins at one temperature (issue 40 item 3; src/experiments/
+// loop_margins.cpp): the linearised plant sampled as `track` drives it (current set at each
+// sample, reached over the first plant step of plant_dt_s, held; the sensor read at the sample),
+// the Pid above with its coefficients at sample_rate_Hz, the amplifier's A per unit, the error
+// in um. Gain margin [dB] at the phase crossover (phase -180 deg), phase margin [deg] at the gain
+// crossover (|L| = 1), the smallest of each from 0.1 Hz to the Nyquist frequency (inf where
+// there is no crossing); the closed loop's largest pole magnitude (< 1: stable, the linear loop
+// without clipping) and that pole's frequency [Hz].
+struct LoopMargins {
+  double temperature_C = 0;
+  double gain_margin_dB = std::numeric_limits<double>::infinity(), phase_crossover_Hz = 0;
+  double phase_margin_deg = std::numeric_limits<double>::infinity(), gain_crossover_Hz = 0;
+  double spectral_radius = 0, dominant_Hz = 0;
+  bool stable = false;
+};
+LoopMargins pid_loop_margins(const StateSpace& plant, const PidGains& g, double sample_rate_Hz,
+                             double plant_dt_s, double amplifier_A_per_unit);
+
 // Temperature feed-forward (gmasim compensate, include/gmasim/experiments/compensate.hpp): at
 // operating temperature T the coil current is
 //   i = bias + g(T) (u_PID + (r(t) - y_bias) / K_ref),   clipped to +-current_limit_A,
@@ -284,12 +303,24 @@ struct TrackPoint {
   double feedforward_gain = 1.0;                // g(T) of the temperature feed-forward
   // The inverse feed-forward's current over the whole run (0 when it is off) [A].
   double feedforward_min_A = 0, feedforward_max_A = 0;
+  // The sampled error's sign changes per sample over the last period (about 2 f / f_s for a
+  // loop that tracks; about 1 for one that rings at the Nyquist frequency), the frequency they
+  // imply, alternation x f_s / 2 [Hz], and whether it exceeds kLimitCycleAlternation.
+  double error_alternation = 0, error_oscillation_Hz = 0;
+  bool limit_cycle = false;
   bool diverged = false;
   std::string error;
 };
 
+// TrackPoint::limit_cycle: the sampled error changes sign at more than half the samples of the
+// last period, i.e. it oscillates above a quarter of the sample rate.
+inline constexpr double kLimitCycleAlternation = 0.5;
+
 struct TrackResult {
   std::vector<TrackPoint> points;  // order: temperature, amplitude, frequency
+  // The PID loop's margins at each temperature of the request (pid_loop_margins about the
+  // bias; with the temperature feed-forward the loop gain includes its g(T)).
+  std::vector<LoopMargins> margins;
   TimeSeries example;  // one run (first point): t_s, reference_um, y_um, current_A, error_um
   double plant_dt_s = 0;
   double wall_time_s = 0;
