@@ -53,30 +53,26 @@ SampledPlant sample(const StateSpace& ss, double Ts, double dt) {
   return p;
 }
 
-}  // namespace
+// The PID per sample at its rate (Pid's coefficients), times the amplifier; the error in um.
+struct SampledPid {
+  double a, kp, ki, kd;
+  cd at(cd z) const { return a * (kp + ki * z / (z - 1.0) + kd * (1.0 - 1.0 / z)); }
+};
 
-LoopMargins pid_loop_margins(const StateSpace& plant, const PidGains& g, double sample_rate_Hz,
-                             double plant_dt_s, double amplifier_A_per_unit) {
-  const double Ts = 1.0 / sample_rate_Hz;
-  const SampledPlant p = sample(plant, Ts, plant_dt_s);
-  const int n = plant.n_states;
-  // The PID per sample at this rate (Pid's coefficients), the error in um: e = -1e6 y.
-  const double a = amplifier_A_per_unit, kp = g.kp,
-               ki = g.ki * g.reference_rate_Hz / sample_rate_Hz,
-               kd = g.kd * sample_rate_Hz / g.reference_rate_Hz;
-  LoopMargins out;
-  out.temperature_C = plant.temperature_C;
-  // The loop gain L(z) = a C_pid(z) 1e6 P(z), C_pid = kp + ki z/(z - 1) + kd (1 - 1/z), on z =
-  // e^{j w Ts} from 0.1 Hz to the Nyquist frequency; the phase unwrapped from the low end.
-  const int N = 6000;
-  const double f0 = 0.1, f1 = 0.5 * sample_rate_Hz;
+// The loop gain L(z) = C_pid(z) 1e6 P(z) on z = e^{j w Ts} from 0.1 Hz to the Nyquist frequency,
+// the phase unwrapped from the low end: the smallest phase margin (180 + phase at |L| = 1) and
+// gain margin (-20 log10 |L| where the phase crosses -180 mod 360; at z = -1, where L is real,
+// when it is negative: the sampled loop's classic limit cycle).
+void unit_circle_margins(const SampledPlant& p, const SampledPid& c, double Ts, LoopMargins& out) {
+  const auto n = static_cast<Eigen::Index>(p.G.size());
   auto loop_gain = [&](cd z) {
     const Eigen::VectorXcd x = (z * Eigen::MatrixXcd::Identity(n, n) - p.Phi.cast<cd>())
                                    .partialPivLu()
                                    .solve((p.G - p.R).cast<cd>() + p.R.cast<cd>() / z);
-    const cd P = 1e6 * (p.C.cast<cd>() * x)(0);
-    return a * (kp + ki * z / (z - 1.0) + kd * (1.0 - 1.0 / z)) * P;
+    return c.at(z) * 1e6 * (p.C.cast<cd>() * x)(0);
   };
+  const int N = 6000;
+  const double f0 = 0.1, f1 = 0.5 / Ts;
   double prev_phase = 0.0, prev_mag = 0.0, prev_f = 0.0, unwrap = 0.0;
   for (int k = 0; k < N; ++k) {
     const double f = f0 * std::pow(f1 / f0, static_cast<double>(k) / N);
@@ -86,8 +82,7 @@ LoopMargins pid_loop_margins(const StateSpace& plant, const PidGains& g, double 
     if (k > 0) {
       while (phase - prev_phase > 180.0) phase -= 360.0, unwrap -= 360.0;
       while (phase - prev_phase < -180.0) phase += 360.0, unwrap += 360.0;
-      // |L| = 1 crossings: the phase margin 180 + phase there (the smallest).
-      if ((prev_mag - 1.0) * (mag - 1.0) <= 0.0 && prev_mag != mag) {
+      if ((prev_mag - 1.0) * (mag - 1.0) <= 0.0 && prev_mag != mag) {  // |L| = 1
         const double t = (1.0 - prev_mag) / (mag - prev_mag);
         const double pm = 180.0 + prev_phase + t * (phase - prev_phase);
         const double pm_wrapped = pm - 360.0 * std::floor((pm + 180.0) / 360.0);
@@ -96,10 +91,9 @@ LoopMargins pid_loop_margins(const StateSpace& plant, const PidGains& g, double 
           out.gain_crossover_Hz = prev_f + t * (f - prev_f);
         }
       }
-      // Phase = -180 (mod 360) crossings: the gain margin -20 log10 |L| there (the smallest).
       const double a0 = std::floor((prev_phase + 180.0) / 360.0),
                    a1 = std::floor((phase + 180.0) / 360.0);
-      if (a0 != a1) {
+      if (a0 != a1) {  // phase = -180 (mod 360)
         const double target = 360.0 * std::max(a0, a1) - 180.0;
         const double t = (target - prev_phase) / (phase - prev_phase);
         const double gm = -20.0 * std::log10(prev_mag + t * (mag - prev_mag));
@@ -113,24 +107,25 @@ LoopMargins pid_loop_margins(const StateSpace& plant, const PidGains& g, double 
     prev_mag = mag;
     prev_f = f;
   }
-  // At the Nyquist frequency z = -1 and L is real: a negative L is a phase crossover there (the
-  // sampled loop's classic limit cycle, the error flipping sign every sample).
   const cd L_nyquist = loop_gain(cd(-1.0, 0.0));
-  if (L_nyquist.real() < 0.0) {
-    const double gm = -20.0 * std::log10(std::abs(L_nyquist));
-    if (gm < out.gain_margin_dB) {
-      out.gain_margin_dB = gm;
-      out.phase_crossover_Hz = f1;
-    }
+  const double gm = -20.0 * std::log10(std::abs(L_nyquist));
+  if (L_nyquist.real() < 0.0 && gm < out.gain_margin_dB) {
+    out.gain_margin_dB = gm;
+    out.phase_crossover_Hz = f1;
   }
-  // The closed loop (r = 0, no clipping), state (x_k, i_k-1, S_k-1, e_k-1):
-  //   e_k = -1e6 C x_k, S_k = S_k-1 + e_k, i_k = a (kp e_k + ki S_k + kd (e_k - e_k-1)).
+}
+
+// The closed loop (r = 0, no clipping), state (x_k, i_k-1, S_k-1, e_k-1):
+//   e_k = -1e6 C x_k, S_k = S_k-1 + e_k, i_k = a (kp e_k + ki S_k + kd (e_k - e_k-1));
+// its largest pole magnitude and that pole's frequency.
+void closed_loop_poles(const SampledPlant& p, const SampledPid& c, double Ts, LoopMargins& out) {
+  const auto n = static_cast<Eigen::Index>(p.G.size());
   Mat Acl = Mat::Zero(n + 3, n + 3);
   const Eigen::RowVectorXd e_x = -1e6 * p.C;
   Eigen::RowVectorXd i_row = Eigen::RowVectorXd::Zero(n + 3);
-  i_row.head(n) = a * (kp + ki + kd) * e_x;
-  i_row(n + 1) = a * ki;
-  i_row(n + 2) = -a * kd;
+  i_row.head(n) = c.a * (c.kp + c.ki + c.kd) * e_x;
+  i_row(n + 1) = c.a * c.ki;
+  i_row(n + 2) = -c.a * c.kd;
   Acl.topRows(n) = (p.G - p.R) * i_row;
   Acl.topLeftCorner(n, n) += p.Phi;
   Acl.block(0, n, n, 1) += p.R;
@@ -147,6 +142,20 @@ LoopMargins pid_loop_margins(const StateSpace& plant, const PidGains& g, double 
     }
   }
   out.stable = out.spectral_radius < 1.0;
+}
+
+}  // namespace
+
+LoopMargins pid_loop_margins(const StateSpace& plant, const PidGains& g, double sample_rate_Hz,
+                             double plant_dt_s, double amplifier_A_per_unit) {
+  const double Ts = 1.0 / sample_rate_Hz;
+  const SampledPlant p = sample(plant, Ts, plant_dt_s);
+  const SampledPid c{amplifier_A_per_unit, g.kp, g.ki * g.reference_rate_Hz / sample_rate_Hz,
+                     g.kd * sample_rate_Hz / g.reference_rate_Hz};
+  LoopMargins out;
+  out.temperature_C = plant.temperature_C;
+  unit_circle_margins(p, c, Ts, out);
+  closed_loop_poles(p, c, Ts, out);
   return out;
 }
 
