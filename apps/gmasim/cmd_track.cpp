@@ -140,6 +140,11 @@ int run_track_cmd(TrackArgs& a) {
       "(the amplifier), clipped to +-{} A; sensor noise {} um RMS\n",
       g.kp, g.ki, g.kd, g.reference_rate_Hz, a.req.sample_rate_Hz, res.plant_dt_s * 1e6,
       a.req.bias_A, a.req.amplifier_A_per_unit, a.req.current_limit_A, a.req.sensor_noise_um);
+  const double amp = a.req.amplifier_A_per_unit;
+  fmt::print(
+      "  in one unit (the coil current per um of error, through the amplifier): a kp = {:.4g} "
+      "A/um, a Ki = {:.4g} A/(um s), a Kd = {:.4g} A s/um\n",
+      amp * g.kp, amp * g.ki * g.reference_rate_Hz, amp * g.kd / g.reference_rate_Hz);
   fmt::print("  reference y_bias + A sin(2 pi f t); errors over the last of {} periods\n",
              a.req.periods);
   fmt::print("  {:>6} {:>7} {:>7} {:>11} {:>11} {:>8} {:>9} {:>14}\n", "T degC", "A um", "f Hz",

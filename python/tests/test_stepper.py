@@ -138,3 +138,23 @@ def test_run_releases_the_gil(mdma):
 def test_version():
     assert gmasim.__version__ == "0.1.0"
     assert isinstance(gmasim.__git_describe__, str)
+
+
+def test_the_readmes_replay_line_holds(mdma):
+    # README.md, "From your own code": the line it gives, run as written.
+    import pathlib
+    import re
+    readme = (pathlib.Path(__file__).resolve().parents[2] / "README.md").read_text()
+    line = re.search(r'`(i = r\["series"\]\["current_A"\]; gmasim\.Stepper\(m, 20, r\["dt_s"\], '
+                     r'current_A=i\[0\]\)\.run\(i\[1:\]\))`', readme)
+    assert line, "README.md no longer gives the replay line"
+    m = mdma
+    r = gmasim.simulate(m, temperature_C=20, current_pp_A=8, frequency_Hz=10, periods=1)
+    ns = {"gmasim": gmasim, "m": m, "r": r}
+    i_line, run_expr = line.group(1).split("; ", 1)
+    exec(i_line, ns)
+    y = eval(run_expr, ns)
+    np.testing.assert_array_equal(y, r["series"]["y_um"][1:])
+    # and the plain use the README warns about does differ (the first step from 0 A)
+    plain = gmasim.Stepper(m, 20, r["dt_s"]).run(ns["i"])
+    assert np.max(np.abs(plain - r["series"]["y_um"])) > 1.0
