@@ -363,3 +363,37 @@ TEST(Records, BadRecordsAreRefusedWithFileLineAndRule) {
   EXPECT_THAT(msg,
               HasSubstr("rod = 'rod9' is not a rod of the model (its rods: rod1, rod2, rod3)"));
 }
+
+// Issue 41: the fit report names a field record's drive by its field, not "I p-p 0 A": the
+// condition's drive span in kA/m (drive_pp, drive_label) from the record's own samples; a
+// current record's in A.
+TEST(Records, FitReportGivesAFieldRecordsDriveInKiloAmperesPerMetre) {
+  SyntheticRequest r;
+  r.temperatures_C = {20};
+  r.currents_pp_A = {12};
+  r.current_min_A = -6;
+  r.quasi_static = true;
+  r.drive = DriveInput::Field;
+  r.samples_per_period = 50;
+  r.noise_pct = 0.0;
+  r.with_flux = false;
+  const ModelSpec spec =
+      load_model_spec(std::string(GMASIM_SOURCE_DIR) + "/models/single_rod.toml");
+  FitSpec fit;
+  fit.parameters.push_back({"rod.ja.k0_A_per_m", 1000.0, 9000.0, ParamScale::Log, false, 0.0, 1});
+  const MeasurementSet set = synthesize_measurements(compile(spec), r);
+  const Objective obj(spec, set, fit, ObjectiveSettings{});
+  const std::vector<ConditionFit> fits = obj.condition_fits(obj.start_unit());
+  ASSERT_EQ(fits.size(), 1u);
+  const auto& H = set.items[0].drive;
+  const auto [lo, hi] = std::minmax_element(H.begin(), H.end());
+  EXPECT_EQ(fits[0].drive_label, "H p-p [kA/m]");
+  EXPECT_DOUBLE_EQ(fits[0].drive_pp, (*hi - *lo) * 1e-3);
+  EXPECT_GT(fits[0].drive_pp, 1.0);  // tens of kA/m for 12 A p-p
+  r.drive = DriveInput::Current;
+  const MeasurementSet cur = synthesize_measurements(compile(spec), r);
+  const Objective obj_cur(spec, cur, fit, ObjectiveSettings{});
+  const std::vector<ConditionFit> fc = obj_cur.condition_fits(obj_cur.start_unit());
+  EXPECT_EQ(fc[0].drive_label, "I p-p [A]");
+  EXPECT_NEAR(fc[0].drive_pp, 12.0, 1e-9);
+}

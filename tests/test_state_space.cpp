@@ -8,7 +8,6 @@
 #include <cmath>
 #include <complex>
 #include <cstdio>
-#include <unsupported/Eigen/MatrixFunctions>
 
 #include "builtin_models.hpp"
 #include "gmasim/experiments/experiments.hpp"
@@ -16,6 +15,7 @@
 #include "gmasim/mechanics/mechanics.hpp"
 #include "gmasim/mechanics/state_space.hpp"
 #include "gmasim/simulate/run_loop.hpp"
+#include "mechanics/dense.hpp"
 
 using namespace gmasim;
 
@@ -148,12 +148,12 @@ double step_response_mismatch(double dI) {
   const Mat A = Eigen::Map<const Eigen::Matrix<double, -1, -1, Eigen::RowMajor>>(ss.A.data(), n, n);
   const Eigen::VectorXd B = Eigen::Map<const Eigen::VectorXd>(ss.B.data(), n);
   const Eigen::RowVectorXd C = Eigen::Map<const Eigen::RowVectorXd>(ss.C.data(), n);
-  const Mat Phi = (A * h).exp();
+  const Mat Phi = dense::exponential(A * h);
   const Eigen::VectorXd Gamma = A.partialPivLu().solve((Phi - Mat::Identity(n, n)) * B * dI);
   // The step ramps the current over its first h (step() interpolates the current linearly over
   // a step): to second order in h, the ideal step's response h/2 later. So the state space is
   // sampled at t_k - h/2: its state after h/2 of the step, then whole steps.
-  const Mat half = (A * (0.5 * h)).exp();
+  const Mat half = dense::exponential(A * (0.5 * h));
   Eigen::VectorXd x = A.partialPivLu().solve((half - Mat::Identity(n, n)) * B * dI);
   State s = bias;
   const double y0 = s.y_m, final_m = ss.dc_gain() * dI;

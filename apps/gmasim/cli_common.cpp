@@ -25,7 +25,10 @@
 
 namespace gmasim::cli {
 
+// stdout is flushed first: when both streams go to one file or pipe (2>&1), a message then
+// comes after the lines printed before it, not ahead of the buffered header (issue 41).
 void print_error(const std::string& what) {
+  std::fflush(stdout);
   std::fprintf(stderr, "gmasim: error: %s\n", what.c_str());
 }
 
@@ -163,6 +166,7 @@ Model load_model_args(const ModelArgs& a) {
 }
 
 void print_warning(const std::string& what) {
+  std::fflush(stdout);
   std::fprintf(stderr, "gmasim: warning: %s\n", what.c_str());
 }
 

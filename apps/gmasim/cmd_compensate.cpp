@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <memory>
 
 #include "commands.hpp"
@@ -25,7 +26,12 @@ struct CompensateArgs : ExperimentArgs<CompensateRequest> {
   bool no_track = false;
 };
 
-void print_schedule(const CompensateArgs& a, const CompensateResult& res) {
+// A steady temperature rise of the housing above this, from the schedule's largest copper loss
+// over the thermal network's housing-to-ambient conductance, is warned about: it is the 10 K
+// step of compensate's usual grid (judgement).
+constexpr double kSteadyRiseWarn_K = 10.0;
+
+void print_schedule(const Model& m, const CompensateArgs& a, const CompensateResult& res) {
   const auto& r = a.req;
   fmt::print(
       "  target stroke {:.3f} um ({}); drive: biased sine at {} Hz, adjusting {}; |i| <= {} A\n",
@@ -39,18 +45,37 @@ void print_schedule(const CompensateArgs& a, const CompensateResult& res) {
       : r.adjust == CompensationAdjust::Swing   ? "the p-p about the mean"
                                                 : "min and p-p together",
       r.max_current_A);
-  fmt::print("  {:>6} {:>9} {:>9} {:>9} {:>7} {:>10} {:>12} {:>8} {:>5}\n", "T degC", "i_pp A",
-             "i_min A", "i_max A", "gain", "stroke um", "uncomp. um", "hyst um", "sims");
+  fmt::print("  {:>6} {:>9} {:>9} {:>9} {:>8} {:>10} {:>12} {:>8} {:>8} {:>5}\n", "T degC",
+             "i_pp A", "i_min A", "i_max A", "i_pp/ref", "stroke um", "uncomp. um", "hyst um",
+             "P_Cu W", "sims");
+  double P_max = 0.0;
   for (const auto& p : res.points) {
     if (p.diverged) {
       fmt::print("  {:6.1f}  diverged: {}\n", p.temperature_C, p.error);
       continue;
     }
-    fmt::print("  {:6.1f} {:9.4f} {:9.4f} {:9.4f} {:7.4f} {:10.3f} {:12.3f} {:8.3f} {:5d}{}\n",
-               p.temperature_C, p.current_pp_A, p.current_min_A, p.current_max_A, p.gain,
-               p.stroke_um, p.uncompensated_stroke_um, p.hysteresis_um, p.evaluations,
-               p.reachable ? "" : "  not reachable: the largest drive falls short");
+    const double P = coil_copper_loss_W(m, p.current_min_A, p.current_pp_A, p.temperature_C);
+    P_max = std::max(P_max, P);
+    fmt::print(
+        "  {:6.1f} {:9.4f} {:9.4f} {:9.4f} {:8.4f} {:10.3f} {:12.3f} {:8.3f} {:8.1f} {:5d}{}\n",
+        p.temperature_C, p.current_pp_A, p.current_min_A, p.current_max_A, p.gain, p.stroke_um,
+        p.uncompensated_stroke_um, p.hysteresis_um, P, p.evaluations,
+        p.reachable ? "" : "  not reachable: the largest drive falls short");
   }
+  fmt::print(
+      "  i_pp/ref: the schedule's current p-p over the reference's. P_Cu: the coil's copper loss "
+      "I_rms^2 R(T) with the coil at T ({:g} ohm at {:g} degC, thermal_network); the schedule "
+      "holds the actuator at T, the loss heats it: `gmasim simulate --self-heating` shows by how "
+      "much\n",
+      m.thermal_network.coil_resistance_ohm, m.T_ref_C);
+  const double rise_K = P_max / m.thermal_network.G_housing_ambient_W_per_K;
+  if (rise_K > kSteadyRiseWarn_K)
+    print_warning(fmt::format(
+        "the schedule drives the coil at up to {:.0f} W of copper loss: in steady state that holds "
+        "the housing {:.0f} K above ambient (thermal_network.housing_to_ambient_W_per_K = {:g}), "
+        "so the actuator will not stay at the scheduled temperature without cooling; "
+        "`gmasim simulate --self-heating` shows it",
+        P_max, rise_K, m.thermal_network.G_housing_ambient_W_per_K));
 }
 
 void print_track(const CompensatedTrack& t) {
@@ -114,7 +139,7 @@ int run_compensate_cmd(CompensateArgs& a) {
         model, a.req, a.track, stderr_progress("compensate track", a.progress)));
   auto files = write_report(a.out, "compensate", compensate_report(model, a.req, res, tr.get()));
   fmt::print("gmasim compensate  model: {}\n", model_label(a.model));
-  print_schedule(a, res);
+  print_schedule(model, a, res);
   if (tr) print_track(*tr);
   if (a.plot) files.push_back(render_plot("compensate", a.out));
   fmt::print("  {} temperatures in {:.2f} s on {} threads\n  wrote {}\n", res.points.size(),

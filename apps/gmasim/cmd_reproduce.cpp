@@ -121,8 +121,13 @@ class StageProgress {
           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
       if (total_ == 0)
         fmt::print(stderr, "reproduce: the first stage is running, {:.0f} s elapsed\n", el);
-      else
+      else if (done_ < total_)
         fmt::print(stderr, "reproduce: {}/{} stages done, {:.0f} s elapsed\n", done_, total_, el);
+      else  // every stage is done: the report and its figures are being written (issue 41)
+        fmt::print(stderr,
+                   "reproduce: all {} stages done; writing the report and figures, {:.0f} s "
+                   "elapsed\n",
+                   total_, el);
       std::fflush(stderr);
     }
   }

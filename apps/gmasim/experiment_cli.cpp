@@ -1,8 +1,10 @@
 #include "experiment_cli.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -10,6 +12,7 @@
 #include <filesystem>
 #include <memory>
 #include <mutex>
+#include <vector>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/io/io.hpp"
@@ -120,13 +123,25 @@ std::string render_plot(const std::string& command, const std::string& dir) {
   c.python_path = python_package_path();
   c.module = "gmasim.command_figures";
   c.args = {command, dir};
+  namespace fs = std::filesystem;
+  const auto started = fs::file_time_type::clock::now();
   const int rc = run_python(c);
   if (rc == 127)
     throw InputError(fmt::format("--plot: cannot run {} (install python3-matplotlib)", c.python));
   if (rc != 0)
     throw InputError(fmt::format(
         "--plot: the figure renderer failed ({}); the data files are written", c.text()));
-  return (std::filesystem::path(dir) / (command + ".png")).string();
+  // Every figure the renderer wrote, the command's own first (simulate --self-heating also
+  // writes self_heating.png).
+  const std::string own = (fs::path(dir) / (command + ".png")).string();
+  std::vector<std::string> others;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (e.path().extension() == ".png" && e.path().string() != own &&
+        e.last_write_time(ec) >= started)
+      others.push_back(e.path().string());
+  std::sort(others.begin(), others.end());
+  return others.empty() ? own : fmt::format("{}, {}", own, fmt::join(others, ", "));
 }
 
 }  // namespace gmasim::cli

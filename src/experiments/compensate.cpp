@@ -299,6 +299,13 @@ CompensatedTrack run_compensated_track(const Model& m, const CompensateRequest& 
   return out;
 }
 
+double coil_copper_loss_W(const Model& m, double i_min_A, double i_pp_A, double T_C) {
+  const double mean = i_min_A + 0.5 * i_pp_A, amp = 0.5 * i_pp_A;
+  const auto& n = m.thermal_network;
+  return (mean * mean + 0.5 * amp * amp) * n.coil_resistance_ohm *
+         (1.0 + n.coil_alpha_per_K * (T_C - m.T_ref_C));
+}
+
 Report compensate_report(const Model& m, const CompensateRequest& req, const CompensateResult& res,
                          const CompensatedTrack* track) {
   Report r;
@@ -320,6 +327,7 @@ Report compensate_report(const Model& m, const CompensateRequest& req, const Com
                "uncompensated_stroke_um",
                "hysteresis_um",
                "B_pp_T",
+               "copper_loss_W",
                "evaluations",
                "reachable",
                "status",
@@ -327,11 +335,12 @@ Report compensate_report(const Model& m, const CompensateRequest& req, const Com
   const double nan = std::nan("");
   for (const auto& p : res.points) {
     const bool ok = !p.diverged;
-    t.rows.push_back({p.temperature_C, ok ? p.current_pp_A : nan, ok ? p.current_min_A : nan,
-                      ok ? p.current_max_A : nan, ok ? p.gain : nan, ok ? p.stroke_um : nan,
-                      ok ? p.uncompensated_stroke_um : nan, ok ? p.hysteresis_um : nan,
-                      ok ? p.B_pp_T : nan, p.evaluations, p.reachable,
-                      p.diverged ? "diverged" : "ok", p.error});
+    t.rows.push_back(
+        {p.temperature_C, ok ? p.current_pp_A : nan, ok ? p.current_min_A : nan,
+         ok ? p.current_max_A : nan, ok ? p.gain : nan, ok ? p.stroke_um : nan,
+         ok ? p.uncompensated_stroke_um : nan, ok ? p.hysteresis_um : nan, ok ? p.B_pp_T : nan,
+         ok ? coil_copper_loss_W(m, p.current_min_A, p.current_pp_A, p.temperature_C) : nan,
+         p.evaluations, p.reachable, p.diverged ? "diverged" : "ok", p.error});
   }
   r.tables.push_back(std::move(t));
   if (track != nullptr) {

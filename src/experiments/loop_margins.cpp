@@ -3,13 +3,12 @@
 // drives it, the paper's discrete PID, their loop gain on the unit circle and the closed loop's
 // poles. docs/experiments.md, "Closed-loop tracking".
 #include <Eigen/Dense>
-#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <complex>
 #include <limits>
-#include <unsupported/Eigen/MatrixFunctions>
 
 #include "gmasim/experiments/experiments.hpp"
+#include "mechanics/dense.hpp"
 
 namespace gmasim {
 namespace {
@@ -38,17 +37,17 @@ SampledPlant sample(const StateSpace& ss, double Ts, double dt) {
   M.topLeftCorner(n, n) = A;
   M.block(0, n, n, 1) = B;
   M(n, n + 1) = 1.0 / dt;
-  const Mat E =
-      (M * dt).exp();  // (0,n): int_0^dt e^{As} B ds; (0,n+1): int_0^dt e^{As} B (dt-s)/dt
+  const Mat E = dense::exponential(
+      M * dt);  // (0,n): int_0^dt e^{As} B ds; (0,n+1): int_0^dt e^{As} B (dt-s)/dt
   const Vec W = E.block(0, n, n, 1) - E.block(0, n + 1, n, 1);
   Mat Mt = Mat::Zero(n + 1, n + 1);
   Mt.topLeftCorner(n, n) = A;
   Mt.block(0, n, n, 1) = B;
-  const Mat Et = (Mt * Ts).exp();
+  const Mat Et = dense::exponential(Mt * Ts);
   SampledPlant p;
   p.Phi = Et.topLeftCorner(n, n);
   p.G = Et.block(0, n, n, 1);
-  p.R = (A * (Ts - dt)).exp() * W;
+  p.R = dense::exponential(A * (Ts - dt)) * W;
   p.C = Eigen::Map<const Eigen::RowVectorXd>(ss.C.data(), n);
   return p;
 }
@@ -71,7 +70,7 @@ void unit_circle_margins(const SampledPlant& p, const SampledPid& c, double Ts, 
                                    .solve((p.G - p.R).cast<cd>() + p.R.cast<cd>() / z);
     return c.at(z) * 1e6 * (p.C.cast<cd>() * x)(0);
   };
-  const int N = 6000;
+  const int N = 1500;
   const double f0 = 0.1, f1 = 0.5 / Ts;
   double prev_phase = 0.0, prev_mag = 0.0, prev_f = 0.0, unwrap = 0.0;
   for (int k = 0; k < N; ++k) {
@@ -133,12 +132,11 @@ void closed_loop_poles(const SampledPlant& p, const SampledPid& c, double Ts, Lo
   Acl.row(n + 1).head(n) = e_x;
   Acl(n + 1, n + 1) = 1.0;
   Acl.row(n + 2).head(n) = e_x;
-  const Eigen::EigenSolver<Mat> es(Acl, false);
-  for (Eigen::Index k = 0; k < es.eigenvalues().size(); ++k) {
-    const double r = std::abs(es.eigenvalues()(k));
+  for (const cd& z : dense::eigenvalues(Acl)) {
+    const double r = std::abs(z);
     if (r > out.spectral_radius) {
       out.spectral_radius = r;
-      out.dominant_Hz = std::abs(std::arg(es.eigenvalues()(k))) / (2.0 * M_PI * Ts);
+      out.dominant_Hz = std::abs(std::arg(z)) / (2.0 * M_PI * Ts);
     }
   }
   out.stable = out.spectral_radius < 1.0;

@@ -90,6 +90,12 @@ std::vector<ConditionFit> Objective::condition_fits(const std::vector<double>& u
     f.compared = f.samples - cd.compare_begin;
     f.pp = cd.pp_um;
     f.response_unit = std::string(meas.response_unit());
+    if (!meas.drive.empty()) {
+      const auto [lo, hi] = std::minmax_element(meas.drive.begin(), meas.drive.end());
+      const bool field = meas.drive_kind == DriveInput::Field;
+      f.drive_label = field ? "H p-p [kA/m]" : "I p-p [A]";
+      f.drive_pp = (*hi - *lo) * (field ? 1e-3 : 1.0);
+    }
     std::vector<double> y, B;
     const bool has_flux = !meas.flux_T.empty();
     try {

@@ -134,6 +134,8 @@ void write_condition(JsonWriter& w, const ConditionFit& c) {
   w.key("error").string(c.error);
   w.key("overlay").string(c.overlay_file);
   w.key("response_unit").string(c.response_unit);
+  // The record's drive span: drive_pp_A (current records) or drive_pp_kA_per_m (field records).
+  w.key(c.drive_label.starts_with("H") ? "drive_pp_kA_per_m" : "drive_pp_A").number(c.drive_pp);
   w.key("quasi_static").boolean(c.condition.quasi_static);
   w.key("offset").string(offset_mode_name(c.condition.offset));
   // The constant the offset rule added to the simulated response (fitted or first_sample).
@@ -258,6 +260,12 @@ std::string offset_text(const ConditionFit& c) {
   return s;
 }
 
+// "I 8 A" or "H 120 kA/m": the record's drive span.
+std::string drive_text(const ConditionFit& c) {
+  const bool field = c.drive_label.starts_with("H");
+  return fmt::format("{} {:.4g} {}", field ? "H" : "I", c.drive_pp, field ? "kA/m" : "A");
+}
+
 // Each condition's fit (in the record's response unit), and where its overlay is.
 std::string markdown_conditions(const IdentifyResult& r) {
   std::string s =
@@ -265,22 +273,23 @@ std::string markdown_conditions(const IdentifyResult& r) {
       "displacement_um, ppm of strain_ppm. The offset is the constant the record's offset rule "
       "added to the simulated response (`fitted`: the least-squares constant; `first_sample`: "
       "the shift aligning the first rows; `absolute`: none). f = 0: not periodic (or "
-      "quasi-static).\n\n"
-      "| condition | T [degC] | f [Hz] | I p-p [A] | weight | p-p | RMS | RMS [%] | max err | "
+      "quasi-static). drive p-p: the record's current (I, A) or applied field (H, kA/m) over its "
+      "samples.\n\n"
+      "| condition | T [degC] | f [Hz] | drive p-p | weight | p-p | RMS | RMS [%] | max err | "
       "offset | flux RMS [%] |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& c : r.conditions) {
     if (c.failed) {
-      s += fmt::format("| {} | {:g} | {:g} | {:g} | {:g} | - | failed: {} | | | | |\n", c.label,
-                       c.condition.temperature_C, c.condition.frequency_Hz,
-                       c.condition.current_pp_A, c.weight, c.error);
+      s += fmt::format("| {} | {:g} | {:g} | {} | {:g} | - | failed: {} | | | | |\n", c.label,
+                       c.condition.temperature_C, c.condition.frequency_Hz, drive_text(c), c.weight,
+                       c.error);
       continue;
     }
     const std::string& u = c.response_unit;
     s += fmt::format(
-        "| {} | {:g} | {:g} | {:g} | {:g} | {:.3f} {} | {:.4f} {} | {:.3f} | {:.4f} {} | {} | {} "
+        "| {} | {:g} | {:g} | {} | {:g} | {:.3f} {} | {:.4f} {} | {:.3f} | {:.4f} {} | {} | {} "
         "|\n",
-        c.label, c.condition.temperature_C, c.condition.frequency_Hz, c.condition.current_pp_A,
-        c.weight, c.pp, u, c.rms, u, c.rms_pct, c.max_err, u, offset_text(c),
+        c.label, c.condition.temperature_C, c.condition.frequency_Hz, drive_text(c), c.weight, c.pp,
+        u, c.rms, u, c.rms_pct, c.max_err, u, offset_text(c),
         c.flux_rms_pct >= 0 ? fmt::format("{:.3f}", c.flux_rms_pct) : "-");
   }
   s += "\nOverlays (measured vs simulated): `overlay_<condition>.csv`, drawn into "

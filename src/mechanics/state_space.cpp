@@ -4,12 +4,12 @@
 #include <fmt/format.h>
 
 #include <Eigen/Dense>
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 
 #include "gmasim/errors.hpp"
 #include "gmasim/physics/magnetic.hpp"
+#include "mechanics/dense.hpp"
 
 namespace gmasim {
 namespace {
@@ -217,8 +217,7 @@ double StateSpace::dc_gain(int out) const {
 }
 
 std::vector<std::complex<double>> StateSpace::poles() const {
-  const Eigen::EigenSolver<Eigen::MatrixXd> es(balanced(*this).A, false);
-  std::vector<cd> p(es.eigenvalues().data(), es.eigenvalues().data() + n_states);
+  std::vector<cd> p = dense::eigenvalues(balanced(*this).A);
   std::sort(p.begin(), p.end(), by_imag_then_real);
   return p;
 }
@@ -232,18 +231,15 @@ std::vector<std::complex<double>> StateSpace::zeros(int out) const {
   M.bottomLeftCorner(1, n) = b.C.row(out);
   M(n, n) = D[static_cast<std::size_t>(out)];
   N.topLeftCorner(n, n).setIdentity();
-  const Eigen::GeneralizedEigenSolver<Eigen::MatrixXd> ges(M, N, false);
   // The pencil's infinite eigenvalues (N is singular) come out with beta ~ 0, as huge values: a
   // zero is listed when it is finite and within 1000 times the fastest pole's magnitude (beyond,
   // the pencil's rounding cannot tell a zero from infinity).
   double reach = 1.0;
   for (const cd& p : poles()) reach = std::max(reach, std::abs(p));
   std::vector<cd> z;
-  for (Eigen::Index k = 0; k < ges.alphas().size(); ++k) {
-    const cd zk = ges.alphas()(k) / ges.betas()(k);
+  for (const cd& zk : dense::generalized_eigenvalues(M, N))
     if (std::isfinite(zk.real()) && std::isfinite(zk.imag()) && std::abs(zk) <= 1e3 * reach)
       z.push_back(zk);
-  }
   std::sort(z.begin(), z.end(), by_imag_then_real);
   return z;
 }

@@ -105,5 +105,11 @@ check "model list" 0 "single_rod_preisach +single rod \(Preisach\)" "$B" model l
 check "bare model name" 0 "OK \(67 parameters, 1 rods" "$B" model check single_rod_preisach
 check "bare --model name" 0 "stroke" "$B" simulate --model single_rod --current-min 0 --periods 1 --out "$T/bare"
 check "help has units" 0 "Operating temperature \[degC\]" "$B" simulate --help
+# Issue 41: a warning comes after the stdout lines printed before it when both streams go to one
+# file (stdout is flushed first): the drift warning at 150 degC follows the run's header.
+"$B" simulate --temperature 150 --current-pp 0.5 --periods 1 --out "$T/drift" >"$T/drift.log" 2>&1
+h="$(grep -n '^gmasim simulate\|temperature 150' "$T/drift.log" | head -1 | cut -d: -f1)"
+w="$(grep -n 'warning: the thermal offset drift' "$T/drift.log" | head -1 | cut -d: -f1)"
+[[ -n "$h" && -n "$w" && "$h" -lt "$w" ]] && pass=$((pass + 1)) || { fail=$((fail + 1)); echo "FAIL: the drift warning (line ${w:-none}) before the header (line ${h:-none})"; }
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]

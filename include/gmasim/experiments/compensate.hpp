@@ -93,6 +93,11 @@ TemperatureFeedforward loop_temperature_feedforward(const Model& m, const Compen
 CompensatedTrack run_compensated_track(const Model& m, const CompensateRequest& creq,
                                        TrackRequest treq, const ProgressFn& progress = {});
 
+// The coil's copper loss under a biased sine of p-p i_pp_A from i_min_A with the coil at T_C
+// [W]: I_rms^2 R(T), I_rms^2 = mean^2 + (i_pp/2)^2 / 2, R(T) = R (1 + alpha (T - T_ref)) of
+// [thermal_network] (the schedule's column copper_loss_W).
+double coil_copper_loss_W(const Model& m, double i_min_A, double i_pp_A, double T_C);
+
 Report compensate_report(const Model& m, const CompensateRequest& req, const CompensateResult& res,
                          const CompensatedTrack* track = nullptr);
 

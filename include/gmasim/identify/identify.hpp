@@ -232,9 +232,13 @@ struct ConditionFit {
   // displacement_um, "ppm" for strain_ppm records); fit_report.json names them
   // pp_<unit>, rms_<unit>, max_err_<unit>.
   std::string response_unit = "um";
-  double pp = 0.0;       // peak-to-peak of the measured response (compared samples)
-  double rms = 0.0;      // RMS of simulated - measured
-  double rms_pct = 0.0;  // rms / pp [%] (the paper's normalisation)
+  // The record's drive over its samples: "I p-p [A]" of current_A, "H p-p [kA/m]" of
+  // field_A_per_m (the report's drive column; condition.current_pp_A is 0 for a field record).
+  std::string drive_label = "I p-p [A]";
+  double drive_pp = 0.0;  // in drive_label's unit
+  double pp = 0.0;        // peak-to-peak of the measured response (compared samples)
+  double rms = 0.0;       // RMS of simulated - measured
+  double rms_pct = 0.0;   // rms / pp [%] (the paper's normalisation)
   double max_err = 0.0;
   // The constant added to the simulated response by the record's offset rule (offset =
   // first_sample or fitted; 0 for absolute), in the response unit, and the same for flux_T
