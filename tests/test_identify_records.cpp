@@ -218,21 +218,36 @@ TEST(Records, PrecycledRecordIsTheSteadyLoop) {
 }
 
 // ---- offsets and the objective ----------------------------------------------------------
-TEST(Records, RelativeStrainFitsOnlyWithItsOffsetRule) {
+// A quasi-static field-driven record of models/single_rod.toml at 20 degC, 12 A p-p from -6 A,
+// 50 samples, noise-free, without flux; the fit of its JA k0 alone.
+namespace {
+SyntheticRequest field_record_request() {
   SyntheticRequest r;
   r.temperatures_C = {20};
   r.currents_pp_A = {12};
   r.current_min_A = -6;
   r.quasi_static = true;
   r.drive = DriveInput::Field;
-  r.response = ResponseOutput::Strain;
   r.samples_per_period = 50;
   r.noise_pct = 0.0;
   r.with_flux = false;
-  const ModelSpec spec =
-      load_model_spec(std::string(GMASIM_SOURCE_DIR) + "/models/single_rod.toml");
+  return r;
+}
+ModelSpec records_single_rod() {
+  return load_model_spec(std::string(GMASIM_SOURCE_DIR) + "/models/single_rod.toml");
+}
+FitSpec k0_fit() {
   FitSpec fit;
   fit.parameters.push_back({"rod.ja.k0_A_per_m", 1000.0, 9000.0, ParamScale::Log, false, 0.0, 1});
+  return fit;
+}
+}  // namespace
+
+TEST(Records, RelativeStrainFitsOnlyWithItsOffsetRule) {
+  SyntheticRequest r = field_record_request();
+  r.response = ResponseOutput::Strain;
+  const ModelSpec spec = records_single_rod();
+  const FitSpec fit = k0_fit();
   auto rms_at_truth = [&](OffsetMode written, OffsetMode declared, double shift) {
     SyntheticRequest q = r;
     q.offset = written;
@@ -368,19 +383,9 @@ TEST(Records, BadRecordsAreRefusedWithFileLineAndRule) {
 // condition's drive span in kA/m (drive_pp, drive_label) from the record's own samples; a
 // current record's in A.
 TEST(Records, FitReportGivesAFieldRecordsDriveInKiloAmperesPerMetre) {
-  SyntheticRequest r;
-  r.temperatures_C = {20};
-  r.currents_pp_A = {12};
-  r.current_min_A = -6;
-  r.quasi_static = true;
-  r.drive = DriveInput::Field;
-  r.samples_per_period = 50;
-  r.noise_pct = 0.0;
-  r.with_flux = false;
-  const ModelSpec spec =
-      load_model_spec(std::string(GMASIM_SOURCE_DIR) + "/models/single_rod.toml");
-  FitSpec fit;
-  fit.parameters.push_back({"rod.ja.k0_A_per_m", 1000.0, 9000.0, ParamScale::Log, false, 0.0, 1});
+  SyntheticRequest r = field_record_request();
+  const ModelSpec spec = records_single_rod();
+  const FitSpec fit = k0_fit();
   const MeasurementSet set = synthesize_measurements(compile(spec), r);
   const Objective obj(spec, set, fit, ObjectiveSettings{});
   const std::vector<ConditionFit> fits = obj.condition_fits(obj.start_unit());
