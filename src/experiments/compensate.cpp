@@ -17,6 +17,7 @@
 #include "experiments/parallel.hpp"
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/experiment_fields.hpp"
+#include "gmasim/model/self_heating.hpp"
 #include "gmasim/model/validate.hpp"
 #include "gmasim/simulate/simulate.hpp"
 #include "request_meta.hpp"
@@ -301,9 +302,7 @@ CompensatedTrack run_compensated_track(const Model& m, const CompensateRequest& 
 
 double coil_copper_loss_W(const Model& m, double i_min_A, double i_pp_A, double T_C) {
   const double mean = i_min_A + 0.5 * i_pp_A, amp = 0.5 * i_pp_A;
-  const auto& n = m.thermal_network;
-  return (mean * mean + 0.5 * amp * amp) * n.coil_resistance_ohm *
-         (1.0 + n.coil_alpha_per_K * (T_C - m.T_ref_C));
+  return (mean * mean + 0.5 * amp * amp) * coil_resistance_ohm(m.thermal_network, m.T_ref_C, T_C);
 }
 
 Report compensate_report(const Model& m, const CompensateRequest& req, const CompensateResult& res,

@@ -37,9 +37,12 @@ Table roots_table(const std::string& name, const std::vector<std::complex<double
 
 }  // namespace
 
-StateSpace linearize_plant(const Model& m, double temperature_C, double bias_A) {
-  const Conditions c = make_conditions(m, temperature_C);
+StateSpace linearize_plant(const Model& m, const Conditions& c, double bias_A) {
   return state_space(m, linearise(m, c, settle_at_bias(m, c, bias_A, BiasState::Anhysteretic)));
+}
+
+StateSpace linearize_plant(const Model& m, double temperature_C, double bias_A) {
+  return linearize_plant(m, make_conditions(m, temperature_C), bias_A);
 }
 
 Report linearize_report(const Model& m, const StateSpace& ss) {

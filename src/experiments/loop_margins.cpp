@@ -148,8 +148,8 @@ LoopMargins pid_loop_margins(const StateSpace& plant, const PidGains& g, double 
                              double plant_dt_s, double amplifier_A_per_unit) {
   const double Ts = 1.0 / sample_rate_Hz;
   const SampledPlant p = sample(plant, Ts, plant_dt_s);
-  const SampledPid c{amplifier_A_per_unit, g.kp, g.ki * g.reference_rate_Hz / sample_rate_Hz,
-                     g.kd * sample_rate_Hz / g.reference_rate_Hz};
+  const Pid::PerSample k = Pid::per_sample(g, sample_rate_Hz);
+  const SampledPid c{amplifier_A_per_unit, k.kp, k.ki, k.kd};
   LoopMargins out;
   out.temperature_C = plant.temperature_C;
   unit_circle_margins(p, c, Ts, out);

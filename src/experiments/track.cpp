@@ -28,12 +28,17 @@ namespace gmasim {
 // ---------------------------------------------------------------------------------------
 // PID
 // ---------------------------------------------------------------------------------------
+Pid::PerSample Pid::per_sample(const PidGains& g, double sample_rate_Hz) {
+  return {g.kp, g.ki * g.reference_rate_Hz / sample_rate_Hz,
+          g.kd * sample_rate_Hz / g.reference_rate_Hz};
+}
+
 Pid::Pid(const PidGains& g, double sample_rate_Hz, double u_min, double u_max)
-    : kp_(g.kp),
-      ki_s_(g.ki * g.reference_rate_Hz / sample_rate_Hz),
-      kd_s_(g.kd * sample_rate_Hz / g.reference_rate_Hz),
-      u_min_(u_min),
-      u_max_(u_max) {
+    : u_min_(u_min), u_max_(u_max) {
+  const PerSample k = per_sample(g, sample_rate_Hz);
+  kp_ = k.kp;
+  ki_s_ = k.ki;
+  kd_s_ = k.kd;
   if (!(sample_rate_Hz > 0.0) || !std::isfinite(sample_rate_Hz))
     throw InputError(fmt::format("PID sample rate {} Hz: must be > 0", sample_rate_Hz));
   if (!(g.reference_rate_Hz > 0.0) || !std::isfinite(g.reference_rate_Hz))
@@ -396,10 +401,10 @@ TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& p
         if (idx == 0) res.example = std::move(ex);
       },
       progress);
-  for (double T : r.temperatures_C)
-    res.margins.push_back(pid_loop_margins(linearize_plant(m, T, r.bias_A), r.gains,
-                                           r.sample_rate_Hz, res.plant_dt_s,
-                                           r.amplifier_A_per_unit * r.feedforward.gain_at(T)));
+  for (std::size_t t = 0; t < conds.size(); ++t)  // each temperature's conditions, made above
+    res.margins.push_back(pid_loop_margins(
+        linearize_plant(m, conds[t], r.bias_A), r.gains, r.sample_rate_Hz, res.plant_dt_s,
+        r.amplifier_A_per_unit * r.feedforward.gain_at(r.temperatures_C[t])));
   res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   for (std::size_t i = 0; i < res.points.size(); ++i)
     res.points[i].error_change_pct =

@@ -213,6 +213,12 @@ struct PidGains {
 // [u_min, u_max]; while clipped, the sum does not grow in the clipping direction.
 class Pid {
  public:
+  // The coefficients of u_k at sample_rate_Hz: kp, Ki Ts = ki f_ref/f_s, Kd/Ts = kd f_s/f_ref
+  // (the update below; pid_loop_margins analyses the same loop).
+  struct PerSample {
+    double kp, ki, kd;
+  };
+  static PerSample per_sample(const PidGains& g, double sample_rate_Hz);
   Pid(const PidGains& g, double sample_rate_Hz, double u_min, double u_max);
   double update(double error);  // one sample; returns u
   void reset();
@@ -471,6 +477,7 @@ Report thermal_report(const Model& m, const ThermalExpansionResult& res);
 // (gmasim/mechanics/state_space.hpp); its report: the states with their units, A, B, C, D, the
 // poles and the zeros of y.
 StateSpace linearize_plant(const Model& m, double temperature_C, double bias_A);
+StateSpace linearize_plant(const Model& m, const Conditions& c, double bias_A);  // at c's T
 Report linearize_report(const Model& m, const StateSpace& ss);
 
 }  // namespace gmasim
