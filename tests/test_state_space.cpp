@@ -108,7 +108,7 @@ TEST(StateSpace, PolesAndZerosGiveTheTransferFunction) {
   double worst = 0.0;
   for (double f = 10.0; f <= 10000.0; f *= 1.3)
     worst = std::max(worst, std::abs(k * zpk(f) / p.ss.response(f) - 1.0));
-  EXPECT_LT(worst, 1e-10);  // observed 8.1e-12
+  EXPECT_LT(worst, 1e-11);  // observed 6.7e-13 (shift-invert; the QZ pencil gave 8.1e-12)
   std::printf("zpk vs state space: %.3g relative\n", worst);
 }
 

@@ -12,15 +12,6 @@ std::vector<std::complex<double>> eigenvalues(const Eigen::MatrixXd& A) {
   return {es.eigenvalues().data(), es.eigenvalues().data() + es.eigenvalues().size()};
 }
 
-std::vector<std::complex<double>> generalized_eigenvalues(const Eigen::MatrixXd& M,
-                                                          const Eigen::MatrixXd& N) {
-  const Eigen::GeneralizedEigenSolver<Eigen::MatrixXd> ges(M, N, false);
-  std::vector<std::complex<double>> z;
-  for (Eigen::Index k = 0; k < ges.alphas().size(); ++k)
-    z.push_back(ges.alphas()(k) / ges.betas()(k));
-  return z;
-}
-
 Eigen::MatrixXd exponential(const Eigen::MatrixXd& A) { return A.exp(); }
 
 }  // namespace gmasim::dense

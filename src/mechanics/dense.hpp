@@ -1,5 +1,5 @@
-// Dense linear algebra of the linearised plant (src/mechanics/dense.cpp): Eigen's eigenvalue,
-// generalized-eigenvalue and matrix-exponential algorithms, each instantiated once for the state
+// Dense linear algebra of the linearised plant (src/mechanics/dense.cpp): Eigen's eigenvalue
+// and matrix-exponential algorithms, each instantiated once for the state
 // space (gmasim/mechanics/state_space.hpp), the PID loop's margins
 // (src/experiments/loop_margins.cpp) and their tests -- they are the heaviest templates of the
 // build.
@@ -13,10 +13,6 @@ namespace gmasim::dense {
 
 // The eigenvalues of A (Eigen::EigenSolver, values only).
 std::vector<std::complex<double>> eigenvalues(const Eigen::MatrixXd& A);
-// The generalized eigenvalues alpha/beta of the pencil (M, N) (Eigen's real QZ); infinite
-// ones (beta = 0) come out non-finite or huge.
-std::vector<std::complex<double>> generalized_eigenvalues(const Eigen::MatrixXd& M,
-                                                          const Eigen::MatrixXd& N);
 // e^A (Eigen's unsupported MatrixFunctions: scaling and squaring with Pade approximants).
 Eigen::MatrixXd exponential(const Eigen::MatrixXd& A);
 

@@ -33,8 +33,8 @@ struct StateSpace {
   double dc_gain(int out = 0) const;
   // Eigenvalues of A [1/s], sorted by imaginary part then real part.
   std::vector<std::complex<double>> poles() const;
-  // The finite transmission zeros of output `out` [1/s]: the finite generalized eigenvalues of
-  // ([A B; C D], [I 0; 0 0]).
+  // The finite transmission zeros of output `out` [1/s]: the eigenvalues of its zero dynamics
+  // (A - B C A^r / (C A^(r-1) B) on ker [C; ...; C A^(r-1)], r the relative degree).
   std::vector<std::complex<double>> zeros(int out = 0) const;
 };
 
