@@ -8,6 +8,7 @@
 
 #include "builtin_models.hpp"
 #include "gmasim/experiments/compensate.hpp"
+#include "gmasim/simulate/simulate.hpp"
 
 using namespace gmasim;
 
@@ -31,4 +32,45 @@ TEST(CompensatePower, CopperLossIsTheSinesRmsSquaredTimesTheWindingsResistance) 
   ASSERT_NE(col, t.columns.end());
   const auto j = static_cast<std::size_t>(col - t.columns.begin());
   EXPECT_EQ(t.rows.at(0).at(j).number, coil_copper_loss_W(m, -3.0, 9.7, 70.0));
+}
+
+// Issue 41: compensate's default target is one every temperature reaches. With the amplifier
+// at 6 A the reference drive's stroke (8 A p-p from -3 A at 20 degC) is beyond the 150 degC
+// reach, so the default target is lowered to that reach -- the stroke of the largest drive,
+// which an independent run reproduces -- and every point is solved; the reference's stroke,
+// given explicitly or with lower_target_to_reach off, leaves 150 degC unreachable.
+TEST(CompensateReach, DefaultTargetIsTheSmallestReachWhenTheReferenceIsBeyondIt) {
+  const Model& m = gmasim_test::mdma();
+  CompensateRequest r;
+  r.temperatures_C = {20.0, 150.0};
+  r.max_current_A = 6.0;
+  r.periods = 2.0;
+  const CompensateResult res = run_compensate(m, r);
+  ASSERT_EQ(res.points.size(), 2u);
+  const CompensatePoint& hot = res.points[1];
+  EXPECT_TRUE(res.target_lowered);
+  EXPECT_LT(res.target_stroke_um, res.reference.stroke_um);
+  EXPECT_EQ(res.target_stroke_um, std::min(res.points[0].reach_stroke_um, hot.reach_stroke_um));
+  SimulationSettings s;
+  s.temperature_C = 150.0;
+  s.waveform = biased_sine(9.0, r.frequency_Hz, -3.0);  // the largest drive: -3 A to 6 A
+  s.periods = r.periods;
+  EXPECT_NEAR(simulate(m, s).metrics.stroke_um, hot.reach_stroke_um, 1e-9);
+  for (const CompensatePoint& p : res.points) {
+    EXPECT_TRUE(p.reachable && !p.diverged) << p.temperature_C << ": " << p.error;
+    EXPECT_NEAR(p.stroke_um, res.target_stroke_um, r.tolerance_um);
+    EXPECT_LE(p.current_max_A, r.max_current_A + 1e-12);
+  }
+  CompensateRequest keep = r;
+  keep.lower_target_to_reach = false;
+  CompensateRequest given = r;
+  given.target_stroke_um = res.reference.stroke_um;
+  for (const CompensateRequest& q : {keep, given}) {
+    const CompensateResult k = run_compensate(m, q);
+    EXPECT_FALSE(k.target_lowered);
+    EXPECT_EQ(k.target_stroke_um, res.reference.stroke_um);
+    EXPECT_TRUE(k.points[0].reachable);
+    EXPECT_FALSE(k.points[1].reachable);
+    EXPECT_EQ(k.points[1].reach_stroke_um, hot.reach_stroke_um);
+  }
 }

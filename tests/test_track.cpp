@@ -207,6 +207,7 @@ TEST(Compensate, UnreachableTargetsAndBadRequestsAreReported) {
   r.temperatures_C = {150.0};
   r.max_current_A = 6.0;  // the reference 5 A peak fits, the hot drive does not
   r.periods = 2.0;
+  r.lower_target_to_reach = false;  // the reference's stroke, reachable or not
   const auto res = gmasim::run_compensate(m, r);
   EXPECT_FALSE(res.points[0].reachable);
   EXPECT_NEAR(res.points[0].current_max_A, 6.0, 1e-12);

@@ -31,51 +31,69 @@ struct CompensateArgs : ExperimentArgs<CompensateRequest> {
 // step of compensate's usual grid (judgement).
 constexpr double kSteadyRiseWarn_K = 10.0;
 
-void print_schedule(const Model& m, const CompensateArgs& a, const CompensateResult& res) {
+void print_target(const CompensateArgs& a, const CompensateResult& res) {
   const auto& r = a.req;
+  const std::string reference =
+      fmt::format("{} A p-p from {} A at {} degC", r.reference_current_pp_A, r.current_min_A,
+                  r.reference_temperature_C);
   fmt::print(
       "  target stroke {:.3f} um ({}); drive: biased sine at {} Hz, adjusting {}; |i| <= {} A\n",
       res.target_stroke_um,
-      r.target_stroke_um > 0.0
-          ? std::string("given")
-          : fmt::format("{} A p-p from {} A at {} degC", r.reference_current_pp_A, r.current_min_A,
-                        r.reference_temperature_C),
+      r.target_stroke_um > 0.0 ? std::string("given")
+      : res.target_lowered     ? "the largest stroke every temperature reaches"
+                               : reference,
       r.frequency_Hz,
       r.adjust == CompensationAdjust::Amplitude ? "the p-p (minimum held)"
       : r.adjust == CompensationAdjust::Swing   ? "the p-p about the mean"
                                                 : "min and p-p together",
       r.max_current_A);
-  fmt::print("  {:>6} {:>9} {:>9} {:>9} {:>8} {:>10} {:>12} {:>8} {:>8} {:>5}\n", "T degC",
-             "i_pp A", "i_min A", "i_max A", "i_pp/ref", "stroke um", "uncomp. um", "hyst um",
-             "P_Cu W", "sims");
-  double P_max = 0.0;
+  if (res.target_lowered)
+    fmt::print(
+        "  the reference drive ({}) gives {:.3f} um, beyond the reach of |i| <= {} A at some "
+        "temperatures (column 'reach um'); --target-stroke {:.3f} keeps it (those temperatures "
+        "are then reported not reachable)\n",
+        reference, res.reference.stroke_um, r.max_current_A, res.reference.stroke_um);
+}
+
+void print_schedule(const Model& m, const CompensateArgs& a, const CompensateResult& res) {
+  print_target(a, res);
+  fmt::print("  {:>6} {:>9} {:>9} {:>9} {:>8} {:>10} {:>11} {:>9} {:>8} {:>8} {:>5}\n", "T degC",
+             "i_pp A", "i_min A", "i_max A", "i_pp/ref", "stroke um", "uncomp. um", "reach um",
+             "hyst um", "P_Cu W", "sims");
   for (const auto& p : res.points) {
     if (p.diverged) {
       fmt::print("  {:6.1f}  diverged: {}\n", p.temperature_C, p.error);
       continue;
     }
     const double P = coil_copper_loss_W(m, p.current_min_A, p.current_pp_A, p.temperature_C);
-    P_max = std::max(P_max, P);
     fmt::print(
-        "  {:6.1f} {:9.4f} {:9.4f} {:9.4f} {:8.4f} {:10.3f} {:12.3f} {:8.3f} {:8.1f} {:5d}{}\n",
+        "  {:6.1f} {:9.4f} {:9.4f} {:9.4f} {:8.4f} {:10.3f} {:11.3f} {:9.3f} {:8.3f} {:8.1f} "
+        "{:5d}{}\n",
         p.temperature_C, p.current_pp_A, p.current_min_A, p.current_max_A, p.gain, p.stroke_um,
-        p.uncompensated_stroke_um, p.hysteresis_um, P, p.evaluations,
+        p.uncompensated_stroke_um, p.reach_stroke_um, p.hysteresis_um, P, p.evaluations,
         p.reachable ? "" : "  not reachable: the largest drive falls short");
   }
   fmt::print(
-      "  i_pp/ref: the schedule's current p-p over the reference's. P_Cu: the coil's copper loss "
-      "I_rms^2 R(T) with the coil at T ({:g} ohm at {:g} degC, thermal_network); the schedule "
-      "holds the actuator at T, the loss heats it: `gmasim simulate --self-heating` shows by how "
-      "much\n",
-      m.thermal_network.coil_resistance_ohm, m.T_ref_C);
-  const double rise_K = P_max / m.thermal_network.G_housing_ambient_W_per_K;
+      "  i_pp/ref: the schedule's current p-p over the reference's. reach: the stroke of the "
+      "largest drive |i| <= {:g} A allows. P_Cu: the coil's copper loss I_rms^2 R(T) with the "
+      "coil at T ({:g} ohm at {:g} degC, thermal_network)\n",
+      a.req.max_current_A, m.thermal_network.coil_resistance_ohm, m.T_ref_C);
+  // The coil-heating line: the schedule holds the actuator at T, the loss heats it.
+  const double G = m.thermal_network.G_housing_ambient_W_per_K;
+  const ScheduleHeating heat = schedule_heating(m, res);
+  const double P_max = heat.max_copper_loss_W, rise_K = heat.steady_rise_K;
+  fmt::print(
+      "  coil heating: the largest loss, {:.1f} W at {:g} degC, over the housing-to-ambient "
+      "conductance {:g} W/K is a steady rise of {:.1f} K; `gmasim simulate --self-heating` gives "
+      "its transient\n",
+      P_max, heat.at_temperature_C, G, rise_K);
   if (rise_K > kSteadyRiseWarn_K)
     print_warning(fmt::format(
         "the schedule drives the coil at up to {:.0f} W of copper loss: in steady state that holds "
         "the housing {:.0f} K above ambient (thermal_network.housing_to_ambient_W_per_K = {:g}), "
         "so the actuator will not stay at the scheduled temperature without cooling; "
         "`gmasim simulate --self-heating` shows it",
-        P_max, rise_K, m.thermal_network.G_housing_ambient_W_per_K));
+        P_max, rise_K, G));
 }
 
 void print_track(const CompensatedTrack& t) {

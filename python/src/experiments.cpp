@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <complex>
+#include <memory>
 
 #include "bindings.hpp"
 #include "gmasim/errors.hpp"
@@ -105,6 +106,44 @@ py::dict track_feedforward(const Model& m, const TrackRequest& r, const std::str
   return report_dict(feedforward_report(m, q, res));
 }
 
+// controller=: a Python callable (reference_um, measured_um, temperature_C) -> current_A, called
+// at every sample of the loop (TrackRequest::controller), with its reset() before each run if
+// it has one. With a controller run_track runs its points one after another in the calling
+// thread, which keeps the GIL (track() does not release it then), so a call costs only the
+// Python call itself: the arguments go by vectorcall, without a tuple. The callable is held by
+// a shared pointer whose deleter takes the GIL, so copies of the request never touch its
+// reference count without it. An exception it raises ends the run and reaches the caller
+// unchanged.
+void attach_controller(TrackRequest& r, const py::object& controller) {
+  if (!PyCallable_Check(controller.ptr()))
+    throw InputError(
+        "track: controller must be a callable (reference_um, measured_um, "
+        "temperature_C) -> current_A, not " +
+        std::string(py::str(py::type::of(controller).attr("__name__"))));
+  auto held = std::shared_ptr<py::object>(new py::object(controller), [](py::object* o) {
+    py::gil_scoped_acquire gil;
+    delete o;
+  });
+  r.controller = [held](double ref_um, double y_um, double T_C) {
+    PyObject* args[3] = {PyFloat_FromDouble(ref_um), PyFloat_FromDouble(y_um),
+                         PyFloat_FromDouble(T_C)};
+    PyObject* out = PyObject_Vectorcall(held->ptr(), args, 3, nullptr);
+    for (PyObject* a : args) Py_XDECREF(a);
+    if (out == nullptr) throw py::error_already_set();
+    const auto i = py::reinterpret_steal<py::object>(out);
+    if (PyFloat_CheckExact(out)) return PyFloat_AS_DOUBLE(out);
+    try {
+      return i.cast<double>();
+    } catch (const py::cast_error&) {
+      throw InputError("track: the controller returned " +
+                       std::string(py::str(py::type::of(i).attr("__name__"))) +
+                       ", not a current in A (a float)");
+    }
+  };
+  if (py::hasattr(controller, "reset"))
+    r.controller_reset = [held] { (*held).attr("reset")(); };
+}
+
 void bind_track(py::module_& mod) {
   def_request<TrackRequest>(
       mod, "track",
@@ -115,17 +154,32 @@ void bind_track(py::module_& mod) {
       "'none': the model itself; 'both'), for each of `controllers` (pid, pid_temperature, "
       "pid_inverse): tables 'runs' (one row per run, rms_error_um), 'ratios' (RMS(pid) / "
       "RMS(controller) over the plants: median, min, max) and 'inverse' (the linear part's "
-      "fitted inverse per temperature). docs/experiments.md, 'Inverse-model feed-forward'",
+      "fitted inverse per temperature). docs/experiments.md, 'Inverse-model feed-forward'.\n"
+      "controller=f replaces the PID by your own: f(reference_um, measured_um, temperature_C) "
+      "-> current_A at every sample (clipped to +-current_limit_A), f.reset() before each run "
+      "if it has one; the runs are then sequential. docs/experiments.md, 'Your controller in "
+      "the loop'",
       [](const Model& m, TrackRequest& r, const std::string& feedforward,
-         const std::string& mismatch, const std::vector<std::string>& controllers) {
+         const std::string& mismatch, const std::vector<std::string>& controllers,
+         const py::object& controller) {
+        if (!controller.is_none()) {
+          if (feedforward != "none")
+            throw InputError(
+                "track: controller= replaces the PID; it cannot be combined with feedforward='" +
+                feedforward + "'");
+          attach_controller(r, controller);
+        }
         if (feedforward != "none")
           return track_feedforward(m, r, feedforward, mismatch, controllers);
-        const TrackResult res = without_gil([&] { return run_track(m, r); });
+        // With a controller the points run in this thread, with the GIL (attach_controller).
+        const TrackResult res =
+            r.controller ? run_track(m, r) : without_gil([&] { return run_track(m, r); });
         return report_dict(track_report(m, r, res));
       },
       Extra<std::string>{"feedforward", "none"}, Extra<std::string>{"mismatch", "all"},
       Extra<std::vector<std::string>>{
-          "controllers", track_controller_names(FeedforwardEvaluationRequest{}.controllers)});
+          "controllers", track_controller_names(FeedforwardEvaluationRequest{}.controllers)},
+      Extra<py::object>{"controller", py::none()});
 }
 
 // compensate(): the drive schedule that restores the stroke, and its tracking.

@@ -116,9 +116,9 @@ void validate_request(const Model& m, const CompensateRequest& r) {
 
 // The drive x in (0, x_hi] whose stroke at temperature T is the target (a root of
 // stroke(x) - target: bracketed from the reference drive, solved by TOMS 748), or x_hi when
-// even that falls short.
+// even that falls short. *reach: x_hi's run at T if already made.
 CompensatePoint solve_point(const detail::RunFn& run_fn, const CompensateRequest& r, double T,
-                            double target, double x_ref, double x_hi) {
+                            double target, double x_ref, double x_hi, const DriveRun* reach) {
   CompensatePoint p;
   p.temperature_C = T;
   int evals = 0;
@@ -130,7 +130,9 @@ CompensatePoint solve_point(const detail::RunFn& run_fn, const CompensateRequest
   };
   try {
     p.uncompensated_stroke_um = stroke(x_ref).stroke_um;
-    Metrics top = stroke(x_hi);
+    if (reach != nullptr && reach->diverged) throw DivergenceError(reach->error);
+    const Metrics top = reach != nullptr ? reach->metrics : stroke(x_hi);
+    p.reach_stroke_um = top.stroke_um;
     double x = x_hi;
     if (top.stroke_um < target) {
       p.reachable = false;  // the point holds the largest drive
@@ -235,11 +237,28 @@ CompensateResult run_compensate(const Model& m, const CompensateRequest& r,
   res.threads = resolve_thread_count(r.threads, r.temperatures_C.size());
   const double x_hi = max_drive(r);
   const double x_ref = reference_drive(r);
+  // A default target is lowered to the smallest reach when the reference's stroke exceeds it:
+  // the largest drive's run at each temperature first (its stroke is the envelope).
+  std::vector<DriveRun> reach;
+  if (r.target_stroke_um == 0.0 && r.lower_target_to_reach) {
+    reach.resize(r.temperatures_C.size());
+    detail::lockstep_searches(m, r.temperatures_C.size(), res.threads, r.lanes,
+                              [&](std::size_t i, const detail::RunFn& run) {
+                                reach[i] = run_drive(run, r, r.temperatures_C[i], x_hi);
+                              },
+                              {});
+    for (const DriveRun& d : reach)
+      if (!d.diverged && d.metrics.stroke_um < res.target_stroke_um) {
+        res.target_stroke_um = d.metrics.stroke_um;
+        res.target_lowered = true;
+      }
+  }
   // One search per temperature; in lanes, the searches' runs advance together (lockstep.hpp).
   detail::lockstep_searches(
       m, r.temperatures_C.size(), res.threads, r.lanes,
       [&](std::size_t i, const detail::RunFn& run) {
-        res.points[i] = solve_point(run, r, r.temperatures_C[i], res.target_stroke_um, x_ref, x_hi);
+        res.points[i] = solve_point(run, r, r.temperatures_C[i], res.target_stroke_um, x_ref, x_hi,
+                                    reach.empty() ? nullptr : &reach[i]);
       },
       progress);
   res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
@@ -268,6 +287,7 @@ TemperatureFeedforward loop_temperature_feedforward(const Model& m, const Compen
   q.current_min_A = treq.bias_A - half;
   q.reference_current_pp_A = 2.0 * half;
   q.target_stroke_um = 0.0;
+  q.lower_target_to_reach = false;  // the gains are relative to the reference drive
   q.max_current_A = treq.current_limit_A;
   q.temperatures_C = treq.temperatures_C;
   std::sort(q.temperatures_C.begin(), q.temperatures_C.end());
@@ -305,6 +325,20 @@ double coil_copper_loss_W(const Model& m, double i_min_A, double i_pp_A, double 
   return (mean * mean + 0.5 * amp * amp) * coil_resistance_ohm(m.thermal_network, m.T_ref_C, T_C);
 }
 
+ScheduleHeating schedule_heating(const Model& m, const CompensateResult& res) {
+  ScheduleHeating h;
+  for (const auto& p : res.points) {
+    if (p.diverged) continue;
+    const double P = coil_copper_loss_W(m, p.current_min_A, p.current_pp_A, p.temperature_C);
+    if (P > h.max_copper_loss_W) {
+      h.max_copper_loss_W = P;
+      h.at_temperature_C = p.temperature_C;
+    }
+  }
+  h.steady_rise_K = h.max_copper_loss_W / m.thermal_network.G_housing_ambient_W_per_K;
+  return h;
+}
+
 Report compensate_report(const Model& m, const CompensateRequest& req, const CompensateResult& res,
                          const CompensatedTrack* track) {
   Report r;
@@ -314,6 +348,11 @@ Report compensate_report(const Model& m, const CompensateRequest& req, const Com
                            req);  // the request's table (gmasim/experiments/experiment_fields.hpp)
   fields::insert_meta_after(r, "frequency_Hz", "target_stroke_um", res.target_stroke_um);
   fields::insert_meta_after(r, "target_stroke_um", "reference_stroke_um", res.reference.stroke_um);
+  fields::insert_meta_after(r, "reference_stroke_um", "target_lowered_to_reach",
+                            res.target_lowered);
+  const ScheduleHeating heat = schedule_heating(m, res);
+  r.meta.emplace_back("max_copper_loss_W", heat.max_copper_loss_W);
+  r.meta.emplace_back("steady_rise_K", heat.steady_rise_K);
   r.meta.emplace_back("wall_time_s", res.wall_time_s);
   Table t;
   t.name = "schedule";
@@ -324,6 +363,7 @@ Report compensate_report(const Model& m, const CompensateRequest& req, const Com
                "gain",
                "stroke_um",
                "uncompensated_stroke_um",
+               "reach_stroke_um",
                "hysteresis_um",
                "B_pp_T",
                "copper_loss_W",
@@ -337,7 +377,8 @@ Report compensate_report(const Model& m, const CompensateRequest& req, const Com
     t.rows.push_back(
         {p.temperature_C, ok ? p.current_pp_A : nan, ok ? p.current_min_A : nan,
          ok ? p.current_max_A : nan, ok ? p.gain : nan, ok ? p.stroke_um : nan,
-         ok ? p.uncompensated_stroke_um : nan, ok ? p.hysteresis_um : nan, ok ? p.B_pp_T : nan,
+         ok ? p.uncompensated_stroke_um : nan, ok ? p.reach_stroke_um : nan,
+         ok ? p.hysteresis_um : nan, ok ? p.B_pp_T : nan,
          ok ? coil_copper_loss_W(m, p.current_min_A, p.current_pp_A, p.temperature_C) : nan,
          p.evaluations, p.reachable, p.diverged ? "diverged" : "ok", p.error});
   }

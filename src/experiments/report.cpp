@@ -112,6 +112,8 @@ Report track_report(const Model& m, const TrackRequest& req, const TrackResult& 
   Report r = base("track", m);
   fields::add_request_meta(r, req);
   fields::insert_meta_after(r, "sample_rate_Hz", "plant_dt_s", res.plant_dt_s);
+  r.meta.emplace_back("controller",
+                      req.controller ? "user (TrackRequest::controller)" : "PID (gains above)");
   r.meta.emplace_back("error_window", "the last whole period of the reference, every plant step");
   r.meta.emplace_back("threads", res.threads);
   r.meta.emplace_back("wall_time_s", res.wall_time_s);

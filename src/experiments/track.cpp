@@ -168,6 +168,10 @@ void detail::check_track_request(const TrackRequest& r) {
   if (!(r.dt_s >= 0.0) || !std::isfinite(r.dt_s))
     throw InputError(fmt::format("dt = {} s (--dt): must be >= 0 (0: the automatic rule)", r.dt_s));
   check_feedforward(r.feedforward);
+  if (r.controller && (r.inverse.enabled || r.feedforward.enabled()))
+    throw InputError(
+        "track: a user controller replaces the PID; it cannot be combined with the inverse or "
+        "the temperature feed-forward (put them in the controller)");
   if (r.inverse.enabled && r.feedforward.enabled())
     throw InputError(
         "track: the inverse and the temperature feed-forward cannot be combined: choose one");
@@ -232,6 +236,7 @@ struct SampledController {
   std::mt19937_64 rng;
   TimeSeries* example;
   InverseFeedforward* inverse;
+  double temperature_C;
   std::normal_distribution<double> noise{0.0, 1.0};
   double I = 0.0, ff_min = 0.0, ff_max = 0.0;
   // The sampled error's sign changes over the last period (from after_s): a loop that rings at
@@ -244,6 +249,17 @@ struct SampledController {
     if (pairs >= 0 && e * e_last < 0.0) ++flips;
     ++pairs;
     e_last = e;
+  }
+
+  // The user controller's current, clipped by the amplifier.
+  double user_current(double tk, double y_meas) {
+    const double i = r.controller(ref.at(tk), y_meas, temperature_C);
+    if (!std::isfinite(i))
+      throw InputError(fmt::format(
+          "track: the controller returned {} A at sample {} (t = {:g} s, {:g} degC): a current "
+          "must be a finite number",
+          i, std::lround(tk / grid.sample_s), tk, temperature_C));
+    return std::clamp(i, -r.current_limit_A, r.current_limit_A);
   }
 
   // With the inverse feed-forward: i = clip(i_ff + a u); the PID's limits follow i_ff.
@@ -262,6 +278,11 @@ struct SampledController {
     const double y_meas =
         s.y_m * 1e6 + r.sensor_noise_um * (r.sensor_noise_um > 0.0 ? noise(rng) : 0.0);
     count_sign(tk, ref.at(tk) - y_meas);
+    if (r.controller) {
+      I = user_current(tk, y_meas);
+      log(s, tk);
+      return I;
+    }
     if (inverse != nullptr) {
       I = with_inverse(tk, ref.at(tk) - y_meas);
       log(s, tk);
@@ -338,7 +359,9 @@ void detail::track_run(const TrackPlant& plant, const TrackRequest& r, const Tra
                             g,
                             std::mt19937_64(seed),
                             example,
-                            plant.inverse};
+                            plant.inverse,
+                            j.T};
+    if (r.controller_reset) r.controller_reset();
     if (plant.inverse != nullptr) plant.inverse->reset();
     ErrorOverLastPeriod err{ref, (t_end - period) + 1e-12 * period};
     drive.after_s = err.after_s;
@@ -382,7 +405,7 @@ TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& p
 
   TrackResult res;
   res.plant_dt_s = 1.0 / r.sample_rate_Hz / static_cast<double>(sub);
-  res.threads = resolve_thread_count(r.threads, jobs.size());
+  res.threads = r.controller ? 1 : resolve_thread_count(r.threads, jobs.size());
   res.points.resize(jobs.size());
   const auto wall0 = std::chrono::steady_clock::now();
   detail::parallel_for(
@@ -401,7 +424,7 @@ TrackResult run_track(const Model& m, const TrackRequest& r, const ProgressFn& p
         if (idx == 0) res.example = std::move(ex);
       },
       progress);
-  for (std::size_t t = 0; t < conds.size(); ++t)  // each temperature's conditions, made above
+  for (std::size_t t = 0; t < conds.size() && !r.controller; ++t)  // the PID's, per temperature
     res.margins.push_back(pid_loop_margins(
         linearize_plant(m, conds[t], r.bias_A), r.gains, r.sample_rate_Hz, res.plant_dt_s,
         r.amplifier_A_per_unit * r.feedforward.gain_at(r.temperatures_C[t])));

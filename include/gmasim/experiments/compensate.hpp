@@ -22,8 +22,10 @@ const char* compensation_adjust_name(CompensationAdjust a);
 CompensationAdjust parse_compensation_adjust(const std::string& name);
 
 struct CompensateRequest {
-  // The target: the stroke of the reference drive at the reference temperature, or
-  // target_stroke_um if > 0.
+  // The target: target_stroke_um if > 0; else the stroke of the reference drive at the
+  // reference temperature, lowered (when lower_target_to_reach) to the smallest of the
+  // temperatures' reach -- the stroke of the largest drive max_current_A allows -- if it
+  // exceeds that, so that every temperature of the schedule reaches the default target.
   double reference_temperature_C = 20.0;
   double reference_current_pp_A = 8.0;
   double current_min_A = -3.0;  // of the reference drive
@@ -39,14 +41,18 @@ struct CompensateRequest {
   // The searches of the temperatures run in lock step, their runs advancing together in SIMD
   // lanes (gmasim/simulate/lanes.hpp) where the model allows; false: one simulate() per run.
   bool lanes = true;
+  // false: a default target stays the reference's stroke even where no drive reaches it (the
+  // temperature feed-forward's schedule, whose gains are relative to the reference drive).
+  bool lower_target_to_reach = true;
 };
 
 struct CompensatePoint {
   double temperature_C = 0;
   double current_pp_A = 0, current_min_A = 0, current_max_A = 0;  // the compensated drive
-  double gain = 0;                       // pp / pp_ref (Amplitude, Swing) or g (Scale) [-]
-  double stroke_um = 0;                  // with the compensated drive
-  double uncompensated_stroke_um = 0;    // with the reference drive at this temperature
+  double gain = 0;                     // pp / pp_ref (Amplitude, Swing) or g (Scale) [-]
+  double stroke_um = 0;                // with the compensated drive
+  double uncompensated_stroke_um = 0;  // with the reference drive at this temperature
+  double reach_stroke_um = 0;          // with the largest drive max_current_A allows (the envelope)
   double hysteresis_um = 0, B_pp_T = 0;  // with the compensated drive
   int evaluations = 0;                   // simulations of the root search
   bool reachable = true;  // false: even max_current_A gives less than the target (the point
@@ -57,7 +63,8 @@ struct CompensatePoint {
 
 struct CompensateResult {
   double target_stroke_um = 0;
-  Metrics reference;  // the reference drive at the reference temperature
+  bool target_lowered = false;  // the reference's stroke was beyond some temperature's reach
+  Metrics reference;            // the reference drive at the reference temperature
   std::vector<CompensatePoint> points;
   double wall_time_s = 0;
   int threads = 0;
@@ -97,6 +104,13 @@ CompensatedTrack run_compensated_track(const Model& m, const CompensateRequest& 
 // [W]: I_rms^2 R(T), I_rms^2 = mean^2 + (i_pp/2)^2 / 2, R(T) = R (1 + alpha (T - T_ref)) of
 // [thermal_network] (the schedule's column copper_loss_W).
 double coil_copper_loss_W(const Model& m, double i_min_A, double i_pp_A, double T_C);
+
+// What a schedule costs the coil: its largest copper loss, where, and the steady rise of the
+// housing above ambient that loss gives over thermal_network.housing_to_ambient_W_per_K [K].
+struct ScheduleHeating {
+  double max_copper_loss_W = 0, at_temperature_C = 0, steady_rise_K = 0;
+};
+ScheduleHeating schedule_heating(const Model& m, const CompensateResult& res);
 
 Report compensate_report(const Model& m, const CompensateRequest& req, const CompensateResult& res,
                          const CompensatedTrack* track = nullptr);

@@ -143,7 +143,7 @@ struct RequestFields<TrackRequest> {
       field<R>("periods", "-", kPeriods, "--periods",
                "Reference periods per run [-]; errors over the last", All, GMASIM_REF(R, periods)),
       field<R>("dt_s", "s", nonnegative(), "--dt",
-               "Plant time step [s]; 0 = automatic (<= 10 us, <= T/2000, divides 1/fs)", Cli,
+               "Plant time step [s]; 0 = automatic (<= 10 us, <= T/2000, divides 1/fs)", kCliPy,
                GMASIM_REF(R, dt_s)),
       threads_row<R>(kCliPy),
       field<R>("feedforward_band_Hz", "Hz", in(0.0, 1e5), "--feedforward-band",

@@ -296,6 +296,16 @@ struct TrackRequest {
   int threads = 0;
   TemperatureFeedforward feedforward;
   InverseFeedforwardRequest inverse;
+  // Your controller in the loop (issue 40, item 4), in place of the PID: called once per
+  // sample with the reference and the measured displacement [um] (noise included) and the
+  // temperature [degC]; it returns the coil current [A], which the amplifier clips to
+  // +-current_limit_A (gains, amplifier scaling and bias are then the controller's own). A
+  // non-finite current stops the run with an InputError naming the sample. controller_reset,
+  // if given, is called before each run (a run per temperature, amplitude and frequency, in
+  // that order). With a controller the runs are sequential (it may hold state) and neither
+  // feed-forward may be set; the margins table stays empty (it is the PID's).
+  std::function<double(double reference_um, double measured_um, double temperature_C)> controller;
+  std::function<void()> controller_reset;
 };
 
 struct TrackPoint {
