@@ -1,0 +1,148 @@
+// gmasim sweep --grid: the sweep crossed with a grid over model keys, each design compiled
+// from the base spec with its values set (include/gmasim/experiments/design_sweep.hpp).
+#include "gmasim/experiments/design_sweep.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <set>
+#include <utility>
+
+#include "gmasim/errors.hpp"
+#include "gmasim/experiments/compensate.hpp"
+#include "gmasim/model/validate.hpp"
+
+namespace gmasim {
+namespace {
+
+// The designs' values: the axes' cartesian product, the first axis slowest.
+std::vector<std::vector<double>> combinations(const std::vector<GridAxis>& axes) {
+  std::vector<std::vector<double>> out{{}};
+  for (const GridAxis& a : axes) {
+    std::vector<std::vector<double>> next;
+    for (const auto& head : out)
+      for (double v : a.values) {
+        next.push_back(head);
+        next.back().push_back(v);
+      }
+    out = std::move(next);
+  }
+  return out;
+}
+
+void check_axes(const ModelSpec& base, const std::vector<GridAxis>& axes) {
+  std::set<std::string> seen;
+  double designs = 1.0;
+  for (const GridAxis& a : axes) {
+    if (a.values.empty())
+      throw InputError(fmt::format("--grid {}: no values (give KEY=v1,v2,...)", a.key));
+    if (!seen.insert(a.key).second)
+      throw InputError(fmt::format("--grid {}: the key is given twice; give each key once", a.key));
+    try {
+      (void)base.get(a.key);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("--grid {}: {}", a.key, e.what()));
+    }
+    designs *= static_cast<double>(a.values.size());
+  }
+  if (designs > kMaxListValues)
+    throw InputError(
+        fmt::format("--grid: {:g} designs (the product of the keys' value counts; "
+                    "limit {:g})",
+                    designs, kMaxListValues));
+}
+
+// The base spec with the design's values set, compiled (its derived quantities follow).
+Model design_model(const ModelSpec& base, const std::vector<GridAxis>& axes,
+                   const std::vector<double>& values) {
+  ModelSpec spec = base;
+  for (std::size_t k = 0; k < axes.size(); ++k) {
+    try {
+      spec.set(axes[k].key, values[k]);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("--grid {}={:g}: {}", axes[k].key, values[k], e.what()));
+    }
+  }
+  return compile(spec);
+}
+
+}  // namespace
+
+DesignSweepResult run_design_sweep(const ModelSpec& base, const std::vector<GridAxis>& axes,
+                                   const SweepRequest& r, const ProgressFn& progress) {
+  check_axes(base, axes);
+  const auto wall0 = std::chrono::steady_clock::now();
+  DesignSweepResult res;
+  res.axes = axes;
+  res.bias_A = FrfRequest{}.bias_A;
+  const auto all = combinations(axes);
+  // Every design compiles before any sweep runs: a value its key's rule refuses stops the
+  // study at once, naming it.
+  std::vector<Model> models;
+  models.reserve(all.size());
+  for (const auto& values : all) models.push_back(design_model(base, axes, values));
+  for (std::size_t d = 0; d < all.size(); ++d) {
+    const Model& m = models[d];
+    DesignPoint p;
+    p.values = all[d];
+    for (const auto& rod : m.rods) p.rods_mass_kg += rod.mass_kg;
+    p.coil_resistance_ohm = m.thermal_network.coil_resistance_ohm;
+    const LinearFrfMarkers lm = linear_frf_markers(m, r.reference_temperature_C, res.bias_A);
+    p.first_resonance_Hz = lm.first_resonance_Hz;
+    p.bandwidth_Hz = lm.bandwidth_3dB_Hz;
+    p.sweep = run_sweep(m, r, progress);
+    for (const SweepPoint& q : p.sweep.points)
+      p.copper_loss_W.push_back(
+          coil_copper_loss_W(m, r.current_min_A, q.current_pp_A, q.temperature_C));
+    for (const SweepPoint& q : p.sweep.reference_points)
+      p.reference_copper_loss_W.push_back(
+          coil_copper_loss_W(m, r.current_min_A, q.current_pp_A, q.temperature_C));
+    res.designs.push_back(std::move(p));
+  }
+  res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return res;
+}
+
+Report design_sweep_report(const Model& base, const SweepRequest& req,
+                           const DesignSweepResult& res) {
+  Report r = sweep_report(base, req, res.designs.empty() ? SweepResult{} : res.designs[0].sweep);
+  r.meta.emplace_back("designs", static_cast<double>(res.designs.size()));
+  r.meta.emplace_back("small_signal_bias_A", res.bias_A);
+  r.meta.emplace_back("design_wall_time_s", res.wall_time_s);
+  const std::vector<std::string> derived = {"rods_mass_kg", "coil_resistance_ohm",
+                                            "first_resonance_Hz", "bandwidth_Hz"};
+  Table designs{"designs", {}, {}};
+  for (const GridAxis& a : res.axes) designs.columns.push_back(a.key);
+  designs.columns.insert(designs.columns.end(), derived.begin(), derived.end());
+  // The points of every design: the axes' values, the derived columns, then the sweep's own.
+  std::vector<Table> points;
+  for (Table& t : r.tables) {
+    Table all{t.name, designs.columns, {}};
+    all.columns.insert(all.columns.end(), t.columns.begin(), t.columns.end());
+    all.columns.insert(all.columns.end() - 2, "coil_copper_loss_W");  // before status, error
+    points.push_back(std::move(all));
+  }
+  for (const DesignPoint& d : res.designs) {
+    std::vector<Cell> head(d.values.begin(), d.values.end());
+    for (double v : {d.rods_mass_kg, d.coil_resistance_ohm, d.first_resonance_Hz, d.bandwidth_Hz})
+      head.emplace_back(v);
+    designs.rows.push_back(head);
+    const Report one = sweep_report(base, req, d.sweep);
+    for (std::size_t t = 0; t < one.tables.size() && t < points.size(); ++t) {
+      const auto& src = one.tables[t];
+      const auto& loss = t == 0 ? d.copper_loss_W : d.reference_copper_loss_W;
+      for (std::size_t i = 0; i < src.rows.size(); ++i) {
+        std::vector<Cell> row = head;
+        row.insert(row.end(), src.rows[i].begin(), src.rows[i].end());
+        row.insert(row.end() - 2, Cell(loss[i]));
+        points[t].rows.push_back(std::move(row));
+      }
+    }
+  }
+  r.tables = std::move(points);
+  r.tables.push_back(std::move(designs));
+  return r;
+}
+
+}  // namespace gmasim
