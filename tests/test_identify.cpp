@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -435,6 +436,16 @@ TEST(Identify, CheckpointRoundTripAndResumeNeverWorse) {
   EXPECT_EQ(b.generations_done, 12);
   EXPECT_LE(b.rms_pct, a.rms_pct);
   EXPECT_GE(b.history.size(), a.history.size());
+  // Issue 41: a second checkpoint appended to the first is refused, not resumed from its first
+  // copy (a truncated one already was).
+  std::stringstream whole;
+  whole << std::ifstream(o.checkpoint_path).rdbuf();
+  std::ofstream(o.checkpoint_path) << whole.str() << whole.str();
+  EXPECT_THAT(input_error([&] { (void)identify(printed_spec(), set, fit, o2); }),
+              HasSubstr("text after the 'end' line ('gmasim-identify-checkpoint 1'): a second "
+                        "checkpoint appended"));
+  std::ofstream(o.checkpoint_path) << whole.str() << "\n\n";  // trailing blank lines are fine
+  EXPECT_TRUE(identify(printed_spec(), set, fit, o2).resumed);
   // Another fit spec cannot resume it.
   IdentifyOptions o3 = o2;
   const FitSpec other = load_fit_spec("rod1.ja.k0_A_per_m:1500:6000:log,material.chi_m:8:60:log");

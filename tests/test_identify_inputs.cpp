@@ -236,3 +236,66 @@ TEST(FitSpec, RejectsBadSpecsWithLine) {
   EXPECT_THAT(input_error([&] { Objective(printed_spec(), none, t); }),
               HasSubstr("t.toml:1: parameter rod1.ja.c0: bound 1.5 is not a valid model value"));
 }
+
+// ---- issue 41: what identify says while and before it searches ----------------------------
+namespace {
+
+IdentifyOptions tiny_search() {
+  IdentifyOptions o;
+  o.islands = 1;
+  o.population = 8;
+  o.generations = 2;
+  o.threads = 1;
+  o.seed = 3;
+  o.objective = gmasim_test::ci_objective();
+  return o;
+}
+
+}  // namespace
+
+// The profile stage (minutes on a measured loop) reports each solve: the parameter being
+// profiled, k of n. chi_m's truth (19.84) is above the bounds, so the optimum sits on the upper
+// bound and its interval is profiled.
+TEST(IdentifyProgress, TheProfileStageReportsEachSolve) {
+  SyntheticRequest rq = ci_request(0.0, 5);
+  rq.temperatures_C = {20};
+  rq.currents_pp_A = {8};
+  rq.frequencies_Hz = {10};
+  const MeasurementSet set = synthesize_measurements(printed_fixture(), rq);
+  const FitSpec fit = load_fit_spec("material.chi_m:8:15:log");
+  IdentifyOptions o = tiny_search();
+  std::vector<IdentifyProgress> seen;
+  o.progress = [&](const IdentifyProgress& p) { seen.push_back(p); };
+  const IdentifyResult r = identify(printed_spec(), set, fit, o);
+  ASSERT_EQ(r.parameters.size(), 1u);
+  EXPECT_EQ(r.parameters[0].ci_method, "profile");
+  long profiles = 0;
+  for (const auto& p : seen)
+    if (p.phase == "profile") {
+      ++profiles;
+      EXPECT_EQ(p.parameter, "material.chi_m");
+      EXPECT_EQ(p.generation, 1);
+      EXPECT_EQ(p.generations, 1);
+      EXPECT_GT(p.evaluations, 0);
+    }
+  EXPECT_GE(profiles, 2);  // at least the march's first point and a refinement
+  EXPECT_EQ(seen.front().phase, "ga");
+}
+
+// A start value the fit moved onto its bound, where the model cannot be evaluated: the message
+// names the start point and what moved, not the start model file (which evaluates).
+TEST(IdentifyProgress, AStartPointMovedOntoABoundThatFailsSaysWhatMoved) {
+  SyntheticRequest rq = ci_request(0.0, 5);
+  rq.temperatures_C = {70};
+  rq.currents_pp_A = {8};
+  rq.frequencies_Hz = {10};
+  const MeasurementSet set = synthesize_measurements(printed_fixture(), rq);
+  // T_c in [40, 60] degC: the fixture's 400 degC moves onto 60, below the record's 70 degC.
+  const FitSpec fit = load_fit_spec("material.Tc_C:40:60");
+  const std::string msg =
+      input_error([&] { (void)identify(printed_spec(), set, fit, tiny_search()); });
+  EXPECT_THAT(msg, HasSubstr("the start point cannot be evaluated"));
+  EXPECT_THAT(msg,
+              HasSubstr("start value material.Tc_C = 400 lies outside [40, 60]: moved onto the "
+                        "bound, the search starts from 60"));
+}

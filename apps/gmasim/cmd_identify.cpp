@@ -243,6 +243,12 @@ int run_identify_body(IdentifyArgs& a, Communicator& comm) {
                      "evaluations/s  %.1f s\n",
                      p.generation, p.generations, p.best_rms_pct, p.evaluations, p.evals_per_s,
                      p.wall_s);
+      } else if (p.phase == "profile") {
+        std::fprintf(stderr,
+                     "gmasim identify: profile %d/%d (%s)  point RMS %.5g %%  %ld evaluations  "
+                     "%.1f s into the profile stage\n",
+                     p.generation, p.generations, p.parameter.c_str(), p.best_rms_pct,
+                     p.evaluations, p.wall_s);
       } else {
         std::fprintf(stderr,
                      "gmasim identify: refine iteration %d  RMS %.5g %%  %ld evaluations  %.1f s\n",

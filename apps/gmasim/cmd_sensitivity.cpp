@@ -36,6 +36,12 @@ struct SensitivityArgs {
 SensitivityParameter parse_param(const std::string& text) {
   const auto colon = text.rfind(':');
   if (colon == std::string::npos) return {text, 0.0};
+  if (text.find(':') != colon)
+    throw InputError(fmt::format(
+        "--param {}: expected NAME or NAME:SCALE (one ':', the absolute step's scale in the "
+        "parameter's unit), e.g. --param material.Ms_A_per_m:1e3; a fit's bounds go in --fit "
+        "(name:lower:upper)",
+        clip_error_message(text)));
   const std::string num = text.substr(colon + 1);
   char* end = nullptr;
   const double s = std::strtod(num.c_str(), &end);

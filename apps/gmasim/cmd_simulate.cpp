@@ -144,6 +144,7 @@ SimulationSettings settings_of(const SimulateArgs& a) {
   s.waveform = make_waveform(a);
   s.periods = a.periods;
   s.duration_s = a.duration_s;
+  s.metrics_window_s = a.metrics_window_s;
   s.dt_s = a.dt_s;
   s.record_every = a.record_every;
   s.progress = stderr_progress("simulate", a.progress);
@@ -201,7 +202,15 @@ void warn_zero_crossing(const Model& m, const SimulateArgs& a, const Waveform& w
 }
 
 void print_metrics(const Result& r, const SimulationSettings& s, const Model& model) {
-  const char* window = s.waveform.periodic() ? "over the last period" : "over the whole run";
+  // The window said: the last period, the run's last S seconds (given, or a table's declared
+  // period), or the whole run (what a waveform that is none of these measures).
+  const double t0 = r.metrics.window_start_s, t1 = r.metrics.window_end_s;
+  const std::string window =
+      s.waveform.periodic() ? std::string("over the last period")
+      : t0 > 0.0
+          ? fmt::format("over the last {:g} s, t {:g}..{:g} s: {}", t1 - t0, t0, t1,
+                        s.metrics_window_s > 0.0 ? "--metrics-window" : "the waveform's period_s")
+          : std::string("over the whole run; --metrics-window S for the last S seconds");
   for (const MetricRow& row : kMetricRows) {  // the table of Metrics (gmasim/simulate.hpp)
     if (row.label.empty()) continue;
     const std::string value =

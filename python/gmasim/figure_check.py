@@ -14,7 +14,10 @@ returns one sentence per defect, using matplotlib's own text extents (every visi
 - a legend that covers a plotted line (a sample of the line, 16 points per segment, inside the
   legend's frame);
 - an axis offset label ("1e-7" above the axis: the unit should be scaled instead), and an
-  annotation that runs outside its axes (into a neighbour, or clipped at the figure's edge).
+  annotation that runs outside its axes (into a neighbour, or clipped at the figure's edge);
+- text under 6 pt; a legend over a tick label; a series of ours drawn with the paper's diamond
+  marker (kept for the paper's values, gid "paper"); a heatmap row or column with no finite
+  value; two panels that draw the same data.
 A figure of several panels needs a title above them all (suptitle); one panel, its own.
 
 :func:`check` raises :class:`FigureProblem` with all of them. :func:`gmasim.plots.save` runs
@@ -241,12 +244,144 @@ def _legend_cover_problems(fig, renderer) -> list[str]:
     return out
 
 
+MIN_FONT_PT = 6.0  # smaller text is unreadable at the figures' 130 dpi and in print
+
+
+def _small_text_problems(fig) -> list[str]:
+    """Text under MIN_FONT_PT points."""
+    return [f"{what} '{t.get_text()[:40]}' is {t.get_fontsize():.3g} pt, under {MIN_FONT_PT:g} pt"
+            for t, what in _texts(fig) if t.get_fontsize() < MIN_FONT_PT]
+
+
+def _legends(fig):
+    out = [leg for leg in fig.legends if leg.get_visible()]
+    for ax in fig.axes:
+        leg = ax.get_legend()
+        if ax.get_visible() and isinstance(leg, Legend) and leg.get_visible():
+            out.append(leg)
+    return out
+
+
+def _legend_tick_problems(fig, renderer, tolerance_px) -> list[str]:
+    """A legend's frame over a tick label of any axes (it hides the scale)."""
+    out = []
+    for leg in _legends(fig):
+        box = leg.get_window_extent(renderer)
+        for ax in fig.axes:
+            if not ax.get_visible() or not ax.axison:
+                continue
+            for axis in (ax.xaxis, ax.yaxis):
+                for t in _visible_ticklabels(axis):
+                    if not t.get_visible() or not t.get_text().strip():
+                        continue
+                    e = t.get_window_extent(renderer)
+                    if min(box.x1, e.x1) - max(box.x0, e.x0) > tolerance_px and \
+                            min(box.y1, e.y1) - max(box.y0, e.y0) > tolerance_px:
+                        out.append(f"a legend covers the tick label '{t.get_text()}' of "
+                                   f"'{ax.get_title() or 'an axes'}'")
+                        break
+    return out
+
+
+PAPER_GID = "paper"  # the gid of the paper's markers (gmasim.plots._mark_paper)
+
+
+def _paper_marker_problems(fig) -> list[str]:
+    """A series of ours drawn with the paper's marker (the diamond), in a plot or a legend."""
+    out = []
+    for ax in fig.axes:
+        for ln in ax.lines:
+            if ln.get_visible() and ln.get_marker() == "D" and ln.get_gid() != PAPER_GID:
+                label = ln.get_label() if not ln.get_label().startswith("_") else "a series"
+                out.append(f"'{label}' in '{ax.get_title() or 'an axes'}' uses the paper's "
+                           "diamond marker")
+    for leg in _legends(fig):  # a legend's handles are copies (no gid): the entry's text says
+        handles = getattr(leg, "legend_handles", None) or getattr(leg, "legendHandles", [])
+        for h, t in zip(handles, leg.get_texts()):
+            if isinstance(h, Line2D) and h.get_marker() == "D" and \
+                    not t.get_text().startswith(PAPER_GID):
+                out.append(f"the legend entry '{t.get_text()[:40]}' uses the paper's diamond marker")
+    return out
+
+
+def _empty_heatmap_problems(fig) -> list[str]:
+    """A heatmap row (or column) with no finite value: an empty band that reads as data."""
+    out = []
+    for ax in fig.axes:
+        for im in ax.images:
+            a = np.ma.masked_invalid(np.ma.asarray(im.get_array(), dtype=float))
+            if a.ndim != 2:
+                continue
+            for axis, what in ((1, "row"), (0, "column")):
+                empty = np.nonzero(np.all(np.ma.getmaskarray(a), axis=axis))[0]
+                if len(empty):
+                    out.append(f"the heatmap of '{ax.get_title() or 'an axes'}' has empty "
+                               f"{what}(s) {', '.join(map(str, empty[:5]))}")
+    return out
+
+
+def _panel_data(ax):
+    """The panel's data, each series scaled by its largest magnitude: two panels that draw
+    the same numbers in two units (µm and % of the stroke) have the same shapes."""
+    def unit(v):
+        v = np.asarray(v, float)
+        m = np.nanmax(np.abs(v)) if v.size and np.any(np.isfinite(v)) else 0.0
+        return v / m if m > 0 else v
+
+    series = []
+    for ln in ax.lines:
+        y = np.asarray(ln.get_ydata(), float)
+        if len(y) > 1:
+            series.append(unit(y))
+    for bars in ax.containers:  # each bar() call a series
+        heights = [p.get_height() for p in bars.patches if hasattr(p, "get_height")]
+        if len(heights) > 1:
+            series.append(unit(heights))
+    return series
+
+
+def _same_data(a, b, rtol=1e-6) -> bool:
+    if len(a) != len(b) or not a:
+        return False
+    for u, v in zip(a, b):
+        if u.shape != v.shape:
+            return False
+        both = np.isfinite(u) & np.isfinite(v)
+        if not np.array_equal(both, np.isfinite(u) | np.isfinite(v)):
+            return False
+        if np.any(np.abs(u[both] - v[both]) > rtol):
+            return False
+    return True
+
+
+def _repeated_panel_problems(fig) -> list[str]:
+    """Two panels that draw the same data, or the same data in another unit (the second tells
+    the reader nothing new)."""
+    out, seen = [], []
+    for ax in fig.axes:
+        if not ax.get_visible() or _is_colorbar(ax):
+            continue
+        data = _panel_data(ax)
+        if not data:
+            continue
+        name = ax.get_title() or ax.get_ylabel() or "an axes"
+        for other, other_name in seen:
+            if _same_data(data, other):
+                out.append(f"panels '{other_name}' and '{name}' draw the same data")
+                break
+        seen.append((data, name))
+    return out
+
+
 def problems(fig, tolerance_px: float = 1.0) -> list[str]:
     """The defects of a figure (an empty list when it reads alone); draws it first."""
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
     return (_label_problems(fig) + _overlap_problems(fig, renderer, tolerance_px)
-            + _legend_cover_problems(fig, renderer) + _layout_problems(fig, renderer))
+            + _legend_cover_problems(fig, renderer) + _layout_problems(fig, renderer)
+            + _small_text_problems(fig) + _legend_tick_problems(fig, renderer, tolerance_px)
+            + _paper_marker_problems(fig) + _empty_heatmap_problems(fig)
+            + _repeated_panel_problems(fig))
 
 
 def check(fig, name: str = "figure") -> None:

@@ -134,7 +134,7 @@ def _mark_paper(ax, x, y, claim, label_text=None):
     if not (np.isfinite(x) and np.isfinite(y)):
         return
     col = _claim_color(claim)
-    ax.plot([x], [y], "D", ms=7, mfc="white", mec=col, mew=1.8, zorder=5)
+    ax.plot([x], [y], "D", ms=7, mfc="white", mec=col, mew=1.8, zorder=5, gid="paper")
     states = getattr(ax.figure, "_gmasim_paper_states", set())
     states.add(claim.get("pass"))
     ax.figure._gmasim_paper_states = states  # the legend explains only the markers drawn
@@ -159,7 +159,7 @@ def _paper_legend(ax, claims=None):
     for state, col, text in ((True, PASS_COLOR, "paper (claim passes)"), (False, FAIL_COLOR, "paper (claim fails, ✗)"),
                              (None, PAPER_COLOR, "paper")):
         if state in kinds:
-            h.append(Line2D([], [], ls="", marker="D", mfc="white", mec=col, mew=1.8))
+            h.append(Line2D([], [], ls="", marker="D", mfc="white", mec=col, mew=1.8, gid="paper"))
             lab.append(text)
     return h, lab
 
@@ -199,7 +199,7 @@ def _temperature_colors(temps):
     return temps, norm, cmap
 
 
-_MARKERS = ("o", "s", "^", "D", "v", "P", "X")
+_MARKERS = ("o", "s", "^", "h", "v", "P", "X")  # no diamond: it marks the paper's values
 _LINESTYLES = ("-", "--", "-.", ":")
 
 
@@ -422,33 +422,58 @@ LAW_LABELS = {"mu_G": "μ_G (eq. 3)", "rho_G": "ρ_G (eq. 8)", "M": "M_s^T (eq. 
 def ablation(ab: Columns, laws: Sequence[str] | None = None,
              title="Ablation: one temperature law frozen at 20 °C", condition="6 A, 70 °C"):
     """Columns law, frequency_Hz, error_rms_um and (when present) error_pct_of_stroke (or `laws`
-    naming the rows in order). The change of the output in % of the stroke, as the paper gives
-    it, beside the same in µm."""
+    naming the rows in order). One panel: the RMS change of the output in µm on a log axis (the
+    laws span six decades), the largest bar of each frequency labelled with its % of the stroke
+    (the paper's unit); a law whose freeze changes nothing is marked 'exactly 0' where its bar
+    would stand."""
     if laws is None:
         laws = list(ab["law"])
     freqs = sorted(set(ab["frequency_Hz"]))
     names = list(dict.fromkeys(laws))
     x = np.arange(len(names))
     w = 0.8 / max(len(freqs), 1)
-    keys = [k for k in ("error_pct_of_stroke", "error_rms_um") if k in ab]
-    ylabels = {"error_pct_of_stroke": "RMS change of the output (% of the stroke)",
-               "error_rms_um": "RMS change of the output (µm)"}
-    fig, axes = plt.subplots(1, len(keys), figsize=(6.0 * len(keys) + 1.4, 4.4), squeeze=False)
-    for ax, key in zip(axes[0], keys):
-        for k, f in enumerate(freqs):
-            vals = []
-            for n in names:
-                idx = [i for i, (law, ff) in enumerate(zip(laws, ab["frequency_Hz"]))
-                       if law == n and np.isclose(ff, f)]
-                vals.append(ab[key][idx[0]] if idx else np.nan)
-            ax.bar(x + (k - (len(freqs) - 1) / 2) * w, vals, w, label=f"{f:g} Hz")
-        ax.set_xticks(x, [LAW_LABELS.get(str(n), str(n)) for n in names], fontsize=8,
-                      rotation=60 if len(names) > 3 else 0, ha="right" if len(names) > 3 else "center",
-                      rotation_mode="anchor")
-        ax.set_xlabel("law whose temperature dependence is frozen")
-        ax.set_ylabel(ylabels[key])
-        ax.grid(alpha=0.3, axis="y")
-    _legend_outside(axes[0][-1], title=f"excitation ({condition})")
+    pct = ab.get("error_pct_of_stroke") if hasattr(ab, "get") else None
+    fig, ax = plt.subplots(figsize=(8.6, 4.6))
+    vals = {}
+    for k, f in enumerate(freqs):
+        v, p = [], []
+        for n in names:
+            idx = [i for i, (law, ff) in enumerate(zip(laws, ab["frequency_Hz"]))
+                   if law == n and np.isclose(ff, f)]
+            v.append(ab["error_rms_um"][idx[0]] if idx else np.nan)
+            p.append(pct[idx[0]] if idx and pct is not None else np.nan)
+        vals[f] = (np.asarray(v, float), np.asarray(p, float))
+    positive = np.concatenate([v[v > 0] for v, _ in vals.values()]) if vals else np.array([])
+    floor = 10 ** np.floor(np.log10(positive.min())) / 3 if positive.size else 1e-6
+    for k, f in enumerate(freqs):
+        v, p = vals[f]
+        xs = x + (k - (len(freqs) - 1) / 2) * w
+        ax.bar(xs, np.where(v > 0, v, np.nan), w, bottom=floor, label=f"{f:g} Hz")
+    # The largest law's change in % of the stroke (the paper's unit), once above its group.
+    first = np.array(vals[freqs[0]][0], float) if freqs else np.array([])
+    first[[str(n) == "all" for n in names]] = np.nan  # the largest single law
+    if first.size and np.any(np.isfinite(first)):
+        top = int(np.nanargmax(first))
+        p_top = [vals[f][1][top] for f in freqs]
+        if all(np.isfinite(p_top)):
+            peak = max(vals[f][0][top] for f in freqs)
+            ax.annotate(" / ".join(f"{q:.1f}" for q in p_top) + " %\nof the stroke", (x[top], peak),
+                        xytext=(0, 3), textcoords="offset points", ha="center", va="bottom",
+                        fontsize=7)
+    for j, n in enumerate(names):
+        if all(vals[f][0][j] == 0 for f in freqs):
+            ax.annotate("exactly 0\n(no drift\nin the model)" if str(n) == "F_pm" else "exactly 0",
+                        (x[j], floor), xytext=(0, 4), textcoords="offset points", ha="center",
+                        va="bottom", fontsize=7, color="0.3")
+    ax.set_yscale("log")
+    ax.set_ylim(floor, positive.max() * 8 if positive.size else 1.0)
+    ax.set_xticks(x, [LAW_LABELS.get(str(n), str(n)) for n in names], fontsize=8,
+                  rotation=60 if len(names) > 3 else 0, ha="right" if len(names) > 3 else "center",
+                  rotation_mode="anchor")
+    ax.set_xlabel("law whose temperature dependence is frozen")
+    ax.set_ylabel("RMS change of the output (µm)")
+    ax.grid(alpha=0.3, axis="y")
+    _legend_outside(ax, title=f"excitation ({condition})")
     fig.suptitle(title)
     fig.tight_layout()
     return fig
@@ -513,7 +538,8 @@ def sensitivity_heatmap(quantities: Sequence[str], parameters: Sequence[str], pe
     S = np.asarray(per_tolerance, dtype=float)
     nq, npar = S.shape
     panels = 2 if correlation is not None else 1
-    fig = plt.figure(figsize=(3.6 + 0.42 * npar * panels + 1.5 * (panels - 1), max(3.4, 2.0 + 0.2 * nq)))
+    fig = plt.figure(figsize=(4.2 + 0.55 * npar * panels + 1.8 * (panels - 1),
+                              max(3.8, 2.4 + 0.26 * nq)))
     ax = fig.add_subplot(1, panels, 1)
     finite = S[np.isfinite(S)]
     vmax = max(float(np.max(np.abs(finite))) if finite.size else 1.0, 1.0)
@@ -522,33 +548,46 @@ def sensitivity_heatmap(quantities: Sequence[str], parameters: Sequence[str], pe
                    interpolation="nearest")
     labels = [q + ("*" if relative_rows is not None and relative_rows[i] else "")
               for i, q in enumerate(quantities)]
-    ax.set_yticks(range(nq), labels, fontsize=6)
-    ax.set_xticks(range(npar), parameters, fontsize=6, rotation=60, ha="right")
-    if nq * npar <= 800:
+    ax.set_yticks(range(nq), labels, fontsize=7)
+    ax.set_xticks(range(npar), parameters, fontsize=7, rotation=60, ha="right",
+                  rotation_mode="anchor")
+    ax.set_xlabel("parameter")
+    ax.set_ylabel("quantity (claim or metric)")
+    fl = np.asarray(flags) if flags is not None else np.full(S.shape, "ok", dtype=object)
+    if nq * npar <= 800:  # the value in each cell, except a crossed-out (flagged) one
         for i in range(nq):
             for j in range(npar):
-                if np.isfinite(S[i, j]) and abs(S[i, j]) >= 0.05:
-                    ax.text(j, i, f"{S[i, j]:.2g}", ha="center", va="center", fontsize=4.5,
+                if np.isfinite(S[i, j]) and abs(S[i, j]) >= 0.05 and fl[i, j] == "ok":
+                    ax.text(j, i, f"{S[i, j]:.2g}", ha="center", va="center", fontsize=6,
                             color="white" if abs(S[i, j]) > 0.3 * vmax else "black")
-    if flags is not None:
-        fl = np.asarray(flags)
-        for i, j in zip(*np.nonzero(fl != "ok")):
-            ax.plot([j - 0.45, j + 0.45], [i - 0.45, i + 0.45], color="black", lw=0.8)
-            ax.plot([j - 0.45, j + 0.45], [i + 0.45, i - 0.45], color="black", lw=0.8)
-    fig.colorbar(im, ax=ax, shrink=0.6, label="Δq per tolerance per unit ln p (or p/s)")
-    ax.set_title(title, fontsize=9)
+    for i, j in zip(*np.nonzero(fl != "ok")):
+        ax.plot([j - 0.45, j + 0.45], [i - 0.45, i + 0.45], color="black", lw=0.8)
+        ax.plot([j - 0.45, j + 0.45], [i + 0.45, i - 0.45], color="black", lw=0.8)
+    # Colour-bar ticks: zero, +-1 tolerance and the extremes, not every decade (they crowd).
+    top = float(10 ** np.floor(np.log10(vmax)))
+    ticks = sorted({-top, -1.0, 0.0, 1.0, top})
+    cb = fig.colorbar(im, ax=ax, shrink=0.8, ticks=ticks)
+    cb.ax.set_yticklabels([f"{t:g}" for t in ticks], fontsize=7)
+    cb.set_label("Δq per tolerance per unit ln p (-)", fontsize=7)
+    ax.set_title("sensitivity (crossed: flagged)", fontsize=8)
     if correlation is not None:
         C = np.asarray(correlation, dtype=float)
         ax2 = fig.add_subplot(1, panels, 2)
         im2 = ax2.imshow(np.ma.masked_invalid(C), cmap="RdBu_r", vmin=-1, vmax=1,
                          interpolation="nearest")
-        ax2.set_xticks(range(npar), parameters, fontsize=6, rotation=60, ha="right")
-        ax2.set_yticks(range(npar), parameters, fontsize=6)
+        ax2.set_xticks(range(npar), parameters, fontsize=7, rotation=60, ha="right",
+                       rotation_mode="anchor")
+        ax2.set_yticks(range(npar), parameters, fontsize=7)
+        ax2.set_xlabel("parameter")
+        ax2.set_ylabel("parameter")
         for i in range(npar):
             for j in range(npar):
                 if np.isfinite(C[i, j]) and i != j and abs(C[i, j]) >= 0.5:
-                    ax2.text(j, i, f"{C[i, j]:.2f}", ha="center", va="center", fontsize=5)
-        fig.colorbar(im2, ax=ax2, shrink=0.6, label="correlation")
-        ax2.set_title("Parameter correlations (from the claims' tolerances)", fontsize=9)
+                    ax2.text(j, i, f"{C[i, j]:.2f}", ha="center", va="center", fontsize=6)
+        cb2 = fig.colorbar(im2, ax=ax2, shrink=0.8, ticks=[-1, -0.5, 0, 0.5, 1])
+        cb2.set_label("correlation (-)", fontsize=7)
+        cb2.ax.tick_params(labelsize=7)
+        ax2.set_title("correlations (from the claims' tolerances)", fontsize=8)
+    fig.suptitle(title, fontsize=9)
     fig.tight_layout()
     return fig

@@ -144,6 +144,22 @@ void attach_controller(TrackRequest& r, const py::object& controller) {
     r.controller_reset = [held] { (*held).attr("reset")(); };
 }
 
+// controller="pid" | "pid_temperature" | "pid_inverse": the built-in controllers of `track
+// --feedforward` on the nominal plant -- the PID, with the temperature schedule about the bias
+// (loop_temperature_feedforward at the evaluation's schedule frequency), or with the dynamic
+// inverse-model feed-forward.
+void builtin_controller(const Model& m, TrackRequest& r, TrackController c) {
+  if (c == TrackController::PidTemperature) {
+    CompensateRequest cq;
+    cq.frequency_Hz = FeedforwardEvaluationRequest{}.schedule_frequency_Hz;
+    r.feedforward = without_gil([&] { return loop_temperature_feedforward(m, cq, r); });
+  }
+  if (c == TrackController::PidInverse) {
+    r.inverse.enabled = true;
+    r.inverse.dynamic = true;
+  }
+}
+
 void bind_track(py::module_& mod) {
   def_request<TrackRequest>(
       mod, "track",
@@ -157,24 +173,32 @@ void bind_track(py::module_& mod) {
       "fitted inverse per temperature). docs/experiments.md, 'Inverse-model feed-forward'.\n"
       "controller=f replaces the PID by your own: f(reference_um, measured_um, temperature_C) "
       "-> current_A at every sample (clipped to +-current_limit_A), f.reset() before each run "
-      "if it has one; the runs are then sequential. docs/experiments.md, 'Your controller in "
-      "the loop'",
+      "if it has one; the runs are then sequential. controller='pid_temperature' or "
+      "'pid_inverse' runs a built-in controller of the feed-forward evaluation on the model "
+      "itself. The result's 'example' holds the first point's run per sample (t_s, "
+      "reference_um, y_um, current_A, error_um). docs/experiments.md, 'Your controller in the "
+      "loop'",
       [](const Model& m, TrackRequest& r, const std::string& feedforward,
          const std::string& mismatch, const std::vector<std::string>& controllers,
          const py::object& controller) {
         if (!controller.is_none()) {
           if (feedforward != "none")
-            throw InputError(
-                "track: controller= replaces the PID; it cannot be combined with feedforward='" +
-                feedforward + "'");
-          attach_controller(r, controller);
+            throw InputError("track: controller= sets the loop's controller; it cannot be "
+                             "combined with feedforward='" +
+                             feedforward + "' (which compares controllers on mismatched plants)");
+          if (py::isinstance<py::str>(controller))
+            builtin_controller(m, r, parse_track_controller(controller.cast<std::string>()));
+          else
+            attach_controller(r, controller);
         }
         if (feedforward != "none")
           return track_feedforward(m, r, feedforward, mismatch, controllers);
-        // With a controller the points run in this thread, with the GIL (attach_controller).
+        // With a callable the points run in this thread, with the GIL (attach_controller).
         const TrackResult res =
             r.controller ? run_track(m, r) : without_gil([&] { return run_track(m, r); });
-        return report_dict(track_report(m, r, res));
+        py::dict d = report_dict(track_report(m, r, res));
+        d["example"] = series_dict(res.example);  // the first point's run, sample by sample
+        return d;
       },
       Extra<std::string>{"feedforward", "none"}, Extra<std::string>{"mismatch", "all"},
       Extra<std::vector<std::string>>{

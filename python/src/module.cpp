@@ -229,6 +229,7 @@ py::dict simulate_py(const Model& m, const SimulateOptions& o, py::object wavefo
   s.dt_s = o.dt_s;
   s.record_every = o.record_every;
   s.duration_s = o.duration_s;
+  s.metrics_window_s = o.metrics_window_s;
   s.freeze = parse_freeze(freeze);
   s.waveform = drive_of(waveform, current_A, current_dt_s, o.kind, o.current_pp_A, o.frequency_Hz,
                         o.current_min_A);

@@ -92,7 +92,7 @@ def test_a_controllers_faults_are_reported(mdma):
         gmasim.track(mdma, **one, controller=lambda r, y, T: "one amp")
     with pytest.raises(ValueError, match="must be a callable"):
         gmasim.track(mdma, **one, controller=3.0)
-    with pytest.raises(ValueError, match="replaces the PID"):
+    with pytest.raises(ValueError, match="cannot be combined with feedforward='inverse'"):
         gmasim.track(mdma, **one, controller=PaperPid(), feedforward="inverse")
     # The amplifier clips what the controller asks for.
     r = gmasim.track(mdma, **one, controller=lambda r, y, T: 1e6)
@@ -110,3 +110,33 @@ def test_the_c_api_example_runs_the_paper_pid_as_gmasim_track_does(mdma, tempera
     t = gmasim.track(mdma, temperatures_C=[temperature_C], amplitudes_um=[10.0], frequencies_Hz=[10.0])
     assert c["y_bias_um"] == t["points"]["y_bias_um"][0]
     assert c["error_rms_um"] == t["points"]["error_rms_um"][0]
+
+
+def test_four_controllers_on_one_reference_in_one_figure(mdma, tmp_path, monkeypatch, capsys):
+    """examples/user_controller/compare_controllers.py: PID, PID + temperature schedule, PID +
+    inverse feed-forward and a user controller (PID + a static inverse it measures) at
+    70 degC, 10 um, 100 Hz. Each feed-forward must beat the plain PID's RMS error, and the figure
+    must pass the figure check."""
+    import sys
+
+    from conftest import SOURCE_DIR
+    from gmasim import figure_check
+
+    sys.path.insert(0, str(SOURCE_DIR / "examples" / "user_controller"))
+    import compare_controllers as cc
+
+    res = cc.run(mdma, 70.0, 10.0, 100.0)
+    e = {k: r["points"]["error_rms_um"][0] for k, r in res.items()}
+    assert e["pid_inverse"] < 0.5 * e["pid"]
+    assert e["user"] < e["pid"]
+    assert e["pid_temperature"] < e["pid"]
+    t = res["pid"]["example"]["t_s"]
+    for r in res.values():  # one reference, sampled alike
+        np.testing.assert_array_equal(r["example"]["t_s"], t)
+        np.testing.assert_array_equal(r["example"]["reference_um"], res["pid"]["example"]["reference_um"])
+    figure_check.check(cc.figure(res, 70.0, 10.0, 100.0), "compare_controllers")
+    monkeypatch.setenv("GMASIM_FIGURE_CHECK", "1")
+    assert cc.main(["--out", str(tmp_path)]) == 0
+    printed = capsys.readouterr().out
+    assert "RMS / PID" in printed and f"{e['pid_inverse']:9.4f}" in printed
+    assert (tmp_path / "compare_controllers.png").exists()

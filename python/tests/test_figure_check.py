@@ -120,6 +120,12 @@ COMMANDS = [
                                   "--track-amplitudes", "10", "--track-frequencies", "100"]),
     ("ablate", "ablate", ["ablate", "--frequencies", "10", "--periods", "2"]),
     ("params", "params", ["params-vs-temperature", "--temperatures", "20,70,150", "--periods", "2"]),
+    ("track_feedforward", "track_ff", ["track", "--feedforward", "inverse", "--mismatch", "none",
+                                       "--temperatures", "20,70", "--amplitudes", "10",
+                                       "--frequencies", "10,100", "--periods", "2"]),
+    ("sensitivity", "sensitivity", ["sensitivity", "--param", "material.Ms_A_per_m", "--param",
+                                    "material.chi_m", "--claim", "stroke_drop_8A", "--claim",
+                                    "hysteresis_drop_8A"]),
 ]
 
 
@@ -162,7 +168,8 @@ def test_every_figure_the_tool_writes_reads_alone(figure_problems):
     found, _seconds = figure_problems
     expected = {"simulate/simulate", "simulate_heat/simulate", "simulate_heat/self_heating", "frf_small/frf",
                 "frf_large/frf", "sweep/sweep", "track/track", "compensate/compensate", "ablate/ablate",
-                "params/params", "identify/convergence", "reproduce/claims", "reproduce/loops_8A_10Hz",
+                "params/params", "track_ff/track_feedforward", "sensitivity/sensitivity",
+                "identify/convergence", "reproduce/claims", "reproduce/loops_8A_10Hz",
                 "reproduce/sweep_10Hz", "reproduce/frf", "reproduce/track", "reproduce/retention",
                 "reproduce/params_vs_temperature", "reproduce/ablate"}
     assert expected <= set(found), sorted(expected - set(found))

@@ -158,10 +158,18 @@ cd detail::stepped_sine_point(const Model& m, const Conditions& c, const State& 
           is.push_back(st.current_A - r.bias_A);
         });
   } catch (const DivergenceError& e) {  // the point's temperature and frequency, as the lanes
-    throw DivergenceError(fmt::format("frf: the stepped sine at {:g} degC, {:g} Hz diverged: {}",
-                                      c.temperature_C, fr, e.what()));
+    throw DivergenceError(stepped_sine_divergence(r, c.temperature_C, fr, e.what()));
   }
   return first_harmonic_ratio(ts, ys, is, fr);
+}
+
+std::string detail::stepped_sine_divergence(const FrfRequest& r, double temperature_C, double f_Hz,
+                                            const std::string& why) {
+  return fmt::format(
+      "frf: the stepped sine of +-{:g} A (--amplitude) about the {:g} A bias at {:g} degC, {:g} Hz "
+      "diverged: {}; a smaller --amplitude stays nearer the bias (the small-signal default is "
+      "1e-4 A)",
+      r.amplitude_A, r.bias_A, temperature_C, f_Hz, why);
 }
 
 namespace {

@@ -26,6 +26,10 @@ struct SteppedSineGrid {
 SteppedSineGrid stepped_sine_grid(const SmallSignalModel& lin, const FrfRequest& r, double fr);
 
 // A stepped-sine point's drive at t_s: the bias plus the amplitude's sine at f_Hz [A].
+// The message of a stepped sine that diverged: its temperature, frequency, amplitude (named by
+// its flag: a large --amplitude is the usual cause) and bias, then the run's diagnosis.
+std::string stepped_sine_divergence(const FrfRequest& r, double temperature_C, double f_Hz,
+                                    const std::string& why);
 inline double stepped_sine_current_A(const FrfRequest& r, double f_Hz, double t_s) {
   return r.bias_A + r.amplitude_A * std::sin(2.0 * physics::kPi * f_Hz * t_s);
 }

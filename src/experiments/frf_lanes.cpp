@@ -59,8 +59,7 @@ void run_batch(const Model& m, const std::vector<Conditions>& conds, const std::
       if (q > pts[k].sg.grid.steps) continue;
       if (batch.diverged(k))  // the point's temperature and frequency, then the run's diagnosis
         throw DivergenceError(
-            fmt::format("frf: the stepped sine at {:g} degC, {:g} Hz diverged: {}",
-                        cs[k]->temperature_C, pts[k].f_Hz, batch.error(k)));
+            stepped_sine_divergence(r, cs[k]->temperature_C, pts[k].f_Hz, batch.error(k)));
       if (q <= pts[k].sg.first) continue;
       sums[k].add(t1[k], pts[k].f_Hz, batch.y_m(k) - pts[k].y0_m, current[k] - r.bias_A);
     }

@@ -344,7 +344,7 @@ class GaRun {
     h.evals_per_s = dt > 0 ? static_cast<double>(epoch_evals) / dt : 0.0;
     out_.history.push_back(h);
     if (rank_ == 0 && o_.progress) {
-      o_.progress({"ga", out_.generation, o_.generations, out_.best_f, out_.evaluations,
+      o_.progress({"ga", out_.generation, o_.generations, "", out_.best_f, out_.evaluations,
                    h.evals_per_s, h.wall_s});
     }
   }

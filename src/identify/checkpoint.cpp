@@ -12,6 +12,7 @@
 
 #include "common/text_io.hpp"
 #include "gmasim/errors.hpp"
+#include "gmasim/model/validate.hpp"
 #include "internal.hpp"
 
 namespace gmasim::identify_detail {
@@ -285,6 +286,16 @@ Checkpoint read_checkpoint(const std::string& path) {
     c.rank_islands.push_back(std::move(isl));
   }
   if (in.next() != "end") in.fail("missing 'end' line");
+  // Text after 'end' is not ours: a second checkpoint appended (cat a b > c) or a file
+  // overwritten in place. Resuming from the first copy would hide it.
+  while (in.pos < in.lines.size()) {
+    const std::string& l = in.lines[in.pos++];
+    if (l.find_first_not_of(" \t\r") != std::string::npos)
+      in.fail(
+          fmt::format("text after the 'end' line ('{}'): a second checkpoint appended, or "
+                      "another file's text; resume from a checkpoint gmasim wrote whole",
+                      clip_for_message(l)));
+  }
   return c;
 }
 

@@ -31,9 +31,12 @@ class Profiler {
     prof_.lowest_u = u;
   }
 
-  // The interval of u_j, spending at most `allowance` evaluations; `cut` is set when the
-  // allowance ended a side early.
-  std::pair<double, double> interval(std::size_t j, long allowance, bool& cut) {
+  // The interval of u_j, the k-th of n to profile, spending at most `allowance` evaluations;
+  // `cut` is set when the allowance ended a side early.
+  std::pair<double, double> interval(std::size_t j, std::size_t k, std::size_t n, long allowance,
+                                     bool& cut) {
+    k_ = k;
+    n_ = n;
     end_ = allowance < 0 ? -1 : ev_.evaluations() + allowance;
     cut = false;
     double edge[2] = {0.0, 1.0};
@@ -68,6 +71,12 @@ class Profiler {
     if (ro.f < prof_.lowest_f) {  // a point better than the optimum: kept even if capped
       prof_.lowest_f = ro.f;
       prof_.lowest_u = ro.u;
+    }
+    if (comm_.rank() == 0 && o_.progress) {  // the stage can take minutes: say where it is
+      const double wall =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0_).count();
+      o_.progress({"profile", static_cast<int>(k_ + 1), static_cast<int>(n_), obj_.names()[j], ro.f,
+                   ev_.evaluations(), 0.0, wall});
     }
     if (ro.capped) return std::nullopt;  // not minimised over the others: no profile value
     return chi;
@@ -119,6 +128,8 @@ class Profiler {
 
   const Objective& obj_;
   BatchEvaluator& ev_;
+  std::size_t k_ = 0, n_ = 0;  // the parameter being profiled, of n (progress)
+  std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
   const std::vector<double>& u_;
   double chi_opt_, thr_;
   const IdentifyOptions& o_;
@@ -271,7 +282,7 @@ void set_profile_intervals(const Objective& obj, BatchEvaluator& ev, const std::
         prof.budget < 0 ? -1
                         : std::max(0L, prof.budget - spent) / static_cast<long>(todo.size() - k);
     bool cut = false;
-    const auto [ulo, uhi] = profiler.interval(j, allowance, cut);
+    const auto [ulo, uhi] = profiler.interval(j, k, todo.size(), allowance, cut);
     std::vector<double> a = u, b = u;
     a[j] = ulo;
     b[j] = uhi;

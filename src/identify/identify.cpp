@@ -1,6 +1,7 @@
 // identify(): GA (archipelago.cpp) -> Levenberg-Marquardt (refine.cpp) -> covariance
 // (covariance.cpp) -> per-condition report at the optimum.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <chrono>
 #include <cmath>
@@ -85,6 +86,14 @@ void check_start_evaluates(const Objective& obj, const std::vector<double>& u_st
                            const std::string& source) {
   if (f_start < Objective::kPenalty) return;
   const std::string why = obj.failure_reason(u_start);
+  // The start point is the model's values unless the fit spec gave a start or a value was moved
+  // into its bounds: then the model file may evaluate fine, and the message says what moved.
+  if (!obj.notes().empty())
+    throw InputError(fmt::format(
+        "the start point cannot be evaluated on the data and targets (--data, --fit): {}; it is "
+        "the start model {} (--model) with the fit's changes:\n  {}\nchange the start values or "
+        "the bounds in the fit spec (--fit) before searching",
+        why.empty() ? "its error is not finite" : why, source, fmt::join(obj.notes(), "\n  ")));
   throw InputError(fmt::format(
       "the start model {} (--model) cannot be evaluated on the data and targets (--data, "
       "--fit): {}{}",
@@ -109,7 +118,7 @@ void refine_champion(const Objective& obj, BatchEvaluator& ev, const GaOutcome& 
       h.wall_s = wall_before + std::chrono::duration<double>(Clock::now() - t0).count();
       res.history.push_back(h);
       if (comm.rank() == 0 && o.progress)
-        o.progress({"refine", it, o.refine_iterations, rms, h.evaluations, 0.0, h.wall_s});
+        o.progress({"refine", it, o.refine_iterations, "", rms, h.evaluations, 0.0, h.wall_s});
     };
     RefineOutcome ro = refine_lm(obj, ev, u, o, comm, on_iter);
     res.refine_summary = ro.summary;

@@ -2,6 +2,7 @@
 // (and optionally flux density) at every compared sample, plus scalar targets. The sum of
 // squares of the residuals is the square of the weighted RMS error in % of peak-to-peak.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cmath>
@@ -103,7 +104,25 @@ Param make_param(const ModelSpec& start, const FitSpec& fit, const FitParameter&
   return p;
 }
 
+// Every fitted name the start model does not know (an old unit-less spelling, a typo), all of
+// them in one message rather than the first alone (issue 41).
+void check_parameter_names(const Objective::Impl& I) {
+  std::vector<std::string> bad;
+  for (const auto& fp : I.fit.parameters) {
+    try {
+      (void)I.start.key_of(fp.name);
+    } catch (const InputError& e) {
+      bad.push_back(located(I.fit.source, fp.line, e.what()));
+    }
+  }
+  if (bad.size() == 1) throw InputError(bad.front());
+  if (bad.size() > 1)
+    throw InputError(fmt::format("{} of the fit's {} parameter names are not the model's:\n  {}",
+                                 bad.size(), I.fit.parameters.size(), fmt::join(bad, "\n  ")));
+}
+
 void add_parameters(Objective::Impl& I) {
+  check_parameter_names(I);
   std::set<std::string> seen;
   for (const auto& fp : I.fit.parameters) {
     const Param p = make_param(I.start, I.fit, fp, seen);
@@ -115,11 +134,14 @@ void add_parameters(Objective::Impl& I) {
     const auto& fp = I.fit.parameters[j];
     const Param& p = I.params[j];
     double v = fp.has_start ? fp.start : I.start.params.at(p.key).value;
+    if (fp.has_start && v != I.start.params.at(p.key).value)
+      I.notes.push_back(fmt::format("start value {} = {:g} from the fit spec (the model has {:g})",
+                                    p.key, v, I.start.params.at(p.key).value));
     if (v < p.lo || v > p.hi) {
       const double c = std::clamp(v, p.lo, p.hi);
       I.notes.push_back(
-          fmt::format("start value {} = {:g} lies outside [{:g}, {:g}]: the search "
-                      "starts from {:g}",
+          fmt::format("start value {} = {:g} lies outside [{:g}, {:g}]: moved onto the bound, "
+                      "the search starts from {:g}",
                       p.key, v, p.lo, p.hi, c));
       v = c;
     }

@@ -182,9 +182,21 @@ ModelSpec apply_assignments(ModelSpec spec, const std::vector<std::string>& assi
   if (!options.empty()) spec.set_options(options);
   for (const auto& [shown, name, value] : numbers) {
     double v = 0;
-    if (io_detail::parse_finite(value, v) != io_detail::CellError::None)
+    if (io_detail::parse_finite(value, v) != io_detail::CellError::None) {
+      if (name.starts_with("meta."))  // text: a model's name and description
+        throw InputError(fmt::format(
+            "{} '{}': {} is text, not a parameter; --set changes the model's numbers (and the "
+            "words of options.*): edit [meta] in the file (gmasim model save writes one to edit)",
+            flag, shown, name));
+      try {
+        (void)spec.get(name);  // the parameter exists: the value is what is wrong
+      } catch (const InputError& e) {
+        throw InputError(fmt::format("{} '{}': {}", flag, shown, e.what()));
+      }
       throw InputError(
-          fmt::format("{} '{}': the value '{}' is not a finite number", flag, shown, value));
+          fmt::format("{} '{}': {} takes a number; the value '{}' is not a finite number", flag,
+                      shown, name, value));
+    }
     try {
       spec.set(name, v);
     } catch (const InputError& e) {  // name the flag too (issue 19, item 11)

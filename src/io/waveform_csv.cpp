@@ -33,6 +33,21 @@ void append_row(const std::string& path, long line_no, std::string_view current_
   w.table_current_A.push_back(v[1]);
 }
 
+// A comment line before the header: "# period_s = P" declares the waveform's period (the
+// metrics are over the run's last P seconds); other comments are notes, skipped.
+void read_comment(const std::string& path, long line_no, std::string_view line, Waveform& w) {
+  std::string_view body = io_detail::trim(line.substr(1));
+  const auto eq = body.find('=');
+  if (eq == std::string_view::npos || io_detail::trim(body.substr(0, eq)) != "period_s") return;
+  const std::string_view value = io_detail::trim(body.substr(eq + 1));
+  double P = 0.0;
+  if (io_detail::parse_finite(value, P) != io_detail::CellError::None || !(P > 0.0))
+    throw InputError(located(
+        path, line_no,
+        fmt::format("period_s = '{}': the waveform's period must be a number > 0 s", value)));
+  w.table_period_s = P;
+}
+
 }  // namespace
 
 Waveform load_waveform_csv(const std::string& path) {
@@ -53,7 +68,11 @@ Waveform load_waveform_csv(const std::string& path) {
     rest = nl == std::string_view::npos ? std::string_view{} : rest.substr(nl + 1);
     ++line_no;
     const std::string_view line = io_detail::trim(raw);
-    if (line.empty()) continue;  // blank lines are skipped
+    if (line.empty()) continue;                   // blank lines are skipped
+    if (!header_seen && line.starts_with('#')) {  // comments before the header
+      read_comment(path, line_no, line, w);
+      continue;
+    }
     const auto cells = io_detail::split_cells(line);
     if (!header_seen) {
       if (cells.size() != 2 || cells[0] != kColumns[0] || cells[1] != kColumns[1]) {
@@ -104,6 +123,10 @@ Waveform load_waveform_csv(const std::string& path) {
     throw InputError(located(
         path, line_no, fmt::format("needs at least 2 data rows, found {}", w.table_t_s.size())));
   }
+  if (w.table_period_s > w.table_t_s.back())
+    throw InputError(located(path, 1,
+                             fmt::format("period_s = {:g} s is longer than the waveform ({:g} s)",
+                                         w.table_period_s, w.table_t_s.back())));
   return w;
 }
 

@@ -140,6 +140,12 @@ void build_circuit(const ModelSpec& spec, Model& m) {
            fmt::format("rod '{}' of stack.rods is in no circuit branch: add a "
                        "[[circuit.branches]] with rod = \"{}\"",
                        spec.rods[r], spec.rods[r]));
+  // No coil, no drive: every current would give stroke 0 and a copper loss (issue 41).
+  if (std::none_of(c.branches.begin(), c.branches.end(),
+                   [](const CircuitBranch& b) { return b.coil_turns > 0.0; }))
+    fail(spec, spec.branches.empty() ? 0 : spec.branches.front().line,
+         "no circuit branch carries a coil (coil_turns > 0 in one of [[circuit.branches]]): the "
+         "coil current would drive nothing; give the drive coil's branch its turns");
   finalize_circuit(c, m.rod_count(), spec.source);
 }
 

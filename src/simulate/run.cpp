@@ -58,7 +58,31 @@ namespace {
 struct RunLength {
   StepGrid grid;
   double duration_s = 0;
+  double window_s = 0;  // not a biased sine: the metrics' window, the run's last window_s
 };
+
+// The metrics' window of a waveform that is not a biased sine (SimulationSettings::
+// metrics_window_s): the given one, else a table's declared period, else the whole run.
+double metrics_window(const SimulationSettings& s, double duration_s) {
+  const auto& w = s.waveform;
+  if (!(s.metrics_window_s >= 0.0) || !std::isfinite(s.metrics_window_s))
+    throw InputError(fmt::format(
+        "metrics window = {} s (--metrics-window, metrics_window_s): must be >= 0 (0: {})",
+        s.metrics_window_s, "a table's declared period, else the whole run"));
+  const double W = s.metrics_window_s > 0.0        ? s.metrics_window_s
+                   : w.kind == WaveformKind::Table ? w.table_period_s
+                                                   : 0.0;
+  if (W == 0.0) return duration_s;
+  if (W > duration_s * (1.0 + 1e-12))
+    throw InputError(fmt::format(
+        "metrics window = {:g} s ({}) is longer than the run, {:g} s: give a shorter window or a "
+        "longer run (--duration)",
+        W,
+        s.metrics_window_s > 0.0 ? "--metrics-window"
+                                 : "period_s of " + clip_for_message(w.table_source),
+        duration_s));
+  return std::min(W, duration_s);
+}
 
 // A step the user gave (dt_s, --dt): within [kMinStepDt_s, kMaxStepDt_s], and for a periodic
 // run (or a chirp's highest frequency) at least kMinStepsPerPeriod steps per period.
@@ -87,6 +111,11 @@ RunLength run_length(const SimulationSettings& s) {
   const auto& w = s.waveform;
   check_user_dt(s);
   RunLength L;
+  if (w.periodic() && s.metrics_window_s != 0.0)
+    throw InputError(fmt::format(
+        "metrics window = {:g} s (--metrics-window): a biased sine's metrics are over its last "
+        "period; the window is for the other waveforms (dc, step, chirp, a CSV table)",
+        s.metrics_window_s));
   double dt = s.dt_s > 0.0 ? s.dt_s : auto_dt(w);
   double per_steps = 0.0;  // periodic: steps per period
   if (w.periodic()) {
@@ -103,12 +132,22 @@ RunLength run_length(const SimulationSettings& s) {
     if (!(L.duration_s > 0.0))
       throw InputError(
           fmt::format("duration = {} s (--duration, duration_s): must be > 0", L.duration_s));
-    if (L.duration_s < dt * (1.0 - 1e-9))
+    if (L.duration_s < dt * (1.0 - 1e-9)) {
+      // A table's own span, when no --duration was given, is the file's fault, not the flag's.
+      if (s.duration_s == 0.0 && w.kind == WaveformKind::Table)
+        throw InputError(fmt::format(
+            "{}: the waveform spans {:g} s (its last time), shorter than one time step ({:g} s); "
+            "give samples over a longer span, or --duration, or a shorter --dt",
+            w.table_source.empty() ? std::string("waveform table")
+                                   : clip_for_message(w.table_source),
+            L.duration_s, dt));
       throw InputError(fmt::format(
           "duration = {:g} s (--duration): shorter than one time step ({:g} s); lengthen the run "
           "or give a shorter --dt",
           L.duration_s, dt));
+    }
   }
+  if (!w.periodic()) L.window_s = metrics_window(s, L.duration_s);
   L.grid = StepGrid::covering(
       0.0, L.duration_s, dt,
       w.kind == WaveformKind::Table && !w.table_source.empty()
@@ -120,15 +159,23 @@ RunLength run_length(const SimulationSettings& s) {
         "simulation: {} steps recorded every {} give {:.4g} rows (limit {:g}); record less often "
         "(record_every, --record-every) or shorten the run",
         L.grid.steps, s.record_every, rows, kMaxRecordedRows));
-  // The metrics' window (the last period, or the whole run) must hold enough recorded samples.
-  const double window_steps = w.periodic() ? per_steps : static_cast<double>(L.grid.steps);
+  // The metrics' window (the last period, the given window, or the whole run) must hold enough
+  // recorded samples.
+  const bool whole = !w.periodic() && L.window_s == L.duration_s;
+  const double window_steps = w.periodic() ? per_steps
+                              : whole      ? static_cast<double>(L.grid.steps)
+                                           : std::floor(L.window_s / L.grid.dt_s);
   const double samples = std::floor(window_steps / s.record_every) + (w.periodic() ? 0.0 : 1.0);
   if (samples < kMinMetricSamples)
     throw InputError(fmt::format(
         "record_every = {} (--record-every) with {:g} steps {} records {:g} sample(s) there: the "
         "metrics need at least {:g}; record more often{}",
-        s.record_every, window_steps, w.periodic() ? "per period" : "in the run", samples,
-        kMinMetricSamples, w.periodic() ? "" : " or lengthen the run (--duration)"));
+        s.record_every, window_steps,
+        w.periodic() ? "per period"
+        : whole      ? "in the run"
+                     : "in the metrics window",
+        samples, kMinMetricSamples,
+        w.periodic() ? "" : " or lengthen the window (--metrics-window) or the run (--duration)"));
   return L;
 }
 
@@ -480,6 +527,8 @@ Result run_simulation(const Model& m, const SimulationSettings& s, bool metrics_
   EnergyWindow energy;
   energy.enabled = s.energy_ledger || s.self_heating.enabled;
   if (w.periodic()) energy.start_step = nsteps - std::lround(w.period_s() / L.grid.dt_s);
+  if (!w.periodic() && L.window_s < duration)
+    energy.start_step = std::max(0L, nsteps - std::lround(L.window_s / L.grid.dt_s));
   energy.end_step = nsteps;
   energy.R_ohm = coil_resistance_ohm(m.thermal_network, m.T_ref_C, s.temperature_C);
   const auto wall0 = std::chrono::steady_clock::now();
@@ -513,7 +562,8 @@ Result run_simulation(const Model& m, const SimulationSettings& s, bool metrics_
     r.metrics = compute_metrics(r.series, duration - per, duration);
     r.has_metrics = true;
   } else if (!r.diverged && r.series.rows() >= 3) {
-    r.metrics = compute_metrics(r.series, 0.0, duration);
+    r.metrics =
+        compute_metrics(r.series, L.window_s < duration ? duration - L.window_s : 0.0, duration);
     r.has_metrics = true;
     if (w.kind == WaveformKind::Step) r.step = step_metrics(r.series, w.step_time_s);
   }

@@ -209,5 +209,60 @@ check "quasi-static increments 1e300" 2 "quasi-static increments per range" "$B"
 check "quasi-static increments 0" 2 "quasi-static increments per range" "$B" "${QS[@]}" --quasi-static-increments 0
 check "a quasi-static field loop fits" 0 "" "$B" "${QS[@]}"
 
+# ---- issue 41: the last hostile cases ----------------------------------------------------
+# A model whose circuit carries no coil is refused where it is, not run with stroke 0.
+sed 's/^coil_turns = 500.0.*/coil_turns = 0.0/' "$SRC/models/single_rod.toml" >no_coil.toml
+check "41 no coil in the circuit" 2 "no_coil.toml:[0-9]+: no circuit branch carries a coil" \
+  "$B" model check no_coil.toml
+check "41 --param with two colons names the form" 2 "--param material.Ms_A_per_m:1:2: expected NAME or NAME:SCALE" \
+  "$B" sensitivity --param material.Ms_A_per_m:1:2 --out sens41
+check "41 --set of a text key says it is text" 2 "meta.name is text, not a parameter" \
+  "$B" model save --set 'meta.name=q" # [x]' --out ms41.toml
+check "41 --set of a number with a word" 2 "material.Ms_A_per_m takes a number; the value 'big' is not a finite number" \
+  "$B" model save --set material.Ms_A_per_m=big --out ms41.toml
+check "41 --set of an unknown key with a word" 2 "unknown parameter 'material.colour'" \
+  "$B" model save --set material.colour=red --out ms41.toml
+printf 't_s,current_A\n0,0\n1e-320,1\n' >w_tiny.csv
+check "41 a waveform shorter than a step blames the file" 2 "w_tiny.csv: the waveform spans .* shorter than one time step" \
+  "$B" simulate --waveform w_tiny.csv --out s41
+cat >fit_old_names.toml <<'TOML'
+[[parameter]]
+name = "rod1.ja.k0"
+lower = 1000
+upper = 5000
+[[parameter]]
+name = "material.Ms"
+lower = 5e5
+upper = 9e5
+[[parameter]]
+name = "material.chi_m"
+lower = 8
+upper = 50
+[[target]]
+kind = "stroke_um"
+temperature_C = 20
+current_pp_A = 8
+current_min_A = -3
+frequency_Hz = 10
+value = 50
+TOML
+OLD=("$B" identify --fit fit_old_names.toml --out old.toml --islands 1 --population 8 --generations 1 --no-plots --quiet)
+check "41 every old unit-less fit name reported (count)" 2 "2 of the fit's 3 parameter names are not the model's" "${OLD[@]}"
+check "41 every old unit-less fit name reported (first)" 2 "fit_old_names.toml:1: .*write 'rod1.ja.k0_A_per_m'" "${OLD[@]}"
+check "41 every old unit-less fit name reported (second)" 2 "fit_old_names.toml:5: .*write 'material.Ms_A_per_m'" "${OLD[@]}"
+
+# ---- issue 39 item 3: design studies ----------------------------------------------------
+GRID=("$B" sweep --model single_rod --current-min 0 --currents 4 --temperatures 20 --periods 2)
+check "39 sweep --grid runs two designs" 0 "design rod.length_m=0.08: rods 0.0" \
+  "${GRID[@]}" --grid rod.length_m=0.05,0.08 --out grid1
+ok "39 sweep --grid writes one row per design" test "$(wc -l <grid1/sweep_designs.csv)" -eq 3
+ok "39 sweep --grid puts the key beside every point" grep -q "^rod.length_m," grid1/sweep.csv
+check "39 --grid of an unknown key names it" 2 "--grid rod.colour_m: " \
+  "${GRID[@]}" --grid rod.colour_m=1,2 --out grid2
+check "39 --grid of a value the key refuses" 2 "--grid rod.length_m=-0.01: " \
+  "${GRID[@]}" --grid rod.length_m=0.05,-0.01 --out grid3
+check "39 --grid without values" 2 "--grid 'rod.length_m': expected KEY=v1,v2" \
+  "${GRID[@]}" --grid rod.length_m --out grid4
+
 echo "$pass passed, $fail failed"
 [[ $fail -eq 0 ]]

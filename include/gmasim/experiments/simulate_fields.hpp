@@ -25,6 +25,7 @@ struct SimulateOptions {
   double level_A = 0.0, step_to_A = 0.0, step_time_s = 0.0;               // dc, step
   double f0_Hz = 1.0, f1_Hz = 1000.0, amplitude_A = 1.0, offset_A = 0.0;  // chirp
   double duration_s = 0.0;
+  double metrics_window_s = 0.0;
   bool self_heating = false;
   double thermal_step_s = 0.0;
 };
@@ -77,6 +78,10 @@ struct RequestFields<SimulateOptions> {
       field<R>("duration_s", "s", nonnegative(), "--duration",
                "Run length for dc/step/chirp/CSV waveforms [s] (CSV: default its last time)",
                kCliPy, GMASIM_REF(R, duration_s)),
+      field<R>("metrics_window_s", "s", nonnegative(), "--metrics-window",
+               "Not a biased sine: the metrics over the run's last S seconds [s]; 0 = a CSV's "
+               "declared period (# period_s = P), else the whole run",
+               kCliPy, GMASIM_REF(R, metrics_window_s)),
       field<R>("self_heating", "-", any(), "--self-heating",
                "Let the actuator heat itself: coil copper loss and rod eddy/hysteresis losses "
                "drive the [thermal_network] (coil, rods, housing, ambient); the rods' "

@@ -383,8 +383,9 @@ std::unique_ptr<Communicator> make_mpi_communicator(int* argc, char*** argv);
 // identify()
 // =======================================================================================
 struct IdentifyProgress {
-  std::string phase;                    // "ga" or "refine"
-  int generation = 0, generations = 0;  // GA; refine: iteration
+  std::string phase;                    // "ga", "refine" or "profile"
+  int generation = 0, generations = 0;  // GA; refine: iteration; profile: parameter k of n
+  std::string parameter;                // profile: the parameter being profiled
   double best_rms_pct = 0.0;
   long evaluations = 0;  // all ranks
   double evals_per_s = 0.0;
@@ -422,7 +423,7 @@ struct IdentifyOptions {
   int checkpoint_every = 10;  // generations
   std::string resume_path;
   ObjectiveSettings objective;
-  // Called on rank 0 after every migration epoch and refinement iteration.
+  // Called on rank 0 after every migration epoch, refinement iteration and profile solve.
   std::function<void(const IdentifyProgress&)> progress;
   // Polled between epochs / iterations: true stops cleanly (SIGINT). May be null.
   const std::atomic<bool>* stop = nullptr;

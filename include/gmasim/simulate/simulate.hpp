@@ -33,6 +33,9 @@ struct Waveform {
   // Table (CSV t_s,current_A): linear interpolation, held constant past the ends.
   std::vector<double> table_t_s, table_current_A;
   std::string table_source;
+  // Table: the period the file declares (a "# period_s = P" line before its header), 0 if none:
+  // the metrics are then over the run's last P seconds, as a biased sine's over its last period.
+  double table_period_s = 0.0;
 
   double current_at(double t_s) const;  // [A]
   // BiasedSine's current [A] at a time whose cos(2 pi f t) is given: current_at's formula, for
@@ -75,6 +78,10 @@ struct SimulationSettings {
   double duration_s = 0.0;  // run length for the others (Table: its last time if 0)
   double dt_s = 0.0;        // 0: the automatic rule, auto_dt()
   int record_every = 1;     // decimation of the recorded time series
+  // The metrics' window for a waveform that is not a biased sine: the run's last
+  // metrics_window_s seconds; 0: a table's declared period (table_period_s), else the whole
+  // run. A biased sine's metrics are over its last period (a window > 0 is refused there).
+  double metrics_window_s = 0.0;
   Freeze freeze;
   SelfHeatingSettings self_heating;
   // Called with (steps done, steps in all) about every 1 % of the run (never inside step()).
