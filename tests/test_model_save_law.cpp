@@ -31,9 +31,7 @@ std::vector<std::string> to_preisach_template() {
           "rod.preisach.n_c=2",
           "rod.preisach.c0=0.1",
           "rod.preisach.a0_A_per_m=5947",
-          "rod.preisach.alpha0=-0.0377",
-          "preload.force_N=500",
-          "mechanics.elements.spring.stiffness_N_per_m=2e6"};
+          "rod.preisach.alpha0=-0.0377"};
 }
 
 }  // namespace
@@ -107,4 +105,32 @@ TEST(ModelSaveLaw, AnOmittedOptionAtItsDefaultLeavesTheFile) {
   const ModelSpec ja = load_model_spec(model_path("single_rod.toml"));
   const ModelSpec same = apply_assignments(ja, {"options.magnetisation_law=jiles_atherton"});
   EXPECT_EQ(model_toml(same, "test"), ja.text);
+}
+
+// Issue 39 item 2: the shipped Preisach template is the single-rod template with another law --
+// the same numbers (geometry, material, preload, spring, circuit, thermal network) and options,
+// but for options.magnetisation_law and the law's table ([meta] is text, not a parameter).
+TEST(ModelSaveLaw, ThePreisachTemplateIsTheSingleRodWithAnotherLaw) {
+  const ModelSpec ja = load_model_spec(model_path("single_rod.toml"));
+  const ModelSpec pr = load_model_spec(model_path("single_rod_preisach.toml"));
+  auto law_key = [](const std::string& name) {
+    return name.starts_with("rod.ja.") || name.starts_with("rod.preisach.");
+  };
+  std::size_t shared = 0;
+  for (const auto& [name, pv] : ja.params) {
+    if (law_key(name)) continue;
+    ASSERT_EQ(pr.params.count(name), 1u) << name << " is not in the Preisach template";
+    EXPECT_EQ(pr.params.at(name).value, pv.value) << name;
+    ++shared;
+  }
+  for (const auto& [name, pv] : pr.params) {
+    if (!law_key(name)) {
+      EXPECT_EQ(ja.params.count(name), 1u) << name << " is only in Preisach's";
+    }
+  }
+  EXPECT_GT(shared, 30u);
+  ModelSpec same_law = pr;
+  same_law.set_option("options.magnetisation_law", "jiles_atherton");
+  EXPECT_EQ(same_law.options, ja.options);
+  EXPECT_NE(pr.options, ja.options);
 }
