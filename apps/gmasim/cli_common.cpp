@@ -114,17 +114,20 @@ std::string model_label(const std::string& path) {
                       : path;
 }
 
-std::string shipped_models_dir() {
+std::string beside_executable(const std::string& relative) {
   namespace fs = std::filesystem;
-  if (const char* env = std::getenv("GMASIM_MODELS_DIR"); env && *env) return env;
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  const fs::path dir =
-      ec ? fs::path() : exe.parent_path().parent_path() / "share" / "gmasim" / "models";
-  if (fs::is_directory(dir, ec)) return dir.string();
-  // A binary of the build tree: the source's models.
-  return fs::is_directory(GMASIM_SOURCE_MODELS_DIR, ec) ? std::string(GMASIM_SOURCE_MODELS_DIR)
-                                                        : std::string();
+  if (ec) return {};
+  const fs::path dir = (exe.parent_path().parent_path() / relative).lexically_normal();
+  return fs::is_directory(dir, ec) ? dir.string() : std::string();
+}
+
+// The installed models (<prefix>/share/gmasim/models), or the build tree's copy of them at the
+// same place relative to the executable.
+std::string shipped_models_dir() {
+  if (const char* env = std::getenv("GMASIM_MODELS_DIR"); env && *env) return env;
+  return beside_executable("share/gmasim/models");
 }
 
 std::string resolve_model_path(const std::string& path) {

@@ -60,8 +60,11 @@ std::vector<FileArg> model_inputs(const ModelArgs& a);
 void prepare_output_dir(const std::string& dir, const std::vector<std::string>& stems,
                         const std::vector<FileArg>& inputs);
 
-// The shipped model files (docs/model.md, "Model files"): $GMASIM_MODELS_DIR, else the
-// installed <prefix>/share/gmasim/models beside the executable's bin/; "" if neither.
+// <exe>/../<relative> when that directory exists, else "": how the CLI finds what ships beside
+// it, the same in an install prefix and in the build tree (no absolute path compiled in).
+std::string beside_executable(const std::string& relative);
+// The shipped model files (docs/model.md, "Model files"): $GMASIM_MODELS_DIR, else
+// <exe>/../share/gmasim/models (the installed prefix's, or the build tree's copy); "" if neither.
 std::string shipped_models_dir();
 // A --model value that names no file here but a shipped model ("mdma_printed.toml",
 // "models/mdma_printed.toml"): the shipped file's path; any other value unchanged.

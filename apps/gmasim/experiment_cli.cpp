@@ -113,9 +113,11 @@ std::vector<std::string> write_report(const std::string& dir, const std::string&
   return write_report_files(dir, stem, r);
 }
 
+// The installed package (<prefix>/share/gmasim/python), else the build tree's (<exe>/../python).
 std::string python_package_path() {
-  const char* env = std::getenv("GMASIM_PYTHONPATH");
-  return env != nullptr ? env : GMASIM_PYTHON_PACKAGE_DIR;
+  if (const char* env = std::getenv("GMASIM_PYTHONPATH"); env != nullptr) return env;
+  const std::string installed = beside_executable("share/gmasim/python");
+  return installed.empty() ? beside_executable("python") : installed;
 }
 
 std::string render_plot(const std::string& command, const std::string& dir) {

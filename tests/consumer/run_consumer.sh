@@ -30,6 +30,23 @@ if grep -rl -e "$build" -e "$src/" "$libdir"; then
   echo "package_consumer: the installed CMake package refers to the build or source tree" >&2
   exit 1
 fi
+# Issue 41: a relocatable install -- no build- or source-tree path in the installed CLI, the
+# Python package in the prefix (the CLI's --plot uses it; PYTHONPATH=it imports gmasim).
+if strings "$prefix/bin/gmasim" | grep -e "$build" -e "$src/"; then
+  echo "package_consumer: the installed CLI holds a build- or source-tree path (above)" >&2
+  exit 1
+fi
+[[ -f "$prefix/share/gmasim/python/gmasim/__init__.py" ]] ||
+  { echo "package_consumer: the Python package was not installed" >&2; exit 1; }
+if /usr/bin/python3 -c "import numpy, matplotlib" 2>/dev/null; then
+  (cd "$work" && PYTHONPATH="$prefix/share/gmasim/python" /usr/bin/python3 -c \
+    "import gmasim; r = gmasim.simulate(gmasim.Model(), periods=1); assert r['metrics']['stroke_um'] > 0") ||
+    { echo "package_consumer: the installed Python package does not import" >&2; exit 1; }
+  (cd "$work" && "$prefix/bin/gmasim" simulate --periods 1 --plot --out plot_from_prefix > plot.log 2>&1) ||
+    { cat "$work/plot.log" >&2; echo "package_consumer: --plot failed from the prefix" >&2; exit 1; }
+  [[ -f "$work/plot_from_prefix/simulate.png" ]]
+  echo "installed Python package: imports, and the CLI's --plot draws with it"
+fi
 version="$("$prefix/bin/gmasim" --version)"
 echo "installed CLI: $version"
 [[ "$version" == "gmasim 0.1.0"* ]]
