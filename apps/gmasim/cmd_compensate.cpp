@@ -21,9 +21,7 @@ namespace {
 
 struct CompensateArgs : ExperimentArgs<CompensateRequest> {
   std::string adjust = "amplitude";
-  std::string track_temperatures, track_amplitudes = "10,20", track_frequencies = "10,100";
-  TrackRequest track;
-  bool no_track = false;
+  bool no_track = false;  // CompensateTracking::enabled off
 };
 
 // A steady temperature rise of the housing above this, from the schedule's largest copper loss
@@ -127,34 +125,16 @@ int run_compensate_cmd(CompensateArgs& a) {
   warn_temperatures(model, a.req.temperatures_C, "--temperatures");
   warn_temperatures(model, {a.req.reference_temperature_C}, "--reference-temperature");
   a.req.adjust = parse_compensation_adjust(a.adjust);
-  if (!a.no_track) {
-    a.track.temperatures_C = a.track_temperatures.empty()
-                                 ? a.req.temperatures_C
-                                 : parse_list(a.track_temperatures, "--track-temperatures", "degC");
-    a.track.amplitudes_um = parse_list(a.track_amplitudes, "--track-amplitudes", "um");
-    a.track.frequencies_Hz = parse_list(a.track_frequencies, "--track-frequencies", "Hz");
-    a.track.threads = a.req.threads;
-    // The tracking's numbers under compensate's own flag names, before the schedule's runs
-    // (track's checks named --amplitudes, --frequencies; the schedule's --current-min and
-    // --max-current, for --bias and --current-limit).
-    for (double A : a.track.amplitudes_um)
-      require_positive_at_most(A, kMaxTrackAmplitude_um, "tracking amplitude (--track-amplitudes)",
-                               "um");
-    for (double f : a.track.frequencies_Hz)
-      require_positive_at_most(f, kMaxFrequency_Hz, "tracking frequency (--track-frequencies)",
-                               "Hz");
-    require_positive_at_most(a.track.current_limit_A, kMaxCurrent_A,
-                             "tracking current limit (--current-limit)", "A");
-    require_in(a.track.bias_A, -a.track.current_limit_A, a.track.current_limit_A,
-               "tracking bias current (--bias)", "A");
-  }
+  a.req.tracking.enabled = !a.no_track;
+  // The tracking's numbers under compensate's own flag names, before the schedule's runs.
+  if (a.req.tracking.enabled) (void)compensate_track_request(a.req);
   prepare_output_dir(a.out, {"compensate"}, model_inputs(a.model));
   const CompensateResult res =
       run_compensate(model, a.req, stderr_progress("compensate", a.progress));
   std::unique_ptr<CompensatedTrack> tr;
-  if (!a.no_track)
-    tr = std::make_unique<CompensatedTrack>(run_compensated_track(
-        model, a.req, a.track, stderr_progress("compensate track", a.progress)));
+  if (a.req.tracking.enabled)
+    tr = std::make_unique<CompensatedTrack>(
+        run_compensated_track(model, a.req, stderr_progress("compensate track", a.progress)));
   auto files = write_report(a.out, "compensate", compensate_report(model, a.req, res, tr.get()));
   fmt::print("gmasim compensate  model: {}\n", model_label(a.model));
   print_schedule(model, a, res);
@@ -180,16 +160,6 @@ Runner add_compensate(CLI::App& app) {
         ->check(CLI::IsMember({"amplitude", "swing", "scale"}))
         ->capture_default_str();
     sub->add_flag("--no-track", a.no_track, "Skip the tracking comparison");
-    sub->add_option("--track-temperatures", a.track_temperatures,
-                    "Tracking temperatures [degC]; default: the schedule's");
-    sub->add_option("--track-amplitudes", a.track_amplitudes, "Tracking amplitudes [um]")
-        ->capture_default_str();
-    sub->add_option("--track-frequencies", a.track_frequencies, "Tracking frequencies [Hz]")
-        ->capture_default_str();
-    sub->add_option("--bias", a.track.bias_A, "Tracking: coil bias current [A]")
-        ->capture_default_str();
-    sub->add_option("--current-limit", a.track.current_limit_A, "Tracking: amplifier limit +- [A]")
-        ->capture_default_str();
     // the tracking's flags with --no-track were ignored: a usage error instead
     CLI::Option* no_track = sub->get_option("--no-track");
     for (const char* flag : {"--track-temperatures", "--track-amplitudes", "--track-frequencies",

@@ -140,8 +140,7 @@ void attach_controller(TrackRequest& r, const py::object& controller) {
                        ", not a current in A (a float)");
     }
   };
-  if (py::hasattr(controller, "reset"))
-    r.controller_reset = [held] { (*held).attr("reset")(); };
+  if (py::hasattr(controller, "reset")) r.controller_reset = [held] { (*held).attr("reset")(); };
 }
 
 // controller="pid" | "pid_temperature" | "pid_inverse": the built-in controllers of `track
@@ -183,9 +182,10 @@ void bind_track(py::module_& mod) {
          const py::object& controller) {
         if (!controller.is_none()) {
           if (feedforward != "none")
-            throw InputError("track: controller= sets the loop's controller; it cannot be "
-                             "combined with feedforward='" +
-                             feedforward + "' (which compares controllers on mismatched plants)");
+            throw InputError(
+                "track: controller= sets the loop's controller; it cannot be "
+                "combined with feedforward='" +
+                feedforward + "' (which compares controllers on mismatched plants)");
           if (py::isinstance<py::str>(controller))
             builtin_controller(m, r, parse_track_controller(controller.cast<std::string>()));
           else
@@ -211,29 +211,22 @@ void bind_compensate(py::module_& mod) {
   def_request<CompensateRequest>(
       mod, "compensate",
       "Temperature compensation: the drive restoring the target stroke at each temperature "
-      "(table 'schedule'), and with track=True PID tracking plain vs with temperature "
-      "feed-forward (table 'track'). docs/experiments.md",
-      [](const Model& m, CompensateRequest& r, const std::string& adjust, bool track,
-         std::vector<double> track_amplitudes_um, std::vector<double> track_frequencies_Hz,
-         double bias_A) {
+      "(table 'schedule'), and (unless track=False) PID tracking plain vs with temperature "
+      "feed-forward (table 'track'; track_* arguments, bias_A, current_limit_A: the CLI's "
+      "--track-*, --bias, --current-limit with the same defaults). docs/experiments.md",
+      [](const Model& m, CompensateRequest& r, const std::string& adjust, bool track) {
         r.adjust = parse_compensation_adjust(adjust);
+        r.tracking.enabled = track;
+        if (track) (void)compensate_track_request(r);  // its numbers, before the schedule's runs
         return report_dict(without_gil([&] {
           const CompensateResult res = run_compensate(m, r);
           if (!track) return compensate_report(m, r, res);
-          TrackRequest t;
-          t.temperatures_C = r.temperatures_C;
-          t.amplitudes_um = std::move(track_amplitudes_um);
-          t.frequencies_Hz = std::move(track_frequencies_Hz);
-          t.bias_A = bias_A;
-          t.threads = r.threads;
-          const CompensatedTrack ct = run_compensated_track(m, r, t);
+          const CompensatedTrack ct = run_compensated_track(m, r);
           return compensate_report(m, r, res, &ct);
         }));
       },
       Extra<std::string>{"adjust", compensation_adjust_name(CompensateRequest{}.adjust)},
-      Extra<bool>{"track", false}, Extra<std::vector<double>>{"track_amplitudes_um", {10.0}},
-      Extra<std::vector<double>>{"track_frequencies_Hz", {10.0}},
-      Extra<double>{"bias_A", TrackRequest{}.bias_A});
+      Extra<bool>{"track", CompensateTracking{}.enabled});
 }
 
 // The temperature laws: ablate() (Fig. 20), params_vs_temperature() (Fig. 18-19) and

@@ -129,3 +129,23 @@ def test_track_inverse_feedforward_and_its_figure(mdma, tmp_path):
             w.writerows(zip(*[list(v) for v in table.values()]))
     fig = command_figures.track_feedforward(tmp_path)
     _check_axes(fig)
+
+
+def test_compensate_tracking_defaults_are_the_clis(gmasim_bin):
+    """Issue 41: compensate's tracking options are one table (CompensateTracking) for the CLI
+    and Python, so their defaults agree: tracking on, 10 and 20 um, 10 and 100 Hz, the 1 A bias
+    and the +-10 A limit."""
+    import re
+    import subprocess
+
+    first = gmasim.compensate.__doc__.strip().splitlines()[0]
+    for arg, value in (("track", "True"), ("track_amplitudes_um", "[10.0, 20.0]"),
+                       ("track_frequencies_Hz", "[10.0, 100.0]"), ("track_temperatures_C", "[]"),
+                       ("bias_A", "1.0"), ("current_limit_A", "10.0")):
+        assert re.search(rf"{arg}: [^=]+ = {re.escape(value)}[,)]", first), (arg, first)
+    help_text = subprocess.run([gmasim_bin, "compensate", "--help"], check=True, capture_output=True,
+                               text=True).stdout
+    for flag, value in (("--track-amplitudes", "10,20"), ("--track-frequencies", "10,100"),
+                        ("--bias", "1"), ("--current-limit", "10")):
+        assert re.search(rf"{flag} \S+={re.escape(value)}\b", help_text), (flag, help_text)
+    assert "--no-track" in help_text

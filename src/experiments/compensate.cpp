@@ -320,6 +320,32 @@ CompensatedTrack run_compensated_track(const Model& m, const CompensateRequest& 
   return out;
 }
 
+TrackRequest compensate_track_request(const CompensateRequest& creq) {
+  const CompensateTracking& k = creq.tracking;
+  for (double A : k.amplitudes_um)
+    require_positive_at_most(A, kMaxTrackAmplitude_um, "tracking amplitude (--track-amplitudes)",
+                             "um");
+  for (double f : k.frequencies_Hz)
+    require_positive_at_most(f, kMaxFrequency_Hz, "tracking frequency (--track-frequencies)", "Hz");
+  require_positive_at_most(k.current_limit_A, kMaxCurrent_A,
+                           "tracking current limit (--current-limit)", "A");
+  require_in(k.bias_A, -k.current_limit_A, k.current_limit_A, "tracking bias current (--bias)",
+             "A");
+  TrackRequest t;
+  t.temperatures_C = k.temperatures_C.empty() ? creq.temperatures_C : k.temperatures_C;
+  t.amplitudes_um = k.amplitudes_um;
+  t.frequencies_Hz = k.frequencies_Hz;
+  t.bias_A = k.bias_A;
+  t.current_limit_A = k.current_limit_A;
+  t.threads = creq.threads;
+  return t;
+}
+
+CompensatedTrack run_compensated_track(const Model& m, const CompensateRequest& creq,
+                                       const ProgressFn& progress) {
+  return run_compensated_track(m, creq, compensate_track_request(creq), progress);
+}
+
 double coil_copper_loss_W(const Model& m, double i_min_A, double i_pp_A, double T_C) {
   const double mean = i_min_A + 0.5 * i_pp_A, amp = 0.5 * i_pp_A;
   return (mean * mean + 0.5 * amp * amp) * coil_resistance_ohm(m.thermal_network, m.T_ref_C, T_C);

@@ -21,6 +21,18 @@ enum class CompensationAdjust { Amplitude, Swing, Scale };
 const char* compensation_adjust_name(CompensationAdjust a);
 CompensationAdjust parse_compensation_adjust(const std::string& name);
 
+// The tracking comparison compensate runs beside the schedule (run_compensated_track): the PID of
+// `gmasim track` plain and with the schedule as temperature feed-forward. One struct for the
+// CLI's options and Python's arguments, so their defaults are one (issue 41).
+struct CompensateTracking {
+  bool enabled = true;                          // CLI --no-track, Python track=False: off
+  std::vector<double> temperatures_C;           // empty: the schedule's temperatures
+  std::vector<double> amplitudes_um{10, 20};    // the references' amplitudes [um]
+  std::vector<double> frequencies_Hz{10, 100};  // and frequencies [Hz]
+  double bias_A = TrackRequest{}.bias_A;        // the loop's bias [A]
+  double current_limit_A = TrackRequest{}.current_limit_A;  // the amplifier's +- limit [A]
+};
+
 struct CompensateRequest {
   // The target: target_stroke_um if > 0; else the stroke of the reference drive at the
   // reference temperature, lowered (when lower_target_to_reach) to the smallest of the
@@ -44,6 +56,7 @@ struct CompensateRequest {
   // false: a default target stays the reference's stroke even where no drive reaches it (the
   // temperature feed-forward's schedule, whose gains are relative to the reference drive).
   bool lower_target_to_reach = true;
+  CompensateTracking tracking;
 };
 
 struct CompensatePoint {
@@ -99,6 +112,12 @@ TemperatureFeedforward loop_temperature_feedforward(const Model& m, const Compen
                                                     const ProgressFn& progress = {});
 CompensatedTrack run_compensated_track(const Model& m, const CompensateRequest& creq,
                                        TrackRequest treq, const ProgressFn& progress = {});
+// The tracking of creq.tracking (TrackRequest's defaults otherwise; its temperatures the
+// schedule's when none are given), its numbers checked under compensate's own flag names
+// (--track-amplitudes, --track-frequencies, --bias, --current-limit); then the comparison.
+TrackRequest compensate_track_request(const CompensateRequest& creq);
+CompensatedTrack run_compensated_track(const Model& m, const CompensateRequest& creq,
+                                       const ProgressFn& progress = {});
 
 // The coil's copper loss under a biased sine of p-p i_pp_A from i_min_A with the coil at T_C
 // [W]: I_rms^2 R(T), I_rms^2 = mean^2 + (i_pp/2)^2 / 2, R(T) = R (1 + alpha (T - T_ref)) of

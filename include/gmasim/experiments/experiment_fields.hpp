@@ -11,6 +11,7 @@
 #include "gmasim/experiments/feedforward.hpp"
 #include "gmasim/experiments/request_table.hpp"
 #include "gmasim/experiments/sensitivity.hpp"
+#include "gmasim/experiments/shared_rows.hpp"
 #include "gmasim/model/validate.hpp"
 
 namespace gmasim::fields {
@@ -18,7 +19,6 @@ namespace gmasim::fields {
 inline constexpr unsigned kCliPy = Cli | Python;
 inline constexpr unsigned kCliMeta = Cli | Meta;
 inline constexpr Rule kCurrent = in(-kMaxCurrent_A, kMaxCurrent_A);
-inline constexpr Rule kPeriods = in(1.0, kMaxPeriods);
 
 // Rows that several requests share, spelled once.
 // threads: resolve_thread_count() checks it (0 or 1..kMaxThreads) with its own message.
@@ -54,11 +54,8 @@ struct RequestFields<SweepRequest> {
                "grid)",
                All, GMASIM_REF(R, reference_temperature_C)),
       current_min_row<R>("Minimum of the biased sine [A] (paper: -3 A)"),
-      field<R>("periods", "-", kPeriods, "--periods",
-               "Periods per point [-]; metrics over the last one", All, GMASIM_REF(R, periods)),
-      field<R>("dt_s", "s", nonnegative(), "--dt",
-               "Time step [s]; 0 = automatic rule (T/2000, at most 10 us)", All,
-               GMASIM_REF(R, dt_s)),
+      periods_row<R>("Periods per point [-]; metrics over the last one", All),
+      dt_row<R>("Time step [s]; 0 = automatic rule (T/2000, at most 10 us)", All),
       threads_row<R>(kCliPy),
   };
 };
@@ -140,11 +137,8 @@ struct RequestFields<TrackRequest> {
                GMASIM_REF(R, sensor_noise_um), "sensor_noise_um_rms"),
       field<R>("noise_seed", "-", any(), "--seed", "Seed of the sensor-noise generator [-]",
                kCliMeta, GMASIM_REF(R, noise_seed)),
-      field<R>("periods", "-", kPeriods, "--periods",
-               "Reference periods per run [-]; errors over the last", All, GMASIM_REF(R, periods)),
-      field<R>("dt_s", "s", nonnegative(), "--dt",
-               "Plant time step [s]; 0 = automatic (<= 10 us, <= T/2000, divides 1/fs)", kCliPy,
-               GMASIM_REF(R, dt_s)),
+      periods_row<R>("Reference periods per run [-]; errors over the last", All),
+      dt_row<R>("Plant time step [s]; 0 = automatic (<= 10 us, <= T/2000, divides 1/fs)", kCliPy),
       threads_row<R>(kCliPy),
       field<R>("feedforward_band_Hz", "Hz", in(0.0, 1e5), "--feedforward-band",
                "Fit band of the linear part's inverse [Hz]", kCliPy,
@@ -164,8 +158,7 @@ struct RequestFields<AblateRequest> {
       field<R>("current_pp_A", "A", positive(), "--current-pp", "Current peak-to-peak [A]", All,
                GMASIM_REF(R, current_pp_A)),
       current_min_row<R>(),
-      field<R>("periods", "-", kPeriods, "--periods", "Periods per run [-]; errors over the last",
-               kCliMeta, GMASIM_REF(R, periods)),
+      periods_row<R>("Periods per run [-]; errors over the last", kCliMeta),
       threads_row<R>(Cli),
   };
 };
@@ -185,12 +178,10 @@ struct RequestFields<ParamsVsTemperatureRequest> {
                "Current peak-to-peak values of the retention table [A]; list or range", Cli,
                GMASIM_REF(R, retention_currents_pp_A)),
       current_min_row<R>(),
-      field<R>("periods", "-", kPeriods, "--periods",
-               "Periods per run [-]; statistics over the last", kCliMeta, GMASIM_REF(R, periods)),
-      field<R>("dt_s", "s", nonnegative(), "--dt",
-               "Time step [s]; 0 = automatic rule (T/2000, at most 10 us; gmasim reproduce "
-               "gives the claims' 25 us at 10 Hz)",
-               All, GMASIM_REF(R, dt_s)),
+      periods_row<R>("Periods per run [-]; statistics over the last", kCliMeta),
+      dt_row<R>("Time step [s]; 0 = automatic rule (T/2000, at most 10 us; gmasim reproduce "
+                "gives the claims' 25 us at 10 Hz)",
+                All),
       threads_row<R>(Cli),
   };
 };
@@ -218,15 +209,25 @@ struct RequestFields<CompensateRequest> {
                kCliPy, GMASIM_REF(R, target_stroke_um)),
       field<R>("frequency_Hz", "Hz", in(0.0, kMaxFrequency_Hz), "--frequency",
                "Drive frequency [Hz]", All, GMASIM_REF(R, frequency_Hz)),
-      field<R>("periods", "-", kPeriods, "--periods",
-               "Periods per run; the stroke is over the last [-]", Cli, GMASIM_REF(R, periods)),
+      periods_row<R>("Periods per run; the stroke is over the last [-]", Cli),
       field<R>("max_current_A", "A", in(0.0, kMaxCurrent_A), "--max-current",
                "Largest |current| any drive may reach [A]", All, GMASIM_REF(R, max_current_A)),
       field<R>("tolerance_um", "um", in(1e-9, 1e3), "--tolerance",
                "Stroke tolerance of the solved drive [um]", All, GMASIM_REF(R, tolerance_um)),
-      field<R>("dt_s", "s", nonnegative(), "--dt", "Time step [s]; 0 = automatic rule", Cli,
-               GMASIM_REF(R, dt_s)),
+      dt_row<R>("Time step [s]; 0 = automatic rule", Cli),
       threads_row<R>(kCliPy),
+      // The tracking comparison (CompensateTracking): the CLI's and Python's one set of defaults.
+      field<R>("track_temperatures_C", "degC", finite(), "--track-temperatures",
+               "Tracking temperatures [degC]; default: the schedule's", kCliPy,
+               GMASIM_REF(R, tracking.temperatures_C)),
+      field<R>("track_amplitudes_um", "um", in(0.0, kMaxTrackAmplitude_um), "--track-amplitudes",
+               "Tracking amplitudes [um]", kCliPy, GMASIM_REF(R, tracking.amplitudes_um)),
+      field<R>("track_frequencies_Hz", "Hz", in(0.0, kMaxFrequency_Hz), "--track-frequencies",
+               "Tracking frequencies [Hz]", kCliPy, GMASIM_REF(R, tracking.frequencies_Hz)),
+      field<R>("bias_A", "A", kCurrent, "--bias", "Tracking: coil bias current [A]", kCliPy,
+               GMASIM_REF(R, tracking.bias_A)),
+      field<R>("current_limit_A", "A", in(0.0, kMaxCurrent_A), "--current-limit",
+               "Tracking: amplifier limit +- [A]", kCliPy, GMASIM_REF(R, tracking.current_limit_A)),
   };
 };
 

@@ -12,6 +12,7 @@
 #include <tuple>
 
 #include "gmasim/experiments/request_table.hpp"
+#include "gmasim/experiments/shared_rows.hpp"
 #include "gmasim/model/validate.hpp"
 
 namespace gmasim {
@@ -44,15 +45,11 @@ struct RequestFields<SimulateOptions> {
                "Biased sine: current peak-to-peak [A]", kCliPy, GMASIM_REF(R, current_pp_A)),
       field<R>("frequency_Hz", "Hz", positive(), "--frequency", "Biased sine: frequency [Hz]",
                kCliPy, GMASIM_REF(R, frequency_Hz)),
-      field<R>("periods", "-", in(1.0, kMaxPeriods), "--periods",
-               "Biased sine: number of periods to run [-]; metrics use the last", kCliPy,
-               GMASIM_REF(R, periods)),
+      periods_row<R>("Biased sine: number of periods to run [-]; metrics use the last", kCliPy),
       field<R>("current_min_A", "A", finite(), "--current-min",
                "Biased sine: current minimum [A] (paper: -3 A)", kCliPy,
                GMASIM_REF(R, current_min_A)),
-      field<R>("dt_s", "s", nonnegative(), "--dt",
-               "Time step [s]; 0 = automatic rule (T/2000, at most 10 us)", kCliPy,
-               GMASIM_REF(R, dt_s)),
+      dt_row<R>("Time step [s]; 0 = automatic rule (T/2000, at most 10 us)", kCliPy),
       field<R>("record_every", "-", in(1.0, 2e9), "--record-every",
                "Record every N-th step [-]; not given, a run over 10000 rows writes one row in "
                "ceil(rows/10000) to timeseries.csv (the metrics use every step)",
