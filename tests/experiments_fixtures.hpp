@@ -16,7 +16,7 @@ namespace gmasim_experiments_test {
 using gmasim_test::mdma;
 using gmasim_test::mdma_printed;
 
-inline constexpr double kTwoPi = 2.0 * gmasim::physics::kPi;
+using gmasim::physics::kTwoPi;  // one constant: no ambiguity beside gmasim::physics in a unity file
 
 template <class F>
 std::string input_error_of(F&& f) {

@@ -23,7 +23,8 @@ namespace {
 
 // The sine reference's deviation and derivatives at t (as the tracking loop previews it).
 std::array<double, 4> target_sine(double A_um, double f_Hz, double t) {
-  const double w = kTwoPi * f_Hz, s = A_um * std::sin(w * t), c = A_um * std::cos(w * t);
+  const double w = gmasim::physics::kTwoPi * f_Hz, s = A_um * std::sin(w * t),
+               c = A_um * std::cos(w * t);
   return {s, w * c, -w * w * s, -w * w * w * c};
 }
 
@@ -50,7 +51,7 @@ TEST(Feedforward, LinearInverseInvertsTheSmallSignalResponse) {
   const SmallSignalModel L = linearise(m, c, s);
   const double f = 5.0;  // w a1 << 1: the phase of H is -w a1
   const double phase = std::arg(L.response(f) / L.response(0.0));
-  EXPECT_NEAR(-phase / (kTwoPi * f), lin.a[0], 0.01 * lin.a[0]);
+  EXPECT_NEAR(-phase / (gmasim::physics::kTwoPi * f), lin.a[0], 0.01 * lin.a[0]);
   EXPECT_NEAR(lin.static_gain_um_per_A, std::abs(L.response(0.0)) * 1e6, 1e-9);
   EXPECT_NE(input_error_of([&] { (void)fit_linear_inverse(m, c, 1.0, 0.0); }), "(no InputError)");
 }

@@ -240,6 +240,15 @@ TEST(FitSpec, RejectsBadSpecsWithLine) {
 // ---- issue 41: what identify says while and before it searches ----------------------------
 namespace {
 
+// One noise-free 8 A, 10 Hz record of the printed fixture at T.
+MeasurementSet one_record_at(double T) {
+  SyntheticRequest rq = ci_request(0.0, 5);
+  rq.temperatures_C = {T};
+  rq.currents_pp_A = {8};
+  rq.frequencies_Hz = {10};
+  return synthesize_measurements(printed_fixture(), rq);
+}
+
 IdentifyOptions tiny_search() {
   IdentifyOptions o;
   o.islands = 1;
@@ -257,11 +266,7 @@ IdentifyOptions tiny_search() {
 // profiled, k of n. chi_m's truth (19.84) is above the bounds, so the optimum sits on the upper
 // bound and its interval is profiled.
 TEST(IdentifyProgress, TheProfileStageReportsEachSolve) {
-  SyntheticRequest rq = ci_request(0.0, 5);
-  rq.temperatures_C = {20};
-  rq.currents_pp_A = {8};
-  rq.frequencies_Hz = {10};
-  const MeasurementSet set = synthesize_measurements(printed_fixture(), rq);
+  const MeasurementSet set = one_record_at(20.0);
   const FitSpec fit = load_fit_spec("material.chi_m:8:15:log");
   IdentifyOptions o = tiny_search();
   std::vector<IdentifyProgress> seen;
@@ -285,11 +290,7 @@ TEST(IdentifyProgress, TheProfileStageReportsEachSolve) {
 // A start value the fit moved onto its bound, where the model cannot be evaluated: the message
 // names the start point and what moved, not the start model file (which evaluates).
 TEST(IdentifyProgress, AStartPointMovedOntoABoundThatFailsSaysWhatMoved) {
-  SyntheticRequest rq = ci_request(0.0, 5);
-  rq.temperatures_C = {70};
-  rq.currents_pp_A = {8};
-  rq.frequencies_Hz = {10};
-  const MeasurementSet set = synthesize_measurements(printed_fixture(), rq);
+  const MeasurementSet set = one_record_at(70.0);
   // T_c in [40, 60] degC: the fixture's 400 degC moves onto 60, below the record's 70 degC.
   const FitSpec fit = load_fit_spec("material.Tc_C:40:60");
   const std::string msg =

@@ -71,6 +71,8 @@ Runner add_linearize(CLI::App& app) {
   auto out = std::make_shared<std::string>("out/linearize");
   auto T = std::make_shared<double>(20.0);
   auto bias = std::make_shared<double>(1.0);
+  auto amplitude = std::make_shared<double>(0.0);
+  auto freqs = std::make_shared<std::string>("10,100,1000");
   auto* sub = app.add_subcommand(
       "linearize",
       "The small-signal plant current -> displacement (and -> the induction coil's B) about a DC "
@@ -80,13 +82,25 @@ Runner add_linearize(CLI::App& app) {
   add_model_options(sub, *model);
   sub->add_option("--temperature", *T, "Operating temperature [degC]")->capture_default_str();
   sub->add_option("--bias", *bias, "DC bias current [A] (1 A: the FRF's)")->capture_default_str();
+  sub->add_option("--amplitude", *amplitude,
+                  "Large signal: the describing function at this current amplitude about the bias "
+                  "[A] (the stepped sine of gmasim frf --amplitude), beside the small-signal "
+                  "response; 0: none")
+      ->capture_default_str();
+  sub->add_option("--frequencies", *freqs,
+                  "The describing function's frequencies [Hz]: list or start:step:stop")
+      ->capture_default_str();
   sub->add_option("--out", *out, "Output directory")->capture_default_str();
   return [=]() -> int {
     if (!sub->parsed()) return -1;
     const Model m = load_model_args(*model);
     prepare_output_dir(*out, {"linearize"}, model_inputs(*model));
     const StateSpace ss = linearize_plant(m, *T, *bias);
-    auto files = write_report(*out, "linearize", linearize_report(m, ss));
+    std::vector<DescribingPoint> df;
+    if (*amplitude != 0.0)
+      df = describing_function(m, ss, *amplitude, parse_list(*freqs, "--frequencies", "Hz"));
+    auto files = write_report(*out, "linearize",
+                              linearize_report(m, ss, df.empty() ? nullptr : &df, *amplitude));
     const std::string mat = (std::filesystem::path(*out) / "linearize.mat").string();
     write_mat(mat, ss);
     files.push_back(mat);
@@ -99,6 +113,16 @@ Runner add_linearize(CLI::App& app) {
     for (const auto& p : ss.poles()) fmt::print("    {}\n", complex_text(p));
     fmt::print("  zeros (y):\n");
     for (const auto& z : ss.zeros(0)) fmt::print("    {}\n", complex_text(z));
+    if (!df.empty()) {
+      fmt::print(
+          "  describing function at +-{:g} A about the bias (stepped sine), beside the "
+          "small signal:\n  {:>10} {:>12} {:>10} {:>14} {:>12} {:>7}\n",
+          *amplitude, "f Hz", "|Y/I| um/A", "phase deg", "small um/A", "small deg", "ratio");
+      for (const auto& p : df)
+        fmt::print("  {:10.4g} {:12.5g} {:10.2f} {:14.5g} {:12.2f} {:7.3f}\n", p.f_Hz,
+                   p.gain_um_per_A, p.phase_deg, p.small_signal_gain_um_per_A,
+                   p.small_signal_phase_deg, p.gain_um_per_A / p.small_signal_gain_um_per_A);
+    }
     fmt::print("  wrote {}\n", fmt::join(files, ", "));
     return 0;
   };

@@ -1,9 +1,15 @@
 // gmasim linearize (gmasim/experiments/experiments.hpp, linearize_plant, linearize_report): the
 // plant at a temperature and bias as a state space, and its report.
+#include <fmt/format.h>
+
 #include <cmath>
 #include <complex>
 
+#include "experiments/frf_internal.hpp"
+#include "experiments/parallel.hpp"
+#include "gmasim/errors.hpp"
 #include "gmasim/experiments/experiments.hpp"
+#include "gmasim/model/validate.hpp"
 
 namespace gmasim {
 namespace {
@@ -45,7 +51,38 @@ StateSpace linearize_plant(const Model& m, double temperature_C, double bias_A) 
   return linearize_plant(m, make_conditions(m, temperature_C), bias_A);
 }
 
-Report linearize_report(const Model& m, const StateSpace& ss) {
+std::vector<DescribingPoint> describing_function(const Model& m, const StateSpace& ss,
+                                                 double amplitude_A,
+                                                 const std::vector<double>& f_Hz, int threads) {
+  require_positive_at_most(amplitude_A, kMaxCurrent_A,
+                           "describing-function amplitude (--amplitude)", "A");
+  if (f_Hz.empty())
+    throw InputError("describing function: no frequency given (--frequencies): give at least one");
+  for (double f : f_Hz)
+    require_positive_at_most(f, kMaxFrequency_Hz, "describing-function frequency (--frequencies)",
+                             "Hz");
+  const Conditions c = make_conditions(m, ss.temperature_C);
+  const State bias = settle_at_bias(m, c, ss.bias_A, BiasState::Anhysteretic);
+  const SmallSignalModel lin = linearise(m, c, bias);
+  FrfRequest r;
+  r.temperatures_C = {ss.temperature_C};
+  r.bias_A = ss.bias_A;
+  r.amplitude_A = amplitude_A;
+  std::vector<DescribingPoint> out(f_Hz.size());
+  detail::parallel_for(f_Hz.size(), resolve_thread_count(threads, f_Hz.size()),
+                       [&](std::size_t k) {
+                         const std::complex<double> Y =
+                             detail::stepped_sine_point(m, c, bias, lin, r, f_Hz[k]);
+                         const std::complex<double> L = ss.response(f_Hz[k]);
+                         out[k] = {f_Hz[k], 1e6 * std::abs(Y), std::arg(Y) * 180.0 / M_PI,
+                                   1e6 * std::abs(L), std::arg(L) * 180.0 / M_PI};
+                       },
+                       {});
+  return out;
+}
+
+Report linearize_report(const Model& m, const StateSpace& ss,
+                        const std::vector<DescribingPoint>* df, double amplitude_A) {
   Report r;
   r.experiment = "linearize";
   r.meta.emplace_back("model", m.spec.source);
@@ -67,6 +104,17 @@ Report linearize_report(const Model& m, const StateSpace& ss) {
               matrix_table("D", ss.D, ss.outputs, ss.output_units, input),
               roots_table("poles", ss.poles()),
               roots_table("zeros", ss.zeros(0))};
+  if (df != nullptr) {
+    r.meta.emplace_back("describing_function_amplitude_A", amplitude_A);
+    Table t{"describing_function",
+            {"frequency_Hz", "gain_um_per_A", "phase_deg", "small_signal_gain_um_per_A",
+             "small_signal_phase_deg", "gain_ratio"},
+            {}};
+    for (const DescribingPoint& p : *df)
+      t.rows.push_back({p.f_Hz, p.gain_um_per_A, p.phase_deg, p.small_signal_gain_um_per_A,
+                        p.small_signal_phase_deg, p.gain_um_per_A / p.small_signal_gain_um_per_A});
+    r.tables.push_back(std::move(t));
+  }
   return r;
 }
 

@@ -488,6 +488,23 @@ Report thermal_report(const Model& m, const ThermalExpansionResult& res);
 // poles and the zeros of y.
 StateSpace linearize_plant(const Model& m, double temperature_C, double bias_A);
 StateSpace linearize_plant(const Model& m, const Conditions& c, double bias_A);  // at c's T
-Report linearize_report(const Model& m, const StateSpace& ss);
+// The large-signal companion of the state space (issue 40 item 1): the describing function of
+// the plant at a current amplitude about the bias -- the first harmonic of y over that of a
+// sine i = bias + amplitude sin(2 pi f t), from the settled anhysteretic bias state, by the
+// FRF's stepped sine (its settling, measuring periods and time step; gmasim frf --amplitude) --
+// beside the state space's small-signal response at each frequency.
+struct DescribingPoint {
+  double f_Hz = 0;
+  double gain_um_per_A = 0, phase_deg = 0;                            // at the amplitude
+  double small_signal_gain_um_per_A = 0, small_signal_phase_deg = 0;  // the state space's
+};
+// Throws InputError for an amplitude <= 0 or beyond the coil's limit, an empty or non-positive
+// frequency list; DivergenceError naming --amplitude when a run diverges.
+std::vector<DescribingPoint> describing_function(const Model& m, const StateSpace& ss,
+                                                 double amplitude_A,
+                                                 const std::vector<double>& f_Hz, int threads = 0);
+// The report; with `df`, a table "describing_function" at that amplitude too.
+Report linearize_report(const Model& m, const StateSpace& ss,
+                        const std::vector<DescribingPoint>* df = nullptr, double amplitude_A = 0);
 
 }  // namespace gmasim
