@@ -6,7 +6,8 @@ import numpy as np
 from . import _gmasim
 
 
-def linearize(model, temperature_C: float = 20.0, bias_A: float = 1.0, output: str = "y"):
+def linearize(model, temperature_C: float = 20.0, bias_A: float = 1.0, output: str = "y",
+              amplitude_A: float = 0.0, frequencies_Hz=(10.0, 100.0, 1000.0)):
     """The plant current -> ``output`` about a DC bias, as a ``scipy.signal.StateSpace``.
 
     ``output``: ``"y"`` (the sensor's displacement [m]) or ``"B"`` (the induction coil's flux
@@ -14,7 +15,10 @@ def linearize(model, temperature_C: float = 20.0, bias_A: float = 1.0, output: s
     is the current's change [A]; the states are SI (``sys.states``, ``sys.state_units``: the
     rods' fields [A/m], displacements [m] and velocities [m/s], then the sensor mount's two
     states). The returned object also carries ``poles``, ``zeros_y``, ``dc_gain``,
-    ``temperature_C`` and ``bias_A`` (gmasim's own, beside scipy's ``sys.poles``).
+    ``temperature_C`` and ``bias_A`` (gmasim's own, beside scipy's ``sys.poles``). With
+    ``amplitude_A`` > 0 it also carries ``describing_function``: the large-signal gain [um/A]
+    and phase [deg] at that current amplitude about the bias for each of ``frequencies_Hz``,
+    beside the small-signal ones (``gmasim linearize --amplitude``), as a dict of arrays.
 
         sys = gmasim.linearize(gmasim.Model(), temperature_C=70)
         H = sys.C @ np.linalg.solve(2j * np.pi * f * np.eye(len(sys.A)) - sys.A, sys.B)
@@ -25,7 +29,8 @@ def linearize(model, temperature_C: float = 20.0, bias_A: float = 1.0, output: s
     """
     from scipy import signal
 
-    d = _gmasim._linearize(model, float(temperature_C), float(bias_A))
+    d = _gmasim._linearize(model, float(temperature_C), float(bias_A), float(amplitude_A),
+                           [float(f) for f in frequencies_Hz])
     if output == "all":
         rows = list(range(len(d["outputs"])))
     elif output in d["outputs"]:
@@ -44,4 +49,6 @@ def linearize(model, temperature_C: float = 20.0, bias_A: float = 1.0, output: s
     sys.dc_gain = np.asarray(d["dc_gain"])[rows]
     sys.temperature_C = d["temperature_C"]
     sys.bias_A = d["bias_A"]
+    if "describing_function" in d:
+        sys.describing_function = d["describing_function"]
     return sys

@@ -268,10 +268,31 @@ py::list complex_list(const std::vector<std::complex<double>>& z) {
 void bind_linearize(py::module_& mod) {
   mod.def(
       "_linearize",
-      [](const Model& m, double temperature_C, double bias_A) {
+      [](const Model& m, double temperature_C, double bias_A, double amplitude_A,
+         const std::vector<double>& frequencies_Hz) {
         const StateSpace ss =
             without_gil([&] { return linearize_plant(m, temperature_C, bias_A); });
         py::dict d;
+        if (amplitude_A != 0.0) {  // the describing function beside it (gmasim linearize --amplitude)
+          const std::vector<DescribingPoint> df = without_gil(
+              [&] { return describing_function(m, ss, amplitude_A, frequencies_Hz); });
+          std::vector<double> f, g, ph, gs, phs;
+          for (const DescribingPoint& p : df) {
+            f.push_back(p.f_Hz);
+            g.push_back(p.gain_um_per_A);
+            ph.push_back(p.phase_deg);
+            gs.push_back(p.small_signal_gain_um_per_A);
+            phs.push_back(p.small_signal_phase_deg);
+          }
+          py::dict t;
+          t["amplitude_A"] = amplitude_A;
+          t["frequency_Hz"] = to_numpy(f);
+          t["gain_um_per_A"] = to_numpy(g);
+          t["phase_deg"] = to_numpy(ph);
+          t["small_signal_gain_um_per_A"] = to_numpy(gs);
+          t["small_signal_phase_deg"] = to_numpy(phs);
+          d["describing_function"] = t;
+        }
         d["A"] = matrix(ss.A, ss.n_states, ss.n_states);
         d["B"] = matrix(ss.B, ss.n_states, 1);
         d["C"] = matrix(ss.C, ss.n_outputs, ss.n_states);
@@ -290,6 +311,8 @@ void bind_linearize(py::module_& mod) {
         return d;
       },
       py::arg("model"), py::arg("temperature_C") = 20.0, py::arg("bias_A") = 1.0,
+      py::arg("amplitude_A") = 0.0,
+      py::arg("frequencies_Hz") = std::vector<double>{10.0, 100.0, 1000.0},
       "The plant as a state space: {'A', 'B', 'C', 'D', 'states', 'state_units', 'outputs', "
       "'output_units', 'poles', 'zeros_y', 'dc_gain', ...}; gmasim.linearize returns it as a "
       "scipy.signal.StateSpace");

@@ -54,3 +54,22 @@ def test_cli_mat_file_is_the_python_statespace(mdma, gmasim_bin, tmp_path):
         assert d[k] == pytest.approx(getattr(sys, k), rel=0, abs=0), k
     assert d["temperature_C"][0, 0] == 70 and d["bias_A"][0, 0] == 1
     assert (tmp_path / "linearize_A.csv").read_text().splitlines()[0].startswith("row,unit,rod1_H")
+
+
+def test_describing_function_beside_the_state_space(mdma, gmasim_bin, tmp_path):
+    """gmasim.linearize(amplitude_A=1): the large-signal gain at +-1 A about the bias (the FRF's
+    stepped sine) beside the small-signal one, the numbers of `gmasim linearize --amplitude 1`."""
+    import json
+    import subprocess
+
+    sys_ = gmasim.linearize(mdma, temperature_C=20.0, amplitude_A=1.0, frequencies_Hz=[10.0, 100.0])
+    df = sys_.describing_function
+    assert list(df["frequency_Hz"]) == [10.0, 100.0]
+    assert np.all(df["gain_um_per_A"] > 2.0 * df["small_signal_gain_um_per_A"])
+    assert df["small_signal_gain_um_per_A"][0] == pytest.approx(1e6 * sys_.dc_gain[0], rel=1e-3)
+    subprocess.run([gmasim_bin, "linearize", "--amplitude", "1", "--frequencies", "10,100",
+                    "--out", str(tmp_path / "l")], check=True, capture_output=True)
+    rows = json.loads((tmp_path / "l" / "linearize.json").read_text())["tables"]["describing_function"]["rows"]
+    np.testing.assert_allclose(df["gain_um_per_A"], [r["gain_um_per_A"] for r in rows], rtol=1e-12)
+    np.testing.assert_allclose(df["phase_deg"], [r["phase_deg"] for r in rows], atol=1e-9)
+    assert not hasattr(gmasim.linearize(mdma), "describing_function")
