@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "builtin_models.hpp"
+#include "experiments_fixtures.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/mechanics/state_space.hpp"
 #include "test_util.hpp"
@@ -42,13 +43,8 @@ TEST(DescribingFunction, AtOneAmpereIsTheFrfsLargeSignalSteppedSine) {
   const Model& m = gmasim_test::mdma();
   const StateSpace ss = linearize_plant(m, 20.0, 1.0);
   const auto df = describing_function(m, ss, 1.0, {100.0}, 1);
-  FrfRequest r;
-  r.temperatures_C = {20.0};
+  FrfRequest r = gmasim_experiments_test::two_point_frf(20.0, 100.0, 200.0);
   r.amplitude_A = 1.0;
-  r.f_min_Hz = 100.0;
-  r.f_max_Hz = 200.0;
-  r.points = 2;
-  r.peak_refinements = 0;
   const FrfResult frf = run_frf(m, r);
   const FrfCurve& c = frf.curves.at(0);
   ASSERT_EQ(c.f_Hz.front(), 100.0);
@@ -59,4 +55,7 @@ TEST(DescribingFunction, AtOneAmpereIsTheFrfsLargeSignalSteppedSine) {
               ::testing::HasSubstr("--amplitude"));
   EXPECT_THAT(gmasim_test::input_error([&] { (void)describing_function(m, ss, 1.0, {}); }),
               ::testing::HasSubstr("--frequencies"));
+  // The bias too: beyond the coil's limit it is refused by name, not run into a divergence.
+  EXPECT_THAT(gmasim_test::input_error([&] { (void)linearize_plant(m, 20.0, 1e9); }),
+              ::testing::HasSubstr("bias current (--bias, bias_A) = 1e+09 A: must be in"));
 }

@@ -17,12 +17,7 @@ using namespace gmasim_experiments_test;
 // (observed 0.34 % at 20 degC, limit 0.71 mA), at 50 times it does not (observed 16 %); the run is
 // then labelled large-signal and its markers are the stepped sine's.
 TEST(FrfSignal, SmallSignalLimitSeparatesLinearFromLargeResponses) {
-  FrfRequest r;
-  r.temperatures_C = {20};
-  r.f_min_Hz = 5.0;
-  r.f_max_Hz = 100.0;
-  r.points = 2;
-  r.peak_refinements = 0;
+  FrfRequest r = two_point_frf(20.0, 5.0, 100.0);
   const FrfResult small = run_frf(mdma(), r);
   const FrfCurve& c0 = small.curves[0];
   const double limit = c0.small_signal_limit_A;

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "experiments_fixtures.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/io/io.hpp"
 #include "gmasim/physics/preisach.hpp"
@@ -141,12 +142,7 @@ TEST(PreisachAnhysteretic, OddAndIncreasingInTheBias) {
 // virgin curve's magnetisation at the same current.
 TEST(PreisachAnhysteretic, FrfFromTheAnhystereticBiasMatchesTheLinearisation) {
   const Model m = load_model(std::string(GMASIM_SOURCE_DIR) + "/models/single_rod_preisach.toml");
-  FrfRequest r;
-  r.temperatures_C = {20};
-  r.f_min_Hz = 100.0;
-  r.f_max_Hz = 400.0;
-  r.points = 2;
-  r.peak_refinements = 0;
+  FrfRequest r = gmasim_experiments_test::two_point_frf(20.0, 100.0, 400.0);
   r.threads = 1;
   const FrfResult res = run_frf(m, r);
   EXPECT_LT(res.curves[0].max_mismatch_pct, 5e-3);  // observed 3.9e-4 %

@@ -29,28 +29,31 @@ py::object cell_value(const Cell& c) {
   return py::float_(c.number);
 }
 
+// A table as {column: numpy array (numbers) or list (text)}.
+py::dict table_dict(const Table& t) {
+  py::dict cols;
+  for (std::size_t j = 0; j < t.columns.size(); ++j) {
+    bool numeric = true;
+    for (const auto& row : t.rows) numeric = numeric && !row[j].is_text;
+    if (numeric) {
+      std::vector<double> v;
+      v.reserve(t.rows.size());
+      for (const auto& row : t.rows) v.push_back(row[j].number);
+      cols[py::str(t.columns[j])] = to_numpy(v);
+    } else {
+      py::list l;
+      for (const auto& row : t.rows) l.append(cell_value(row[j]));
+      cols[py::str(t.columns[j])] = l;
+    }
+  }
+  return cols;
+}
+
 py::dict report_dict(const Report& r) {
   py::dict out, meta;
   for (const auto& [k, v] : r.meta) meta[py::str(k)] = cell_value(v);
   out["meta"] = meta;
-  for (const auto& t : r.tables) {
-    py::dict cols;
-    for (std::size_t j = 0; j < t.columns.size(); ++j) {
-      bool numeric = true;
-      for (const auto& row : t.rows) numeric = numeric && !row[j].is_text;
-      if (numeric) {
-        std::vector<double> v;
-        v.reserve(t.rows.size());
-        for (const auto& row : t.rows) v.push_back(row[j].number);
-        cols[py::str(t.columns[j])] = to_numpy(v);
-      } else {
-        py::list l;
-        for (const auto& row : t.rows) l.append(cell_value(row[j]));
-        cols[py::str(t.columns[j])] = l;
-      }
-    }
-    out[py::str(t.name)] = cols;
-  }
+  for (const auto& t : r.tables) out[py::str(t.name)] = table_dict(t);
   return out;
 }
 
@@ -273,24 +276,12 @@ void bind_linearize(py::module_& mod) {
         const StateSpace ss =
             without_gil([&] { return linearize_plant(m, temperature_C, bias_A); });
         py::dict d;
-        if (amplitude_A != 0.0) {  // the describing function beside it (gmasim linearize --amplitude)
-          const std::vector<DescribingPoint> df = without_gil(
-              [&] { return describing_function(m, ss, amplitude_A, frequencies_Hz); });
-          std::vector<double> f, g, ph, gs, phs;
-          for (const DescribingPoint& p : df) {
-            f.push_back(p.f_Hz);
-            g.push_back(p.gain_um_per_A);
-            ph.push_back(p.phase_deg);
-            gs.push_back(p.small_signal_gain_um_per_A);
-            phs.push_back(p.small_signal_phase_deg);
-          }
-          py::dict t;
+        if (amplitude_A !=
+            0.0) {  // the describing function beside it (gmasim linearize --amplitude)
+          const std::vector<DescribingPoint> df =
+              without_gil([&] { return describing_function(m, ss, amplitude_A, frequencies_Hz); });
+          py::dict t = table_dict(describing_function_table(df));  // the report's columns
           t["amplitude_A"] = amplitude_A;
-          t["frequency_Hz"] = to_numpy(f);
-          t["gain_um_per_A"] = to_numpy(g);
-          t["phase_deg"] = to_numpy(ph);
-          t["small_signal_gain_um_per_A"] = to_numpy(gs);
-          t["small_signal_phase_deg"] = to_numpy(phs);
           d["describing_function"] = t;
         }
         d["A"] = matrix(ss.A, ss.n_states, ss.n_states);

@@ -53,18 +53,25 @@ void check_axes(const ModelSpec& base, const std::vector<GridAxis>& axes) {
                     designs, kMaxListValues));
 }
 
-// The base spec with the design's values set, compiled (its derived quantities follow).
+// The base spec with the design's values set, compiled (its derived quantities follow); an error
+// names the design.
 Model design_model(const ModelSpec& base, const std::vector<GridAxis>& axes,
                    const std::vector<double>& values) {
   ModelSpec spec = base;
+  std::string design;
   for (std::size_t k = 0; k < axes.size(); ++k) {
+    design += fmt::format("{}{}={:g}", k ? " " : "", axes[k].key, values[k]);
     try {
       spec.set(axes[k].key, values[k]);
     } catch (const InputError& e) {
       throw InputError(fmt::format("--grid {}={:g}: {}", axes[k].key, values[k], e.what()));
     }
   }
-  return compile(spec);
+  try {
+    return compile(spec);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("--grid design {}: {}", design, e.what()));
+  }
 }
 
 }  // namespace
@@ -77,13 +84,12 @@ DesignSweepResult run_design_sweep(const ModelSpec& base, const std::vector<Grid
   res.axes = axes;
   res.bias_A = FrfRequest{}.bias_A;
   const auto all = combinations(axes);
-  // Every design compiles before any sweep runs: a value its key's rule refuses stops the
-  // study at once, naming it.
-  std::vector<Model> models;
-  models.reserve(all.size());
-  for (const auto& values : all) models.push_back(design_model(base, axes, values));
+  // Every design compiles before any sweep runs, so that a value its key's rule refuses stops
+  // the study at once, naming it; each is compiled again when it runs (holding every Model
+  // would cost memory in proportion to the grid, a compile is cheap beside its sweep).
+  for (const auto& values : all) (void)design_model(base, axes, values);
   for (std::size_t d = 0; d < all.size(); ++d) {
-    const Model& m = models[d];
+    const Model m = design_model(base, axes, all[d]);
     DesignPoint p;
     p.values = all[d];
     for (const auto& rod : m.rods) p.rods_mass_kg += rod.mass_kg;
@@ -106,41 +112,50 @@ DesignSweepResult run_design_sweep(const ModelSpec& base, const std::vector<Grid
 
 Report design_sweep_report(const Model& base, const SweepRequest& req,
                            const DesignSweepResult& res) {
-  Report r = sweep_report(base, req, res.designs.empty() ? SweepResult{} : res.designs[0].sweep);
-  r.meta.emplace_back("designs", static_cast<double>(res.designs.size()));
-  r.meta.emplace_back("small_signal_bias_A", res.bias_A);
-  r.meta.emplace_back("design_wall_time_s", res.wall_time_s);
   const std::vector<std::string> derived = {"rods_mass_kg", "coil_resistance_ohm",
                                             "first_resonance_Hz", "bandwidth_Hz"};
   Table designs{"designs", {}, {}};
   for (const GridAxis& a : res.axes) designs.columns.push_back(a.key);
   designs.columns.insert(designs.columns.end(), derived.begin(), derived.end());
-  // The points of every design: the axes' values, the derived columns, then the sweep's own.
-  std::vector<Table> points;
-  for (Table& t : r.tables) {
-    Table all{t.name, designs.columns, {}};
-    all.columns.insert(all.columns.end(), t.columns.begin(), t.columns.end());
-    all.columns.insert(all.columns.end() - 2, "coil_copper_loss_W");  // before status, error
-    points.push_back(std::move(all));
-  }
-  for (const DesignPoint& d : res.designs) {
-    std::vector<Cell> head(d.values.begin(), d.values.end());
-    for (double v : {d.rods_mass_kg, d.coil_resistance_ohm, d.first_resonance_Hz, d.bandwidth_Hz})
+  // Each design's sweep report; the first gives the meta and the tables' columns. The points of
+  // every design: the axes' values, the derived columns, then the sweep's own, with the coil
+  // copper loss before status and error.
+  Report r;
+  double simulations = 0.0;
+  for (std::size_t d = 0; d < res.designs.size(); ++d) {
+    const DesignPoint& dp = res.designs[d];
+    const Report one = sweep_report(base, req, dp.sweep);
+    simulations += static_cast<double>(dp.sweep.simulations);
+    if (d == 0) {
+      r = one;
+      for (Table& t : r.tables) {
+        std::vector<std::string> cols = designs.columns;
+        cols.insert(cols.end(), t.columns.begin(), t.columns.end());
+        cols.insert(cols.end() - 2, "coil_copper_loss_W");
+        t.columns = std::move(cols);
+        t.rows.clear();
+      }
+    }
+    std::vector<Cell> head(dp.values.begin(), dp.values.end());
+    for (double v :
+         {dp.rods_mass_kg, dp.coil_resistance_ohm, dp.first_resonance_Hz, dp.bandwidth_Hz})
       head.emplace_back(v);
     designs.rows.push_back(head);
-    const Report one = sweep_report(base, req, d.sweep);
-    for (std::size_t t = 0; t < one.tables.size() && t < points.size(); ++t) {
-      const auto& src = one.tables[t];
-      const auto& loss = t == 0 ? d.copper_loss_W : d.reference_copper_loss_W;
-      for (std::size_t i = 0; i < src.rows.size(); ++i) {
+    for (std::size_t t = 0; t < one.tables.size() && t < r.tables.size(); ++t) {
+      const auto& loss = t == 0 ? dp.copper_loss_W : dp.reference_copper_loss_W;
+      for (std::size_t i = 0; i < one.tables[t].rows.size(); ++i) {
         std::vector<Cell> row = head;
-        row.insert(row.end(), src.rows[i].begin(), src.rows[i].end());
+        row.insert(row.end(), one.tables[t].rows[i].begin(), one.tables[t].rows[i].end());
         row.insert(row.end() - 2, Cell(loss[i]));
-        points[t].rows.push_back(std::move(row));
+        r.tables[t].rows.push_back(std::move(row));
       }
     }
   }
-  r.tables = std::move(points);
+  for (auto& [key, value] : r.meta)  // every design's simulations, not the first's
+    if (key == "simulations") value = Cell(simulations);
+  r.meta.emplace_back("designs", static_cast<double>(res.designs.size()));
+  r.meta.emplace_back("small_signal_bias_A", res.bias_A);
+  r.meta.emplace_back("design_wall_time_s", res.wall_time_s);
   r.tables.push_back(std::move(designs));
   return r;
 }

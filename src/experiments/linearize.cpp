@@ -44,6 +44,7 @@ Table roots_table(const std::string& name, const std::vector<std::complex<double
 }  // namespace
 
 StateSpace linearize_plant(const Model& m, const Conditions& c, double bias_A) {
+  require_in(bias_A, -kMaxCurrent_A, kMaxCurrent_A, "bias current (--bias, bias_A)", "A");
   return state_space(m, linearise(m, c, settle_at_bias(m, c, bias_A, BiasState::Anhysteretic)));
 }
 
@@ -81,6 +82,17 @@ std::vector<DescribingPoint> describing_function(const Model& m, const StateSpac
   return out;
 }
 
+Table describing_function_table(const std::vector<DescribingPoint>& df) {
+  Table t{"describing_function",
+          {"frequency_Hz", "gain_um_per_A", "phase_deg", "small_signal_gain_um_per_A",
+           "small_signal_phase_deg", "gain_ratio"},
+          {}};
+  for (const DescribingPoint& p : df)
+    t.rows.push_back({p.f_Hz, p.gain_um_per_A, p.phase_deg, p.small_signal_gain_um_per_A,
+                      p.small_signal_phase_deg, p.gain_um_per_A / p.small_signal_gain_um_per_A});
+  return t;
+}
+
 Report linearize_report(const Model& m, const StateSpace& ss,
                         const std::vector<DescribingPoint>* df, double amplitude_A) {
   Report r;
@@ -106,14 +118,7 @@ Report linearize_report(const Model& m, const StateSpace& ss,
               roots_table("zeros", ss.zeros(0))};
   if (df != nullptr) {
     r.meta.emplace_back("describing_function_amplitude_A", amplitude_A);
-    Table t{"describing_function",
-            {"frequency_Hz", "gain_um_per_A", "phase_deg", "small_signal_gain_um_per_A",
-             "small_signal_phase_deg", "gain_ratio"},
-            {}};
-    for (const DescribingPoint& p : *df)
-      t.rows.push_back({p.f_Hz, p.gain_um_per_A, p.phase_deg, p.small_signal_gain_um_per_A,
-                        p.small_signal_phase_deg, p.gain_um_per_A / p.small_signal_gain_um_per_A});
-    r.tables.push_back(std::move(t));
+    r.tables.push_back(describing_function_table(*df));
   }
   return r;
 }

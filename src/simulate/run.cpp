@@ -63,12 +63,9 @@ struct RunLength {
 
 // The metrics' window of a waveform that is not a biased sine (SimulationSettings::
 // metrics_window_s): the given one, else a table's declared period, else the whole run.
+// validate() has checked metrics_window_s itself.
 double metrics_window(const SimulationSettings& s, double duration_s) {
   const auto& w = s.waveform;
-  if (!(s.metrics_window_s >= 0.0) || !std::isfinite(s.metrics_window_s))
-    throw InputError(fmt::format(
-        "metrics window = {} s (--metrics-window, metrics_window_s): must be >= 0 (0: {})",
-        s.metrics_window_s, "a table's declared period, else the whole run"));
   const double W = s.metrics_window_s > 0.0        ? s.metrics_window_s
                    : w.kind == WaveformKind::Table ? w.table_period_s
                                                    : 0.0;
@@ -111,11 +108,6 @@ RunLength run_length(const SimulationSettings& s) {
   const auto& w = s.waveform;
   check_user_dt(s);
   RunLength L;
-  if (w.periodic() && s.metrics_window_s != 0.0)
-    throw InputError(fmt::format(
-        "metrics window = {:g} s (--metrics-window): a biased sine's metrics are over its last "
-        "period; the window is for the other waveforms (dc, step, chirp, a CSV table)",
-        s.metrics_window_s));
   double dt = s.dt_s > 0.0 ? s.dt_s : auto_dt(w);
   double per_steps = 0.0;  // periodic: steps per period
   if (w.periodic()) {
@@ -481,6 +473,15 @@ void validate(const SimulationSettings& s) {
     require_in(s.periods, 1.0, kMaxPeriods, "periods (--periods)");
   }
   require_nonnegative(s.duration_s, "duration", "s");
+  if (!(s.metrics_window_s >= 0.0) || !std::isfinite(s.metrics_window_s))
+    throw InputError(fmt::format(
+        "metrics window = {} s (--metrics-window, metrics_window_s): must be >= 0 (0: {})",
+        s.metrics_window_s, "a table's declared period, else the whole run"));
+  if (s.waveform.periodic() && s.metrics_window_s != 0.0)
+    throw InputError(fmt::format(
+        "metrics window = {:g} s (--metrics-window): a biased sine's metrics are over its last "
+        "period; the window is for the other waveforms (dc, step, chirp, a CSV table)",
+        s.metrics_window_s));
   const RunLength L = run_length(s);
   // A step at t <= 0 is not one (the rest state is made at current_at(0), the step's current),
   // nor is one at or after the run's end: either ran with no step and a zero stroke.

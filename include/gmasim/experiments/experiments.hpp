@@ -503,6 +503,9 @@ struct DescribingPoint {
 std::vector<DescribingPoint> describing_function(const Model& m, const StateSpace& ss,
                                                  double amplitude_A,
                                                  const std::vector<double>& f_Hz, int threads = 0);
+// The describing function as a table (frequency_Hz, gain_um_per_A, phase_deg,
+// small_signal_gain_um_per_A, small_signal_phase_deg, gain_ratio): the report's, and Python's.
+Table describing_function_table(const std::vector<DescribingPoint>& df);
 // The report; with `df`, a table "describing_function" at that amplitude too.
 Report linearize_report(const Model& m, const StateSpace& ss,
                         const std::vector<DescribingPoint>* df = nullptr, double amplitude_A = 0);
