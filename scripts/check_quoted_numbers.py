@@ -36,6 +36,7 @@ malformed marker or bad usage.
 from __future__ import annotations
 
 import argparse
+import concurrent.futures
 import dataclasses
 import json
 import math
@@ -180,27 +181,38 @@ def quoted_in(paragraph: str, value_text: str) -> bool:
 
 
 class Runner:
-    """Runs each distinct command once; {tmp} is one directory per command."""
+    """Runs each distinct command once, whichever file quotes it; {tmp} is one directory per
+    command. prefetch() runs the distinct commands `jobs` at a time (each is one process with
+    its own {tmp}, so they do not share state); run() then reads the cache."""
 
     def __init__(self, gmasim: str, root: pathlib.Path, timeout: float):
         self.gmasim, self.root, self.timeout = gmasim, root, timeout
         self.cache: dict[tuple, tuple[str, pathlib.Path | None, str]] = {}
         self.tmp = tempfile.TemporaryDirectory(prefix="gmasim_check_")
 
+    def prefetch(self, checks: list[Check], jobs: int) -> None:
+        keys = list(dict.fromkeys(tuple(c.command) for c in checks))
+        with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+            list(pool.map(self._execute, keys))
+
+    def _execute(self, key: tuple) -> None:
+        if key in self.cache:
+            return
+        tmp = pathlib.Path(tempfile.mkdtemp(dir=self.tmp.name))
+        argv = [self.gmasim] + [a.replace("{tmp}", str(tmp)) for a in key[1:]]
+        try:
+            p = subprocess.run(argv, cwd=self.root, capture_output=True, text=True,
+                               timeout=self.timeout)
+        except subprocess.TimeoutExpired:
+            self.cache[key] = ("", tmp, f"timed out after {self.timeout:g} s")
+        else:
+            err = "" if p.returncode == 0 else (
+                f"exit status {p.returncode}: {p.stderr.strip()[-400:]}")
+            self.cache[key] = (p.stdout, tmp, err)
+
     def run(self, check: Check) -> tuple[str, pathlib.Path]:
         key = tuple(check.command)
-        if key not in self.cache:
-            tmp = pathlib.Path(tempfile.mkdtemp(dir=self.tmp.name))
-            argv = [self.gmasim] + [a.replace("{tmp}", str(tmp)) for a in check.command[1:]]
-            try:
-                p = subprocess.run(argv, cwd=self.root, capture_output=True, text=True,
-                                   timeout=self.timeout)
-            except subprocess.TimeoutExpired:
-                self.cache[key] = ("", tmp, f"timed out after {self.timeout:g} s")
-            else:
-                err = "" if p.returncode == 0 else (
-                    f"exit status {p.returncode}: {p.stderr.strip()[-400:]}")
-                self.cache[key] = (p.stdout, tmp, err)
+        self._execute(key)
         stdout, tmp, err = self.cache[key]
         if err:
             raise RuntimeError(f"`{' '.join(check.command)}` failed: {err}")
@@ -248,6 +260,8 @@ def main(argv=None) -> int:
     ap.add_argument("--gmasim", required=True, help="the gmasim executable to run")
     ap.add_argument("--root", help="working directory of the commands (default: the repository)")
     ap.add_argument("--timeout", type=float, default=1800.0, help="per command [s]")
+    ap.add_argument("--jobs", type=int, default=2,
+                    help="distinct commands run at once (default 2: the CI machine's cores)")
     ap.add_argument("--require-checks", action="store_true",
                     help="fail if a file holds no check (a test page must test something)")
     a = ap.parse_args(argv)
@@ -258,13 +272,21 @@ def main(argv=None) -> int:
         print(f"check_quoted_numbers: {e}", file=sys.stderr)
         return 2
     failed = empty = 0
+    runners: dict[pathlib.Path, Runner] = {}  # one per working directory: a command runs once
+    for f, cs in checks.items():
+        root = pathlib.Path(a.root) if a.root else find_root(f)
+        if cs and root not in runners:
+            runners[root] = Runner(a.gmasim, root, a.timeout)
+    for root, runner in runners.items():
+        runner.prefetch([c for f, cs in checks.items() for c in cs
+                         if (pathlib.Path(a.root) if a.root else find_root(f)) == root], a.jobs)
     for f, cs in checks.items():
         if not cs:
             if a.require_checks:
                 print(f"{f}: FAIL: no check marker (<!-- check: ... -->)")
                 empty += 1
             continue
-        runner = Runner(a.gmasim, pathlib.Path(a.root) if a.root else find_root(f), a.timeout)
+        runner = runners[pathlib.Path(a.root) if a.root else find_root(f)]
         for c in cs:
             ok, what = evaluate(c, runner)
             print(f"{c.where}: {'ok' if ok else 'FAIL'}: {what}")

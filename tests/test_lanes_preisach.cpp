@@ -1,7 +1,7 @@
 // The Preisach law in the batched SIMD lanes (src/lanes/preisach_lanes-inl.h, docs/lanes.md
 // "Preisach lanes") on models/single_rod_preisach.toml: each lane equals the width-1 instance
-// bit for bit (on the dispatched target and on the fallback); each lane follows the scalar
-// step() -- whose PreisachLaw is the reference -- to the rounding of the vector erfc and exp,
+// bit for bit (on the dispatched target and on the fallback); each lane equals the scalar step()
+// bit for bit (the law is one text over the number type: gmasim/physics/preisach_law-inl.h),
 // with lanes at different temperatures, current amplitudes and frequencies whose currents reverse
 // inside the period (minor loops: pushes onto the extrema stack and wiping-out); make_states and
 // simulate_lanes (the sweep's path) match make_state and simulate().
@@ -78,17 +78,13 @@ TEST(PreisachLanes, FallbackTargetsEqualTheirWidthOneInstance) {
   EXPECT_GE(tried, 1);
 }
 
-// Each lane against the scalar step() (PreisachLaw: std::erfc, std::exp): 9 lanes, 3000 steps
-// (1.5 to 6 periods), the scalar runs reversing and wiping out (else this tests nothing). The
-// lanes' erfc and exp differ from libm's by a few units in the last place (1e-13 of y); where that
-// rounding moves a Newton convergence decision (1e-7 A/m + 1e-11 |H|: the steep Preisach slope
-// turns it into ~1e-10 of y), the step differs by as much, and the hysteresis carries it until the
-// extremum is wiped out. The stacks' depths may differ: a periodic input returns to its own
-// extrema, and whether it passes one (wiping out the pair) or stops a rounding short of it is
-// decided by the last digits -- such a pair encloses a triangle of measure ~(1e-13)^2, nothing in
-// M. Compared: y (of 1 um), B, H (of 1e4 A/m), M, M_irr (of 1e5 A/m), mu_r, and the point the
-// stack is at (x_now, mu_now). Observed largest relative difference 3.7e-11 to 1.7e-10 (y, at
-// one Newton decision, which the last digits place; ~1e-12 elsewhere); tolerance 2e-9.
+// Each lane against the scalar step() (PreisachLaw): 9 lanes, 3000 steps (1.5 to 6 periods), the
+// scalar runs reversing and wiping out (else this tests nothing). The law is one text over the
+// number type (gmasim/physics/preisach_law-inl.h: its Everett function, erfc and exp, Newton solve
+// and trial), so every lane equals the scalar step bit for bit and the stacks keep the same
+// depth: y, B, H, M, M_irr, mu_r and the point the stack is at (x_now, mu_now) compared exactly
+// (before issue 38 the lanes had their own erfc and exp: 3.7e-11 to 1.7e-10 of y, depths
+// differing where a periodic input stopped a rounding short of its own extremum).
 TEST(PreisachLanes, FollowTheScalarStep) {
   const std::size_t n = 9;
   const PreisachRuns runs(n);
@@ -120,7 +116,7 @@ TEST(PreisachLanes, FollowTheScalarStep) {
       auto rel = [&](double x, double ref, double scale, const char* what) {
         const double e = std::fabs(x - ref) / scale;
         worst = std::max(worst, e);
-        EXPECT_LE(e, 2e-9) << what << " lane " << i << " step " << k;
+        EXPECT_EQ(x, ref) << what << " lane " << i << " step " << k;
       };
       rel(s.y_m, r.y_m, 1e-6, "y");
       rel(s.B_T, r.B_T, 1.0, "B");
@@ -134,6 +130,7 @@ TEST(PreisachLanes, FollowTheScalarStep) {
           "x_now");
       ++checks;
       if (got.preisach.n != ref.preisach.n) ++depth_differs;
+      EXPECT_EQ(got.preisach.n, ref.preisach.n) << "lane " << i << " step " << k;
     }
   }
   std::printf(
@@ -147,8 +144,8 @@ TEST(PreisachLanes, FollowTheScalarStep) {
   }
 }
 
-// make_states (the ramp in lanes, rest_increment) against make_state; observed 1.5e-14
-// relative; tolerance 1e-13. The increment and the step allocate nothing.
+// make_states (the ramp in lanes, rest_increment) against make_state: bit for bit (1.5e-14
+// before the law was one text). The increment and the step allocate nothing.
 TEST(PreisachLanes, MakeStatesMatchMakeState) {
   const std::size_t n = 6;
   const PreisachRuns runs(n);
@@ -166,7 +163,7 @@ TEST(PreisachLanes, MakeStatesMatchMakeState) {
     auto rel = [&](double x, double r, double scale) {
       const double e = std::fabs(x - r) / scale;
       worst = std::max(worst, e);
-      EXPECT_LE(e, 1e-13) << "lane " << i;
+      EXPECT_EQ(x, r) << "lane " << i;
     };
     rel(got[i].y_m, ref.y_m, 1e-6);
     rel(got[i].B_T, ref.B_T, 1.0);
@@ -193,11 +190,12 @@ TEST(PreisachLanes, MakeStatesMatchMakeState) {
 }
 
 // simulate_lanes (what `gmasim sweep` runs) against simulate(): the metrics of biased and
-// bipolar sines at three temperatures; observed 1.2e-13 of the stroke; tolerance 1e-12.
+// bipolar sines at three temperatures: bit for bit (1.2e-13 of the stroke before the law was
+// one text).
 TEST(PreisachLanes, SimulateLanesMatchesSimulate) {
   const std::vector<SimulationSettings> set =
       gmasim_test::biased_sine_settings({20.0, 50.0, 80.0}, {2.0, 6.0}, 100.0, 2);
-  const double worst = gmasim_test::expect_simulate_lanes_matches(model(), set, 1e-12);
+  const double worst = gmasim_test::expect_simulate_lanes_matches(model(), set, 0.0);
   std::printf("Preisach simulate_lanes vs simulate: largest relative difference %.3g\n", worst);
 }
 

@@ -56,6 +56,16 @@ struct Lanes {
   friend HWY_INLINE M true_mask(Lanes) { return {hn::FirstN(D(), hn::Lanes(D()))}; }
   friend HWY_INLINE Lanes abs(Lanes a) { return hn::Abs(a.v); }
   friend HWY_INLINE Lanes sqrt(Lanes a) { return hn::Sqrt(a.v); }
+  friend HWY_INLINE Lanes table_at(const double* t, Lanes j) {
+    const hn::RebindToSigned<D> di;
+    return hn::GatherIndex(D(), t, hn::ConvertTo(di, j.v));
+  }
+  // 2^n for integers n in [-1022, 1023]: the exponent field n + 1023 over a zero mantissa.
+  friend HWY_INLINE Lanes pow2i(Lanes n) {
+    const hn::RebindToSigned<D> di;
+    const auto e = hn::Add(hn::ConvertTo(di, n.v), hn::Set(di, 1023));
+    return hn::BitCast(D(), hn::ShiftLeft<52>(e));
+  }
   // The scalar function f in each lane where m holds, x kept elsewhere (libm: the scalar step's
   // own algorithm).
   template <class F>
@@ -98,15 +108,47 @@ HWY_NOINLINE void oscillator_free_closed_form_where(LaneMask<D> where, Lanes<D> 
   ed1 = hn::Load(d, ad1);
 }
 
+// The Preisach law's stack read at x, lane by lane (physics::preisach_base on each lane's own
+// stack: the stacks differ in depth from lane to lane), as the scalar overload
+// (gmasim/physics/laws.hpp) reads its one stack.
+template <class D>
+HWY_NOINLINE void preisach_base_at(const physics::PreisachHistory* h, Lanes<D> x, Lanes<D>& xb,
+                                   Lanes<D>& mub, Lanes<D>& mcb, Lanes<D>& mub_u, LaneMask<D>& up,
+                                   LaneMask<D>& same) {
+  constexpr std::size_t kMax = hn::MaxLanes(D());
+  HWY_ALIGN double xs[kMax], b_x[kMax], b_mu[kMax], b_mc[kMax], b_mu_u[kMax], b_up[kMax],
+      b_same[kMax];
+  const D d;
+  hn::Store(x.v, d, xs);
+  for (std::size_t l = 0; l < hn::Lanes(d); ++l) {
+    const physics::PreisachBase b = physics::preisach_base(h[l], xs[l]);
+    b_x[l] = b.xb;
+    b_mu[l] = b.mub;
+    b_mc[l] = b.mcb;
+    b_mu_u[l] = b.mub_u;
+    b_up[l] = b.up ? 1.0 : 0.0;
+    b_same[l] = b.same ? 1.0 : 0.0;
+  }
+  xb = hn::Load(d, b_x);
+  mub = hn::Load(d, b_mu);
+  mcb = hn::Load(d, b_mc);
+  mub_u = hn::Load(d, b_mu_u);
+  up = {hn::Ne(hn::Load(d, b_up), hn::Zero(d))};
+  same = {hn::Ne(hn::Load(d, b_same), hn::Zero(d))};
+}
+
 // The step's laws (gmasim/physics/laws-inl.h), the same text as the scalar step's, compiled for
 // this target: physics laws over Lanes<D> (rod_mechanics, oscillator_step, ...).
 namespace laws {
 using ::gmasim::lanes::HWY_NAMESPACE::oscillator_free_closed_form_where;
+using ::gmasim::lanes::HWY_NAMESPACE::preisach_base_at;
 #define GMASIM_LAW_INLINE HWY_INLINE
 #define GMASIM_LAW_RARE HWY_NOINLINE
 #include "gmasim/physics/laws-inl.h"  // NOLINT(build/include): once per target, by design
 // after laws-inl.h, whose series and anchors it uses (a block of its own: clang-format keeps it)
 #include "gmasim/physics/ja_law-inl.h"  // NOLINT(build/include): likewise
+// after ja_law-inl.h, whose langevin_pair it uses
+#include "gmasim/physics/preisach_law-inl.h"  // NOLINT(build/include): likewise
 #undef GMASIM_LAW_INLINE
 #undef GMASIM_LAW_RARE
 }  // namespace laws

@@ -51,13 +51,12 @@ struct PreisachLaw {
   static MoveStart begin_move(const RodConditions&, const RodState&) { return {}; }
   static Trial trial_from(const RodConditions& rc, const RodState& r, const MoveStart&, double H1,
                           double M_guess) {
-    Trial t{r.M_A_per_m, 0.0, 0.0, H1 != r.H_A_per_m, {}};
-    if (!t.moved) {
-      t.dM_dH = reversible_susceptibility(rc, r);
-      return t;
-    }
-    t.M = physics::preisach_magnetisation(H1, rc.MsT_mag, rc.preisach, r.preisach, M_guess,
-                                          &t.dM_dH, &t.x1, &t.point);
+    // the law's trial, written once (physics::preisach_trial; the lanes run the same text)
+    const physics::PreisachTrialT<double> p =
+        physics::preisach_trial(physics::preisach_constants(rc.MsT_mag, rc.preisach), &r.preisach,
+                                r.H_A_per_m, r.M_A_per_m, H1, M_guess);
+    Trial t{p.M, p.dM_dH, p.x1, p.moved, {}};
+    if (t.moved) t.point = {p.mu, p.mc, p.mu_u, 0.0, physics::preisach_base(r.preisach, p.x1).base};
     return t;
   }
   // The consistent state's joint Newton solve (as JilesAthertonLaw's): the law's own inner

@@ -11,6 +11,8 @@
 //   select(m, a, b)    a where m holds, b elsewhere (a branch becomes a select)
 //   any(m), all(m), none(m), true_mask(x) (every lane)
 //   abs(x), sqrt(x)    exact in IEEE arithmetic
+//   pow2i(n)           2^n for an integer n in [-1022, 1023] (exact: the Preisach law's exp)
+//   table_at(t, j)     t[j] for an integer j (a gather over the lanes: the same element)
 //   each(f, x, m)      a scalar function f (libm's std::exp, std::cos) applied to each lane
 //                      where m holds (x kept elsewhere):
 //                      the lanes call the scalar step's own algorithm, so that no lane differs
@@ -23,6 +25,7 @@
 // scalar instance does the work only where it is needed, the lanes where one lane needs it.
 #pragma once
 
+#include <bit>
 #include <cmath>
 #include <utility>
 
@@ -38,6 +41,12 @@ inline bool none(bool m) { return !m; }
 inline bool true_mask(double) { return true; }  // every lane (the one)
 inline double abs(double x) { return std::fabs(x); }
 inline double sqrt(double x) { return std::sqrt(x); }
+inline double table_at(const double* t, double j) { return t[static_cast<long long>(j)]; }
+// 2^n as its bits: the exponent field n + 1023 over a zero mantissa (as the lanes build it).
+inline double pow2i(double n) {
+  return std::bit_cast<double>(static_cast<unsigned long long>(static_cast<long long>(n) + 1023)
+                               << 52);
+}
 template <class F>
 inline double each(F f, double x, bool where) {
   return where ? f(x) : x;

@@ -9,7 +9,10 @@
 // Fields are reduced, x = H_e / H_c^T: the law's coercivity law scales the whole distribution
 // (docs/model.md). With this distribution the Everett function (the measure of a triangle of
 // the Preisach plane) and its first moments are closed forms of the Gaussian CDF.
-// Header-only, allocation-free.
+// The distribution and the extrema stack: gmasim/physics/preisach_history.hpp. The law's
+// evaluation (Everett function, Newton solve, trial) is written once over the number type in
+// gmasim/physics/preisach_law-inl.h; this header gives its double conveniences, the AC
+// demagnetisation, the anhysteretic state and the energy. Header-only, allocation-free.
 #pragma once
 
 #include <algorithm>
@@ -18,210 +21,34 @@
 #include <limits>
 
 #include "gmasim/physics/jiles_atherton.hpp"
+#include "gmasim/physics/laws.hpp"
 #include "gmasim/physics/magnetic.hpp"
+#include "gmasim/physics/preisach_history.hpp"
 
 namespace gmasim::physics {
 
-inline constexpr int kPreisachBins = 8;
-// Entries of the extrema stack (two of them are the saturation sentinels).
-inline constexpr int kPreisachCapacity = 64;
-
-// The distribution in reduced units (one rod at one temperature).
-struct PreisachDistribution {
-  double sigma_u = 0.5;                          // std of h_u / H_c^T
-  std::array<double, kPreisachBins + 1> edge{};  // bin edges of h_c / H_c^T
-  std::array<double, kPreisachBins> density{};   // f_c on each bin (integrates to 1)
-};
-
-// The log-normal histogram of width sigma_c (edges exp(sigma_c z_j), z_j = -3 + 6j/K, each
-// bin weighted by its normal probability, renormalised to 1) and the interaction spread.
-inline PreisachDistribution preisach_distribution(double sigma_c, double sigma_u) {
-  PreisachDistribution d;
-  d.sigma_u = sigma_u;
-  auto Phi = [](double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); };
-  const double total = Phi(3.0) - Phi(-3.0);
-  for (int j = 0; j <= kPreisachBins; ++j)
-    d.edge[j] = std::exp(sigma_c * (-3.0 + 6.0 * j / kPreisachBins));
-  for (int j = 0; j < kPreisachBins; ++j) {
-    const double z0 = -3.0 + 6.0 * j / kPreisachBins, z1 = -3.0 + 6.0 * (j + 1) / kPreisachBins;
-    d.density[j] = (Phi(z1) - Phi(z0)) / total / (d.edge[j + 1] - d.edge[j]);
-  }
-  return d;
+// The distribution's numbers as the law's template reads them.
+inline PreisachBins preisach_bins(const PreisachDistribution& d) {
+  PreisachBins k{};
+  k.s = d.sigma_u;
+  for (int j = 0; j <= kPreisachBins; ++j) k.edge[j] = d.edge[static_cast<std::size_t>(j)];
+  for (int j = 0; j < kPreisachBins; ++j) k.density[j] = d.density[static_cast<std::size_t>(j)];
+  return k;
 }
 
-// The Gaussian f_u of standard deviation s, its CDF F, A = int F and Y = int y F(y) dy.
-struct GaussTerms {
-  double F, f, A, Y;
-};
-inline GaussTerms gauss_terms(double y, double s) {
-  const double F = 0.5 * std::erfc(-y / (s * std::sqrt(2.0)));
-  const double f = std::exp(-0.5 * (y / s) * (y / s)) / (s * std::sqrt(2.0 * kPi));
-  const double A = y * F + s * s * f;
-  const double B = 0.5 * (y * y + s * s) * F + 0.5 * y * s * s * f;  // int A
-  return {F, f, A, y * A - B};
-}
-
-// The triangle T(a, b) = {b <= beta <= alpha <= a} of the Preisach plane: its measure E (the
-// Everett function), its moments in h_c and h_u, and dE/da, dE/db. a may be +inf, b -inf.
-struct Everett {
-  double E = 0, Ec = 0, Eu = 0, dE_da = 0, dE_db = 0;
-};
-
-// One side of the triangle: the integrals over h in [p, q] of F(a - h) (side a) or F(b + h)
-// (side b), of h times it, and of the density f there, from the Gaussian terms at the two ends
-// (gp at p, gq at q: gauss_terms(a - p) and gauss_terms(a - q) on side a, gauss_terms(b + p)
-// and gauss_terms(b + q) on side b).
-struct SideIntegrals {
-  double I0 = 0, I1 = 0, J = 0;
-};
-inline SideIntegrals side_a(double a, const GaussTerms& gp, const GaussTerms& gq) {
-  return {gp.A - gq.A, a * (gp.A - gq.A) - (gp.Y - gq.Y), gp.F - gq.F};
-}
-inline SideIntegrals side_b(double b, const GaussTerms& gp, const GaussTerms& gq) {
-  return {gq.A - gp.A, (gq.Y - gp.Y) - b * (gq.A - gp.A), gq.F - gp.F};
-}
-
-// E(a, b) = int_0^D f_c(h) [F(a - h) - F(b + h)] dh, D = (a - b)/2; Ec with h f_c(h) in place
-// of f_c; Eu = int_0^D f_c(h) s^2 [f(b + h) - f(a - h)] dh (int u f(u) du = -s^2 f(u)).
-// The upper limit D (where a - h = b + h) adds nothing to the derivatives. A bin's Gaussian terms
-// at its upper edge are the next bin's at its lower edge, so each edge is evaluated once (as the
-// lanes do, src/lanes/preisach_lanes-inl.h); a = +inf makes side a {q - p, (q^2 - p^2)/2, 0},
-// b = -inf side b nothing.
+// The Everett function of the triangle T(a, b) (everett_bins; a may be +inf, b -inf).
 inline Everett everett(const PreisachDistribution& d, double a, double b) {
-  Everett e;
-  if (!(a > b)) return e;
-  const bool a_inf = std::isinf(a), b_inf = std::isinf(b);
-  const double D = (a_inf || b_inf) ? std::numeric_limits<double>::infinity() : 0.5 * (a - b);
-  const double s = d.sigma_u;
-  GaussTerms ga_p{}, gb_p{}, ga_q{}, gb_q{};
-  if (!a_inf) ga_p = gauss_terms(a - d.edge[0], s);
-  if (!b_inf) gb_p = gauss_terms(b + d.edge[0], s);
-  for (int j = 0; j < kPreisachBins && d.edge[j] < D; ++j) {
-    const double p = d.edge[j], q = std::min(d.edge[j + 1], D), w = d.density[j];
-    SideIntegrals A{q - p, 0.5 * (q * q - p * p), 0.0}, B{};
-    if (!a_inf) {
-      ga_q = gauss_terms(a - q, s);
-      A = side_a(a, ga_p, ga_q);
-      ga_p = ga_q;
-    }
-    if (!b_inf) {
-      gb_q = gauss_terms(b + q, s);
-      B = side_b(b, gb_p, gb_q);
-      gb_p = gb_q;
-    }
-    e.E += w * (A.I0 - B.I0);
-    e.Ec += w * (A.I1 - B.I1);
-    e.Eu += w * s * s * (B.J - A.J);
-    e.dE_da += w * A.J;
-    e.dE_db -= w * B.J;
-  }
-  return e;
+  return everett_bins(preisach_bins(d), a, b);
 }
-
-// The state of the hysterons: the staircase of the Preisach plane as the stack of the input's
-// alternating dominant extrema (Mayergoyz 1991, ch. 1.2), oldest first. Entry 0 is +inf (a
-// maximum: positive saturation), entry 1 is -inf (a minimum: negative saturation); entries
-// alternate max/min, so entry k is a maximum for even k. At each extremum it keeps the
-// up-switched measure mu (M_P / M_s = 2 mu - 1) and the moments of the up-switched set in h_c
-// and h_u. The input moves from the last extremum toward x_now (rising if that is a minimum).
-// Fixed capacity: no allocation. Wiping-out removes a pair whenever the input passes the
-// extremum before the last one, so a bounded input keeps the stack bounded; a reversal that
-// finds it full forgets the innermost pair first (docs/model.md, "The Preisach law").
-struct PreisachHistory {
-  std::array<double, kPreisachCapacity> x{}, mu{}, mc{}, mu_u{};
-  int n = 0;  // entries in use (0: not initialised)
-  double x_now = 0, mu_now = 0, mc_now = 0, mu_u_now = 0;
-  long forgotten = 0;   // reversals that found the stack full
-  double last_dmc = 0;  // |change of the h_c moment| over the last committed move
-};
 
 // The up-switched measure (and its moments) at reduced input x1, reached monotonically from
 // the history's x_now, without changing the history. mu' = d mu / d x1 along that move.
-struct PreisachPoint {
-  double mu = 0, mc = 0, mu_u = 0, dmu_dx = 0;
-  int base = 0;       // the extremum the move continues from (index, or n for x_now itself)
-  bool push = false;  // the move reverses: x_now becomes an extremum
-};
-
-// Where a move to x1 continues from (preisach_point's search of the stack, without the Everett
-// function): the base extremum (index, or n for x_now), its input and up-switched measure and
-// moments, the direction, and whether the move reverses. same: x1 == x_now (nothing moves).
-struct PreisachBase {
-  double xb = 0, mub = 0, mcb = 0, mub_u = 0;
-  int base = 0;
-  bool up = false, push = false, same = false;
-};
-inline PreisachBase preisach_base(const PreisachHistory& h, double x1) {
-  PreisachBase r;
-  if (x1 == h.x_now) {
-    r = {h.x_now, h.mu_now, h.mc_now, h.mu_u_now, h.n, false, false, true};
-    return r;
-  }
-  const bool rising_now = (h.n - 1) % 2 == 1;  // the last entry is a minimum
-  r.up = x1 > h.x_now;
-  r.push = r.up != rising_now;
-  int len = h.n + (r.push ? 1 : 0);
-  auto xs = [&](int k) { return k == h.n ? h.x_now : h.x[k]; };
-  // Wiping-out: passing the extremum before the base removes the base and that extremum.
-  while (len >= 3 && (r.up ? x1 >= xs(len - 2) : x1 <= xs(len - 2))) len -= 2;
-  r.base = len - 1;
-  r.xb = xs(r.base);
-  r.mub = r.base == h.n ? h.mu_now : h.mu[r.base];
-  r.mcb = r.base == h.n ? h.mc_now : h.mc[r.base];
-  r.mub_u = r.base == h.n ? h.mu_u_now : h.mu_u[r.base];
-  return r;
-}
-
 inline PreisachPoint preisach_point(const PreisachDistribution& d, const PreisachHistory& h,
                                     double x1) {
-  PreisachPoint r;
   const PreisachBase b = preisach_base(h, x1);
-  if (b.same) {
-    r = {h.mu_now, h.mc_now, h.mu_u_now, 0.0, h.n, false};
-    return r;
-  }
-  r.push = b.push;
-  r.base = b.base;
-  if (b.up) {  // the triangle T(x1, xb) switches up
-    const Everett e = everett(d, x1, b.xb);
-    r.mu = b.mub + e.E;
-    r.mc = b.mcb + e.Ec;
-    r.mu_u = b.mub_u + e.Eu;
-    r.dmu_dx = e.dE_da;
-  } else {  // the triangle T(xb, x1) switches down
-    const Everett e = everett(d, b.xb, x1);
-    r.mu = b.mub - e.E;
-    r.mc = b.mcb - e.Ec;
-    r.mu_u = b.mub_u - e.Eu;
-    r.dmu_dx = -e.dE_db;
-  }
-  return r;
-}
-
-// Moves the history to x1, given the point p = preisach_point(d, h, x1) (its mu, mc, mu_u and
-// base): pushes x_now if the move reverses (forgetting the innermost pair first if the stack
-// is full), pops what the move wiped out, and records the change of the h_c moment (the
-// switching loss, physics below).
-inline void preisach_commit_point(PreisachHistory& h, double x1, const PreisachPoint& p) {
-  h.last_dmc = std::fabs(p.mc - h.mc_now);
-  if (x1 == h.x_now) return;
-  if (p.base == h.n) {  // the move reverses at x_now and wipes nothing: x_now is an extremum
-    if (h.n == kPreisachCapacity) {  // full: forget the innermost pair (not the sentinels)
-      h.n -= 2;
-      ++h.forgotten;
-    }
-    h.x[h.n] = h.x_now;
-    h.mu[h.n] = h.mu_now;
-    h.mc[h.n] = h.mc_now;
-    h.mu_u[h.n] = h.mu_u_now;
-    ++h.n;
-  } else {
-    h.n = p.base + 1;  // the extrema the move passed are wiped out
-  }
-  h.x_now = x1;
-  h.mu_now = p.mu;
-  h.mc_now = p.mc;
-  h.mu_u_now = p.mu_u;
+  const PreisachPointT<double> p =
+      preisach_point_from(preisach_bins(d), b.xb, b.mub, b.mcb, b.mub_u, b.up, b.same, x1);
+  return {p.mu, p.mc, p.mu_u, p.dmu_dx, b.base, b.push};
 }
 
 // Moves the history to x1 (preisach_commit_point at the point preisach_point computes).
@@ -293,48 +120,35 @@ struct PreisachCoefficients {  // at one temperature
   PreisachDistribution dist;   // the hysterons, in reduced fields
 };
 
-// The end magnetisation of a move to field H1 from the history h (not committed): Newton on
-//   g(M) = M - M_s^T [(1 - c)(2 mu(x) - 1) + c L(H_e/a)] = 0 with its exact derivative
-// (H_e and x depend on M through alpha), from M_guess. dM_dH (if given) receives
-// chi_e / (1 - alpha chi_e), chi_e = M_s [(1 - c) 2 mu'(x) / H_c + c L'(H_e/a) / a]; x1 (if
-// given) the reduced input the move ends at; point (if given) the up-switched measure there
-// (preisach_point at x1), which preisach_commit_point commits without evaluating the
-// distribution again.
+// The law's constants at one temperature as its template reads them (inv_a = 1/a and inv_hc =
+// 1/H_c as the lanes pack them).
+inline PreisachConstants preisach_constants(double MsT_A_per_m, const PreisachCoefficients& p) {
+  return {MsT_A_per_m,          p.c, p.alpha, p.a_A_per_m, 1.0 / p.a_A_per_m, 1.0 / p.Hc_A_per_m,
+          preisach_bins(p.dist)};
+}
+
+// The end magnetisation of a move to field H1 from the history h (not committed): the law's
+// Newton solve (preisach_solve) from M_guess. dM_dH (if given) receives chi_e / (1 - alpha
+// chi_e); x1 (if given) the reduced input the move ends at; point (if given) the up-switched
+// measure there, which preisach_commit_point commits without evaluating the distribution again.
 inline double preisach_magnetisation(double H1, double MsT_A_per_m, const PreisachCoefficients& p,
                                      const PreisachHistory& h, double M_guess, double* dM_dH,
                                      double* x1, PreisachPoint* point = nullptr) {
-  const double inv_a = 1.0 / p.a_A_per_m, inv_hc = 1.0 / p.Hc_A_per_m;
-  const double tol = 1e-12 * MsT_A_per_m;
-  double M = M_guess;
-  for (int it = 0; it < 60; ++it) {
-    const double He = H1 + p.alpha * M;
-    const double x = He * inv_hc;
-    const PreisachPoint pt = preisach_point(p.dist, h, x);
-    const LangevinValue lv = langevin_pair(He * inv_a);
-    const double Mnew = MsT_A_per_m * ((1.0 - p.c) * (2.0 * pt.mu - 1.0) + p.c * lv.L);
-    const double chi_e =
-        MsT_A_per_m * ((1.0 - p.c) * 2.0 * pt.dmu_dx * inv_hc + p.c * lv.dL * inv_a);
-    const double g = M - Mnew;
-    if (std::fabs(g) <= tol || it == 59) {
-      if (dM_dH) *dM_dH = chi_e / (1.0 - p.alpha * chi_e);
-      if (x1) *x1 = x;
-      if (point) *point = pt;
-      return Mnew;
-    }
-    double dg = 1.0 - p.alpha * chi_e;
-    if (dg < 0.2) dg = 0.2;  // alpha > 0 (positive feedback): damp the Newton step
-    M -= g / dg;
+  const PreisachSolveT<double> s =
+      preisach_solve(true, preisach_constants(MsT_A_per_m, p), &h, H1, M_guess);
+  if (dM_dH) *dM_dH = s.chi_e / (1.0 - p.alpha * s.chi_e);
+  if (x1) *x1 = s.x1;
+  if (point) {
+    const PreisachBase b = preisach_base(h, s.x1);
+    *point = {s.mu, s.mc, s.mu_u, 0.0, b.base, b.push};
   }
-  return M;
+  return s.M;
 }
 
-// The slope at a reversal (the hysterons' part has zero slope there, E ~ (a - b)^2): the
-// reversible part with the mean field, c M_s L'/a / (1 - alpha c M_s L'/a).
+// The slope at a reversal (preisach_reversible_slope): the reversible part with the mean field.
 inline double preisach_reversible_susceptibility(double H, double M, double MsT_A_per_m,
                                                  const PreisachCoefficients& p) {
-  const double He = H + p.alpha * M;
-  const double chi_e = p.c * MsT_A_per_m / p.a_A_per_m * langevin_derivative(He / p.a_A_per_m);
-  return chi_e / (1.0 - p.alpha * chi_e);
+  return preisach_reversible_slope(preisach_constants(MsT_A_per_m, p), H, M);
 }
 
 // Energy (docs/model.md, "Energy ledgers"): a hysteron of weight w switching up at H_e = alpha'
