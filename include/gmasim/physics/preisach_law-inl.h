@@ -73,8 +73,12 @@ GMASIM_LAW_INLINE T exp_nonpositive(T x) {
   const T n = round_even(k * (1.0 / 32.0) - 0.484375);  // floor(k / 32): k / 32 - 15.5 / 32
   const T j = k - n * 32.0;                             // 0 .. 31
   const T r = (xc - k * (kLn2Hi / 32.0)) - k * (kLn2Lo / 32.0);
-  T p = 1.0 / 720.0;
-  for (double c : {1.0 / 120.0, 1.0 / 24.0, 1.0 / 6.0, 0.5, 1.0, 1.0}) p = p * r + c;
+  // Horner, written out (a loop over the coefficients kept p in a general register)
+  const T p =
+      ((((((1.0 / 720.0) * r + 1.0 / 120.0) * r + 1.0 / 24.0) * r + 1.0 / 6.0) * r + 0.5) * r +
+       1.0) *
+          r +
+      1.0;
   const T n1 = round_even(n * 0.5 - 0.25);  // floor(n / 2)
   const T e = ((table_at(kTwoToJOver32, j) * p) * pow2i(n1)) * pow2i(n - n1);
   return select(number, select(under, T(0.0), e), x);
@@ -115,27 +119,43 @@ GMASIM_LAW_INLINE T erfc_cody(T x, T& gauss,
   T small = 1.0, mid = 1.0, tail = 1.0;
   if (any(is_small)) {  // |x| <= 0.46875
     T num = a[4] * ysq, den = ysq;
-    for (int i = 0; i < 3; ++i) {
-      num = (num + a[i]) * ysq;
-      den = (den + b[i]) * ysq;
-    }
+    num = (num + a[0]) * ysq;
+    den = (den + b[0]) * ysq;
+    num = (num + a[1]) * ysq;
+    den = (den + b[1]) * ysq;
+    num = (num + a[2]) * ysq;
+    den = (den + b[2]) * ysq;
     small = 1.0 - (x * (num + a[3])) / (den + b[3]);
   }
   if (any(!is_small && is_mid)) {  // 0.46875 < |x| <= 4
-    T num = c[8] * y, den = y;
-    for (int i = 0; i < 7; ++i) {
-      num = (num + c[i]) * y;
-      den = (den + dd[i]) * y;
-    }
+    T num = c[8] * y, den = y;     // Horner over c[0..6] and dd[0..6], written out
+    num = (num + c[0]) * y;
+    den = (den + dd[0]) * y;
+    num = (num + c[1]) * y;
+    den = (den + dd[1]) * y;
+    num = (num + c[2]) * y;
+    den = (den + dd[2]) * y;
+    num = (num + c[3]) * y;
+    den = (den + dd[3]) * y;
+    num = (num + c[4]) * y;
+    den = (den + dd[4]) * y;
+    num = (num + c[5]) * y;
+    den = (den + dd[5]) * y;
+    num = (num + c[6]) * y;
+    den = (den + dd[6]) * y;
     mid = (num + c[7]) / (den + dd[7]);
   }
   if (!all(is_mid)) {  // |x| > 4
     const T z = 1.0 / ysq;
     T num = p[5] * z, den = z;
-    for (int i = 0; i < 4; ++i) {
-      num = (num + p[i]) * z;
-      den = (den + q[i]) * z;
-    }
+    num = (num + p[0]) * z;
+    den = (den + q[0]) * z;
+    num = (num + p[1]) * z;
+    den = (den + q[1]) * z;
+    num = (num + p[2]) * z;
+    den = (den + q[2]) * z;
+    num = (num + p[3]) * z;
+    den = (den + q[3]) * z;
     tail = (kRsqrtPi - (z * (num + p[4])) / (den + q[4])) / y;
   }
   // t <= y on the grid of 1/16 (floor(16 y), or one below where 16 y is an even integer's
