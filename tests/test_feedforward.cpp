@@ -14,6 +14,7 @@
 #include "gmasim/errors.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/experiments/feedforward.hpp"
+#include "gmasim/io/io.hpp"
 #include "gmasim/model/model.hpp"
 
 using namespace gmasim;
@@ -151,6 +152,14 @@ TEST(Feedforward, SixteenMismatchedPlants) {
   EXPECT_NEAR(p.material.lambda_s, 0.9 * mdma().material.lambda_s, 1e-15);
   for (std::size_t i = 0; i < p.rods.size(); ++i)
     EXPECT_NEAR(p.rods[i].ja.k0_A_per_m, 0.9 * mdma().rods[i].ja.k0_A_per_m, 1e-9);
+  // A Preisach plant's k+/- scales its own loop-width parameter, H_c0 (it scaled the JA table,
+  // which a Preisach rod does not read: the mismatch did nothing).
+  const Model pre = load_model(std::string(GMASIM_SOURCE_DIR) + "/models/single_rod_preisach.toml");
+  const Model pp = mismatched_plant(pre, v[15]);
+  for (std::size_t i = 0; i < pp.rods.size(); ++i) {
+    EXPECT_NEAR(pp.rods[i].preisach.Hc0_A_per_m, 0.9 * pre.rods[i].preisach.Hc0_A_per_m, 1e-9);
+    EXPECT_EQ(pp.rods[i].ja.k0_A_per_m, pre.rods[i].ja.k0_A_per_m);
+  }
   EXPECT_EQ(parse_track_controller("pid_inverse"), TrackController::PidInverse);
   EXPECT_NE(input_error_of([] { (void)parse_track_controller("lqr"); }), "(no InputError)");
 }

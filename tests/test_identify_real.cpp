@@ -133,8 +133,17 @@ TEST(RealLoop, FieldInKiloampsPerMetreIsReadOrRefused) {
   const std::string msg = input_error([&] { (void)Objective(single_rod(), bad, fit); });
   EXPECT_THAT(msg, HasSubstr("wrong.csv"));
   EXPECT_THAT(msg, HasSubstr("column field_A_per_m"));
-  EXPECT_THAT(msg, HasSubstr("anhysteretic field a"));
+  EXPECT_THAT(msg, HasSubstr("anhysteretic shape field a"));
   EXPECT_THAT(msg, HasSubstr("name the column field_kA_per_m"));
+  // A Preisach rod has no anhysteretic shape a (its JA table is not read: a = 0 let every
+  // record pass before): the law names its own field, the hysterons' median coercive field.
+  const ModelSpec pre =
+      load_model_spec(std::string(GMASIM_SOURCE_DIR) + "/models/single_rod_preisach.toml");
+  const FitSpec pre_fit =
+      fit_of({{"rod.preisach.Hc0_A_per_m", 500.0, 9000.0, ParamScale::Log, false, 0.0, 1}});
+  const std::string pmsg = input_error([&] { (void)Objective(pre, bad, pre_fit); });
+  EXPECT_THAT(pmsg, HasSubstr("median coercive field H_c"));
+  EXPECT_THAT(pmsg, HasSubstr("name the column field_kA_per_m"));
   // Both field columns at once are refused.
   EXPECT_THAT(input_error([&] {
                 (void)load_measurement_csv(

@@ -19,6 +19,7 @@
 #include "gmasim/experiments/compensate.hpp"
 #include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/feedforward.hpp"
+#include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/model/validate.hpp"
 
 namespace gmasim {
@@ -145,7 +146,11 @@ Model mismatched_plant(const Model& m, const PlantMismatch& x) {
   auto scale = [&](const std::string& key, double f) { spec.set(key, spec.get(key) * f); };
   scale("material.Ms_A_per_m", x.Ms_factor);
   scale("material.lambda_s", x.lambda_s_factor);
-  for (const auto& rod : spec.rods) scale(rod + ".ja.k0_A_per_m", x.k_factor);
+  // k+/-: the parameter that sets the loop's width, the law's own (JA k0, Preisach H_c0)
+  const std::string width = with_magnetisation_law(m.options.magnetisation_law, [](auto law) {
+    return std::string(decltype(law)::loop_width_key);
+  });
+  for (const auto& rod : spec.rods) scale(rod + "." + width, x.k_factor);
   spec.source = m.spec.source + " (plant " + x.label + ")";
   return compile(spec);
 }

@@ -12,6 +12,7 @@
 
 #include "gmasim/errors.hpp"
 #include "gmasim/identify/identify.hpp"
+#include "gmasim/magnetisation/laws.hpp"
 #include "gmasim/model/validate.hpp"
 #include "identify/objective_impl.hpp"
 
@@ -159,7 +160,12 @@ void check_field_magnitude(const Model& start_model, const Measurement& meas) {
   if (meas.drive_kind != DriveInput::Field) return;
   const std::size_t rod = identify_detail::record_rod(start_model, meas);
   const Conditions c = make_conditions(start_model, meas.condition.temperature_C);
-  const double a = c.rods[rod].ja.a_A_per_m;
+  // the law's own field scale (JA: a^T; Preisach: H_c^T), named by the law
+  const char* field_name = "";
+  const double a = with_magnetisation_law(start_model.options.magnetisation_law, [&](auto law) {
+    field_name = decltype(law)::characteristic_field_name;
+    return decltype(law)::characteristic_field_A_per_m(c.rods[rod]);
+  });
   double hmax = 0.0;
   for (double h : meas.drive) hmax = std::max(hmax, std::fabs(h));
   if (hmax >= kMinFieldOverA * a) return;
@@ -169,12 +175,13 @@ void check_field_magnitude(const Model& start_model, const Measurement& meas) {
   throw InputError(located(
       meas.path, 0,
       fmt::format("column {}: the largest |field| is {:g} {} = {:g} A/m, below {:g} x the "
-                  "anhysteretic field a = {:.4g} A/m of rod '{}' at {:g} degC (the rule: a "
-                  "record's field must reach {:g} a, or the rod barely leaves its demagnetised "
+                  "{} = {:.4g} A/m of rod '{}' at {:g} degC (the rule: a record's field must "
+                  "reach {:g} times that field, or the rod barely leaves its demagnetised "
                   "state); if the values are in kA/m, name the column field_kA_per_m (read x "
                   "1000), or convert them to A/m",
-                  col, in_col, col == "field_kA_per_m" ? "kA/m" : "A/m", hmax, kMinFieldOverA, a,
-                  start_model.rods[rod].name, meas.condition.temperature_C, kMinFieldOverA)));
+                  col, in_col, col == "field_kA_per_m" ? "kA/m" : "A/m", hmax, kMinFieldOverA,
+                  field_name, a, start_model.rods[rod].name, meas.condition.temperature_C,
+                  kMinFieldOverA)));
 }
 
 // One record: its compared samples and peak-to-peak values; checked against the start model.

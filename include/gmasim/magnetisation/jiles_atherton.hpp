@@ -158,6 +158,13 @@ struct JilesAthertonLaw {
   // The field excursion about a reversal that stays (nearly) reversible [A/m]: the FRF's
   // small-signal limit is 10 % of it. JA: c k / (1 - c) (eq. 9: the reversible range of M_irr
   // pinned); infinite when c >= 1.
+  // The field the law's loop is shaped by, which a field-driven record must reach (identify's
+  // check of a record's units): eq. (10)'s anhysteretic shape a^T.
+  static constexpr const char* characteristic_field_name = "anhysteretic shape field a";
+  static double characteristic_field_A_per_m(const RodConditions& rc) { return rc.ja.a_A_per_m; }
+  // The parameter that sets the loop's width, which track's plant mismatches scale (k+/-).
+  static constexpr const char* loop_width_key = "ja.k0_A_per_m";
+
   static double reversible_field_range(const RodConditions& rc) {
     if (!(rc.ja.c < 1.0)) return std::numeric_limits<double>::infinity();
     return rc.ja.c * rc.ja.k_A_per_m / (1.0 - rc.ja.c);

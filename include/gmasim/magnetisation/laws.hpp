@@ -8,6 +8,8 @@
 //   ode_*                 the law as an ODE for the RK4 reference
 //   reduce_to_anhysteretic, anhysteretic_magnetisation, hold_anhysteretic
 //                         the FRF's anhysteretic bias state
+//   characteristic_field_A_per_m (and _name), loop_width_key
+//                         identify's field-record check and track's plant mismatches
 // Its constants land in RodModel through its parameter rows and reach RodConditions through
 // its temperature laws (src/model/magnetisation/<law>.cpp). The step is compiled once per
 // law (step_law<Law>); a run dispatches once, by with_magnetisation_law, not per step.

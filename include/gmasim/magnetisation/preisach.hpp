@@ -129,6 +129,15 @@ struct PreisachLaw {
   // The field excursion about a reversal that switches no hysteron [A/m]: a move of dx from a
   // reversal switches those with 2 h_c <= dx, none below the smallest coercive field of the
   // histogram, so 2 edge_0 H_c^T (effective field; the FRF's small-signal limit is 10 % of it).
+  // The field the law's loop is shaped by, which a field-driven record must reach (identify's
+  // check of a record's units): the hysterons' median coercive field H_c^T.
+  static constexpr const char* characteristic_field_name = "median coercive field H_c";
+  static double characteristic_field_A_per_m(const RodConditions& rc) {
+    return rc.preisach.Hc_A_per_m;
+  }
+  // The parameter that sets the loop's width, which track's plant mismatches scale (k+/-).
+  static constexpr const char* loop_width_key = "preisach.Hc0_A_per_m";
+
   static double reversible_field_range(const RodConditions& rc) {
     return 2.0 * rc.preisach.dist.edge[0] * rc.preisach.Hc_A_per_m;
   }
