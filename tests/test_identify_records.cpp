@@ -395,10 +395,25 @@ TEST(Records, FitReportGivesAFieldRecordsDriveInKiloAmperesPerMetre) {
   EXPECT_EQ(fits[0].drive_label, "H p-p [kA/m]");
   EXPECT_DOUBLE_EQ(fits[0].drive_pp, (*hi - *lo) * 1e-3);
   EXPECT_GT(fits[0].drive_pp, 1.0);  // tens of kA/m for 12 A p-p
+  // The loop's widths (loop_widths), in kA/m: the start is the truth, so the simulated loop's
+  // widths are the measured ones; an open loop at every level (a width of a few kA/m).
+  EXPECT_EQ(fits[0].width_unit, "kA/m");
+  for (std::size_t k = 0; k < kLoopWidthFractions.size(); ++k) {
+    EXPECT_GT(fits[0].width_measured[k], 0.1) << k;
+    EXPECT_NEAR(fits[0].width_simulated[k], fits[0].width_measured[k],
+                1e-6 * fits[0].width_measured[k])
+        << k;
+  }
+  IdentifyResult res;
+  res.conditions = fits;
+  EXPECT_NE(fit_report_json(res, FitProvenance{}).find("\"width_measured_kA_per_m\": ["),
+            std::string::npos);
+  EXPECT_NE(fit_report_markdown(res, FitProvenance{}).find("### Loop width"), std::string::npos);
   r.drive = DriveInput::Current;
   const MeasurementSet cur = synthesize_measurements(compile(spec), r);
   const Objective obj_cur(spec, cur, fit, ObjectiveSettings{});
   const std::vector<ConditionFit> fc = obj_cur.condition_fits(obj_cur.start_unit());
   EXPECT_EQ(fc[0].drive_label, "I p-p [A]");
   EXPECT_NEAR(fc[0].drive_pp, 12.0, 1e-9);
+  EXPECT_EQ(fc[0].width_unit, "A");
 }

@@ -51,6 +51,22 @@ void fill_fit(ConditionFit& f, const Measurement& meas, const CondData& cd,
     const double ppB = peak_to_peak(std::span<const double>(meas.flux_T).subspan(cd.compare_begin));
     if (ppB > 0.0) f.flux_rms_pct = 100.0 * std::sqrt(ssB / static_cast<double>(f.compared)) / ppB;
   }
+  f.width_measured.fill(std::nan(""));
+  f.width_simulated.fill(std::nan(""));
+  if (meas.drive.size() == f.samples && f.compared >= 3) {
+    // the loop's widths over the compared samples, at the measured span's levels
+    const std::size_t b = cd.compare_begin, m = f.samples - b;
+    const std::span<const double> x = std::span<const double>(meas.drive).subspan(b, m),
+                                  ym = std::span<const double>(meas.response).subspan(b, m),
+                                  ys = std::span<const double>(y).subspan(b, m);
+    const auto [lo, hi] = std::minmax_element(ym.begin(), ym.end());
+    const bool field = meas.drive_kind == DriveInput::Field;
+    f.width_unit = field ? "kA/m" : "A";
+    f.width_measured = loop_widths(x, ym, *lo, *hi);
+    f.width_simulated = loop_widths(x, ys, *lo, *hi);
+    for (double* w : {f.width_measured.data(), f.width_simulated.data()})
+      for (std::size_t k = 0; k < 4; ++k) w[k] *= field ? 1e-3 : 1.0;
+  }
   TimeSeries& ts = f.overlay;
   // Timed current/displacement records keep their historical column names; the others
   // name their own columns (sample index, field, strain).

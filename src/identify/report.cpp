@@ -136,6 +136,20 @@ void write_condition(JsonWriter& w, const ConditionFit& c) {
   w.key("response_unit").string(c.response_unit);
   // The record's drive span: drive_pp_A (current records) or drive_pp_kA_per_m (field records).
   w.key(c.drive_label.starts_with("H") ? "drive_pp_kA_per_m" : "drive_pp_A").number(c.drive_pp);
+  // The loop's widths at 20/40/60/80 % of the measured span (null: a branch does not cross).
+  const std::string wu = c.width_unit == "kA/m" ? "kA_per_m" : c.width_unit;
+  for (const auto& [name, v] : {std::pair{"width_measured_", &c.width_measured},
+                                std::pair{"width_simulated_", &c.width_simulated}}) {
+    w.key(name + wu).begin_array(JsonLayout::Inline);
+    for (double x : *v) {
+      if (std::isfinite(x)) {
+        w.number(x);
+      } else {
+        w.null();
+      }
+    }
+    w.end_array();
+  }
   w.key("quasi_static").boolean(c.condition.quasi_static);
   w.key("offset").string(offset_mode_name(c.condition.offset));
   // The constant the offset rule added to the simulated response (fitted or first_sample).
@@ -267,6 +281,24 @@ std::string drive_text(const ConditionFit& c) {
 }
 
 // Each condition's fit (in the record's response unit), and where its overlay is.
+// The loops' widths, measured beside simulated, at the levels of kLoopWidthFractions.
+std::string markdown_loop_widths(const IdentifyResult& r) {
+  std::string s =
+      "\n### Loop width\n\nThe loop's width (the drive between its falling and rising branches) "
+      "at 20/40/60/80 % of the measured response's span, measured / simulated, in the drive's "
+      "unit (kA/m of a field record, A of a current record); - where a branch does not cross "
+      "the level.\n\n| condition | 20 % | 40 % | 60 % | 80 % |\n|---|---|---|---|---|\n";
+  auto cell = [](double x) { return std::isfinite(x) ? fmt::format("{:.4g}", x) : "-"; };
+  for (const auto& c : r.conditions) {
+    if (c.failed) continue;
+    s += "| " + c.label + " (" + c.width_unit + ")";
+    for (std::size_t k = 0; k < kLoopWidthFractions.size(); ++k)
+      s += " | " + cell(c.width_measured[k]) + " / " + cell(c.width_simulated[k]);
+    s += " |\n";
+  }
+  return s;
+}
+
 std::string markdown_conditions(const IdentifyResult& r) {
   std::string s =
       "## Conditions\n\np-p, RMS, max err and offset are in the record's response unit: um of "
@@ -292,6 +324,7 @@ std::string markdown_conditions(const IdentifyResult& r) {
         u, c.rms, u, c.rms_pct, c.max_err, u, offset_text(c),
         c.flux_rms_pct >= 0 ? fmt::format("{:.3f}", c.flux_rms_pct) : "-");
   }
+  s += markdown_loop_widths(r);
   s += "\nOverlays (measured vs simulated): `overlay_<condition>.csv`, drawn into "
        "`overlay_<condition>.png` by `python3 -m gmasim.command_figures identify <this "
        "directory>`.\n\n";

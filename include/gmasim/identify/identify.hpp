@@ -10,6 +10,7 @@
 // See docs/identify.md for the algorithms and why, and docs/data.md for the file formats.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <functional>
 #include <limits>
@@ -248,9 +249,27 @@ struct ConditionFit {
   double flux_rms_pct = -1.0;  // -1: no flux column (or flux not fitted)
   bool failed = false;         // the simulation diverged or a value was invalid
   std::string error;
+  // The loop's width at kLoopWidthFractions of the measured response's span (compared
+  // samples), measured and simulated at the same levels (loop_widths), in the drive's unit:
+  // kA/m of a field record, A of a current record (width_unit); NaN where a branch of the loop
+  // does not cross the level. A law whose loop closes too early shows here first.
+  std::string width_unit = "A";
+  std::array<double, 4> width_measured{}, width_simulated{};
   // Overlay: t_s, current_A, measured_um, simulated_um, compared (1/0)
   TimeSeries overlay;
 };
+
+// The levels of ConditionFit's loop widths, as fractions of the measured response's span.
+inline constexpr std::array<double, 4> kLoopWidthFractions = {0.2, 0.4, 0.6, 0.8};
+
+// The horizontal width of a hysteresis loop (drive x, response y, sample by sample) at the levels
+// L = lo + f (hi - lo), f in kLoopWidthFractions: at each level, the drive where y crosses L
+// (linear between samples), on the half of the drive that holds its largest magnitude (a
+// butterfly's two halves mirror each other; a unipolar loop has one), split by the drive's
+// direction there; the width is |mean crossing while the drive falls - mean crossing while it
+// rises|. NaN where either branch does not cross L. Units: x's.
+std::array<double, 4> loop_widths(std::span<const double> x, std::span<const double> y, double lo,
+                                  double hi);
 
 struct TargetFit {
   std::string label, kind;
