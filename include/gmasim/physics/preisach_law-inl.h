@@ -84,6 +84,14 @@ GMASIM_LAW_INLINE T exp_nonpositive(T x) {
   return select(number, select(under, T(0.0), e), x);
 }
 
+// num = (num + p[i]) x and den = (den + q[i]) x for i = 0 .. N - 1: the Horner steps of a
+// rational function's numerator and denominator, unrolled at compile time (a fold over I).
+template <std::size_t... I, class T>
+GMASIM_LAW_INLINE void horner_steps(std::index_sequence<I...>, T& num, T& den, T x, const double* p,
+                                    const double* q) {
+  ((num = (num + p[I]) * x, den = (den + q[I]) * x), ...);
+}
+
 // erfc(x) after W. J. Cody, "Rational Chebyshev approximations for the error function", Math.
 // Comp. 23 (1969) 631-637 (the double-precision coefficients of his specfun routine CALERF,
 // netlib): |x| <= 0.46875: 1 - x R1(x^2); 0.46875 < |x| <= 4: exp(-x^2) R2(|x|); |x| > 4:
@@ -119,43 +127,18 @@ GMASIM_LAW_INLINE T erfc_cody(T x, T& gauss,
   T small = 1.0, mid = 1.0, tail = 1.0;
   if (any(is_small)) {  // |x| <= 0.46875
     T num = a[4] * ysq, den = ysq;
-    num = (num + a[0]) * ysq;
-    den = (den + b[0]) * ysq;
-    num = (num + a[1]) * ysq;
-    den = (den + b[1]) * ysq;
-    num = (num + a[2]) * ysq;
-    den = (den + b[2]) * ysq;
+    horner_steps(std::make_index_sequence<3>{}, num, den, ysq, a, b);
     small = 1.0 - (x * (num + a[3])) / (den + b[3]);
   }
   if (any(!is_small && is_mid)) {  // 0.46875 < |x| <= 4
-    T num = c[8] * y, den = y;     // Horner over c[0..6] and dd[0..6], written out
-    num = (num + c[0]) * y;
-    den = (den + dd[0]) * y;
-    num = (num + c[1]) * y;
-    den = (den + dd[1]) * y;
-    num = (num + c[2]) * y;
-    den = (den + dd[2]) * y;
-    num = (num + c[3]) * y;
-    den = (den + dd[3]) * y;
-    num = (num + c[4]) * y;
-    den = (den + dd[4]) * y;
-    num = (num + c[5]) * y;
-    den = (den + dd[5]) * y;
-    num = (num + c[6]) * y;
-    den = (den + dd[6]) * y;
+    T num = c[8] * y, den = y;
+    horner_steps(std::make_index_sequence<7>{}, num, den, y, c, dd);
     mid = (num + c[7]) / (den + dd[7]);
   }
   if (!all(is_mid)) {  // |x| > 4
     const T z = 1.0 / ysq;
     T num = p[5] * z, den = z;
-    num = (num + p[0]) * z;
-    den = (den + q[0]) * z;
-    num = (num + p[1]) * z;
-    den = (den + q[1]) * z;
-    num = (num + p[2]) * z;
-    den = (den + q[2]) * z;
-    num = (num + p[3]) * z;
-    den = (den + q[3]) * z;
+    horner_steps(std::make_index_sequence<4>{}, num, den, z, p, q);
     tail = (kRsqrtPi - (z * (num + p[4])) / (den + q[4])) / y;
   }
   // t <= y on the grid of 1/16 (floor(16 y), or one below where 16 y is an even integer's
