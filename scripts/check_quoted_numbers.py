@@ -272,21 +272,23 @@ def main(argv=None) -> int:
         print(f"check_quoted_numbers: {e}", file=sys.stderr)
         return 2
     failed = empty = 0
-    runners: dict[pathlib.Path, Runner] = {}  # one per working directory: a command runs once
+    # One runner per working directory, so that a command quoted in several files runs once;
+    # each runs its distinct commands `--jobs` at a time before the checks read them.
+    roots = {f: pathlib.Path(a.root) if a.root else find_root(f) for f in files}
+    by_root: dict[pathlib.Path, list[Check]] = {}
     for f, cs in checks.items():
-        root = pathlib.Path(a.root) if a.root else find_root(f)
-        if cs and root not in runners:
-            runners[root] = Runner(a.gmasim, root, a.timeout)
-    for root, runner in runners.items():
-        runner.prefetch([c for f, cs in checks.items() for c in cs
-                         if (pathlib.Path(a.root) if a.root else find_root(f)) == root], a.jobs)
+        if cs:
+            by_root.setdefault(roots[f], []).extend(cs)
+    runners = {root: Runner(a.gmasim, root, a.timeout) for root in by_root}
+    for root, cs in by_root.items():
+        runners[root].prefetch(cs, a.jobs)
     for f, cs in checks.items():
         if not cs:
             if a.require_checks:
                 print(f"{f}: FAIL: no check marker (<!-- check: ... -->)")
                 empty += 1
             continue
-        runner = runners[pathlib.Path(a.root) if a.root else find_root(f)]
+        runner = runners[roots[f]]
         for c in cs:
             ok, what = evaluate(c, runner)
             print(f"{c.where}: {'ok' if ok else 'FAIL'}: {what}")

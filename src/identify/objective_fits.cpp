@@ -64,8 +64,8 @@ void fill_fit(ConditionFit& f, const Measurement& meas, const CondData& cd,
     f.width_unit = field ? "kA/m" : "A";
     f.width_measured = loop_widths(x, ym, *lo, *hi);
     f.width_simulated = loop_widths(x, ys, *lo, *hi);
-    for (double* w : {f.width_measured.data(), f.width_simulated.data()})
-      for (std::size_t k = 0; k < 4; ++k) w[k] *= field ? 1e-3 : 1.0;
+    for (auto* w : {&f.width_measured, &f.width_simulated})
+      for (double& v : *w) v *= field ? 1e-3 : 1.0;  // A/m -> kA/m
   }
   TimeSeries& ts = f.overlay;
   // Timed current/displacement records keep their historical column names; the others

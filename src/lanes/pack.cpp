@@ -86,18 +86,19 @@ void pack_preisach(LaneData& L, std::size_t j, const Conditions& c, const State&
   using namespace lanes;
   const int n = L.st.rods;
   for (int i = 0; i < n; ++i) {
-    const physics::PreisachCoefficients& p = c.rods[static_cast<std::size_t>(i)].preisach;
+    const RodConditions& rc = c.rods[static_cast<std::size_t>(i)];
+    // the law's constants as the scalar law forms them (physics::preisach_constants: 1/a, 1/H_c);
+    // M_s^T is the rod's kMsTMag
+    const physics::PreisachConstants k = physics::preisach_constants(rc.MsT_mag, rc.preisach);
     auto at = [&](int f) -> double& { return L.pre.field(f, i, n)[j]; };
-    at(kPreC) = p.c;
-    at(kPreAlpha) = p.alpha;
-    at(kPreA) = p.a_A_per_m;
-    at(kPreInvA) = 1.0 / p.a_A_per_m;  // the scalar law's inv_a
-    at(kPreInvHc) = 1.0 / p.Hc_A_per_m;
-    at(kPreSigmaU) = p.dist.sigma_u;
-    for (int b = 0; b <= physics::kPreisachBins; ++b)
-      at(kPreEdge0 + b) = p.dist.edge[static_cast<std::size_t>(b)];
-    for (int b = 0; b < physics::kPreisachBins; ++b)
-      at(kPreDensity0 + b) = p.dist.density[static_cast<std::size_t>(b)];
+    at(kPreC) = k.c;
+    at(kPreAlpha) = k.alpha;
+    at(kPreA) = k.a;
+    at(kPreInvA) = k.inv_a;
+    at(kPreInvHc) = k.inv_hc;
+    at(kPreSigmaU) = k.bins.s;
+    for (int b = 0; b <= physics::kPreisachBins; ++b) at(kPreEdge0 + b) = k.bins.edge[b];
+    for (int b = 0; b < physics::kPreisachBins; ++b) at(kPreDensity0 + b) = k.bins.density[b];
     L.pre.history(i)[j] = s.rods[static_cast<std::size_t>(i)].preisach;
   }
 }

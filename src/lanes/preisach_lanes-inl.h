@@ -147,12 +147,7 @@ HWY_INLINE void law_commit(const Chunk<D>& c, const Magnetic<PreisachLanes, D>& 
         h[l].last_dmc = 0.0;
         continue;
       }
-      physics::PreisachPoint p;
-      p.mu = mu[l];
-      p.mc = mc[l];
-      p.mu_u = mu_u[l];
-      p.base = physics::preisach_base(h[l], x1[l]).base;
-      physics::preisach_commit_point(h[l], x1[l], p);
+      physics::preisach_commit_reached(h[l], x1[l], mu[l], mc[l], mu_u[l]);
     }
   }
 }

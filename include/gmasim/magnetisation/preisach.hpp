@@ -46,7 +46,7 @@ struct PreisachLaw {
   struct Trial {
     double M, dM_dH, x1;
     bool moved;
-    physics::PreisachPoint point;  // the up-switched measure at x1, committed as it is
+    double mu, mc, mu_u;  // the up-switched measure at x1 and its moments, committed as they are
   };
   static MoveStart begin_move(const RodConditions&, const RodState&) { return {}; }
   static Trial trial_from(const RodConditions& rc, const RodState& r, const MoveStart&, double H1,
@@ -55,9 +55,7 @@ struct PreisachLaw {
     const physics::PreisachTrialT<double> p =
         physics::preisach_trial(physics::preisach_constants(rc.MsT_mag, rc.preisach), &r.preisach,
                                 r.H_A_per_m, r.M_A_per_m, H1, M_guess);
-    Trial t{p.M, p.dM_dH, p.x1, p.moved, {}};
-    if (t.moved) t.point = {p.mu, p.mc, p.mu_u, 0.0, physics::preisach_base(r.preisach, p.x1).base};
-    return t;
+    return {p.M, p.dM_dH, p.x1, p.moved, p.mu, p.mc, p.mu_u};
   }
   // The consistent state's joint Newton solve (as JilesAthertonLaw's): the law's own inner
   // solve converges within trial_from, so M_next = M and the trial is always converged.
@@ -78,7 +76,7 @@ struct PreisachLaw {
       return;
     }
     r.M_A_per_m = t.M;
-    physics::preisach_commit_point(r.preisach, t.x1, t.point);
+    physics::preisach_commit_reached(r.preisach, t.x1, t.mu, t.mc, t.mu_u);
     r.Mirr_A_per_m = rc.MsT_mag * (1.0 - rc.preisach.c) * (2.0 * r.preisach.mu_now - 1.0);
   }
 

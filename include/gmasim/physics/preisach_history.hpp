@@ -120,4 +120,14 @@ inline void preisach_commit_point(PreisachHistory& h, double x1, const PreisachP
   h.mu_u_now = p.mu_u;
 }
 
+// Commits a move to x1 whose end measure (mu, with its moments mc and mu_u) the law's solve
+// found (preisach_law-inl.h): the stack is searched for the extremum the move continues from
+// (preisach_base), then preisach_commit_point pushes and pops. The scalar law's commit_trial and
+// the lanes' commit (each lane's own stack) both commit this way.
+inline void preisach_commit_reached(PreisachHistory& h, double x1, double mu, double mc,
+                                    double mu_u) {
+  const PreisachBase b = preisach_base(h, x1);
+  preisach_commit_point(h, x1, {mu, mc, mu_u, 0.0, b.base, b.push});
+}
+
 }  // namespace gmasim::physics

@@ -11,8 +11,8 @@
 // Jiles-Atherton law does with its one exponential): erfc and exp are written below over T in
 // + - * / and exact primitives (pow2i, table_at), and the scalar instance runs the same
 // algorithm. A lane is therefore the scalar step bit for bit, and no SIMD target differs (no FMA:
-// the library is built with -ffp-contract=off). Both are within a few units in the last place of
-// libm (tests/test_preisach.cpp holds them against std::erfc and std::exp).
+// the library is built with -ffp-contract=off). Both are within a few units in the last place
+// (tests/test_preisach.cpp holds them against the C library's in long double).
 
 // exp(x) for x <= 0 (the law's arguments; 0 below -745.2, where exp underflows), table-driven as
 // in Tang, ACM TOMS 15 (1989) 144: x = (32 n + j) ln2/32 + r, |r| <= ln2/64, exp(x) =
