@@ -25,6 +25,11 @@
 
 namespace gmasim::cli {
 
+int env_int(const char* name, int fallback) {
+  const char* v = std::getenv(name);
+  return v ? std::atoi(v) : fallback;
+}
+
 // stdout is flushed first: when both streams go to one file or pipe (2>&1), a message then
 // comes after the lines printed before it, not ahead of the buffered header (issue 41).
 void print_error(const std::string& what) {

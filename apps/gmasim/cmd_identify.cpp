@@ -76,11 +76,6 @@ std::string command_line() {
   return cmd.empty() ? "gmasim identify" : cmd;
 }
 
-int env_int(const char* name, int fallback) {
-  const char* v = std::getenv(name);
-  return v ? std::atoi(v) : fallback;
-}
-
 // What identify reads: the start model, the manifest and its measurement files, the fit spec
 // (when it is a file) and the checkpoint it resumes.
 std::vector<FileArg> identify_inputs(const IdentifyArgs& a, const MeasurementSet& data) {

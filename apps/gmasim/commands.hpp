@@ -39,6 +39,7 @@ Runner add_params(CLI::App& app);       // cmd_params.cpp: params-vs-temperature
 Runner add_thermal(CLI::App& app);      // cmd_params.cpp: thermal
 Runner add_compensate(CLI::App& app);   // cmd_compensate.cpp
 Runner add_sensitivity(CLI::App& app);  // cmd_sensitivity.cpp
+Runner add_design(CLI::App& app);       // cmd_design.cpp
 
 // --model FILE and --set name=value (repeatable), on every command that runs a model.
 struct ModelArgs {
@@ -72,6 +73,7 @@ std::string resolve_model_path(const std::string& path);
 CLI::Validator model_path_transform();  // resolve_model_path as a CLI11 transform
 
 // Shared helpers.
+int env_int(const char* name, int fallback);       // an integer environment variable, or fallback
 std::string model_label(const std::string& path);  // "models/mdma.toml (built-in)" or path
 void print_error(const std::string& what);
 void print_warning(const std::string& what);  // "gmasim: warning: ..." on stderr

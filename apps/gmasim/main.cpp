@@ -56,6 +56,7 @@ int main(int argc, char** argv) {
   runners.push_back(gmasim::cli::add_thermal(app));
   runners.push_back(gmasim::cli::add_compensate(app));
   runners.push_back(gmasim::cli::add_sensitivity(app));
+  runners.push_back(gmasim::cli::add_design(app));
   try {
     app.parse(argc, argv);
     gmasim::cli::require_finite_numbers(app);

@@ -126,6 +126,10 @@ COMMANDS = [
     ("sensitivity", "sensitivity", ["sensitivity", "--param", "material.Ms_A_per_m", "--param",
                                     "material.chi_m", "--claim", "stroke_drop_8A", "--claim",
                                     "hysteresis_drop_8A"]),
+    ("design", "design", ["design", "--variable", "preload.force_N=950:3000", "--variable",
+                          "drive.current_pp_A=4:12", "--maximize", "stroke_um@20", "--minimize",
+                          "coil_copper_loss_W@20", "--constraint", "temperature_rise_K@20<=20",
+                          "--population", "8", "--generations", "2"]),
 ]
 
 
@@ -168,7 +172,7 @@ def test_every_figure_the_tool_writes_reads_alone(figure_problems):
     found, _seconds = figure_problems
     expected = {"simulate/simulate", "simulate_heat/simulate", "simulate_heat/self_heating", "frf_small/frf",
                 "frf_large/frf", "sweep/sweep", "track/track", "compensate/compensate", "ablate/ablate",
-                "params/params", "track_ff/track_feedforward", "sensitivity/sensitivity",
+                "params/params", "track_ff/track_feedforward", "sensitivity/sensitivity", "design/design",
                 "identify/convergence", "reproduce/claims", "reproduce/loops_8A_10Hz",
                 "reproduce/sweep_10Hz", "reproduce/frf", "reproduce/track", "reproduce/retention",
                 "reproduce/params_vs_temperature", "reproduce/ablate"}
