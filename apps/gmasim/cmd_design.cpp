@@ -107,32 +107,8 @@ int run_design_body(DesignArgs& a, Communicator& comm) {
 }
 
 int run_design_cmd(DesignArgs& a) {
-  const bool launched = launched_by_mpi();
-  const bool use_mpi = a.mpi == "on" || (a.mpi == "auto" && launched);
-  if (!use_mpi && launched && env_int("OMPI_COMM_WORLD_SIZE", 1) > 1)
-    throw InputError(mpi_compiled()
-                         ? "design: launched by mpirun with --mpi off: every rank would run the "
-                           "same search and write the same files"
-                         : "design: launched by mpirun, but this gmasim was built without MPI");
-  std::unique_ptr<Communicator> comm =
-      use_mpi ? make_mpi_communicator(nullptr, nullptr) : make_serial_communicator();
-  try {
-    return run_design_body(a, *comm);
-  } catch (const InputError& e) {
-    if (comm->rank() == 0) print_error(e.what());
-    if (comm->size() > 1) {
-      remove_created_output_dirs_if_empty();
-      comm->abort(2);
-    }
-    return 2;
-  } catch (const std::exception& e) {
-    print_error(fmt::format("internal error (rank {}): {}", comm->rank(), e.what()));
-    if (comm->size() > 1) {
-      remove_created_output_dirs_if_empty();
-      comm->abort(4);
-    }
-    return 4;
-  }
+  return run_on_ranks(a.mpi, "design",
+                      [&](Communicator& comm) { return run_design_body(a, comm); });
 }
 
 void add_problem_options(CLI::App* sub, DesignArgs& a) {

@@ -268,36 +268,9 @@ int run_identify_body(IdentifyArgs& a, Communicator& comm) {
   return r.interrupted ? 130 : 0;
 }
 
-// MPI's abort ends every rank without returning to main(), whose cleanup of a failed command's
-// empty output directories therefore runs here first.
-void abort_ranks(Communicator& comm, int code) {
-  remove_created_output_dirs_if_empty();
-  comm.abort(code);
-}
-
 int run_identify(IdentifyArgs& a) {
-  const bool launched = launched_by_mpi();
-  const bool use_mpi = a.mpi == "on" || (a.mpi == "auto" && launched);
-  if (!use_mpi && launched && env_int("OMPI_COMM_WORLD_SIZE", 1) > 1) {
-    throw InputError(mpi_compiled()
-                         ? "identify: launched by mpirun with --mpi off: every rank would run the "
-                           "same search and write the same files"
-                         : "identify: launched by mpirun, but this gmasim was built without MPI");
-  }
-  std::unique_ptr<Communicator> comm =
-      use_mpi ? make_mpi_communicator(nullptr, nullptr) : make_serial_communicator();
-  const bool root = comm->rank() == 0;
-  try {
-    return run_identify_body(a, *comm);
-  } catch (const InputError& e) {
-    if (root) print_error(e.what());
-    if (comm->size() > 1) abort_ranks(*comm, 2);
-    return 2;  // main() removes the empty output directories of a failed command
-  } catch (const std::exception& e) {
-    print_error(fmt::format("internal error (rank {}): {}", comm->rank(), e.what()));
-    if (comm->size() > 1) abort_ranks(*comm, 4);
-    return 4;
-  }
+  return run_on_ranks(a.mpi, "identify",
+                      [&](Communicator& comm) { return run_identify_body(a, comm); });
 }
 
 int run_synthesize(SynthArgs& a) {

@@ -12,6 +12,7 @@
 #include "gmasim/experiments/design_sweep.hpp"
 #include "gmasim/experiments/experiment_fields.hpp"
 #include "gmasim/experiments/experiments.hpp"
+#include "gmasim/identify/design.hpp"
 #include "gmasim/io/io.hpp"
 #include "request_options.hpp"
 
@@ -20,6 +21,7 @@ namespace {
 
 struct SweepArgs : ExperimentArgs<SweepRequest> {
   std::vector<std::string> grid;  // --grid KEY=v1,v2,... (repeatable)
+  std::string mpi = "auto";       // --grid's designs over MPI ranks
 };
 
 // "KEY=v1,v2,..." or "KEY=start:step:stop".
@@ -71,17 +73,28 @@ int report_divergence(const SweepResult& res, int diverged, const std::string& d
   return 3;
 }
 
-int run_design_sweep_cmd(SweepArgs& a, const Model& model) {
+// The design study, its designs shared over the MPI ranks (rank 0 gathers them and writes).
+int run_design_sweep_cmd(SweepArgs& a, Communicator& comm) {
+  const bool root = comm.rank() == 0;
+  const Model model = load_model_args(a.model);
+  a.options.apply();
+  if (root) {
+    warn_temperatures(model, a.req.temperatures_C, "--temperatures");
+    warn_temperatures(model, {a.req.reference_temperature_C}, "--reference-temperature");
+    prepare_output_dir(a.out, {"sweep"}, model_inputs(a.model));
+  }
   std::vector<GridAxis> axes;
   for (const auto& g : a.grid) axes.push_back(grid_axis(g));
-  const DesignSweepResult res =
-      run_design_sweep(model.spec, axes, a.req, stderr_progress("sweep", a.progress));
+  const DesignSweepResult res = run_design_sweep_ranks(
+      model.spec, axes, a.req, comm, root ? stderr_progress("sweep", a.progress) : ProgressFn{});
+  if (!root) return 0;
   auto files = write_report(a.out, "sweep", design_sweep_report(model, a.req, res));
   fmt::print("gmasim sweep  model: {}\n", model_label(a.model));
   fmt::print(
-      "  {} designs x {} points in {:.2f} s; metrics over the last of {} periods; changes vs {} "
+      "  {} designs x {} points on {} rank(s) in {:.2f} s; metrics over the last of {} periods; "
+      "changes vs {} "
       "degC; small-signal markers at {} degC about the {:g} A bias\n",
-      res.designs.size(), res.designs.empty() ? 0 : res.designs[0].sweep.points.size(),
+      res.designs.size(), res.designs.empty() ? 0 : res.designs[0].sweep.points.size(), comm.size(),
       res.wall_time_s, a.req.periods, a.req.reference_temperature_C, a.req.reference_temperature_C,
       res.bias_A);
   int status = 0;
@@ -105,12 +118,18 @@ int run_design_sweep_cmd(SweepArgs& a, const Model& model) {
 }
 
 int run_sweep_cmd(SweepArgs& a) {
+  if (!a.grid.empty())
+    return run_on_ranks(a.mpi, "sweep --grid",
+                        [&](Communicator& comm) { return run_design_sweep_cmd(a, comm); });
+  if (launched_by_mpi() && env_int("OMPI_COMM_WORLD_SIZE", 1) > 1)
+    throw InputError(
+        "sweep: launched by mpirun: MPI ranks share the designs of --grid; a sweep without "
+        "--grid runs on the cores of one machine (--threads)");
   const Model model = load_model_args(a.model);
   a.options.apply();
   warn_temperatures(model, a.req.temperatures_C, "--temperatures");
   warn_temperatures(model, {a.req.reference_temperature_C}, "--reference-temperature");
   prepare_output_dir(a.out, {"sweep"}, model_inputs(a.model));
-  if (!a.grid.empty()) return run_design_sweep_cmd(a, model);
   const SweepResult res = run_sweep(model, a.req, stderr_progress("sweep", a.progress));
   auto files = write_report(a.out, "sweep", sweep_report(model, a.req, res));
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "gmasim/errors.hpp"
+#include "gmasim/identify/identify.hpp"
 #include "gmasim/io/io.hpp"
 #include "gmasim/model/model.hpp"
 
@@ -73,7 +74,14 @@ std::string resolve_model_path(const std::string& path);
 CLI::Validator model_path_transform();  // resolve_model_path as a CLI11 transform
 
 // Shared helpers.
-int env_int(const char* name, int fallback);       // an integer environment variable, or fallback
+int env_int(const char* name, int fallback);  // an integer environment variable, or fallback
+// Runs body on the command's processes: MPI ranks when `mpi` is "on", or "auto" and mpirun/srun
+// launched it; one process otherwise (refused under mpirun with more than one rank). An
+// InputError is printed by rank 0 (exit 2), any other exception by its rank (exit 4); with
+// several ranks either ends them all (MPI_Abort) after removing the command's empty output
+// directories.
+int run_on_ranks(const std::string& mpi, const std::string& command,
+                 const std::function<int(Communicator&)>& body);
 std::string model_label(const std::string& path);  // "models/mdma.toml (built-in)" or path
 void print_error(const std::string& what);
 void print_warning(const std::string& what);  // "gmasim: warning: ..." on stderr

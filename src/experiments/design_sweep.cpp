@@ -77,7 +77,8 @@ Model design_model(const ModelSpec& base, const std::vector<GridAxis>& axes,
 }  // namespace
 
 DesignSweepResult run_design_sweep(const ModelSpec& base, const std::vector<GridAxis>& axes,
-                                   const SweepRequest& r, const ProgressFn& progress) {
+                                   const SweepRequest& r, const ProgressFn& progress, int rank,
+                                   int ranks) {
   check_axes(base, axes);
   const auto wall0 = std::chrono::steady_clock::now();
   DesignSweepResult res;
@@ -89,9 +90,13 @@ DesignSweepResult run_design_sweep(const ModelSpec& base, const std::vector<Grid
   // would cost memory in proportion to the grid, a compile is cheap beside its sweep).
   for (const auto& values : all) (void)design_model(base, axes, values);
   for (std::size_t d = 0; d < all.size(); ++d) {
-    const Model m = design_model(base, axes, all[d]);
     DesignPoint p;
     p.values = all[d];
+    if (ranks > 1 && static_cast<int>(d % static_cast<std::size_t>(ranks)) != rank) {
+      res.designs.push_back(std::move(p));  // another rank's
+      continue;
+    }
+    const Model m = design_model(base, axes, all[d]);
     for (const auto& rod : m.rods) p.rods_mass_kg += rod.mass_kg;
     p.coil_resistance_ohm = m.thermal_network.coil_resistance_ohm;
     const LinearFrfMarkers lm = linear_frf_markers(m, r.reference_temperature_C, res.bias_A);

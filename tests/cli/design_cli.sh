@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # gmasim design from the command line (issue 39, item 3): the same front on 1 thread, 2 threads
 # and 2 MPI ranks; a search stopped after 2 generations and resumed to 4 equals the 4-generation
-# search; refused inputs name the flag. Usage: design_cli.sh GMASIM WORK_DIR [MPIEXEC]
+# search; refused inputs name the flag; sweep --grid on 2 ranks equals one process. Usage: design_cli.sh GMASIM WORK_DIR [MPIEXEC]
 set -euo pipefail
 GMASIM="$1"
 WORK="$2"
@@ -64,6 +64,11 @@ refused 2 "expected QUANTITY<=BOUND" design --variable preload.force_N=950:3000 
 refused 1 "requires --checkpoint\|--resume requires" design --variable preload.force_N=950:3000 \
   --maximize stroke_um@20 --minimize rods_mass_kg --resume
 
+# The design study of sweep --grid, whose designs the MPI ranks share below.
+GRID=(sweep --model single_rod --current-min 0 --currents 4 --temperatures 20,70
+      --grid rod.length_m=0.05,0.06,0.08 --grid circuit.branches.coil.coil_turns=500,800)
+"$GMASIM" "${GRID[@]}" --out grid_one >/dev/null
+
 if [[ -n "$MPIEXEC" ]]; then
   # Containers: no CMA single-copy, allow root, allow 2 ranks on fewer cores.
   export OMPI_MCA_btl_vader_single_copy_mechanism=none
@@ -72,5 +77,19 @@ if [[ -n "$MPIEXEC" ]]; then
     >mpi.txt 2>mpi_err.txt || { cat mpi.txt mpi_err.txt; exit 1; }
   grep -q "on 2 rank(s)" mpi.txt || { echo "FAIL: not 2 ranks"; cat mpi.txt; exit 1; }
   same one mpi
+  "$MPIEXEC" -np 2 --oversubscribe "$GMASIM" "${GRID[@]}" --out grid_mpi >grid_mpi.txt 2>&1 ||
+    { cat grid_mpi.txt; exit 1; }
+  grep -q "6 designs x 2 points on 2 rank(s)" grid_mpi.txt || { cat grid_mpi.txt; exit 1; }
+  for f in sweep.csv sweep_designs.csv; do
+    cmp "grid_one/$f" "grid_mpi/$f" || { echo "FAIL: sweep --grid on 2 ranks: $f differs"; exit 1; }
+  done
+  # A sweep without --grid has nothing to share: refused under mpirun, naming --grid.
+  set +e
+  "$MPIEXEC" -np 2 --oversubscribe "$GMASIM" sweep --temperatures 20 --currents 8 --out plain \
+    >plain.txt 2>&1
+  rc=$?
+  set -e
+  [[ $rc -ne 0 ]] && grep -q "MPI ranks share the designs of --grid" plain.txt ||
+    { echo "FAIL: plain sweep under mpirun"; cat plain.txt; exit 1; }
 fi
 echo "PASS"

@@ -41,8 +41,12 @@ struct DesignSweepResult {
 
 // Throws InputError for an empty axis, a repeated key, a key the model does not have (named
 // with --grid), a value the key's rule refuses, or more than kMaxListValues designs.
+// With ranks > 1 only the designs d with d mod ranks == rank run (each is still compiled and
+// checked); the others keep their values and nothing else (identify's run_design_sweep_ranks
+// gathers them from the ranks that ran them).
 DesignSweepResult run_design_sweep(const ModelSpec& base, const std::vector<GridAxis>& axes,
-                                   const SweepRequest& r, const ProgressFn& progress = {});
+                                   const SweepRequest& r, const ProgressFn& progress = {},
+                                   int rank = 0, int ranks = 1);
 
 // The sweep report with one column per axis and the derived columns (rods_mass_kg,
 // coil_resistance_ohm, first_resonance_Hz, bandwidth_Hz, and per point coil_copper_loss_W:

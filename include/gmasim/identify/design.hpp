@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "gmasim/experiments/design_sweep.hpp"
 #include "gmasim/experiments/experiments.hpp"
 #include "gmasim/identify/identify.hpp"
 #include "gmasim/model/model.hpp"
@@ -154,4 +155,13 @@ Nsga2Outcome nsga2_search(
 std::vector<std::size_t> feasible_front(const std::vector<std::vector<double>>& values,
                                         std::size_t nobj);
 
+}  // namespace gmasim
+
+namespace gmasim {
+// gmasim sweep --grid on MPI ranks (issue 39, item 3): design d runs on rank d mod N (its points
+// on that rank's threads), and rank 0 gathers every design's numbers exactly (17 significant
+// digits), so its result is the one process's. The other ranks return their own designs only.
+DesignSweepResult run_design_sweep_ranks(const ModelSpec& base, const std::vector<GridAxis>& axes,
+                                         const SweepRequest& r, Communicator& comm,
+                                         const ProgressFn& progress = {});
 }  // namespace gmasim
