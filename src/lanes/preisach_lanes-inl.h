@@ -125,16 +125,17 @@ HWY_INLINE void take_trial(D, M done, M /*real*/, const PreisachLaneTrial<D>& t,
 }
 
 template <class D>
-HWY_INLINE void commit_law_state(const Magnetic<PreisachLanes, D>&, RodStates<D>&, int) {}
+HWY_INLINE void commit_law_state(const typename PreisachLanes::template Start<D>&, RodStates<D>&,
+                                 int) {}
 template <class D>
-HWY_INLINE void law_commit(const Chunk<D>& c, const Magnetic<PreisachLanes, D>& mg, Mk<D> keep) {
+HWY_INLINE void law_commit(const Chunk<D>& c, const PreisachLaneTrial<D>* trial, Mk<D> keep) {
   const D d = c.d;
   constexpr std::size_t W = kPad;
   const std::size_t n = hn::Lanes(d);
   double kept[W], moved[W], x1[W], mu[W], mc[W], mu_u[W];
   hn::StoreU(hn::IfThenElseZero(keep, C(d, 1.0)), d, kept);
   for (int i = 0; i < c.n; ++i) {
-    const auto& tr = mg.trial[i];
+    const auto& tr = trial[i];
     hn::StoreU(hn::IfThenElseZero(tr.moved, C(d, 1.0)), d, moved);
     hn::StoreU(tr.x1, d, x1);
     hn::StoreU(tr.mu, d, mu);

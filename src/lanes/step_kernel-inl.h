@@ -1,8 +1,9 @@
 // The consistent step over SIMD lanes (docs/lanes.md): model/step.cpp's step_law for W
-// simulations at once, in the same stages -- the consistent magnetic state by Newton's method
-// (per lane, masked), the mechanics (eq. 11-18), the sensor mount, the outputs -- and with the
-// same checks (step() and run_loop()), recorded per lane instead of thrown. Included once per
-// target by src/lanes/step_lanes.cpp (hwy/foreach_target.h).
+// simulations at once, in the same stages -- the consistent magnetic state (the scalar step's
+// own text, gmasim/physics/joint_newton-inl.h, run with the lanes' context LaneNewton), the
+// mechanics (eq. 11-18), the sensor mount, the outputs -- and with the same checks (step() and
+// run_loop()), recorded per lane instead of thrown. Included once per target by
+// src/lanes/step_lanes.cpp (hwy/foreach_target.h).
 #if defined(GMASIM_LANES_STEP_KERNEL_INL_H_) == defined(HWY_TARGET_TOGGLE)
 #ifdef GMASIM_LANES_STEP_KERNEL_INL_H_
 #undef GMASIM_LANES_STEP_KERNEL_INL_H_
@@ -218,42 +219,22 @@ HWY_INLINE void take_trial(D d, M done, M real, const T& t, T& tr, std::size_t& 
   keep_common_trial(done, t, tr);
 }
 
-// Per rod, what the Newton solve fixes at the step's start and what it ends with.
-// g = 2 kappa / h (eddy_static_field_trapezoid; 0 at rest).
-template <class Law, class D>
-struct Magnetic {
-  V<D> H[kMaxRods], Mg[kMaxRods], B0[kMaxRods], Bs[kMaxRods], g[kMaxRods];
-  typename Law::template Start<D> start[kMaxRods];  // each rod's move (its anchors, JA)
-  typename Law::template Trial<D> trial[kMaxRods];
-};
-template <class D>
-HWY_INLINE void law_commit(const Chunk<D>&, const Magnetic<JilesAthertonLanes, D>&, Mk<D>) {}
-// The law's state the step commits beside M and M_irr, into the rods' state (stored with it):
-// the JA law's anchors as its last evaluation left them (JilesAthertonLaw::commit_trial's
+// The JA law's state the step commits beside M and M_irr, into the rods' state (stored with it):
+// its anchors as its last evaluation left them (JilesAthertonLaw::commit_trial's
 // r.ja_exp = *t.near).
 template <class D>
-HWY_INLINE void commit_law_state(const Magnetic<JilesAthertonLanes, D>& mg, RodStates<D>& s,
-                                 int i) {
-  const auto& near = mg.start[i].near;
-  s.f[kJaLangevinY][i] = near.langevin.y.v;
-  s.f[kJaLangevinE][i] = near.langevin.e.v;
-  s.f[kJaLagY][i] = near.lag.y.v;
-  s.f[kJaLagE][i] = near.lag.e.v;
+HWY_INLINE void commit_law_state(const typename JilesAthertonLanes::template Start<D>& st,
+                                 RodStates<D>& s, int i) {
+  s.f[kJaLangevinY][i] = st.near.langevin.y.v;
+  s.f[kJaLangevinE][i] = st.near.langevin.e.v;
+  s.f[kJaLagY][i] = st.near.lag.y.v;
+  s.f[kJaLagE][i] = st.near.lag.e.v;
 }
-
-// model/step.cpp's next_correction_within_tolerance per lane: after an undamped correction the
-// next one is bounded by 2 law_steps (the sum of the laws' own steps |M_next - M*|); true where
-// that bound is within a quarter of every rod's field tolerance, 1e-7 A/m + 1e-11 |H|.
+// The law's state kept outside RodStates (the Preisach stacks), after the step, in the lanes
+// that keep it: none for the JA law.
 template <class D>
-HWY_INLINE Mk<D> next_correction_within_tolerance(D d, int n, V<D> law_steps, const V<D>* H) {
-  const V<D> bound = hn::Mul(C(d, 2.0), law_steps);
-  Mk<D> within = hn::FirstN(d, hn::Lanes(d));
-  for (int i = 0; i < n; ++i)
-    within = hn::And(
-        within, hn::Le(bound, hn::Mul(C(d, 0.25),
-                                      hn::Add(C(d, 1e-7), hn::Mul(C(d, 1e-11), hn::Abs(H[i]))))));
-  return within;
-}
+HWY_INLINE void law_commit(const Chunk<D>&, const typename JilesAthertonLanes::template Trial<D>*,
+                           Mk<D>) {}
 
 // One circuit solve of the vector, and the lanes (not padding) that need it (LaneData's
 // lane_solves, vector_solves).
@@ -264,163 +245,115 @@ HWY_INLINE void count_solve(const Chunk<D>& c, Mk<D> done) {
   ++c.L.vector_solves;
 }
 
-// The lanes of an iterate that neither converged nor are done, where their largest step is not
-// finite or at the cap (60): accepted where it is within 1 mA/m, failed otherwise (kFailNewton,
-// named by the rod of that step). Returns the lanes that stop.
-template <class D>
-HWY_INLINE Mk<D> stopped(D d, int n, Mk<D> done, V<D> worst, V<D> worst_rod, int it, V<D> t1,
-                         Fails<D>& fails) {
-  const Mk<D> stop =
-      hn::AndNot(done, hn::Or(hn::Not(hn::IsFinite(worst)),
-                              it == 60 ? hn::FirstN(d, hn::Lanes(d)) : hn::FirstN(d, 0)));
-  const Mk<D> accept = hn::And(stop, hn::Le(worst, C(d, 1e-3)));  // 1 mA/m
-  const Mk<D> bad = hn::AndNot(accept, stop);
-  if (!hn::AllFalse(d, bad)) {
-    for (int i = 0; i < n; ++i)  // the rod of the largest step names the failure
-      fails.mark(d, hn::And(bad, hn::Eq(worst_rod, C(d, static_cast<double>(i)))), kFailNewton,
-                 worst, i, t1, hn::Zero(d));
-  }
-  return stop;
-}
-
-// Rod i's flux density B0 at the step's start, its eddy terms e0 = H_c - H and g = 2 kappa / h
-// and the first guess (H, M) of newton_fields; quasi_static: no eddy term, the guess (H_n, M_n).
+// The lanes' context of the consistent state's solve (gmasim/physics/joint_newton-inl.h, the one
+// text the scalar step also runs: laws::joint_newton_start, joint_newton, joint_newton_commit):
+// the rods' state in RodStates, the circuit's low-rank solve per lane (circuit_solve: the rods'
+// MMF N I + F_pm pm plus their linearised extra), the law's trial kept per lane (take_trial) and
+// its state committed (commit_law_state, law_commit), a failure recorded in the lane's record
+// (Fails) instead of thrown.
 template <class Law, class D>
-HWY_INLINE void first_guess(const Chunk<D>& c, const RodStates<D>& s, int i, V<D> two_over_h,
-                            bool quasi_static, Magnetic<Law, D>& mg, V<D>& e0) {
-  const D d = c.d;
-  mg.B0[i] = hn::Mul(C(d, physics::kMu0), hn::Add(s.f[kH][i], s.f[kM][i]));
-  if (quasi_static) {
-    e0 = mg.g[i] = hn::Zero(d);
-    mg.H[i] = s.f[kH][i];
-    mg.Mg[i] = s.f[kM][i];
-    return;
-  }
-  e0 = hn::Sub(s.f[kHc][i], s.f[kH][i]);
-  mg.g[i] = hn::Mul(c.rod(kKappa, i), two_over_h);
-  mg.H[i] = hn::Add(hn::Mul(C(d, 3.0), hn::Sub(s.f[kH][i], s.f[kHprev][i])), s.f[kHprev2][i]);
-  mg.Mg[i] = hn::Add(hn::Mul(C(d, 3.0), hn::Sub(s.f[kM][i], s.f[kMprev][i])), s.f[kMprev2][i]);
-}
-
-// Newton's method on the rods' fields and magnetisations jointly (model/step.cpp,
-// consistent_magnetic_update): the first guess extrapolated quadratically from the last three
-// steps (H = 3 (H_n - H_n-1) + H_n-2, M likewise); at each iterate (H*, M*) each rod's law
-// evaluated once (joint_trial: no inner solve), its magnetisation corrected by the law's Newton
-// step to M_next and linearised into a branch U = R_eff phi + U_off, the circuit solved, H* moved
-// to the field its flux implies and M* to M_next + dM/dH dH. Per lane: a lane whose field
-// corrections are all below 1e-7 A/m + 1e-11 |H| and whose laws all hold (|g| <= 1e-12 M_s^T)
-// keeps that iterate and its trial (the last evaluation is committed); so does a lane, after an
-// undamped correction (iterates 1-8), whose laws all hold and whose next correction is bounded
-// within a quarter of every rod's field tolerance (next_correction_within_tolerance) -- without
-// the confirming solve, which runs only while some lane of the vector still needs it. The loop
-// ends when every lane has converged or failed, or at the cap (60), where a lane whose largest
-// step (field or law) is within 1 mA/m is accepted and the others fail (kFailNewton, the rod of
-// that step). quasi_static (make_state's ramp, consistent_magnetic_update's quasi_static): no
-// eddy term, the first guess at H_n and M_n.
-template <class Law, class D>
-HWY_INLINE void newton_fields(const Chunk<D>& c, const RodStates<D>& s, V<D> I, V<D> pm, V<D> h,
-                              V<D> t1, bool quasi_static, Magnetic<Law, D>& mg, Fails<D>& fails) {
-  const D d = c.d;
-  const int n = c.n;
-  constexpr double kMu0 = physics::kMu0;
-  V<D> e0[kMaxRods], inv_mud[kMaxRods];
-  const V<D>* g = mg.g;
-  const V<D> two_over_h = hn::Div(C(d, 2.0), h);
-  auto& start = mg.start;
-  typename Law::template Rod<D> rod[kMaxRods];
+struct LaneNewton {
+  using N = Lanes<D>;
+  using M = LaneMask<D>;
+  const Chunk<D>& c;
+  RodStates<D>& s;
+  V<D> I, pm, t1;
+  Fails<D>& fails;
+  Mk<D> real;  // the lanes that are not padding
   typename Law::template Constants<D> k[kMaxRods];
-  for (int i = 0; i < n; ++i) {
-    law_rod(c, s, i, k[i], rod[i]);
-    start[i] = Law::begin_move(d, k[i], rod[i]);
-    first_guess(c, s, i, two_over_h, quasi_static, mg, e0[i]);
-  }
-  Mk<D> done = fails.failed;
-  const Mk<D> real = hn::FirstN(d, c.j < c.L.n ? c.L.n - c.j : 0);
-  for (int it = 0; !hn::AllTrue(d, done); ++it) {
-    V<D> R[kMaxRods], mmf[kMaxRods], phi[kMaxRods];
-    V<D> law_steps = hn::Zero(d);  // sum over the rods of |M_next - M*|
-    Mk<D> laws_hold = hn::FirstN(d, hn::Lanes(d));
-    for (int i = 0; i < n; ++i) {
-      const auto t = Law::joint_trial(d, k[i], rod[i], start[i], mg.H[i], mg.Mg[i], hn::Not(done));
-      auto& tr = mg.trial[i];
-      take_trial(d, done, real, t, tr, c.L.full_solves);
-      laws_hold = hn::And(laws_hold, tr.converged);
-      law_steps = hn::Add(law_steps, hn::Abs(hn::Sub(tr.M_next, mg.Mg[i])));
-      mg.Bs[i] = hn::Mul(C(d, kMu0), hn::Add(mg.H[i], tr.M_next));
-      inv_mud[i] = hn::Mul(tr.inv_mu_r, C(d, 1.0 / kMu0));
-      R[i] = hn::Add(hn::Mul(c.rod(kLengthPerArea, i), hn::Add(inv_mud[i], g[i])), c.rod(kRs, i));
-      const V<D> extra = hn::Mul(
-          hn::Neg(c.rod(kLength, i)),
-          hn::Sub(hn::Sub(hn::Sub(mg.H[i], hn::Mul(mg.Bs[i], inv_mud[i])), hn::Mul(g[i], mg.B0[i])),
-                  e0[i]));
-      mmf[i] =
-          hn::Add(hn::Add(hn::Mul(c.rod(kCoilTurns, i), I), hn::Mul(c.rod(kPmMmf, i), pm)), extra);
-    }
-    if (it >= 1 && it <= 8) {  // the iterate has converged without the confirming solve
-      done =
-          hn::Or(done, hn::And(laws_hold, next_correction_within_tolerance(d, n, law_steps, mg.H)));
-      if (hn::AllTrue(d, done)) break;
-    }
-    count_solve(c, done);
-    const Mk<D> ok = circuit_solve(c, R, mmf, I, pm, phi);
-    fails.mark(d, hn::AndNot(done, hn::Not(ok)), kFailCircuit, hn::Zero(d), -1, t1, hn::Zero(d));
-    done = hn::Or(done, fails.failed);
-    V<D> worst = hn::Zero(d), worst_rod = hn::Zero(d), dH[kMaxRods];
-    Mk<D> converged = hn::FirstN(d, hn::Lanes(d));
-    for (int i = 0; i < n; ++i) {
-      dH[i] = hn::Mul(hn::Sub(hn::Mul(phi[i], c.rod(kInvArea, i)), mg.Bs[i]), inv_mud[i]);
-      const V<D> adH = hn::Abs(dH[i]);
-      // the rod's Newton step: its field's and its law's; NaN propagates
-      const V<D> dM = hn::Abs(hn::Sub(mg.trial[i].M_next, mg.Mg[i]));
-      const V<D> step = hn::IfThenElse(hn::Le(dM, adH), adH, dM);
-      const Mk<D> larger = hn::Not(hn::Le(step, worst));
-      worst = hn::IfThenElse(larger, step, worst);
-      worst_rod = hn::IfThenElse(larger, C(d, static_cast<double>(i)), worst_rod);
-      converged = hn::And(hn::And(converged, mg.trial[i].converged),
-                          hn::Le(adH, hn::Add(C(d, 1e-7), hn::Mul(C(d, 1e-11), hn::Abs(mg.H[i])))));
-    }
-    done = hn::Or(done, converged);
-    done = hn::Or(done, stopped(d, n, done, worst, worst_rod, it, t1, fails));
-    const V<D> damping = C(d, it < 8 ? 1.0 : 0.5);
-    for (int i = 0; i < n; ++i) {  // the lanes still iterating: the next iterate
-      const V<D> step = hn::Mul(damping, dH[i]);
-      mg.H[i] = hn::IfThenElse(done, mg.H[i], hn::Add(mg.H[i], step));
-      const auto& tr = mg.trial[i];
-      mg.Mg[i] = hn::IfThenElse(done, mg.Mg[i], hn::Add(tr.M_next, hn::Mul(tr.dM_dH, step)));
-    }
-  }
-}
+  typename Law::template Rod<D> rod[kMaxRods];
+  typename Law::template Start<D> start[kMaxRods];
+  typename Law::template Trial<D> trial[kMaxRods];
+  V<D> Rv[kMaxRods], mmf[kMaxRods], ph[kMaxRods];  // the circuit's last solve
 
-// Commit of the end-of-step magnetic state (model/step.cpp, commit_rod): the last Newton
-// trial at H1 as it is (its M, M_irr and flux density B1), the eddy field (eq. 7,
-// trapezoidal), the first guess's histories, mu_r = 1 + dM/dH and the rod's flux.
-template <class Law, class D>
-HWY_INLINE void commit_fields(const Chunk<D>& c, RodStates<D>& s, bool quasi_static,
-                              const Magnetic<Law, D>& mg) {
-  const D d = c.d;
-  constexpr double kMu0 = physics::kMu0;
-  for (int i = 0; i < c.n; ++i) {
-    const auto& tr = mg.trial[i];
-    const V<D> H1 = mg.H[i], B1 = hn::Mul(C(d, kMu0), hn::Add(H1, tr.M)), kappa = c.rod(kKappa, i);
-    s.f[kMprev2][i] = s.f[kMprev][i];
-    s.f[kMprev][i] = s.f[kM][i];
+  LaneNewton(const Chunk<D>& c_, RodStates<D>& s_, V<D> I_, V<D> pm_, V<D> t1_, Fails<D>& f_)
+      : c(c_),
+        s(s_),
+        I(I_),
+        pm(pm_),
+        t1(t1_),
+        fails(f_),
+        real(hn::FirstN(c_.d, c_.j < c_.L.n ? c_.L.n - c_.j : 0)) {}
+  HWY_INLINE int rods() const { return c.n; }
+  HWY_INLINE laws::RodMagneticT<N> load(int i) const {
+    return {s.f[kH][i],     s.f[kHc][i],     s.f[kHprev][i], s.f[kHprev2][i], s.f[kM][i],
+            s.f[kMprev][i], s.f[kMprev2][i], s.f[kMuR][i],   s.f[kTau][i],    s.f[kPhi][i]};
+  }
+  HWY_INLINE void store(int i, const laws::RodMagneticT<N>& r) {
+    s.f[kH][i] = r.H.v;
+    s.f[kHc][i] = r.Hc.v;
+    s.f[kHprev][i] = r.H_prev.v;
+    s.f[kHprev2][i] = r.H_prev2.v;
+    s.f[kM][i] = r.M.v;
+    s.f[kMprev][i] = r.M_prev.v;
+    s.f[kMprev2][i] = r.M_prev2.v;
+    s.f[kMuR][i] = r.mu_r.v;
+    s.f[kTau][i] = r.tau.v;
+    s.f[kPhi][i] = r.phi.v;
+  }
+  HWY_INLINE N kappa(int i) const { return c.rod(kKappa, i); }
+  HWY_INLINE N length(int i) const { return c.rod(kLength, i); }
+  HWY_INLINE N length_per_area(int i) const { return c.rod(kLengthPerArea, i); }
+  HWY_INLINE N series_reluctance(int i) const { return c.rod(kRs, i); }
+  HWY_INLINE N area(int i) const { return c.rod(kArea, i); }
+  HWY_INLINE N inv_area(int i) const { return c.rod(kInvArea, i); }
+  HWY_INLINE void begin(int i) {
+    law_rod(c, s, i, k[i], rod[i]);
+    start[i] = Law::begin_move(c.d, k[i], rod[i]);
+  }
+  HWY_INLINE void trial_at(int i, N H, N M_iter, M done) {
+    const auto t = Law::joint_trial(c.d, k[i], rod[i], start[i], H.v, M_iter.v, hn::Not(done.m));
+    take_trial(c.d, done.m, real, t, trial[i], c.L.full_solves);
+  }
+  HWY_INLINE N M_of(int i) const { return trial[i].M; }
+  HWY_INLINE N dM_dH(int i) const { return trial[i].dM_dH; }
+  HWY_INLINE N inv_mu_r(int i) const { return trial[i].inv_mu_r; }
+  HWY_INLINE N M_next(int i) const { return trial[i].M_next; }
+  HWY_INLINE M converged(int i) const { return {trial[i].converged}; }
+  // The branch's reluctance and the rod's MMF in the low-rank system: N I + F_pm pm + extra.
+  HWY_INLINE void branch(int i, N R, N extra) {
+    Rv[i] = R.v;
+    mmf[i] =
+        hn::Add(hn::Add(hn::Mul(c.rod(kCoilTurns, i), I), hn::Mul(c.rod(kPmMmf, i), pm)), extra.v);
+  }
+  HWY_INLINE M solve(M done) {
+    const D d = c.d;
+    count_solve(c, done.m);
+    const Mk<D> ok = circuit_solve(c, Rv, mmf, I, pm, ph);
+    fails.mark(d, hn::AndNot(done.m, hn::Not(ok)), kFailCircuit, hn::Zero(d), -1, t1, hn::Zero(d));
+    return {fails.failed};
+  }
+  HWY_INLINE N flux(int i) const { return ph[i]; }
+  // The rod of the largest step names the failure (kFailNewton).
+  HWY_INLINE void newton_failed(M bad, N worst, N worst_rod) {
+    const D d = c.d;
+    for (int i = 0; i < c.n; ++i)
+      fails.mark(d, hn::And(bad.m, hn::Eq(worst_rod.v, C(d, static_cast<double>(i)))), kFailNewton,
+                 worst.v, i, t1, hn::Zero(d));
+  }
+  HWY_INLINE M initially_done() const { return {fails.failed}; }
+  // M_irr and the law's last evaluation (RodState's an_x, an_L, an_dL) from the kept trial, and
+  // its own state (the JA anchors; the Preisach stacks after the step: law_commit).
+  HWY_INLINE void commit_law(int i) {
+    const auto& tr = trial[i];
     s.f[kMirr][i] = tr.Mirr;
-    s.f[kM][i] = tr.M;
-    // eddy_static_field_trapezoid: H1 + g (B1 - B0) - (Hc0 - H0); at rest H_c = H1
-    s.f[kHc][i] = quasi_static ? H1
-                               : hn::Sub(hn::Add(H1, hn::Mul(mg.g[i], hn::Sub(B1, mg.B0[i]))),
-                                         hn::Sub(s.f[kHc][i], s.f[kH][i]));
-    s.f[kHprev2][i] = s.f[kHprev][i];
-    s.f[kHprev][i] = s.f[kH][i];
-    s.f[kH][i] = H1;
-    s.f[kMuR][i] = hn::Add(C(d, 1.0), tr.dM_dH);
-    s.f[kTau][i] = hn::Mul(hn::Mul(C(d, kMu0), s.f[kMuR][i]), kappa);
-    s.f[kPhi][i] = hn::Mul(B1, c.rod(kArea, i));
-    commit_law_state(mg, s, i);
     s.f[kAnX][i] = tr.an_x;
     s.f[kAnL][i] = tr.an_L;
     s.f[kAnDL][i] = tr.an_dL;
+    commit_law_state<D>(start[i], s, i);
   }
+};
+
+// The consistent magnetic state of one step over the lanes (model/step.cpp's
+// consistent_magnetic_update): the one text of joint_newton-inl.h with the lanes' context.
+// h is the step (1 at rest: quasi_static, make_state's ramp, no eddy term).
+template <class Law, class D>
+HWY_INLINE void magnetic_state(LaneNewton<Law, D>& ctx, V<D> h, bool quasi_static) {
+  using N = Lanes<D>;
+  laws::JointNewtonT<N, kMaxRods> f;
+  laws::joint_newton_start(ctx, f, quasi_static, N(hn::Div(C(ctx.c.d, 2.0), h)));
+  laws::joint_newton(ctx, f);
+  laws::joint_newton_commit(ctx, f, quasi_static);
 }
 
 }  // namespace gmasim::lanes::HWY_NAMESPACE

@@ -180,9 +180,8 @@ HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
   const Mk<D> alive = hn::Not(fails.failed);
   const V<D> I = hn::LoadU(d, in.current_A + j), h = hn::LoadU(d, in.dt_s + j);
   const V<D> t1 = hn::Add(g[kT], h);  // step()'s t1 = s.t_s + h
-  Magnetic<Law, D> mg;
-  newton_fields<Law>(c, s, I, c.glob(kPmScale), h, t1, false, mg, fails);
-  commit_fields<Law>(c, s, false, mg);
+  LaneNewton<Law, D> mg(c, s, I, c.glob(kPmScale), t1, fails);
+  magnetic_state(mg, h, false);
   for (int i = 0; i < c.n; ++i) {
     fails.check(d, s.f[kH][i], C(d, 1e9), kFailH, i, t1);
     fails.check(d, s.f[kM][i], hn::Mul(C(d, 1.5), c.rod(kMsTMag, i)), kFailM, i, t1);
@@ -193,7 +192,7 @@ HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
   g[kCurrent] = I;
   run_loop_checks(c, s, g, g[kT], fails);
   const Mk<D> keep = hn::AndNot(fails.failed, alive);  // alive and not failed now
-  law_commit(c, mg, keep);
+  law_commit(c, mg.trial, keep);
   store_rods(c, s, keep);
   for (int f = 0; f < kGlobalStateCount; ++f) hn::BlendedStore(g[f], keep, d, c.glob_at(f));
   store_fails(c, fails);
@@ -210,11 +209,10 @@ HWY_INLINE void ramp_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
   const Mk<D> alive = hn::Not(fails.failed);
   const V<D> I = hn::LoadU(d, in.current_A + j), pm = hn::LoadU(d, in.pm_scale + j);
   const V<D> one = C(d, 1.0), t = hn::Zero(d);
-  Magnetic<Law, D> mg;
-  newton_fields<Law>(c, s, I, pm, one, t, true, mg, fails);
-  commit_fields<Law>(c, s, true, mg);
+  LaneNewton<Law, D> mg(c, s, I, pm, t, fails);
+  magnetic_state(mg, one, true);
   const Mk<D> keep = hn::AndNot(fails.failed, alive);
-  law_commit(c, mg, keep);
+  law_commit(c, mg.trial, keep);
   store_rods(c, s, keep);
   store_fails(c, fails);
 }

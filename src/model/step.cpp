@@ -14,6 +14,7 @@
 #include "gmasim/model/model.hpp"
 #include "gmasim/model/rod_laws.hpp"
 #include "gmasim/model/step_stages.hpp"
+#include "gmasim/physics/joint_newton.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
@@ -88,148 +89,100 @@ void advance_sensor_mount(const SensorMountModel& o, double q0_m, double q1_m, d
   s.q_m = q1_m;
 }
 
-// The consistent state's end of step for one rod: the law's last Newton trial at H1 (its flux
-// density B1), the eddy field of eq. (7) (trapezoid; at rest H_c = H), the histories of the
-// first guess and the slope mu_r = 1 + dM/dH.
-// g = 2 kappa / h (eddy_static_field_trapezoid).
-template <class Law>
-void commit_rod(const RodConditions& rc, RodState& r, const typename Law::JointTrial& trial,
-                double H1, double B0, double B1, bool quasi_static, double g) {
-  r.M_prev2_A_per_m = r.M_prev_A_per_m;
-  r.M_prev_A_per_m = r.M_A_per_m;
-  Law::commit_trial(rc, r, trial);
-  r.Hc_A_per_m =
-      quasi_static ? H1 : eddy_static_field_trapezoid(r.H_A_per_m, H1, r.Hc_A_per_m, B0, B1, g);
-  r.H_prev2_A_per_m = r.H_prev_A_per_m;
-  r.H_prev_A_per_m = r.H_A_per_m;
-  r.H_A_per_m = H1;
-  r.mu_r = 1.0 + trial.dM_dH;
-  r.tau_s = kMu0 * r.mu_r * rc.eddy_geometry_s_m_per_H;
-  r.phi_Wb = B1 * rc.area_m2;
-}
-
-// After a full (undamped) correction the iterate solves the circuit linearised at the last
-// iterate exactly: the rods' branches and the network are linear in (H, M, phi), and M* is on
-// the law's tangent. The next correction is then the circuit's response to the laws' own steps
-// M_next - M* alone (law_steps: the sum of their sizes): at fixed flux a rod's field moves by
-// -(M_next - M*) / mu_r, and the passive network's response adds at most as much, so
-// |dH| <= 2 law_steps. Where every law holds and that bound is within a quarter of every rod's
-// field tolerance, the iterate has converged without the confirming solve (one solve a step).
-inline bool next_correction_within_tolerance(std::size_t n, double law_steps,
-                                             const std::array<double, 8>& H) {
-  for (std::size_t i = 0; i < n; ++i)
-    if (!(2.0 * law_steps <= 0.25 * (1e-7 + 1e-11 * std::fabs(H[i])))) return false;
-  return true;
-}
-
-// A rod's branch U = R_eff phi + U_off linearised at the Newton iterate (H*, M_next) of
-// consistent_magnetic_update, with B* = mu0 (H* + M_next), inv_mud = 1/(mu0 mu_r) and the eddy
-// field's g = 2 kappa / h, B0 and e0 = H_c - H at the step's start: R_eff and the MMF -U_off.
-inline void linearise_rod_branch(const RodConditions& rc, double H, double Bs, double inv_mud,
-                                 double g, double B0, double e0, double& R_eff, double& mmf) {
-  R_eff = rc.length_over_area_per_m * (inv_mud + g) + rc.series_reluctance_per_H;
-  mmf = -rc.length_m * (H - Bs * inv_mud - g * B0 - e0);
-}
-
-// Consistent magnetic state (docs/model.md, "Magnetic state"). At the end of the step every
-// rod i satisfies, with its own JA state (eq. 9) and the circuit (eq. 23):
-//   phi_i = A_i B_i,  B_i = mu0 (H_i + M_i(H_i)),  U_i = l_i H_c,i + R_s,i phi_i  (eq. 7, first
-//   line, with k_f's series reluctance R_s: physics::series_reluctance)
-//   H_c,i = H_i + kappa_i dB_i/dt  (eq. 7's eddy field, trapezoidal over the step)
-// Newton's method on the rods' fields and magnetisations jointly: at the iterate (H*, M*) each
-// rod's law is evaluated once (Law::joint_trial: no inner solve), its magnetisation corrected
-// by the law's own Newton step to M_next and linearised (slope dM/dH) into a branch
-// U = R_eff phi + U_off, the circuit is solved with R_eff and the MMF -U_off, H* moves to the
-// field that flux implies and M* to M_next + dM/dH dH (the law's tangent). Quadratic; damped
-// after 8 iterations (the JA slope jumps where M_irr starts or stops moving). Converged when
-// every field correction is below 1e-7 A/m + 1e-11 |H| and every law holds at its iterate
-// (JA: |M* - F(M*)| <= 1e-12 M_s^T); the last evaluation, which the solve used, is committed as
-// it is (Law::commit_trial). First guess: H and M extrapolated quadratically from the last
-// three steps (H = 3 H_n - 3 H_n-1 + H_n-2), so that one correction usually converges (two
-// solves and two law evaluations a step).
-// quasi_static drops the eddy term (the at-rest ramp of make_state) and starts at H_n.
-// N: the number of rods fixed at compile time (3, the built-in actuator: its loops unrolled), or 0
-// for any (consistent_magnetic_update chooses); the same operations in the same order either way.
-template <class Law, std::size_t N>
-void consistent_magnetic_update_n(const Model& m, const Conditions& c, State& s, double current_A,
-                                  double pm_scale, double h_s, bool quasi_static, double t1) {
-  const std::size_t n = N > 0 ? N : s.rods.size();
-  std::array<double, 8> H, Mg, inv_mud, B0, e0, g, Bs;  // set before read (no fill)
-  std::array<typename Law::MoveStart, 8> start;
+// The scalar step's context of the consistent state's solve (gmasim/physics/joint_newton-inl.h,
+// the one text the lanes also run): the rods' state in State::rods, the circuit solved by the
+// netlist (solve_circuit: the rods' branches R_eff and their extra MMF), the law's own trial and
+// commit (Law::begin_move, joint_trial, commit_trial), and a failure thrown (DivergenceError).
+// NR: the number of rods fixed at compile time (3, the built-in actuator: the loops unrolled), or
+// 0 for any.
+template <class Law, std::size_t NR>
+struct ScalarNewton {
+  const Model& m;
+  const Conditions& c;
+  State& s;
+  double current_A, pm_scale, t1;
+  std::array<typename Law::MoveStart, 8> start;  // set before read (not zeroed: the step's cost)
   std::array<typename Law::JointTrial, 8> trial;
-  const double two_over_h = 2.0 / h_s;
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto& r = s.rods[i];
-    const auto& rc = c.rods[i];
-    start[i] = Law::begin_move(rc, r);
-    B0[i] = flux_density(r.H_A_per_m, r.M_A_per_m);
-    if (quasi_static) {
-      H[i] = r.H_A_per_m;
-      Mg[i] = r.M_A_per_m;
-      e0[i] = g[i] = 0.0;  // no eddy term at rest
-    } else {
-      e0[i] = r.Hc_A_per_m - r.H_A_per_m;
-      g[i] = rc.eddy_geometry_s_m_per_H * two_over_h;
-      H[i] = 3.0 * (r.H_A_per_m - r.H_prev_A_per_m) + r.H_prev2_A_per_m;
-      Mg[i] = 3.0 * (r.M_A_per_m - r.M_prev_A_per_m) + r.M_prev2_A_per_m;
-    }
+
+  ScalarNewton(const Model& m_, const Conditions& c_, State& s_, double current, double pm,
+               double t)
+      : m(m_), c(c_), s(s_), current_A(current), pm_scale(pm), t1(t) {}
+  int rods() const { return NR > 0 ? static_cast<int>(NR) : static_cast<int>(s.rods.size()); }
+  const RodConditions& rc(int i) const { return c.rods[static_cast<std::size_t>(i)]; }
+  RodState& rod(int i) { return s.rods[static_cast<std::size_t>(i)]; }
+  RodMagnetic load(int i) {
+    const RodState& r = rod(i);
+    return {r.H_A_per_m,      r.Hc_A_per_m,      r.H_prev_A_per_m, r.H_prev2_A_per_m, r.M_A_per_m,
+            r.M_prev_A_per_m, r.M_prev2_A_per_m, r.mu_r,           r.tau_s,           r.phi_Wb};
   }
-  constexpr int kMaxIterations = 60;
-  for (int it = 0;; ++it) {
-    bool laws_hold = true;
-    double law_steps = 0.0;  // sum over the rods of |M_next - M*|, the laws' own Newton steps
-    for (std::size_t i = 0; i < n; ++i) {
-      Law::joint_trial(c.rods[i], s.rods[i], start[i], H[i], Mg[i], trial[i]);
-      laws_hold = laws_hold && trial[i].converged;
-      law_steps += std::fabs(trial[i].M_next - Mg[i]);
-    }
-    if (it >= 1 && it <= 8 && laws_hold && next_correction_within_tolerance(n, law_steps, H))
-      break;  // the iterate has converged without the confirming solve (nor its linearisation)
-    for (std::size_t i = 0; i < n; ++i) {  // each rod's branch, linearised at the iterate
-      Bs[i] = flux_density(H[i], trial[i].M_next);
-      inv_mud[i] = trial[i].inv_mu_r * (1.0 / kMu0);
-      linearise_rod_branch(c.rods[i], H[i], Bs[i], inv_mud[i], g[i], B0[i], e0[i],
-                           s.rod_reluctance[i], s.circuit.rod_extra_mmf[i]);
-    }
+  void store(int i, const RodMagnetic& v) {
+    RodState& r = rod(i);
+    r.H_A_per_m = v.H;
+    r.Hc_A_per_m = v.Hc;
+    r.H_prev_A_per_m = v.H_prev;
+    r.H_prev2_A_per_m = v.H_prev2;
+    r.M_A_per_m = v.M;
+    r.M_prev_A_per_m = v.M_prev;
+    r.M_prev2_A_per_m = v.M_prev2;
+    r.mu_r = v.mu_r;
+    r.tau_s = v.tau;
+    r.phi_Wb = v.phi;
+    s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[static_cast<std::size_t>(i)])] =
+        v.phi;
+  }
+  double kappa(int i) const { return rc(i).eddy_geometry_s_m_per_H; }
+  double length(int i) const { return rc(i).length_m; }
+  double length_per_area(int i) const { return rc(i).length_over_area_per_m; }
+  double series_reluctance(int i) const { return rc(i).series_reluctance_per_H; }
+  double area(int i) const { return rc(i).area_m2; }
+  double inv_area(int i) const { return rc(i).inv_area_per_m2; }
+  void begin(int i) { start[static_cast<std::size_t>(i)] = Law::begin_move(rc(i), rod(i)); }
+  void trial_at(int i, double H, double M_iter, bool /*done: never, while solving*/) {
+    Law::joint_trial(rc(i), rod(i), start[static_cast<std::size_t>(i)], H, M_iter,
+                     trial[static_cast<std::size_t>(i)]);
+  }
+  const typename Law::JointTrial& t(int i) const { return trial[static_cast<std::size_t>(i)]; }
+  double M_of(int i) const { return t(i).M; }
+  double dM_dH(int i) const { return t(i).dM_dH; }
+  double inv_mu_r(int i) const { return t(i).inv_mu_r; }
+  double M_next(int i) const { return t(i).M_next; }
+  bool converged(int i) const { return t(i).converged; }
+  void branch(int i, double R, double extra) {
+    s.rod_reluctance[static_cast<std::size_t>(i)] = R;
+    s.circuit.rod_extra_mmf[static_cast<std::size_t>(i)] = extra;
+  }
+  bool solve(bool) {
     ++s.newton_solves;
     if (!solve_circuit(m.circuit, s.rod_reluctance, current_A, pm_scale, s.circuit,
                        s.energy.enabled))
       throw DivergenceError(t1, "", "nodal matrix of the circuit", 0.0, "not positive definite");
-    double worst = 0.0;
-    int worst_rod = 0;
-    bool converged = true;
-    std::array<double, 8> dH;  // written for rods 0..n-1 below
-    for (std::size_t i = 0; i < n; ++i) {
-      const double phi = s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])];
-      dH[i] = (phi * c.rods[i].inv_area_per_m2 - Bs[i]) * inv_mud[i];
-      // The rod's Newton step: its field's and its law's (A/m both); NaN propagates.
-      const double dM = std::fabs(trial[i].M_next - Mg[i]);
-      const double step = dM <= std::fabs(dH[i]) ? std::fabs(dH[i]) : dM;
-      if (!(step <= worst)) {
-        worst = step;
-        worst_rod = static_cast<int>(i);
-      }
-      if (!(std::fabs(dH[i]) <= 1e-7 + 1e-11 * std::fabs(H[i])) || !trial[i].converged)
-        converged = false;
-    }
-    if (converged) break;  // the last iterate: its correction is below the tolerance
-    if (it == kMaxIterations || !std::isfinite(worst)) {
-      if (worst <= 1e-3) break;  // 1 mA/m: far below anything the outputs resolve
-      throw DivergenceError(t1, m.rods[static_cast<std::size_t>(worst_rod)].name,
-                            "field H [A/m] of the consistent magnetic state", worst,
-                            "Newton's method did not converge");
-    }
-    const double damping = it < 8 ? 1.0 : 0.5;
-    for (std::size_t i = 0; i < n; ++i) {
-      H[i] += damping * dH[i];
-      Mg[i] = trial[i].M_next + trial[i].dM_dH * damping * dH[i];  // on the law's tangent
-    }
+    return false;
   }
-  for (std::size_t i = 0; i < n; ++i) {  // commit the end-of-step state: the last iterate
-    commit_rod<Law>(c.rods[i], s.rods[i], trial[i], H[i], B0[i], flux_density(H[i], trial[i].M),
-                    quasi_static, g[i]);
-    s.circuit.phi[static_cast<std::size_t>(m.circuit.rod_branch[i])] = s.rods[i].phi_Wb;
+  double flux(int i) const {
+    return s.circuit
+        .phi[static_cast<std::size_t>(m.circuit.rod_branch[static_cast<std::size_t>(i)])];
   }
+  [[noreturn]] void newton_failed(bool, double worst, double worst_rod) {
+    throw DivergenceError(t1, m.rods[static_cast<std::size_t>(worst_rod)].name,
+                          "field H [A/m] of the consistent magnetic state", worst,
+                          "Newton's method did not converge");
+  }
+  bool initially_done() const { return false; }
+  void commit_law(int i) { Law::commit_trial(rc(i), rod(i), trial[static_cast<std::size_t>(i)]); }
+};
+
+// Consistent magnetic state (docs/model.md, "Magnetic state"): the joint Newton solve of the
+// rods' fields and magnetisations with the circuit and its commit, the one text of
+// gmasim/physics/joint_newton-inl.h (joint_newton_start, joint_newton, joint_newton_commit).
+// quasi_static drops the eddy term (the at-rest ramp of make_state) and starts at H_n.
+template <class Law, std::size_t N>
+void consistent_magnetic_update_n(const Model& m, const Conditions& c, State& s, double current_A,
+                                  double pm_scale, double h_s, bool quasi_static, double t1) {
+  ScalarNewton<Law, N> ctx(m, c, s, current_A, pm_scale, t1);
+  JointNewtonT<double, 8> f;  // set before read
+  joint_newton_start(ctx, f, quasi_static, 2.0 / h_s);
+  joint_newton(ctx, f);
+  joint_newton_commit(ctx, f, quasi_static);
 }
 template <class Law>
 void consistent_magnetic_update(const Model& m, const Conditions& c, State& s, double current_A,

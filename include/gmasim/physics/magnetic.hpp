@@ -143,11 +143,8 @@ inline double classical_eddy_coefficient(double r_outer_m, double r_inner_m, dou
 // (kappa = eddy_time_constant(1, ...); for a linear material dB = mu dH this is eq. 7's
 // H(s) = H_c(s)/(1 + tau s) with tau = mu kappa). Trapezoidal average over a step h:
 //   (H_c0 + H_c1)/2 = (H0 + H1)/2 + kappa (B1 - B0)/h,
-// given g = 2 kappa / h [A/(m T)].
-inline double eddy_static_field_trapezoid(double H0, double H1, double Hc0, double B0_T,
-                                          double B1_T, double g_A_per_m_T) {
-  return H1 + g_A_per_m_T * (B1_T - B0_T) - (Hc0 - H0);
-}
+// given g = 2 kappa / h [A/(m T)]: eddy_static_field_trapezoid, written once over the number type
+// in gmasim/physics/joint_newton-inl.h (the consistent state's solve and commit).
 
 // Eq. (8): temperature-dependent resistivity of Terfenol-D [ohm m].
 //   rho^T = rho0 + 2.5e-9 (T - T0)   (the slope is a model parameter, default 2.5e-9)
