@@ -140,7 +140,8 @@ HWY_NOINLINE void preisach_base_at(const physics::PreisachHistory* h, Lanes<D> x
 
 // The step's laws (gmasim/physics/laws-inl.h), the same text as the scalar step's, compiled for
 // this target: physics laws over Lanes<D> (rod_mechanics, oscillator_step, ...), and the
-// consistent state's joint Newton solve and commit (joint_newton-inl.h).
+// consistent state's joint Newton solve and commit (joint_newton-inl.h) and the mechanical
+// stages (mechanics_stage-inl.h).
 namespace laws {
 using ::gmasim::lanes::HWY_NAMESPACE::oscillator_free_closed_form_where;
 using ::gmasim::lanes::HWY_NAMESPACE::preisach_base_at;
@@ -151,8 +152,10 @@ using ::gmasim::lanes::HWY_NAMESPACE::preisach_base_at;
 #include "gmasim/physics/ja_law-inl.h"  // NOLINT(build/include): likewise
 // after ja_law-inl.h, whose langevin_pair it uses
 #include "gmasim/physics/preisach_law-inl.h"  // NOLINT(build/include): likewise
-// the consistent state's solve and commit (the scalar step's: gmasim/physics/joint_newton.hpp)
+// the consistent state's solve and commit (the scalar step's: gmasim/physics/stages.hpp)
 #include "gmasim/physics/joint_newton-inl.h"  // NOLINT(build/include): likewise
+// the mechanical stages (the scalar step's: gmasim/physics/stages.hpp)
+#include "gmasim/physics/mechanics_stage-inl.h"  // NOLINT(build/include): likewise
 #undef GMASIM_LAW_INLINE
 #undef GMASIM_LAW_RARE
 }  // namespace laws

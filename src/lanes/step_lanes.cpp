@@ -15,92 +15,119 @@
 HWY_BEFORE_NAMESPACE();
 namespace gmasim::lanes::HWY_NAMESPACE {
 
-// Stage 3 (model/step.cpp, stage_strain and stage_mechanics): each rod's Delta-E modulus,
-// strain, force and stiffness (eq. 11-14, 17: laws::rod_mechanics), its load stiffness
-// (eq. 18: chain_stiffness) and its oscillator over the step (eq. 15-16, stiffness at mid-step:
-// mid_step_stiffness, oscillator_step); then the sensor mount's probe (base_excited_step). The
-// laws are gmasim/physics's own, instantiated over the lanes' number type (Lanes<D>).
+// The lanes' context of the mechanical stages (gmasim/physics/mechanics_stage-inl.h, the one
+// text the scalar step also runs: laws::strain_stage, oscillators_stage, sensor_mount_stage): the
+// rods' state in RodStates, the sensor mount's in the global fields g, their constants in the
+// LaneData, a failure recorded in the lane's record (Fails).
 template <class D>
-HWY_INLINE void mechanics(const Chunk<D>& c, RodStates<D>& s, V<D> h, V<D> t1, Fails<D>& fails) {
+struct LaneMechanics {
   using N = Lanes<D>;
-  const D d = c.d;
-  const int n = c.n;
-  const Structure& st = c.L.st;
-  N F0[kMaxRods], K0[kMaxRods], compliance[kMaxRods];
-  const N lambda_s = c.glob(kLambdaS);
-  for (int i = 0; i < n; ++i) {
-    F0[i] = s.f[kF][i];
-    K0[i] = N(s.f[kKRod][i]) + N(s.f[kKLoad][i]);
-    const laws::DeltaETermsT<N> dE{c.rod(kInvEs, i), c.rod(kRot, i), c.rod(kCoupling, i),
-                                   c.rod(kMu0Ms2, i), c.rod(kSdE, i)};
-    laws::ExpPointT<N> prestress{s.f[kPrestressY][i], s.f[kPrestressE][i]};
-    const laws::RodMechanicsT<N> k = laws::rod_mechanics<N>(
-        s.f[kM][i], c.rod(kInvMsTE, i), dE, c.rod(kInvMsStrain, i), lambda_s, c.rod(kSigmaP, i),
-        c.rod(kFourSpOverLs, i), c.rod(kArea, i), c.rod(kAreaOverLength, i),
-        c.rod(kLengthPerArea, i), c.rod(kJointCompl, i), prestress);
-    s.f[kPrestressY][i] = prestress.y.v;
-    s.f[kPrestressE][i] = prestress.e.v;
-    s.f[kE][i] = k.E_Pa.v;
-    s.f[kLambda][i] = k.lambda.v;
-    s.f[kF][i] = k.F_N.v;
-    s.f[kKRod][i] = k.k_rod_N_per_m.v;
-    compliance[i] = k.compliance_m_per_N;
-  }
-  for (int i = 0; i < n; ++i) {
-    const auto u = static_cast<std::size_t>(i);
-    const N k_load = laws::chain_stiffness<N>(c.rod(kFixedCompl, i), compliance, st.chain[u].data(),
-                                              st.chain_count[u]);
-    s.f[kKLoad][i] = k_load.v;
-    const N K = laws::mid_step_stiffness<N>(K0[i], s.f[kKRod][i], k_load);
-    s.f[kKOsc][i] = K.v;
-    N x = s.f[kX][i], v = s.f[kV][i];
-    laws::ExpPointT<N> decay{s.f[kOscDecayY][i], s.f[kOscDecayE][i]};
-    laws::oscillator_step<N>(c.rod(kMassOsc, i), c.rod(kInvMassOsc, i), c.rod(kDampOsc, i), K,
-                             F0[i], s.f[kF][i], h, x, v, decay);
-    s.f[kX][i] = x.v;
-    s.f[kV][i] = v.v;
-    s.f[kOscDecayY][i] = decay.y.v;
-    s.f[kOscDecayE][i] = decay.e.v;
-    fails.check(d, s.f[kX][i], C(d, 1.0), kFailX, i, t1);
-  }
-}
+  const Chunk<D>& c;
+  RodStates<D>& s;
+  V<D>* g;
+  V<D> t1;
+  Fails<D>& fails;
 
-// The probe on its bracket (model/step.cpp, advance_sensor_mount) and the outputs
-// (finish_outputs): y = sum x (eq. 20) + the probe's deflection (+ x_T), B of the coil.
+  HWY_INLINE int rods() const { return c.n; }
+  HWY_INLINE laws::RodStrainT<N> strain_state(int i) const {
+    return {s.f[kF][i], s.f[kKRod][i],   s.f[kKLoad][i],
+            s.f[kE][i], s.f[kLambda][i], {s.f[kPrestressY][i], s.f[kPrestressE][i]}};
+  }
+  HWY_INLINE void store_strain(int i, const laws::RodStrainT<N>& v) const {
+    s.f[kF][i] = v.F.v;
+    s.f[kKRod][i] = v.k_rod.v;
+    s.f[kE][i] = v.E.v;
+    s.f[kLambda][i] = v.lambda.v;
+    s.f[kPrestressY][i] = v.prestress.y.v;
+    s.f[kPrestressE][i] = v.prestress.e.v;
+  }
+  HWY_INLINE laws::RodOscillatorT<N> oscillator(int i) const {
+    return {s.f[kF][i],
+            s.f[kKRod][i],
+            s.f[kKLoad][i],
+            s.f[kKOsc][i],
+            s.f[kX][i],
+            s.f[kV][i],
+            {s.f[kOscDecayY][i], s.f[kOscDecayE][i]}};
+  }
+  HWY_INLINE void store_oscillator(int i, const laws::RodOscillatorT<N>& v) const {
+    s.f[kKLoad][i] = v.k_load.v;
+    s.f[kKOsc][i] = v.K_osc.v;
+    s.f[kX][i] = v.x.v;
+    s.f[kV][i] = v.v.v;
+    s.f[kOscDecayY][i] = v.osc_decay.y.v;
+    s.f[kOscDecayE][i] = v.osc_decay.e.v;
+  }
+  HWY_INLINE N x(int i) const { return s.f[kX][i]; }
+  HWY_INLINE N M(int i) const { return s.f[kM][i]; }
+  HWY_INLINE laws::RodMechanicsInputsT<N> inputs(int i) const {
+    return {
+        c.rod(kInvMsTE, i),
+        {c.rod(kInvEs, i), c.rod(kRot, i), c.rod(kCoupling, i), c.rod(kMu0Ms2, i), c.rod(kSdE, i)},
+        c.rod(kInvMsStrain, i),
+        c.rod(kSigmaP, i),
+        c.rod(kFourSpOverLs, i),
+        c.rod(kArea, i),
+        c.rod(kAreaOverLength, i),
+        c.rod(kLengthPerArea, i),
+        c.rod(kJointCompl, i)};
+  }
+  HWY_INLINE N lambda_s() const { return c.glob(kLambdaS); }
+  HWY_INLINE N fixed_compliance(int i) const { return c.rod(kFixedCompl, i); }
+  HWY_INLINE const int* chain(int i) const {
+    return c.L.st.chain[static_cast<std::size_t>(i)].data();
+  }
+  HWY_INLINE int chain_count(int i) const {
+    return c.L.st.chain_count[static_cast<std::size_t>(i)];
+  }
+  HWY_INLINE N mass_osc(int i) const { return c.rod(kMassOsc, i); }
+  HWY_INLINE N inv_mass_osc(int i) const { return c.rod(kInvMassOsc, i); }
+  HWY_INLINE N damping_osc(int i) const { return c.rod(kDampOsc, i); }
+  HWY_INLINE void check_x(int i, N x) const { fails.check(c.d, x.v, C(c.d, 1.0), kFailX, i, t1); }
+  HWY_INLINE bool mount() const { return c.L.st.mount; }
+  HWY_INLINE bool mount_on_output() const { return c.L.st.mount_on_output; }
+  HWY_INLINE N momentum_mass(int i) const { return c.rod(kMomMass, i); }
+  HWY_INLINE N actuator_mass() const { return c.glob(kActMass); }
+  HWY_INLINE N mount_mass() const { return c.glob(kMountMass); }
+  HWY_INLINE N mount_inv_mass() const { return c.glob(kMountInvMass); }
+  HWY_INLINE N mount_damping() const { return c.glob(kMountC); }
+  HWY_INLINE N mount_stiffness() const { return c.glob(kMountK); }
+  HWY_INLINE laws::MountStateT<N> mount_state() const {
+    return {g[kZ], g[kZv], g[kQ], {g[kMountDecayY], g[kMountDecayE]}};
+  }
+  HWY_INLINE void store_mount(const laws::MountStateT<N>& v) const {
+    g[kZ] = v.z.v;
+    g[kZv] = v.zv.v;
+    g[kQ] = v.q.v;
+    g[kMountDecayY] = v.decay.y.v;
+    g[kMountDecayE] = v.decay.e.v;
+  }
+  HWY_INLINE void check_z(N z) const { fails.check(c.d, z.v, C(c.d, 1.0), kFailZ, -1, t1); }
+};
+
+// Stages 2 and 3 (model/step.cpp, stage_strain and stage_mechanics: the same text), then the
+// outputs (finish_outputs): y = y_stack (eq. 20) + the probe's deflection (+ x_T), B of the
+// coil and of each rod.
 template <class D>
-HWY_INLINE void mount_and_outputs(const Chunk<D>& c, RodStates<D>& s, V<D>* g, V<D> h, V<D> t1,
-                                  Fails<D>& fails) {
+HWY_INLINE void mechanics_and_outputs(const Chunk<D>& c, RodStates<D>& s, V<D>* g, V<D> h, V<D> t1,
+                                      Fails<D>& fails) {
   using N = Lanes<D>;
   const D d = c.d;
   const Structure& st = c.L.st;
-  V<D> y = hn::Zero(d);  // eq. (20): y_stack = sum x
-  for (int i = 0; i < c.n; ++i) y = hn::Add(y, s.f[kX][i]);
-  g[kYStack] = y;
-  if (st.mount) {
-    // the bracket's base (model/step.cpp, mount_base_m): the recoil p / M or the output y_stack
-    V<D> q1 = y;
-    if (!st.mount_on_output) {
-      V<D> p = hn::Zero(d);
-      for (int i = 0; i < c.n; ++i) p = hn::Add(p, hn::Mul(c.rod(kMomMass, i), s.f[kX][i]));
-      q1 = hn::Div(p, c.glob(kActMass));
-    }
-    N z = g[kZ], zv = g[kZv];
-    laws::ExpPointT<N> decay{g[kMountDecayY], g[kMountDecayE]};
-    laws::base_excited_step<N>(c.glob(kMountMass), c.glob(kMountInvMass), c.glob(kMountC),
-                               c.glob(kMountK), g[kQ], q1, h, z, zv, decay);
-    g[kZ] = z.v;
-    g[kZv] = zv.v;
-    g[kMountDecayY] = decay.y.v;
-    g[kMountDecayE] = decay.e.v;
-    g[kQ] = q1;
-    fails.check(d, g[kZ], C(d, 1.0), kFailZ, -1, t1);
-  }
+  LaneMechanics<D> k{c, s, g, t1, fails};
+  N F0[kMaxRods], K0[kMaxRods], compliance[kMaxRods];
+  laws::strain_stage<N>(k, F0, K0, compliance);
+  laws::oscillators_stage<N>(k, F0, K0, compliance, N(h));
+  const N y_stack = laws::stack_displacement<N>(k);
+  laws::sensor_mount_stage<N>(k, y_stack, N(h));
+  g[kYStack] = y_stack.v;
+  V<D> y = y_stack.v;
   if (st.mount) y = st.mount_on_output ? g[kZ] : hn::Add(y, hn::Sub(g[kZ], g[kQ]));
   if (st.xT_in_output) y = hn::Add(y, c.glob(kXT));
   g[kY] = y;
   V<D> phi = hn::Zero(d);
-  for (int k = 0; k < st.sensor_count; ++k)
-    phi = hn::Add(phi, s.f[kPhi][st.sensor_rods[static_cast<std::size_t>(k)]]);
+  for (int i = 0; i < st.sensor_count; ++i)
+    phi = hn::Add(phi, s.f[kPhi][st.sensor_rods[static_cast<std::size_t>(i)]]);
   g[kBSensor] = hn::Div(phi, c.glob(kSensorArea));
   for (int i = 0; i < c.n; ++i) s.f[kB][i] = hn::Mul(s.f[kPhi][i], c.rod(kInvArea, i));
 }
@@ -186,8 +213,7 @@ HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
     fails.check(d, s.f[kH][i], C(d, 1e9), kFailH, i, t1);
     fails.check(d, s.f[kM][i], hn::Mul(C(d, 1.5), c.rod(kMsTMag, i)), kFailM, i, t1);
   }
-  mechanics(c, s, h, t1, fails);
-  mount_and_outputs(c, s, g, h, t1, fails);
+  mechanics_and_outputs(c, s, g, h, t1, fails);
   g[kT] = hn::LoadU(d, in.t1_s + j);
   g[kCurrent] = I;
   run_loop_checks(c, s, g, g[kT], fails);

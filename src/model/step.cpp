@@ -14,10 +14,10 @@
 #include "gmasim/model/model.hpp"
 #include "gmasim/model/rod_laws.hpp"
 #include "gmasim/model/step_stages.hpp"
-#include "gmasim/physics/joint_newton.hpp"
 #include "gmasim/physics/magnetic.hpp"
 #include "gmasim/physics/magnetostriction.hpp"
 #include "gmasim/physics/mechanics.hpp"
+#include "gmasim/physics/stages.hpp"
 
 namespace gmasim {
 namespace {
@@ -40,15 +40,90 @@ inline void check(double value, double t, std::string_view rod, const char* quan
   diverged(value, t, rod, quantity, limit);
 }
 
-// Eq. (20): the stack's displacement, the sum of the rods' x.
-double stack_displacement_m(const State& s) {
-  double y = 0.0;
-  for (const auto& r : s.rods) y += r.x_m;
-  return y;
-}
+// The scalar step's context of the mechanical stages (gmasim/physics/mechanics_stage-inl.h, the
+// one text the lanes also run): the rods' state in State::rods, their constants in
+// RodConditions, the sensor mount in State, a failure thrown (DivergenceError at t1).
+struct ScalarMechanics {
+  const Model& m;
+  const Conditions& c;
+  State& s;
+  double t1;
+  RodState* rods_ = s.rods.data();  // the vectors' storage, read once
+  const RodConditions* rcs_ = c.rods.data();
+  int n_ = static_cast<int>(s.rods.size());
+
+  int rods() const { return n_; }
+  const RodConditions& rc(int i) const { return rcs_[i]; }
+  RodState& rod(int i) const { return rods_[i]; }
+  RodStrain strain_state(int i) const {
+    const RodState& r = rod(i);
+    return {r.F_N, r.k_rod_N_per_m, r.k_load_N_per_m, r.E_Pa, r.lambda, r.prestress_exp};
+  }
+  void store_strain(int i, const RodStrain& v) const {
+    RodState& r = rod(i);
+    r.F_N = v.F;
+    r.k_rod_N_per_m = v.k_rod;
+    r.E_Pa = v.E;
+    r.lambda = v.lambda;
+    r.prestress_exp = v.prestress;
+  }
+  RodOscillator oscillator(int i) const {
+    const RodState& r = rod(i);
+    return {r.F_N, r.k_rod_N_per_m, r.k_load_N_per_m, r.K_osc_N_per_m,
+            r.x_m, r.v_m_per_s,     r.osc_decay};
+  }
+  void store_oscillator(int i, const RodOscillator& v) const {
+    RodState& r = rod(i);
+    r.k_load_N_per_m = v.k_load;
+    r.K_osc_N_per_m = v.K_osc;
+    r.x_m = v.x;
+    r.v_m_per_s = v.v;
+    r.osc_decay = v.osc_decay;
+  }
+  double x(int i) const { return rod(i).x_m; }
+  double M(int i) const { return rod(i).M_A_per_m; }
+  RodMechanicsInputs inputs(int i) const {
+    const RodConditions& k = rc(i);
+    return {k.inv_MsT_E_m_per_A,
+            k.dE,
+            k.inv_Ms_strain_m_per_A,
+            k.sigma_p_Pa,
+            k.four_sigma_p_over_lambda_s_Pa,
+            k.area_m2,
+            k.area_over_length_m,
+            k.length_over_area_per_m,
+            k.joint_compliance_m_per_N};
+  }
+  double lambda_s() const { return m.material.lambda_s; }
+  double fixed_compliance(int i) const { return rc(i).fixed_compliance_m_per_N; }
+  const int* chain(int i) const { return rc(i).chain_rods.data(); }
+  int chain_count(int i) const { return rc(i).chain_rod_count; }
+  double mass_osc(int i) const { return rc(i).mass_osc_kg; }
+  double inv_mass_osc(int i) const { return rc(i).inv_mass_osc_per_kg; }
+  double damping_osc(int i) const { return rc(i).damping_osc_N_s_per_m; }
+  void check_x(int i, double x) const {
+    check(x, t1, m.rods[static_cast<std::size_t>(i)].name, "x [m]", 1.0);
+  }
+  bool mount() const { return m.sensor_mount.enabled; }
+  bool mount_on_output() const { return m.options.sensor_mount_base == SensorMountBase::Output; }
+  double momentum_mass(int i) const { return rc(i).momentum_mass_kg; }
+  double actuator_mass() const { return m.sensor_mount.actuator_mass_kg; }
+  double mount_mass() const { return m.sensor_mount.mass_kg; }
+  double mount_inv_mass() const { return 1.0 / m.sensor_mount.mass_kg; }
+  double mount_damping() const { return m.sensor_mount.damping_N_s_per_m; }
+  double mount_stiffness() const { return m.sensor_mount.stiffness_N_per_m; }
+  MountState mount_state() const { return {s.z_m, s.z_v_m_per_s, s.q_m, s.mount_decay}; }
+  void store_mount(const MountState& v) const {
+    s.z_m = v.z;
+    s.z_v_m_per_s = v.zv;
+    s.q_m = v.q;
+    s.mount_decay = v.decay;
+  }
+  void check_z(double z) const { check(z, t1, "sensor mount", "z [m]", 1.0); }
+};
 
 void finish_outputs(const Model& m, const Conditions& c, State& s) {
-  double y = stack_displacement_m(s);
+  double y = stack_displacement<double>(ScalarMechanics{m, c, s, s.t_s});
   s.y_stack_m = y;             // eq. (20)
   if (m.sensor_mount.enabled)  // the probe: its deflection u = q - z, or itself on the output
     y = m.options.sensor_mount_base == SensorMountBase::Output ? s.z_m : y + (s.z_m - s.q_m);
@@ -63,30 +138,6 @@ void finish_outputs(const Model& m, const Conditions& c, State& s) {
   s.B_T = phi / area;
   for (std::size_t i = 0; i < s.rods.size(); ++i)
     s.rods[i].B_T = s.rods[i].phi_Wb * c.rods[i].inv_area_per_m2;
-}
-
-// The housing's recoil q = p / M (model.hpp, SensorMountModel): p = sum (m/2 + m_lr) x.
-double recoil_m(const Model& m, const Conditions& c, const State& s) {
-  double p = 0.0;
-  for (std::size_t i = 0; i < s.rods.size(); ++i) p += c.rods[i].momentum_mass_kg * s.rods[i].x_m;
-  return p / m.sensor_mount.actuator_mass_kg;
-}
-
-// The base of the sensor mount's bracket (options.sensor_mount_base): the housing's recoil, or
-// the output y_stack = sum x (eq. 20).
-double mount_base_m(const Model& m, const Conditions& c, const State& s) {
-  return m.options.sensor_mount_base == SensorMountBase::Recoil ? recoil_m(m, c, s)
-                                                                : stack_displacement_m(s);
-}
-
-// The sensor mount (model.hpp, SensorMountModel): with w = u - q, m w'' + c w' + k w =
-// -(c q' + k q), so z = -w = q - u solves m z'' + c (z' - q') + k (z - q) = 0 with q linear over
-// the step: linear forcing, and oscillator_step is exact.
-void advance_sensor_mount(const SensorMountModel& o, double q0_m, double q1_m, double h_s,
-                          State& s) {
-  base_excited_step(o.mass_kg, 1.0 / o.mass_kg, o.damping_N_s_per_m, o.stiffness_N_per_m, q0_m,
-                    q1_m, h_s, s.z_m, s.z_v_m_per_s, s.mount_decay);
-  s.q_m = q1_m;
 }
 
 // The scalar step's context of the consistent state's solve (gmasim/physics/joint_newton-inl.h,
@@ -240,7 +291,8 @@ void settle_at_rest(const Model& m, const Conditions& c, State& s) {
     r.v_m_per_s = 0.0;
   }
   if (m.sensor_mount.enabled) {  // the probe at rest on its bracket: u = 0
-    s.q_m = s.z_m = mount_base_m(m, c, s);
+    const ScalarMechanics k{m, c, s, s.t_s};
+    s.q_m = s.z_m = mount_base<double>(k, stack_displacement<double>(k));
     s.z_v_m_per_s = 0.0;
   }
   finish_outputs(m, c, s);
@@ -395,11 +447,8 @@ void stage_magnetic(const Model& m, const Conditions& c, State& s, const StepInp
 // and axial stiffness (eq. 17) at its new magnetisation; keeps the start's force and
 // stiffness (eq. 16) and the end's compliance 1/k_rod for stage 3.
 void stage_strain(const Model& m, const Conditions& c, State& s, StepScratch& w) {
-  for (std::size_t i = 0; i < s.rods.size(); ++i) {
-    w.F0_N[i] = s.rods[i].F_N;
-    w.K0_N_per_m[i] = s.rods[i].k_rod_N_per_m + s.rods[i].k_load_N_per_m;
-    w.inv_k_rod[i] = update_rod_mechanics(m.material, c.rods[i], s.rods[i]);
-  }
+  ScalarMechanics k{m, c, s, w.t1_s};
+  strain_stage<double>(k, w.F0_N.data(), w.K0_N_per_m.data(), w.inv_k_rod.data());
 }
 
 // Stage 3: mechanics (eq. 15-18). Each rod's oscillator, exact over the step with the force
@@ -410,20 +459,9 @@ void stage_strain(const Model& m, const Conditions& c, State& s, StepScratch& w)
 // Guard: |x| <= 1 m.
 void stage_mechanics(const Model& m, const Conditions& c, State& s, const StepInput& in,
                      const StepScratch& w) {
-  for (std::size_t i = 0; i < s.rods.size(); ++i) {
-    const auto& rc = c.rods[i];
-    auto& r = s.rods[i];
-    r.k_load_N_per_m = load_stiffness_from_compliances(rc, w.inv_k_rod.data());
-    const double K = mid_step_stiffness(w.K0_N_per_m[i], r.k_rod_N_per_m, r.k_load_N_per_m);
-    r.K_osc_N_per_m = K;
-    oscillator_step(rc.mass_osc_kg, rc.inv_mass_osc_per_kg, rc.damping_osc_N_s_per_m, K, w.F0_N[i],
-                    r.F_N, in.dt_s, r.x_m, r.v_m_per_s, r.osc_decay);
-    check(r.x_m, w.t1_s, m.rods[i].name, "x [m]", 1.0);
-  }
-  if (m.sensor_mount.enabled) {
-    advance_sensor_mount(m.sensor_mount, s.q_m, mount_base_m(m, c, s), in.dt_s, s);
-    check(s.z_m, w.t1_s, "sensor mount", "z [m]", 1.0);
-  }
+  ScalarMechanics k{m, c, s, w.t1_s};
+  oscillators_stage<double>(k, w.F0_N.data(), w.K0_N_per_m.data(), w.inv_k_rod.data(), in.dt_s);
+  sensor_mount_stage<double>(k, stack_displacement<double>(k), in.dt_s);
 }
 
 // Stage 4: the outputs (finish_outputs: eq. 20-21 and the flux densities).

@@ -2,7 +2,7 @@
 // item 1; docs/model.md, "The magnetic state"): the joint Newton solve of the rods' fields and
 // magnetisations with the circuit, and its commit. Two instances of this one text:
 //   T = double             the scalar step (src/model/step.cpp, through
-//                          gmasim/physics/joint_newton.hpp, in gmasim::physics);
+//                          gmasim/physics/stages.hpp, in gmasim::physics);
 //   T = lanes::Lanes<D>    the SIMD lanes (src/lanes/step_kernel-inl.h, per target), each lane
 //                          one simulation, so that a lane is the scalar step by construction.
 // What differs between the two is data, not arithmetic: where the rods' state lives, how the
