@@ -8,7 +8,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libhwy-dev libtomlplusplus-dev libcli11-dev libfmt-dev libmatio-dev
   libgtest-dev libgmock-dev googletest libbenchmark-dev
-  pybind11-dev python3-dev python3-numpy python3-scipy python3-matplotlib python3-pytest
+  pybind11-dev python3-dev python3-numpy python3-scipy python3-matplotlib python3-pytest python3-pandas
   python3-pip python3-venv python3-setuptools python3-wheel
   libpagmo-dev libboost-serialization-dev libtbb-dev libopenmpi-dev openmpi-bin libceres-dev
   clang-format git ca-certificates valgrind

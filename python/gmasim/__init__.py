@@ -17,6 +17,7 @@ adds plotting helpers (``gmasim.plots``). Units are SI and named in every key
     s = gmasim.sensitivity(m, params=["material.Ms_A_per_m"], claims=["stroke_drop_8A"])
     s["derivative"]   # (quantities x parameters): d claim / d ln parameter
     sys = gmasim.linearize(m, temperature_C=70)    # scipy.signal.StateSpace, current -> y [m]
+    df = gmasim.frame(r)                           # pandas DataFrame of the series (t_s index)
 
 Errors: gmasim.InputError (a ValueError: a value out of range, with the rule), TypeError (an
 argument of the wrong type, named), gmasim.DivergenceError (an ArithmeticError: the run
@@ -33,7 +34,7 @@ from . import plots  # noqa: F401
 from ._sensitivity import fit_parameters, sensitivity  # noqa: F401
 from ._linearize import linearize  # noqa: F401
 from ._arguments import checked as _checked
-from ._results import SimulationResult, as_result as _as_result  # noqa: F401
+from ._results import SimulationResult, as_result as _as_result, frame  # noqa: F401
 
 # Every function of the extension module checks its arguments' types first, so that a wrong
 # one is a TypeError naming the argument and the expected type (issue 19, item 11).
@@ -45,4 +46,4 @@ simulate = _as_result(simulate)
 __all__ = ["Model", "Stepper", "simulate", "sweep", "frf", "track", "compensate", "ablate",
            "params_vs_temperature", "parameter_table",
            "thermal_expansion", "claims", "sensitivity", "fit_parameters", "linearize", "plots", "InputError",
-           "DivergenceError", "FREEZE_LAWS", "SimulationResult"]
+           "DivergenceError", "FREEZE_LAWS", "SimulationResult", "frame"]
