@@ -47,6 +47,14 @@ void write_mat(const std::string& path, const StateSpace& ss) {
     write_matrix(file, "B", ss.B, n, 1);
     write_matrix(file, "C", ss.C, p, n);
     write_matrix(file, "D", ss.D, p, 1);
+    for (const StateSpace& b : ss.blocks) {  // the blocks: A_stack, ..., A_mount, ...
+      const std::string k = b.input == "q" ? "_mount" : "_stack";
+      const int bn = b.n_states, bp = b.n_outputs;
+      write_matrix(file, ("A" + k).c_str(), b.A, bn, bn);
+      write_matrix(file, ("B" + k).c_str(), b.B, bn, 1);
+      write_matrix(file, ("C" + k).c_str(), b.C, bp, bn);
+      write_matrix(file, ("D" + k).c_str(), b.D, bp, 1);
+    }
     write_matrix(file, "temperature_C", {ss.temperature_C}, 1, 1);
     write_matrix(file, "bias_A", {ss.bias_A}, 1, 1);
   } catch (...) {
@@ -107,6 +115,11 @@ Runner add_linearize(CLI::App& app) {
     fmt::print("gmasim linearize  model: {}\n", model_label(*model));
     fmt::print("  {} degC, bias {} A: {} states ({}), input dI [A], outputs {}\n", ss.temperature_C,
                ss.bias_A, ss.n_states, fmt::join(ss.states, ", "), fmt::join(ss.outputs, ", "));
+    if (ss.blocks.size() > 1)
+      fmt::print(
+          "  split at the sensor mount: stack ({} states; current -> y_stack, q) and mount "
+          "({} states; q -> dy): {}\n",
+          ss.blocks[0].n_states, ss.blocks[1].n_states, ss.interconnection);
     fmt::print("  DC gain: {:.6g} um/A", 1e6 * ss.dc_gain(0));
     if (ss.n_outputs > 1) fmt::print(", B {:.6g} mT/A", 1e3 * ss.dc_gain(1));
     fmt::print("\n  poles:\n");

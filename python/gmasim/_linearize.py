@@ -19,6 +19,10 @@ def linearize(model, temperature_C: float = 20.0, bias_A: float = 1.0, output: s
     ``amplitude_A`` > 0 it also carries ``describing_function``: the large-signal gain [um/A]
     and phase [deg] at that current amplitude about the bias for each of ``frequencies_Hz``,
     beside the small-signal ones (``gmasim linearize --amplitude``), as a dict of arrays.
+    The plant split at the sensor mount, so that another sensor model can replace it:
+    ``sys.stack`` (current [A] -> ``y_stack``, ``q`` [m], and ``B``), ``sys.mount`` (q [m] ->
+    ``dy`` [m]; None without a mount) and ``sys.interconnection`` ("y = y_stack + dy" on the
+    housing's recoil, "y = dy" when the probe rides on the output, "y = y_stack" without one).
 
         sys = gmasim.linearize(gmasim.Model(), temperature_C=70)
         H = sys.C @ np.linalg.solve(2j * np.pi * f * np.eye(len(sys.A)) - sys.A, sys.B)
@@ -51,4 +55,16 @@ def linearize(model, temperature_C: float = 20.0, bias_A: float = 1.0, output: s
     sys.bias_A = d["bias_A"]
     if "describing_function" in d:
         sys.describing_function = d["describing_function"]
+    # The plant split at the sensor mount: sys.stack (current -> y_stack, q[, B]) and sys.mount
+    # (q -> dy; None without a mount), put together as sys.interconnection says.
+    blocks = []
+    for b in d["blocks"]:
+        bs = signal.StateSpace(np.asarray(b["A"]), np.asarray(b["B"]), np.asarray(b["C"]),
+                               np.asarray(b["D"]))
+        for key in ("states", "state_units", "outputs", "output_units", "input", "input_unit"):
+            setattr(bs, key, b[key])
+        blocks.append(bs)
+    sys.stack = blocks[0]
+    sys.mount = blocks[1] if len(blocks) > 1 else None
+    sys.interconnection = d["interconnection"]
     return sys

@@ -294,6 +294,23 @@ void bind_linearize(py::module_& mod) {
         d["output_units"] = ss.output_units;
         d["temperature_C"] = ss.temperature_C;
         d["bias_A"] = ss.bias_A;
+        py::list blocks;  // the plant split at the sensor mount (StateSpace::blocks)
+        for (const StateSpace& b : ss.blocks) {
+          py::dict bd;
+          bd["A"] = matrix(b.A, b.n_states, b.n_states);
+          bd["B"] = matrix(b.B, b.n_states, 1);
+          bd["C"] = matrix(b.C, b.n_outputs, b.n_states);
+          bd["D"] = matrix(b.D, b.n_outputs, 1);
+          bd["states"] = b.states;
+          bd["state_units"] = b.state_units;
+          bd["outputs"] = b.outputs;
+          bd["output_units"] = b.output_units;
+          bd["input"] = b.input;
+          bd["input_unit"] = b.input_unit;
+          blocks.append(bd);
+        }
+        d["blocks"] = blocks;
+        d["interconnection"] = ss.interconnection;
         d["poles"] = complex_list(ss.poles());
         d["zeros_y"] = complex_list(ss.zeros(0));
         std::vector<double> dc;

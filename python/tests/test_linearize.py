@@ -53,6 +53,9 @@ def test_cli_mat_file_is_the_python_statespace(mdma, gmasim_bin, tmp_path):
     for k in "ABCD":
         assert d[k] == pytest.approx(getattr(sys, k), rel=0, abs=0), k
     assert d["temperature_C"][0, 0] == 70 and d["bias_A"][0, 0] == 1
+    for k in "ABCD":  # the blocks, bit for bit
+        assert d[k + "_stack"] == pytest.approx(getattr(sys.stack, k), rel=0, abs=0), k
+        assert d[k + "_mount"] == pytest.approx(getattr(sys.mount, k), rel=0, abs=0), k
     assert (tmp_path / "linearize_A.csv").read_text().splitlines()[0].startswith("row,unit,rod1_H")
 
 
@@ -73,3 +76,21 @@ def test_describing_function_beside_the_state_space(mdma, gmasim_bin, tmp_path):
     np.testing.assert_allclose(df["gain_um_per_A"], [r["gain_um_per_A"] for r in rows], rtol=1e-12)
     np.testing.assert_allclose(df["phase_deg"], [r["phase_deg"] for r in rows], atol=1e-9)
     assert not hasattr(gmasim.linearize(mdma), "describing_function")
+
+
+def test_the_mount_is_a_separable_block(mdma):
+    """sys.stack (current -> y_stack, q) and sys.mount (q -> dy) put together as
+    sys.interconnection says give the plant; another sensor model can take the mount's place."""
+    sys = gmasim.linearize(mdma, temperature_C=70)
+    assert sys.interconnection == "y = y_stack + dy"
+    assert sys.stack.outputs[:2] == ["y_stack", "q"] and sys.stack.input == "current"
+    assert sys.mount.input == "q" and sys.mount.outputs == ["dy"] and sys.mount.A.shape == (2, 2)
+
+    def resp(s, f, row=0):
+        n = s.A.shape[0]
+        return (s.C[row] @ np.linalg.solve(2j * np.pi * f * np.eye(n) - s.A, s.B))[0] + s.D[row, 0]
+
+    for f in (1.0, 100.0, 1270.0, 5000.0):
+        whole = resp(sys, f)
+        parts = resp(sys.stack, f, 0) + resp(sys.mount, f) * resp(sys.stack, f, 1)
+        assert parts == pytest.approx(whole, rel=1e-12), f

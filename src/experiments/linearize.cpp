@@ -116,6 +116,16 @@ Report linearize_report(const Model& m, const StateSpace& ss,
               matrix_table("D", ss.D, ss.outputs, ss.output_units, input),
               roots_table("poles", ss.poles()),
               roots_table("zeros", ss.zeros(0))};
+  // The plant split at the sensor mount (StateSpace::blocks): each block's A, B, C, D.
+  r.meta.emplace_back("interconnection", ss.interconnection);
+  for (const StateSpace& b : ss.blocks) {
+    const std::string name = b.input == "q" ? "mount" : "stack";
+    const std::vector<std::string> in{b.input};
+    r.tables.push_back(matrix_table(name + "_A", b.A, b.states, b.state_units, b.states));
+    r.tables.push_back(matrix_table(name + "_B", b.B, b.states, b.state_units, in));
+    r.tables.push_back(matrix_table(name + "_C", b.C, b.outputs, b.output_units, b.states));
+    r.tables.push_back(matrix_table(name + "_D", b.D, b.outputs, b.output_units, in));
+  }
   if (df != nullptr) {
     r.meta.emplace_back("describing_function_amplitude_A", amplitude_A);
     r.tables.push_back(describing_function_table(*df));

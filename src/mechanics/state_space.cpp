@@ -158,6 +158,69 @@ struct Builder {
   }
 };
 
+// The stack's block: the full plant's rods' states (the mount's states never feed back into
+// them), with the outputs y_stack = sum x, the mount's base q, and B when the plant has it.
+StateSpace stack_block(const StateSpace& full, const SmallSignalModel& L) {
+  const std::size_t n = static_cast<std::size_t>(L.n), ns = 3 * n;
+  const std::size_t nf = static_cast<std::size_t>(full.n_states);
+  StateSpace b;
+  b.temperature_C = full.temperature_C;
+  b.bias_A = full.bias_A;
+  b.magnetic_state = full.magnetic_state;
+  b.n_states = static_cast<int>(ns);
+  b.states.assign(full.states.begin(), full.states.begin() + static_cast<std::ptrdiff_t>(ns));
+  b.state_units.assign(full.state_units.begin(),
+                       full.state_units.begin() + static_cast<std::ptrdiff_t>(ns));
+  for (std::size_t i = 0; i < ns; ++i) {
+    for (std::size_t j = 0; j < ns; ++j) b.A.push_back(full.A[i * nf + j]);
+    b.B.push_back(full.B[i]);
+  }
+  b.outputs = {"y_stack", "q"};
+  b.output_units = {"m", "m"};
+  std::vector<double> y(ns, 0.0), q(ns, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    y[n + i] = 1.0;
+    q[n + i] = L.sensor_mount && !L.sm_on_output ? L.recoil_per_x[i] : 1.0;
+  }
+  b.C = y;
+  b.C.insert(b.C.end(), q.begin(), q.end());
+  if (full.n_outputs > 1) {  // B: its row of C over the rods' states
+    b.outputs.push_back(full.outputs[1]);
+    b.output_units.push_back(full.output_units[1]);
+    for (std::size_t j = 0; j < ns; ++j) b.C.push_back(full.C[nf + j]);
+  }
+  b.n_outputs = static_cast<int>(b.outputs.size());
+  b.D.assign(b.outputs.size(), 0.0);
+  b.input = full.input;
+  b.input_unit = full.input_unit;
+  return b;
+}
+
+// The mount's block: the bracket base-excited by q, z = q (c s + k)/(m s^2 + c s + k), in observer
+// form (z and zeta = z' + (c/m)(z - q) as states, q as the input without its derivative):
+//   z' = -(c/m) z + zeta + (c/m) q,  zeta' = -(k/m) z + (k/m) q;  dy = z - q (recoil) or z.
+StateSpace mount_block(const StateSpace& full, const SmallSignalModel& L) {
+  const double cm = L.sm_damping_N_s_per_m / L.sm_mass_kg,
+               km = L.sm_stiffness_N_per_m / L.sm_mass_kg;
+  StateSpace b;
+  b.temperature_C = full.temperature_C;
+  b.bias_A = full.bias_A;
+  b.n_states = 2;
+  b.n_outputs = 1;
+  b.A = {-cm, 1.0, -km, 0.0};
+  b.B = {cm, km};
+  b.C = {1.0, 0.0};
+  b.D = {L.sm_on_output ? 0.0 : -1.0};
+  b.states = {"probe_z", "probe_zeta"};
+  b.state_units = {"m", "m/s"};
+  b.outputs = {"dy"};
+  b.output_units = {"m"};
+  b.input = "q";
+  b.input_unit = "m";
+  b.magnetic_state = "none (the sensor mount's bracket)";
+  return b;
+}
+
 Eigen::Map<const Matrix> view(const std::vector<double>& v, int rows, int cols) {
   return {v.data(), rows, cols};
 }
@@ -198,7 +261,27 @@ bool by_imag_then_real(const cd& a, const cd& b) {
 
 }  // namespace
 
+StateSpace state_space_whole(const Model& m, const SmallSignalModel& L);
+
 StateSpace state_space(const Model& m, const SmallSignalModel& L) {
+  StateSpace ss = state_space_whole(m, L);
+  ss.blocks.push_back(stack_block(ss, L));
+  if (L.sensor_mount) ss.blocks.push_back(mount_block(ss, L));
+  ss.interconnection = !L.sensor_mount  ? "y = y_stack"
+                       : L.sm_on_output ? "y = dy"
+                                        : "y = y_stack + dy";
+  return ss;
+}
+
+std::complex<double> StateSpace::blocks_response(double f_Hz) const {
+  if (blocks.empty()) throw InputError("blocks_response: this state space has no blocks");
+  const std::complex<double> y_stack = blocks[0].response(f_Hz, 0);
+  if (blocks.size() < 2) return y_stack;
+  const std::complex<double> dy = blocks[1].response(f_Hz, 0) * blocks[0].response(f_Hz, 1);
+  return interconnection == "y = dy" ? dy : y_stack + dy;
+}
+
+StateSpace state_space_whole(const Model& m, const SmallSignalModel& L) {
   return Builder{m, L, {}, {}, {}, {}, 0}.build();
 }
 

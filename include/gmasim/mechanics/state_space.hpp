@@ -36,6 +36,19 @@ struct StateSpace {
   // The finite transmission zeros of output `out` [1/s]: the eigenvalues of its zero dynamics
   // (A - B C A^r / (C A^(r-1) B) on ker [C; ...; C A^(r-1)], r the relative degree).
   std::vector<std::complex<double>> zeros(int out = 0) const;
+
+  // The plant split at the sensor mount (issue 40, item 1), so that another sensor model can
+  // take the mount's place: blocks[0] is the stack (input the current's change [A]; outputs
+  // "y_stack" [m], the stack's displacement of eq. 20, "q" [m], the mount's base -- the housing's
+  // recoil, or y_stack when the probe rides on the output -- and "B" [T] when this plant has it);
+  // blocks[1] the mount (input q [m]; output "dy" [m], the reading's share: z - q on the recoil,
+  // z on the output; states "probe_z" [m] and "probe_zeta" = z' + (c/m)(z - q) [m/s]), absent
+  // without a mount. `interconnection` says how they give y: "y = y_stack + dy" (recoil),
+  // "y = dy" (on the output) or "y = y_stack" (no mount). Empty for a block itself.
+  std::vector<StateSpace> blocks;
+  std::string interconnection;
+  // y of the blocks put together at f_Hz (interconnection): equal to response(f_Hz, 0).
+  std::complex<double> blocks_response(double f_Hz) const;
 };
 
 // The state space of L; m gives the rods' names and the induction coil's rods. The output "B"
