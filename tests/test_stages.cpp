@@ -15,17 +15,11 @@ using namespace gmasim;
 
 namespace {
 
+// The stages in their one order (physics::run_stages), each the public stage function.
 template <class Law>
 void staged_step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
-  StepScratch w;
-  stage_begin(s, in, w);
-  stage_magnetic<Law>(m, c, s, in, w);
-  stage_strain(m, c, s, w);
-  stage_mechanics(m, c, s, in, w);
-  s.t_s = w.t1_s;
-  s.current_A = in.current_A;
-  stage_outputs(m, c, s);
-  stage_ledger(m, c, s, in, w);
+  ScalarStages<Law> st(m, c, s, in);
+  physics::run_stages(st);
 }
 
 // Runs 300 steps of an 8 A, 400 Hz biased sine both ways; every output and ledger sum equal.

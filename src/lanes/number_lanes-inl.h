@@ -156,6 +156,8 @@ using ::gmasim::lanes::HWY_NAMESPACE::preisach_base_at;
 #include "gmasim/physics/joint_newton-inl.h"  // NOLINT(build/include): likewise
 // the mechanical stages (the scalar step's: gmasim/physics/stages.hpp)
 #include "gmasim/physics/mechanics_stage-inl.h"  // NOLINT(build/include): likewise
+// the stages' order (the scalar step's)
+#include "gmasim/physics/stage_order-inl.h"  // NOLINT(build/include): likewise
 #undef GMASIM_LAW_INLINE
 #undef GMASIM_LAW_RARE
 }  // namespace laws

@@ -105,33 +105,6 @@ struct LaneMechanics {
   HWY_INLINE void check_z(N z) const { fails.check(c.d, z.v, C(c.d, 1.0), kFailZ, -1, t1); }
 };
 
-// Stages 2 and 3 (model/step.cpp, stage_strain and stage_mechanics: the same text), then the
-// outputs (finish_outputs): y = y_stack (eq. 20) + the probe's deflection (+ x_T), B of the
-// coil and of each rod.
-template <class D>
-HWY_INLINE void mechanics_and_outputs(const Chunk<D>& c, RodStates<D>& s, V<D>* g, V<D> h, V<D> t1,
-                                      Fails<D>& fails) {
-  using N = Lanes<D>;
-  const D d = c.d;
-  const Structure& st = c.L.st;
-  LaneMechanics<D> k{c, s, g, t1, fails};
-  N F0[kMaxRods], K0[kMaxRods], compliance[kMaxRods];
-  laws::strain_stage<N>(k, F0, K0, compliance);
-  laws::oscillators_stage<N>(k, F0, K0, compliance, N(h));
-  const N y_stack = laws::stack_displacement<N>(k);
-  laws::sensor_mount_stage<N>(k, y_stack, N(h));
-  g[kYStack] = y_stack.v;
-  V<D> y = y_stack.v;
-  if (st.mount) y = st.mount_on_output ? g[kZ] : hn::Add(y, hn::Sub(g[kZ], g[kQ]));
-  if (st.xT_in_output) y = hn::Add(y, c.glob(kXT));
-  g[kY] = y;
-  V<D> phi = hn::Zero(d);
-  for (int i = 0; i < st.sensor_count; ++i)
-    phi = hn::Add(phi, s.f[kPhi][st.sensor_rods[static_cast<std::size_t>(i)]]);
-  g[kBSensor] = hn::Div(phi, c.glob(kSensorArea));
-  for (int i = 0; i < c.n; ++i) s.f[kB][i] = hn::Mul(s.f[kPhi][i], c.rod(kInvArea, i));
-}
-
 // run_loop's checks after the step (gmasim/run_loop.hpp, advance): y and B finite, every
 // rod's strain, displacement and flux density possible (check_physical_validity).
 template <class D>
@@ -195,6 +168,71 @@ HWY_INLINE void store_rods(const Chunk<D>& c, const RodStates<D>& s, Mk<D> keep)
     for (int i = 0; i < c.n; ++i) hn::BlendedStore(s.f[f][i], keep, c.d, c.rod_at(f, i));
 }
 
+// The lanes' stages for laws::run_stages (gmasim/physics/stage_order-inl.h: the scalar step's
+// order, written once), over the rods' state s and the global fields g of one chunk.
+template <class Law, class D>
+struct LaneStages {
+  using N = Lanes<D>;
+  const Chunk<D>& c;
+  RodStates<D>& s;
+  V<D>* g;
+  Fails<D>& fails;
+  const StepInputs& in;
+  V<D> I, h, t1;
+  LaneNewton<Law, D> mg;  // the magnetic state's solve; its trials are committed after the step
+  LaneMechanics<D> k;
+  N F0[kMaxRods], K0[kMaxRods], compliance[kMaxRods];
+
+  LaneStages(const Chunk<D>& c_, RodStates<D>& s_, V<D>* g_, Fails<D>& f_, const StepInputs& in_)
+      : c(c_),
+        s(s_),
+        g(g_),
+        fails(f_),
+        in(in_),
+        I(hn::LoadU(c_.d, in_.current_A + c_.j)),
+        h(hn::LoadU(c_.d, in_.dt_s + c_.j)),
+        t1(hn::Add(g_[kT], h)),  // step()'s t1 = s.t_s + h
+        mg(c_, s_, I, c_.glob(kPmScale), t1, f_),
+        k{c_, s_, g_, t1, f_} {}
+  // Stage 0: t1 (above); the lanes book no ledgers.
+  HWY_INLINE void begin() {}
+  // Stage 1 (stage_magnetic): the consistent state, then the guards on H and M.
+  HWY_INLINE void magnetic() {
+    magnetic_state(mg, h, false);
+    for (int i = 0; i < c.n; ++i) {
+      fails.check(c.d, s.f[kH][i], C(c.d, 1e9), kFailH, i, t1);
+      fails.check(c.d, s.f[kM][i], hn::Mul(C(c.d, 1.5), c.rod(kMsTMag, i)), kFailM, i, t1);
+    }
+  }
+  // Stages 2 and 3 (stage_strain, stage_mechanics): the scalar step's text.
+  HWY_INLINE void strain() { laws::strain_stage<N>(k, F0, K0, compliance); }
+  HWY_INLINE void mechanics() {
+    laws::oscillators_stage<N>(k, F0, K0, compliance, N(h));
+    laws::sensor_mount_stage<N>(k, laws::stack_displacement<N>(k), N(h));
+  }
+  HWY_INLINE void end_time() {
+    g[kT] = hn::LoadU(c.d, in.t1_s + c.j);
+    g[kCurrent] = I;
+  }
+  // Stage 4 (finish_outputs): y = y_stack (eq. 20) + the probe's deflection (+ x_T), B of the
+  // coil and of each rod.
+  HWY_INLINE void outputs() {
+    const D d = c.d;
+    const Structure& st = c.L.st;
+    V<D> y = laws::stack_displacement<N>(k).v;
+    g[kYStack] = y;
+    if (st.mount) y = st.mount_on_output ? g[kZ] : hn::Add(y, hn::Sub(g[kZ], g[kQ]));
+    if (st.xT_in_output) y = hn::Add(y, c.glob(kXT));
+    g[kY] = y;
+    V<D> phi = hn::Zero(d);
+    for (int i = 0; i < st.sensor_count; ++i)
+      phi = hn::Add(phi, s.f[kPhi][st.sensor_rods[static_cast<std::size_t>(i)]]);
+    g[kBSensor] = hn::Div(phi, c.glob(kSensorArea));
+    for (int i = 0; i < c.n; ++i) s.f[kB][i] = hn::Mul(s.f[kPhi][i], c.rod(kInvArea, i));
+  }
+  HWY_INLINE void ledger() {}  // none: a run with the ledgers on is not put in lanes
+};
+
 // One step of lanes [j, j + Lanes(d)): load, the stages, store where the lane is still alive
 // (a lane that fails keeps its state before the step, as simulate() records it).
 template <class Law, class D>
@@ -205,20 +243,11 @@ HWY_INLINE void step_chunk(D d, LaneData& L, std::size_t j, const StepInputs& in
   for (int f = 0; f < kGlobalStateCount; ++f) g[f] = c.glob(f);
   Fails<D> fails = load_fails(c);
   const Mk<D> alive = hn::Not(fails.failed);
-  const V<D> I = hn::LoadU(d, in.current_A + j), h = hn::LoadU(d, in.dt_s + j);
-  const V<D> t1 = hn::Add(g[kT], h);  // step()'s t1 = s.t_s + h
-  LaneNewton<Law, D> mg(c, s, I, c.glob(kPmScale), t1, fails);
-  magnetic_state(mg, h, false);
-  for (int i = 0; i < c.n; ++i) {
-    fails.check(d, s.f[kH][i], C(d, 1e9), kFailH, i, t1);
-    fails.check(d, s.f[kM][i], hn::Mul(C(d, 1.5), c.rod(kMsTMag, i)), kFailM, i, t1);
-  }
-  mechanics_and_outputs(c, s, g, h, t1, fails);
-  g[kT] = hn::LoadU(d, in.t1_s + j);
-  g[kCurrent] = I;
+  LaneStages<Law, D> st(c, s, g, fails, in);
+  laws::run_stages(st);
   run_loop_checks(c, s, g, g[kT], fails);
   const Mk<D> keep = hn::AndNot(fails.failed, alive);  // alive and not failed now
-  law_commit(c, mg.trial, keep);
+  law_commit(c, st.mg.trial, keep);
   store_rods(c, s, keep);
   for (int f = 0; f < kGlobalStateCount; ++f) hn::BlendedStore(g[f], keep, d, c.glob_at(f));
   store_fails(c, fails);

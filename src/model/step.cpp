@@ -479,18 +479,12 @@ void step(const Model& m, const Conditions& c, State& s, const StepInput& in) {
                          [&](auto law) { step_law<decltype(law)>(m, c, s, in); });
 }
 
-// The step: the stages in order (gmasim/model/step_stages.hpp).
+// The step: the stages in their order, written once (physics::run_stages), each the stage function
+// of gmasim/model/step_stages.hpp (ScalarStages).
 template <class Law>
 void step_law(const Model& m, const Conditions& c, State& s, const StepInput& in) {
-  StepScratch w;
-  stage_begin(s, in, w);
-  stage_magnetic<Law>(m, c, s, in, w);
-  stage_strain(m, c, s, w);
-  stage_mechanics(m, c, s, in, w);
-  s.t_s = w.t1_s;
-  s.current_A = in.current_A;
-  stage_outputs(m, c, s);
-  stage_ledger(m, c, s, in, w);
+  ScalarStages<Law> st(m, c, s, in);
+  physics::run_stages(st);
 }
 
 template void stage_magnetic<JilesAthertonLaw>(const Model&, const Conditions&, State&,

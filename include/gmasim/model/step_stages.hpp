@@ -16,6 +16,7 @@
 
 #include "gmasim/model/energy.hpp"
 #include "gmasim/model/model.hpp"
+#include "gmasim/physics/stages.hpp"
 
 namespace gmasim {
 
@@ -66,6 +67,30 @@ void stage_mechanics(const Model& m, const Conditions& c, State& s, const StepIn
 void stage_outputs(const Model& m, const Conditions& c, State& s);
 void stage_ledger(const Model& m, const Conditions& c, State& s, const StepInput& in,
                   const StepScratch& w);
+
+// The scalar step's stages for physics::run_stages (gmasim/physics/stage_order-inl.h: their order,
+// written once), each the stage function above: step() runs them (step_law<Law>), and so may a
+// test or another integrator.
+template <class Law>
+struct ScalarStages {
+  const Model& m;
+  const Conditions& c;
+  State& s;
+  const StepInput& in;
+  StepScratch w;  // default-initialised, not zeroed (StepScratch: a step's fixed cost)
+  ScalarStages(const Model& m_, const Conditions& c_, State& s_, const StepInput& in_)
+      : m(m_), c(c_), s(s_), in(in_) {}
+  void begin() { stage_begin(s, in, w); }
+  void magnetic() { stage_magnetic<Law>(m, c, s, in, w); }
+  void strain() { stage_strain(m, c, s, w); }
+  void mechanics() { stage_mechanics(m, c, s, in, w); }
+  void end_time() {
+    s.t_s = w.t1_s;
+    s.current_A = in.current_A;
+  }
+  void outputs() { stage_outputs(m, c, s); }
+  void ledger() { stage_ledger(m, c, s, in, w); }
+};
 
 extern template void stage_magnetic<JilesAthertonLaw>(const Model&, const Conditions&, State&,
                                                       const StepInput&, const StepScratch&);
