@@ -9,6 +9,7 @@
 
 #include "gmasim/errors.hpp"
 #include "gmasim/model/circuit.hpp"
+#include "gmasim/physics/stages.hpp"
 
 namespace gmasim {
 
@@ -227,75 +228,43 @@ double potential_drop(const CircuitBranch& br, const Eigen::VectorXd& psi) {
   return (br.from >= 0 ? psi(br.from) : 0.0) - (br.to >= 0 ? psi(br.to) : 0.0);
 }
 
-// The k x k part of the low-rank solve. With D = diag(1/R_rod), F the rods' own MMFs and
-// u = I psi_coil + pm psi_pm, the node potentials are psi = u - W z with z = D (B^T psi + F):
-// z is the rod branches' fluxes phi_r = (drop_r + F_r) / R_r, and B^T psi = B^T u - S z gives
-//   (diag(R) + S) z = B^T u + F,
-// one k x k solve for the rod fluxes themselves (no reciprocal of R). Leaves z in ws.z. The
-// matrix diag(R) + S has the same (dense, k x k) structure every step; it is factorised as
-// L D L^T without square roots in fixed storage, unrolled for K = 1, 2, 4 rods (the hot path of
-// the consistent state's Newton solve; three rods: rod_solve3), K = 0 for any k <= 8.
-// Allocation-free. False if a pivot is not positive or z is not finite.
-template <int K>
-bool rod_solve(const CircuitMatrices& L, const double* R, const double* mmf, double current_A,
-               double pm_scale, int k_any, NodalBuffers& ws) {
-  const int k = K > 0 ? K : k_any;
-  // Written before read (no zero fill: hot path).
-  double A[64], x[8], piv[8], inv_piv[8];
-  const double* S = L.S8.data();
-  for (int r = 0; r < k; ++r) x[r] = current_A * L.bt_coil8[r] + pm_scale * L.bt_pm8[r] + mmf[r];
-  for (int j = 0; j < k; ++j) {  // L D L^T of S + diag(R), unit L below the diagonal of A
-    double d = S[9 * j] + R[j];
-    for (int p = 0; p < j; ++p) d -= A[8 * j + p] * A[8 * j + p] * piv[p];
-    if (!(d > 0.0)) return false;
-    piv[j] = d;
-    inv_piv[j] = 1.0 / d;  // one division per pivot
-    for (int i = j + 1; i < k; ++i) {
-      double a = S[8 * i + j];
-      for (int p = 0; p < j; ++p) a -= A[8 * i + p] * A[8 * j + p] * piv[p];
-      A[8 * i + j] = a * inv_piv[j];
-    }
-  }
-  for (int i = 0; i < k; ++i)
-    for (int p = 0; p < i; ++p) x[i] -= A[8 * i + p] * x[p];
-  for (int i = k - 1; i >= 0; --i) {
-    x[i] *= inv_piv[i];
-    for (int p = i + 1; p < k; ++p) x[i] -= A[8 * p + i] * x[p];
-  }
-  bool finite = true;
-  for (int r = 0; r < k; ++r) finite = finite && std::isfinite(x[r]);
-  if (!finite) return false;
-  for (int r = 0; r < k; ++r) ws.z(r) = x[r];
-  return true;
-}
+// The k x k part of the low-rank solve (physics::rod_solve3, rod_solve_ldlt: written once over the
+// number type in gmasim/physics/rod_circuit-inl.h, which the SIMD lanes also run). With D =
+// diag(1/R_rod), F the rods' own MMFs and u = I psi_coil + pm psi_pm, the node potentials are
+// psi = u - W z with z = D (B^T psi + F): z is the rod branches' fluxes phi_r = (drop_r + F_r) /
+// R_r, and B^T psi = B^T u - S z gives (diag(R) + S) z = B^T u + F, one k x k solve for the rod
+// fluxes themselves. Its matrices in fixed storage (CircuitMatrices: S row-major with stride 8).
+struct FixedMatrices {
+  const CircuitMatrices& L;
+  double S(int a, int b) const { return L.S8[static_cast<std::size_t>(8 * a + b)]; }
+  double bt_coil(int a) const { return L.bt_coil8[static_cast<std::size_t>(a)]; }
+  double bt_pm(int a) const { return L.bt_pm8[static_cast<std::size_t>(a)]; }
+};
 
-// rod_solve for three rods (the built-in actuator), straight-line: A = S + diag(R) is solved by
-// its adjugate, z = adj(A) (B^T u + F) / det A, one division. The pivot test of the L D L^T form
-// is Sylvester's criterion on the leading minors (d_1 = a00, d_2 = m2 / a00, d_3 = det / m2 all
-// > 0). Allocation-free. False if a leading minor is not positive or z is not finite.
-bool rod_solve3(const CircuitMatrices& L, const double* R, const double* mmf, double current_A,
-                double pm_scale, NodalBuffers& ws) {
-  const double* S = L.S8.data();  // rows 0, 1, 2 at S, S + 8, S + 16
-  const double x0 = current_A * L.bt_coil8[0] + pm_scale * L.bt_pm8[0] + mmf[0];
-  const double x1 = current_A * L.bt_coil8[1] + pm_scale * L.bt_pm8[1] + mmf[1];
-  const double x2 = current_A * L.bt_coil8[2] + pm_scale * L.bt_pm8[2] + mmf[2];
-  // A = S + diag(R), its lower triangle (as the L D L^T form reads it).
-  const double a00 = S[0] + R[0], a10 = S[8], a11 = S[9] + R[1];
-  const double a20 = S[16], a21 = S[17], a22 = S[18] + R[2];
-  const double c00 = a11 * a22 - a21 * a21, c01 = a20 * a21 - a10 * a22,
-               c02 = a10 * a21 - a20 * a11;
-  const double c11 = a00 * a22 - a20 * a20, c12 = a10 * a20 - a00 * a21, m2 = a00 * a11 - a10 * a10;
-  const double det = a00 * c00 + a10 * c01 + a20 * c02;
-  if (!(a00 > 0.0 && m2 > 0.0 && det > 0.0)) return false;
-  const double inv_det = 1.0 / det;
-  const double z0 = (c00 * x0 + c01 * x1 + c02 * x2) * inv_det;
-  const double z1 = (c01 * x0 + c11 * x1 + c12 * x2) * inv_det;
-  const double z2 = (c02 * x0 + c12 * x1 + m2 * x2) * inv_det;
-  if (!(std::isfinite(z0) && std::isfinite(z1) && std::isfinite(z2))) return false;
-  ws.z(0) = z0;
-  ws.z(1) = z1;
-  ws.z(2) = z2;
-  return true;
+// The rods' fluxes into ws.z (allocation-free); false where the solve fails (ws.z then holds
+// what it reached: the caller reports the failure and reads none of it).
+bool rod_solve(const CircuitMatrices& L, int k, const double* R, const double* mmf,
+               double current_A, double pm_scale, NodalBuffers& ws) {
+  const FixedMatrices M{L};
+  double* z = ws.z.data();  // sized k by CircuitWorkspace::resize
+  bool ok = false;
+  switch (k) {
+    case 1:
+      ok = physics::rod_solve_ldlt<1>(M, k, R, mmf, current_A, pm_scale, z);
+      break;
+    case 2:
+      ok = physics::rod_solve_ldlt<2>(M, k, R, mmf, current_A, pm_scale, z);
+      break;
+    case 3:
+      ok = physics::rod_solve3(M, R, mmf, current_A, pm_scale, z);
+      break;
+    case 4:
+      ok = physics::rod_solve_ldlt<4>(M, k, R, mmf, current_A, pm_scale, z);
+      break;
+    default:
+      ok = physics::rod_solve_ldlt<0>(M, k, R, mmf, current_A, pm_scale, z);
+  }
+  return ok;
 }
 
 }  // namespace
@@ -313,23 +282,7 @@ bool solve_circuit(const Circuit& c, std::span<const double> rod_reluctance_per_
     mmf[static_cast<std::size_t>(r)] =
         branch_mmf(c.branches[static_cast<std::size_t>(c.rod_branch[static_cast<std::size_t>(r)])],
                    current_A, pm_scale, ws);
-  bool ok = false;
-  switch (k) {
-    case 1:
-      ok = rod_solve<1>(L, R, mmf.data(), current_A, pm_scale, k, nb);
-      break;
-    case 2:
-      ok = rod_solve<2>(L, R, mmf.data(), current_A, pm_scale, k, nb);
-      break;
-    case 3:
-      ok = rod_solve3(L, R, mmf.data(), current_A, pm_scale, nb);
-      break;
-    case 4:
-      ok = rod_solve<4>(L, R, mmf.data(), current_A, pm_scale, k, nb);
-      break;
-    default:
-      ok = rod_solve<0>(L, R, mmf.data(), current_A, pm_scale, k, nb);
-  }
+  const bool ok = rod_solve(L, k, R, mmf.data(), current_A, pm_scale, nb);
   if (!ok) return false;
   // The rod fluxes are the k x k solve's z (the same numbers whether or not the other branches
   // are wanted); the others from the node potentials.

@@ -154,6 +154,8 @@ using ::gmasim::lanes::HWY_NAMESPACE::preisach_base_at;
 #include "gmasim/physics/preisach_law-inl.h"  // NOLINT(build/include): likewise
 // the consistent state's solve and commit (the scalar step's: gmasim/physics/stages.hpp)
 #include "gmasim/physics/joint_newton-inl.h"  // NOLINT(build/include): likewise
+// the rods' circuit system (the scalar netlist's low-rank solve)
+#include "gmasim/physics/rod_circuit-inl.h"  // NOLINT(build/include): likewise
 // the mechanical stages (the scalar step's: gmasim/physics/stages.hpp)
 #include "gmasim/physics/mechanics_stage-inl.h"  // NOLINT(build/include): likewise
 // the stages' order (the scalar step's)

@@ -86,88 +86,16 @@ struct RodStates {
   V<D> f[kRodStateCount][kMaxRods];
 };
 
-// Rod a's right-hand side of the k x k system, (B^T u + F)_a = I (B^T psi_coil)_a + pm
-// (B^T psi_pm)_a + F_a (rod_solve's x, in its order of operations).
+// The rods' circuit system per lane (circuit/netlist.cpp's low-rank solve: the one text of
+// gmasim/physics/rod_circuit-inl.h): the lane's S = B^T G0^-1 B and B^T psi_coil, B^T psi_pm
+// (LaneData's circuit fields: a batch may hold other circuits).
 template <class D>
-HWY_INLINE V<D> rod_rhs(const Chunk<D>& c, int a, V<D> I, V<D> pm, V<D> F) {
-  const D d = c.d;
-  return hn::Add(
-      hn::Add(hn::Mul(I, hn::LoadU(d, c.bt_coil_at(a))), hn::Mul(pm, hn::LoadU(d, c.bt_pm_at(a)))),
-      F);
-}
-
-// The low-rank circuit solve (circuit/netlist.cpp, rod_solve and solve_circuit) per lane: with
-// F the rods' MMFs and u = I psi_coil + pm psi_pm, the rod fluxes themselves solve
-//   (diag(R) + S) phi = B^T u + F
-// (L D L^T, no square roots; no reciprocal of R). ok is false where a pivot is not positive or
-// phi is not finite. One division per pivot, as rod_solve.
-// Three rods (the built-in actuator): netlist.cpp's rod_solve3, A = S + diag(R) solved by its
-// adjugate with one division, Sylvester's criterion for the pivots.
-template <class D>
-HWY_INLINE Mk<D> circuit_solve3(const Chunk<D>& c, const V<D>* R, const V<D>* mmf, V<D> I, V<D> pm,
-                                V<D>* phi) {
-  const D d = c.d;
-  auto S = [&](int a, int b) { return hn::LoadU(d, c.S_at(a, b)); };
-  V<D> x[3];
-  for (int a = 0; a < 3; ++a) x[a] = rod_rhs(c, a, I, pm, mmf[a]);
-  const V<D> a00 = hn::Add(S(0, 0), R[0]), a10 = S(1, 0), a11 = hn::Add(S(1, 1), R[1]);
-  const V<D> a20 = S(2, 0), a21 = S(2, 1), a22 = hn::Add(S(2, 2), R[2]);
-  auto minor = [&](V<D> p, V<D> q, V<D> r, V<D> s) {
-    return hn::Sub(hn::Mul(p, q), hn::Mul(r, s));
-  };
-  const V<D> c00 = minor(a11, a22, a21, a21), c01 = minor(a20, a21, a10, a22);
-  const V<D> c02 = minor(a10, a21, a20, a11), c11 = minor(a00, a22, a20, a20);
-  const V<D> c12 = minor(a10, a20, a00, a21), m2 = minor(a00, a11, a10, a10);
-  const V<D> det = hn::Add(hn::Add(hn::Mul(a00, c00), hn::Mul(a10, c01)), hn::Mul(a20, c02));
-  const V<D> zero = hn::Zero(d);
-  Mk<D> ok = hn::And(hn::And(hn::Gt(a00, zero), hn::Gt(m2, zero)), hn::Gt(det, zero));
-  const V<D> inv_det = hn::Div(C(d, 1.0), det);
-  auto row = [&](V<D> p, V<D> q, V<D> r) {
-    return hn::Add(hn::Add(hn::Mul(p, x[0]), hn::Mul(q, x[1])), hn::Mul(r, x[2]));
-  };
-  phi[0] = hn::Mul(row(c00, c01, c02), inv_det);
-  phi[1] = hn::Mul(row(c01, c11, c12), inv_det);
-  phi[2] = hn::Mul(row(c02, c12, m2), inv_det);
-  for (int a = 0; a < 3; ++a) ok = hn::And(ok, hn::IsFinite(phi[a]));
-  return ok;
-}
-
-template <class D>
-HWY_INLINE Mk<D> circuit_solve(const Chunk<D>& c, const V<D>* R, const V<D>* mmf, V<D> I, V<D> pm,
-                               V<D>* phi) {
-  const D d = c.d;
-  const int n = c.n;
-  if (n == 3) return circuit_solve3(c, R, mmf, I, pm, phi);
-  V<D> S[kMaxRods][kMaxRods], A[kMaxRods][kMaxRods], x[kMaxRods], piv[kMaxRods], inv_piv[kMaxRods];
-  for (int a = 0; a < n; ++a) {
-    x[a] = rod_rhs(c, a, I, pm, mmf[a]);
-    for (int b = 0; b < n; ++b) S[a][b] = hn::LoadU(d, c.S_at(a, b));
-  }
-  Mk<D> ok = hn::FirstN(d, hn::Lanes(d));
-  for (int j = 0; j < n; ++j) {  // L D L^T of S + diag(R), unit L below the diagonal of A
-    V<D> dd = hn::Add(S[j][j], R[j]);
-    for (int p = 0; p < j; ++p) dd = hn::Sub(dd, hn::Mul(hn::Mul(A[j][p], A[j][p]), piv[p]));
-    ok = hn::And(ok, hn::Gt(dd, hn::Zero(d)));
-    piv[j] = dd;
-    inv_piv[j] = hn::Div(C(d, 1.0), dd);  // one division per pivot
-    for (int i = j + 1; i < n; ++i) {
-      V<D> a = S[i][j];
-      for (int p = 0; p < j; ++p) a = hn::Sub(a, hn::Mul(hn::Mul(A[i][p], A[j][p]), piv[p]));
-      A[i][j] = hn::Mul(a, inv_piv[j]);
-    }
-  }
-  for (int i = 0; i < n; ++i)
-    for (int p = 0; p < i; ++p) x[i] = hn::Sub(x[i], hn::Mul(A[i][p], x[p]));
-  for (int i = n - 1; i >= 0; --i) {
-    x[i] = hn::Mul(x[i], inv_piv[i]);
-    for (int p = i + 1; p < n; ++p) x[i] = hn::Sub(x[i], hn::Mul(A[p][i], x[p]));
-  }
-  for (int a = 0; a < n; ++a) {
-    phi[a] = x[a];
-    ok = hn::And(ok, hn::IsFinite(x[a]));
-  }
-  return ok;
-}
+struct LaneMatrices {
+  const Chunk<D>& c;
+  HWY_INLINE Lanes<D> S(int a, int b) const { return hn::LoadU(c.d, c.S_at(a, b)); }
+  HWY_INLINE Lanes<D> bt_coil(int a) const { return hn::LoadU(c.d, c.bt_coil_at(a)); }
+  HWY_INLINE Lanes<D> bt_pm(int a) const { return hn::LoadU(c.d, c.bt_pm_at(a)); }
+};
 
 template <class D>
 HWY_INLINE JaLaneConstants<D> ja_constants(const Chunk<D>& c, int i) {
@@ -247,7 +175,7 @@ HWY_INLINE void count_solve(const Chunk<D>& c, Mk<D> done) {
 
 // The lanes' context of the consistent state's solve (gmasim/physics/joint_newton-inl.h, the one
 // text the scalar step also runs: laws::joint_newton_start, joint_newton, joint_newton_commit):
-// the rods' state in RodStates, the circuit's low-rank solve per lane (circuit_solve: the rods'
+// the rods' state in RodStates, the circuit's low-rank solve per lane (laws::rod_solve3: the rods'
 // MMF N I + F_pm pm plus their linearised extra), the law's trial kept per lane (take_trial) and
 // its state committed (commit_law_state, law_commit), a failure recorded in the lane's record
 // (Fails) instead of thrown.
@@ -264,7 +192,7 @@ struct LaneNewton {
   typename Law::template Rod<D> rod[kMaxRods];
   typename Law::template Start<D> start[kMaxRods];
   typename Law::template Trial<D> trial[kMaxRods];
-  V<D> Rv[kMaxRods], mmf[kMaxRods], ph[kMaxRods];  // the circuit's last solve
+  N Rv[kMaxRods], mmf[kMaxRods], ph[kMaxRods];  // the circuit's last solve
 
   LaneNewton(const Chunk<D>& c_, RodStates<D>& s_, V<D> I_, V<D> pm_, V<D> t1_, Fails<D>& f_)
       : c(c_),
@@ -316,11 +244,16 @@ struct LaneNewton {
     mmf[i] =
         hn::Add(hn::Add(hn::Mul(c.rod(kCoilTurns, i), I), hn::Mul(c.rod(kPmMmf, i), pm)), extra.v);
   }
+  // The rods' fluxes (gmasim/physics/rod_circuit-inl.h, the netlist's low-rank solve), where
+  // they are still solving; a lane whose solve fails is recorded (kFailCircuit).
   HWY_INLINE M solve(M done) {
     const D d = c.d;
     count_solve(c, done.m);
-    const Mk<D> ok = circuit_solve(c, Rv, mmf, I, pm, ph);
-    fails.mark(d, hn::AndNot(done.m, hn::Not(ok)), kFailCircuit, hn::Zero(d), -1, t1, hn::Zero(d));
+    const LaneMatrices<D> L{c};
+    const M ok = c.n == 3 ? laws::rod_solve3<N>(L, Rv, mmf, N(I), N(pm), ph)
+                          : laws::rod_solve_ldlt<0, N>(L, c.n, Rv, mmf, N(I), N(pm), ph);
+    fails.mark(d, hn::AndNot(done.m, hn::Not(ok.m)), kFailCircuit, hn::Zero(d), -1, t1,
+               hn::Zero(d));
     return {fails.failed};
   }
   HWY_INLINE N flux(int i) const { return ph[i]; }
