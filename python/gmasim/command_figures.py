@@ -143,8 +143,13 @@ def simulate(out):
         ax_h.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
     for ax in fig.axes:
         ax.grid(alpha=0.3)
-    fig.suptitle(f"gmasim simulate: {meta.get('model', '')}, {meta.get('temperature_C', '')} °C"
-                 + (", self-heating" if heat.exists() else ""))
+    sets = meta.get("set") or []
+    temp = f"{meta.get('temperature_C', '')} °C"
+    if heat.exists():  # the run started there; the rods warmed up by the metrics window
+        h = read_csv(heat)
+        temp = f"from {meta.get('temperature_C', '')} °C (rods at {h['rods_C'][-1]:.1f} °C at the end), self-heating"
+    fig.suptitle(f"gmasim simulate: {meta.get('model', '')}, {temp}"
+                 + (f"\nwith --set {', '.join(sets)}" if sets else ""), fontsize=10)
     fig.tight_layout()
     if not heat.exists():
         return fig

@@ -486,16 +486,29 @@ def _claim_label(c, width=58):
     return text + (" (fit)" if c.get("fitted") else "")
 
 
+def _claim_value(v) -> str:
+    """A claim's value as the report prints it: 4 significant digits."""
+    return f"{v:.4g}"
+
+
 def claims_overview(claims: Sequence[dict], title="The paper's claims: ours against the paper"):
     """One row per applicable claim of claims.json: ours / paper on a log axis (1 = the
-    paper), green when the claim passes, red when it fails; rankings and bounds without a
-    number are listed with their result."""
+    paper), green when the claim passes, red when it fails; a bound the paper states ("<
+    0.17 %", "> 2000 Hz") is written as ours against the bound, and rankings without a number are
+    listed with their result."""
     rows = [c for c in claims if c.get("result") != "n/a"]
     fig, ax = plt.subplots(figsize=(9.0, 0.26 * len(rows) + 1.4))
     y = np.arange(len(rows))[::-1]
     for yi, c in zip(y, rows):
         col = PASS_COLOR if c.get("pass") else FAIL_COLOR
         paper, ours = c.get("paper"), c.get("ours")
+        rule = str(c.get("tolerance", ""))
+        if rule.startswith(("ours <", "ours >")) and ours is not None and np.isfinite(ours):
+            # A bound the paper states ("less than 0.17 %", "exceeds 2000 Hz"): ours against the
+            # bound in words, not a ratio to it (a passing value far inside a bound is no miss).
+            ax.text(1.0, yi, f" {_claim_value(ours)} {rule[5]} {c.get('paper'):g} {c.get('unit', '')}: "
+                    f"{c.get('result')} (a bound)", color=col, fontsize=6.5, va="center")
+            continue
         if paper is not None and ours is not None and np.isfinite(paper) and paper != 0 and np.isfinite(ours):
             r = ours / paper
             r = r if r > 0 else np.nan
@@ -506,7 +519,6 @@ def claims_overview(claims: Sequence[dict], title="The paper's claims: ours agai
                 if rc != r:
                     ax.text(rc, yi + 0.25, f"×{r:.3g} ", color=col, fontsize=6.5, ha="right" if r > 1 else "left")
                 continue
-        rule = str(c.get("tolerance", ""))
         rule = rule if len(rule) <= 40 else rule[:39] + "…"
         ax.text(1.0, yi, f" {c.get('result')}: {rule}", color=col, fontsize=6.5, va="center")
     ax.axvline(1.0, color="black", lw=0.8)

@@ -144,6 +144,23 @@ def test_claims_overview_counts_and_colours_every_applicable_claim():
     assert any("×20" in t.get_text() for t in ax.texts)  # 3.4 / 0.17 = 20, written out
 
 
+def test_a_bound_claim_is_written_against_its_bound_not_drawn_off_scale():
+    """Issue 41: "< 0.17 %" with ours 0.007 passes; a ratio to the bound (0.04) drew it as an
+    arrow off the axis, like a miss. It is written as ours against the bound instead."""
+    claims = [_claim("shift", "resonance_shift_pct", 0.17, True) | {"ours": 0.007047,
+                                                                   "tolerance": "ours < 0.17 %",
+                                                                   "unit": "%"},
+              _claim("bw", "bandwidth_Hz", 2000.0, False) | {"ours": 1313.0,
+                                                            "tolerance": "ours > 2000 Hz",
+                                                            "unit": "Hz"}]
+    ax = plots.claims_overview(claims).axes[0]
+    assert not [l for l in ax.get_lines() if len(l.get_xdata()) == 1]  # no marker, no arrow
+    texts = [t.get_text() for t in ax.texts]
+    assert any("0.007047 < 0.17 %: pass (a bound)" in t for t in texts), texts
+    assert any("1313 > 2000 Hz: fail (a bound)" in t for t in texts), texts
+    assert [t.get_color() for t in ax.texts] == [plots.PASS_COLOR, plots.FAIL_COLOR]
+
+
 def test_figures_are_written_atomically(tmp_path, monkeypatch):
     import matplotlib.pyplot as plt
     from gmasim import plots
@@ -164,3 +181,23 @@ def test_figures_are_written_atomically(tmp_path, monkeypatch):
     assert (tmp_path / "f.png").read_bytes() == old
     assert sorted(p.name for p in tmp_path.iterdir()) == ["f.png", "f.svg"]
     assert [p.name for p in paths] == ["f.png", "f.svg"]
+
+
+def test_the_simulate_figure_names_the_set_overrides_and_the_heated_rods(gmasim_bin, tmp_path):
+    """Issue 41: simulate.png said nothing of --set, and '20 degC' for a self-heating run whose
+    rods had warmed up; metrics.json now lists the values set, and the title says both."""
+    import json
+    import subprocess
+
+    from gmasim import command_figures
+    out = tmp_path / "s"
+    subprocess.run([gmasim_bin, "simulate", "--periods", "2", "--set", "material.Ms_A_per_m=7.5e5",
+                    "--out", str(out)], check=True, capture_output=True)
+    assert json.loads((out / "metrics.json").read_text())["set"] == ["material.Ms_A_per_m=750000"]
+    fig = command_figures.simulate(out)
+    assert "with --set material.Ms_A_per_m=750000" in fig._suptitle.get_text()
+    heat = tmp_path / "h"
+    subprocess.run([gmasim_bin, "simulate", "--periods", "20", "--frequency", "50", "--self-heating",
+                    "--out", str(heat)], check=True, capture_output=True)
+    title = dict(command_figures.simulate(heat))["simulate"]._suptitle.get_text()
+    assert "from 20 °C (rods at" in title and "°C at the end), self-heating" in title

@@ -454,6 +454,11 @@ std::string metrics_json(const Result& r, const SimulationSettings& s, const Mod
   w.key("model").string(m.spec.source);
   if (const auto it = m.spec.meta.find("meta.name"); it != m.spec.meta.end())
     w.key("model_name").string(it->second);
+  // The values set after loading (--set, ModelSpec::set), as "key=value" in the key's unit.
+  w.key("set").begin_array(io_detail::JsonLayout::Inline);
+  for (const auto& [key, p] : m.spec.params)
+    if (p.assigned) w.string(fmt::format("{}={:g}", key, p.value));
+  w.end_array();
   w.key("temperature_C").number(s.temperature_C);
   w.key("waveform");
   write_waveform(w, s.waveform);
