@@ -373,6 +373,21 @@ def _repeated_panel_problems(fig) -> list[str]:
     return out
 
 
+def _power_tick_problems(fig) -> list[str]:
+    """A log axis that labels its ticks as m×10^0 (matplotlib's minor labels on an axis spanning
+    less than a decade or two): write the plain number (issue 41: '2×10^0', '6×10^0')."""
+    out = []
+    for ax in fig.axes:
+        for which, axis in (("x", ax.xaxis), ("y", ax.yaxis)):
+            for lab in _visible_ticklabels(axis):
+                t = lab.get_text()
+                if "times" in t and "10^{0}" in t.replace(" ", ""):
+                    out.append(f"'{ax.get_title() or 'an axes'}': {which} tick label '{t}' "
+                               "(a power of ten to write as a plain number)")
+                    break
+    return out
+
+
 def problems(fig, tolerance_px: float = 1.0) -> list[str]:
     """The defects of a figure (an empty list when it reads alone); draws it first."""
     fig.canvas.draw()
@@ -381,7 +396,7 @@ def problems(fig, tolerance_px: float = 1.0) -> list[str]:
             + _legend_cover_problems(fig, renderer) + _layout_problems(fig, renderer)
             + _small_text_problems(fig) + _legend_tick_problems(fig, renderer, tolerance_px)
             + _paper_marker_problems(fig) + _empty_heatmap_problems(fig)
-            + _repeated_panel_problems(fig))
+            + _repeated_panel_problems(fig) + _power_tick_problems(fig))
 
 
 def check(fig, name: str = "figure") -> None:

@@ -313,6 +313,8 @@ def bode(frf: Columns, title="Frequency response, current to displacement", clai
         am.axvline(c["paper"], color=_claim_color(c), ls=":", lw=1.2,
                    label=f"paper: −3 dB bandwidth > {c['paper']:g} Hz" + (" ✗" if c.get("pass") is False else ""))
     am.set_ylabel("|Y/I| (dB re 1 µm/A)" if db else "|Y/I| (µm/A)")
+    if not db:
+        plain_log_axis(am, "y")
     ap.set_ylabel("phase (°)")
     ap.set_xlabel("frequency (Hz)")
     _log_frequency_axis(ap)
@@ -328,13 +330,21 @@ def bode(frf: Columns, title="Frequency response, current to displacement", clai
 def _log_frequency_axis(ax):
     """Plain-number ticks on a log frequency axis (more per decade the fewer decades it spans), minor ticks unlabelled
     (matplotlib labels the minor ticks of an axis spanning less than a decade, and those overlap)."""
+    plain_log_axis(ax, "x")
+
+
+def plain_log_axis(ax, which: str = "y"):
+    """Plain-number ticks on a log axis (x or y): 2, 5, 20, not 2×10^0, with more per decade the
+    fewer decades it spans; minor ticks unlabelled."""
     from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
-    lo, hi = ax.get_xlim()
+    axis = ax.xaxis if which == "x" else ax.yaxis
+    lo, hi = ax.get_xlim() if which == "x" else ax.get_ylim()
+    lo, hi = min(lo, hi), max(lo, hi)
     decades = np.log10(hi / lo) if lo > 0 and hi > lo else 3.0
     subs = (1.0,) if decades > 1.6 else (1.0, 2.0, 5.0) if decades > 0.7 else (1.0, 1.5, 2.0, 3.0, 5.0, 7.0)
-    ax.xaxis.set_major_locator(LogLocator(base=10, subs=subs))
-    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _pos: f"{v:g}"))
-    ax.xaxis.set_minor_formatter(NullFormatter())
+    axis.set_major_locator(LogLocator(base=10, subs=subs))
+    axis.set_major_formatter(FuncFormatter(lambda v, _pos: f"{v:g}"))
+    axis.set_minor_formatter(NullFormatter())
 
 
 def tracking_error(track: Columns, title="Closed-loop tracking error against temperature", claims=None):
@@ -467,6 +477,7 @@ def ablation(ab: Columns, laws: Sequence[str] | None = None,
                         va="bottom", fontsize=7, color="0.3")
     ax.set_yscale("log")
     ax.set_ylim(floor, positive.max() * 8 if positive.size else 1.0)
+    plain_log_axis(ax, "y")
     ax.set_xticks(x, [LAW_LABELS.get(str(n), str(n)) for n in names], fontsize=8,
                   rotation=60 if len(names) > 3 else 0, ha="right" if len(names) > 3 else "center",
                   rotation_mode="anchor")

@@ -201,3 +201,20 @@ def test_the_large_signal_frf_figure_says_so(gmasim_bin, tmp_path):
     assert len(frf["frequency_Hz"]) == 5 + 1 + 6  # observed 12
     assert np.all(np.diff(frf["frequency_Hz"]) > 0)
     plt.close(fig)
+
+
+def test_power_of_ten_tick_labels_are_found_and_plain_log_axes_pass():
+    """Issue 41: convergence.png and the FRF labelled ticks '2x10^0', '6x10^0'."""
+    import matplotlib.pyplot as plt
+
+    from gmasim import plots
+    fig, ax = plt.subplots()
+    ax.semilogy([0, 1, 2], [1.5, 3.0, 8.0], label="e")
+    ax.set_title("t")
+    ax.set_xlabel("x (s)")
+    ax.set_ylabel("y (µm)")
+    found = figure_check.problems(fig)
+    assert any("a power of ten to write as a plain number" in p for p in found), found
+    plots.plain_log_axis(ax, "y")
+    assert not [p for p in figure_check.problems(fig) if "power of ten" in p]
+    plt.close(fig)
