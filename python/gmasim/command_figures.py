@@ -75,10 +75,12 @@ def _self_heating_figure(ts, h, meta):
     t, stroke = h["t_s"][2:], h["stroke_um"][2:]
     s0 = float(stroke[0]) if len(stroke) and stroke[0] else np.nan
     ax_d.plot(t, 100.0 * (stroke / s0 - 1.0), color="tab:red", label="stroke change")
-    edges = np.searchsorted(ts["t_s"], h["t_s"])
-    means = np.array([np.mean(ts["y_um"][a:b]) if b > a else np.nan for a, b in zip(edges[:-1], edges[1:])])
-    if len(means) > 2:  # the mean of y over each interval (row k: the interval ending at t_k)
-        ax_d.plot(t, 100.0 * (means[1:] - means[1]) / s0, color="tab:blue", label="offset drift (mean y)")
+    if "y_mean_um" in h and len(h["y_mean_um"]) > 2:
+        # The run's own mean of y over each whole period (self_heating.csv's y_mean_um): an
+        # average of the recorded samples over the rows' intervals, which need not be whole
+        # periods, drew the oscillation of y as a band (issue 41).
+        ym = h["y_mean_um"][2:]
+        ax_d.plot(t, 100.0 * (ym - ym[0]) / s0, color="tab:blue", label="offset drift (mean y)")
     if "xT_um" in ts:
         ax_d.plot(ts["t_s"], 100.0 * (ts["xT_um"] - ts["xT_um"][0]) / s0, color="tab:purple", ls="--",
                   label="thermal expansion x_T")

@@ -199,5 +199,12 @@ def test_the_simulate_figure_names_the_set_overrides_and_the_heated_rods(gmasim_
     heat = tmp_path / "h"
     subprocess.run([gmasim_bin, "simulate", "--periods", "20", "--frequency", "50", "--self-heating",
                     "--out", str(heat)], check=True, capture_output=True)
-    title = dict(command_figures.simulate(heat))["simulate"]._suptitle.get_text()
+    figs = dict(command_figures.simulate(heat))
+    title = figs["simulate"]._suptitle.get_text()
     assert "from 20 °C (rods at" in title and "°C at the end), self-heating" in title
+    # The offset drift is the run's own y_mean_um (not the samples averaged over intervals that
+    # are not whole periods, which drew y's oscillation as a band).
+    h = plots.read_csv(heat / "self_heating.csv")
+    drift = [l for l in figs["self_heating"].axes[1].get_lines() if l.get_label() == "offset drift (mean y)"][0]
+    want = 100.0 * (h["y_mean_um"][2:] - h["y_mean_um"][2]) / h["stroke_um"][2]
+    np.testing.assert_allclose(drift.get_ydata(), want, rtol=0, atol=1e-12)
