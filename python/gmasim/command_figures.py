@@ -159,7 +159,8 @@ def simulate(out):
 
 
 def bode_db(out):
-    """Bode plot in dB (re 1 µm/A). Every marker comes from the data drawn (frf_summary.csv:
+    """Bode plot, |Y/I| in µm/A on a log axis with plain-number ticks (as reproduce's FRF figure;
+    it was in dB, issue 41). Every marker comes from the data drawn (frf_summary.csv:
     markers_from): the -3 dB line 3 dB below their |Y/I| at the lowest frequency, the first
     resonance and the bandwidth, one legend entry per temperature; the paper's 1270 Hz and
     > 2000 Hz as grey lines. The title says small or large signal (frf_summary: large_signal,
@@ -177,7 +178,7 @@ def bode_db(out):
         title = f"Frequency response about a {bias:g} A bias ({stim})"
     else:
         title = "Frequency response"
-    fig = plots.bode(frf, title=title, db=True, large_signal=large)
+    fig = plots.bode(frf, title=title, db=False, large_signal=large)
     am = fig.axes[0]
     temps, norm, cmap = plots._temperature_colors(frf["temperature_C"])
     paper_f, paper_bw = meta.get("paper_first_resonance_Hz"), meta.get("paper_bandwidth_Hz_at_least")
@@ -193,7 +194,7 @@ def bode_db(out):
         src = summ["markers_from"][s][0] if "markers_from" in summ else "linearisation"
         parts = []
         if np.isfinite(g0) and g0 > 0:
-            am.axhline(20 * np.log10(g0) - 3, color=c, ls=":", lw=0.8)
+            am.axhline(g0 * 10.0 ** (-3.0 / 20.0), color=c, ls=":", lw=0.8)
         if np.isfinite(fr) and fr > 0:
             am.axvline(fr, color=c, ls="--", lw=0.8)
             parts.append(f"peak {fr:.0f} Hz")
@@ -211,8 +212,16 @@ def bode_db(out):
         am.axvspan(paper_bw, max(xlim[1], paper_bw), color=plots.PAPER_COLOR, alpha=0.08,
                    label=f"paper: −3 dB bandwidth > {paper_bw:g} Hz")
         am.set_xlim(xlim[0], max(xlim[1], 1.2 * paper_bw))
-    plots._legend_outside(am)
-    fig.tight_layout()
+    # One legend under both panels, in two columns: beside them it took 40 % of the width.
+    if am.get_legend():
+        am.get_legend().remove()
+    handles, labels = am.get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=2, fontsize=7, frameon=False)
+    rows = (len(labels) + 1) // 2
+    legend_in = 0.14 * rows + 0.12  # the legend's height [in] at 7 pt
+    fig.set_size_inches(8.4, 6.2 + legend_in)
+    fig.tight_layout(rect=(0, legend_in / (6.2 + legend_in), 1, 1))
+    plots.plain_log_axis(am, "y")
     return fig
 
 

@@ -341,7 +341,7 @@ def plain_log_axis(ax, which: str = "y"):
     lo, hi = ax.get_xlim() if which == "x" else ax.get_ylim()
     lo, hi = min(lo, hi), max(lo, hi)
     decades = np.log10(hi / lo) if lo > 0 and hi > lo else 3.0
-    subs = (1.0,) if decades > 1.6 else (1.0, 2.0, 5.0) if decades > 0.7 else (1.0, 1.5, 2.0, 3.0, 5.0, 7.0)
+    subs = (1.0,) if decades > 1.6 else (1.0, 2.0, 5.0) if decades > 0.9 else (1.0, 1.5, 2.0, 3.0, 5.0, 7.0)
     axis.set_major_locator(LogLocator(base=10, subs=subs))
     axis.set_major_formatter(FuncFormatter(lambda v, _pos: f"{v:g}"))
     axis.set_minor_formatter(NullFormatter())

@@ -195,8 +195,9 @@ def test_the_large_signal_frf_figure_says_so(gmasim_bin, tmp_path):
     frf = plots.read_csv(out / "frf.csv")
     # the -3 dB reference is the plotted stepped sine's gain at the lowest frequency
     assert summ["reference_gain_um_per_A"][0] == pytest.approx(frf["stepped_mag_um_per_A"][0], rel=1e-9)
-    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]  # one legend under both panels
     assert any("1270 Hz" in t for t in labels), labels
+    assert fig.axes[0].get_ylabel() == "|Y/I| (µm/A)" and fig.axes[0].get_yscale() == "log"
     # the grid, the stepped point at the linearisation's peak and the refinement's 6 evaluations
     assert len(frf["frequency_Hz"]) == 5 + 1 + 6  # observed 12
     assert np.all(np.diff(frf["frequency_Hz"]) > 0)

@@ -50,7 +50,7 @@ def test_sweep_bode_tracking_retention_params_ablation_figures(tmp_path):
            "linear_mag_um_per_A": np.tile(5 / np.sqrt(1 + (f / 300) ** 2), 2),
            "linear_phase_deg": np.tile(-np.degrees(np.arctan(f / 300)), 2)}
     _check_axes(plots.bode(frf))
-    fig = plots.bode(frf, db=True)  # as `gmasim frf --plot` draws it
+    fig = plots.bode(frf, db=True)  # the dB option (gmasim frf --plot draws um/A, as reproduce)
     _check_axes(fig)
     assert "dB" in fig.axes[0].get_ylabel()
     track = {"temperature_C": T, "amplitude_um": np.tile([10.0, 20.0], 3), "frequency_Hz": np.full(6, 10.0),
