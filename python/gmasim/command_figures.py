@@ -113,6 +113,15 @@ def simulate(out):
         if keep.sum() > 10:
             ts = {k: v[keep] for k, v in ts.items()}
     win = _window(ts_all, m)
+    # What the loop panels show: the metrics window (issue 41: a waveform's whole run was titled
+    # "last period").
+    w0, w1 = m.get("window_start_s", 0.0), m.get("window_end_s", 0.0)
+    if (meta.get("waveform") or {}).get("kind") == "biased_sine":
+        span = "last period"
+    elif w1 > w0 and len(win["t_s"]) < len(ts_all["t_s"]):
+        span = f"metrics window {w0:g}-{w1:g} s"
+    else:
+        span = "whole run"
     heat = pathlib.Path(out) / "self_heating.csv"
     fig = plt.figure(figsize=(11, 7.2))
     ax_t = fig.add_subplot(2, 2, 1)
@@ -127,7 +136,7 @@ def simulate(out):
     ax_l.plot(win["current_A"], win["y_um"], lw=1.0)
     ax_l.set_xlabel("current (A)")
     ax_l.set_ylabel("displacement y (µm)")
-    ax_l.set_title("y against current (last period)")
+    ax_l.set_title(f"y against current ({span})")
     _annotate_loop(ax_l, win["current_A"], win["y_um"], m)
     ax_b = fig.add_subplot(2, 2, 3)
     ax_b.plot(ts["t_s"], ts["B_T"], lw=0.8, color="tab:green")
@@ -140,7 +149,7 @@ def simulate(out):
         ax_h.plot(win[f"{r}_H_A_per_m"] / 1e3, win[f"{r}_B_T"], lw=0.8, label=r)
     ax_h.set_xlabel("field H (kA/m)")
     ax_h.set_ylabel("rod flux density φ/A (T)")
-    ax_h.set_title("rods' B-H (last period)")
+    ax_h.set_title(f"rods' B-H ({span})")
     if rods:
         ax_h.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
     for ax in fig.axes:

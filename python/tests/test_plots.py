@@ -208,3 +208,24 @@ def test_the_simulate_figure_names_the_set_overrides_and_the_heated_rods(gmasim_
     drift = [l for l in figs["self_heating"].axes[1].get_lines() if l.get_label() == "offset drift (mean y)"][0]
     want = 100.0 * (h["y_mean_um"][2:] - h["y_mean_um"][2]) / h["stroke_um"][2]
     np.testing.assert_allclose(drift.get_ydata(), want, rtol=0, atol=1e-12)
+
+
+def test_the_loop_panels_say_what_they_show(gmasim_bin, tmp_path):
+    """Issue 41: a waveform's simulate.png titled its whole run 'last period'."""
+    import subprocess
+
+    from gmasim import command_figures
+    t = np.linspace(0.0, 0.1, 2001)
+    wave = tmp_path / "sq.csv"
+    np.savetxt(wave, np.c_[t, np.where((t * 50) % 1 < 0.5, 4.0, -2.0)], delimiter=",",
+               header="t_s,current_A", comments="")
+
+    def loop_title(*args):
+        out = tmp_path / str(len(list(tmp_path.iterdir())))
+        subprocess.run([gmasim_bin, "simulate", *args, "--out", str(out)], check=True, capture_output=True)
+        return [a.get_title() for a in command_figures.simulate(out).axes if "against current" in a.get_title()][0]
+
+    assert loop_title("--waveform", str(wave)) == "y against current (whole run)"
+    assert loop_title("--waveform", str(wave), "--metrics-window", "0.02") == \
+        "y against current (metrics window 0.08-0.1 s)"
+    assert loop_title("--periods", "2") == "y against current (last period)"
