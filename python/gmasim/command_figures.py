@@ -299,8 +299,9 @@ _CONTROLLERS = {"pid": ("PID alone", "o"), "pid_temperature": ("PID + temperatur
 
 def track_feedforward(out):
     """``track --feedforward inverse``: RMS error on every mismatched plant (one panel per loop
-    temperature, at the grid point the issue's goal names if present) and RMS(PID)/RMS(PID +
-    feed-forward) against frequency (median, with the min..max range)."""
+    temperature, at the grid point the issue's goal names if present; a plant whose loop drove the
+    current to its limit is ringed in red) and RMS(PID)/RMS(PID + feed-forward) against frequency
+    (median, with error bars from the smallest to the largest ratio over the plants)."""
     t = read_csv(pathlib.Path(out) / "track.csv")
     q = read_csv(pathlib.Path(out) / "track_ratios.csv")
     temps = sorted(set(t["temperature_C"]))
@@ -308,13 +309,22 @@ def track_feedforward(out):
     A0 = 20.0 if np.any(np.isclose(t["amplitude_um"], 20.0)) else float(t["amplitude_um"][0])
     fig, axes = plt.subplots(1, len(temps) + 1, figsize=(4.2 * (len(temps) + 1), 4.6))
     labels = list(dict.fromkeys(t["mismatch"]))
+    railed = (t["saturated"] == "true") if "saturated" in t else np.zeros(len(t["mismatch"]), bool)
     for ax, T in zip(axes, temps):
-        for c, (name, marker) in _CONTROLLERS.items():
+        for k, (c, (name, marker)) in enumerate(_CONTROLLERS.items()):
             sel = (t["controller"] == c) & np.isclose(t["temperature_C"], T) & \
                 np.isclose(t["frequency_Hz"], f0) & np.isclose(t["amplitude_um"], A0)
             if sel.any():
                 x = [labels.index(m) for m in t["mismatch"][sel]]
-                ax.semilogy(x, t["rms_error_um"][sel], marker, label=name, alpha=0.8)
+                # a colour per controller, the same in every panel (the rings take none of them)
+                ax.semilogy(x, t["rms_error_um"][sel], marker, color=f"C{k}", label=name, alpha=0.8)
+                # A loop that does not track: its current railed at the limit, or its error's RMS
+                # exceeds the reference's own (A / sqrt 2: worse than no output at all).
+                bad = sel & (railed | (t["rms_error_um"] > t["amplitude_um"] / np.sqrt(2.0)))
+                if bad.any():
+                    ax.semilogy([labels.index(m) for m in t["mismatch"][bad]], t["rms_error_um"][bad], "o",
+                                ms=11, mfc="none", mec="red", mew=1.0,
+                                label="no tracking: error above the reference's RMS, or current railed")
         ax.set_xticks(range(len(labels)))
         ax.set_xticklabels(labels, rotation=90, fontsize=6)
         ax.set_xlabel("plant (M_s, k, λ_s ±10 %, temperature ±10 °C)")
@@ -322,27 +332,36 @@ def track_feedforward(out):
         plots.plain_log_axis(ax, "y")
         ax.set_title(f"loop at {T:g} °C, {A0:g} µm, {f0:g} Hz", fontsize=9)
         ax.grid(alpha=0.3, which="both")
-    handles, names = axes[0].get_legend_handles_labels()
-    fig.legend(handles, names, loc="upper center", ncol=3, fontsize=8, bbox_to_anchor=(0.5, 0.95))
+    seen = {}
+    for ax in axes[:-1]:
+        for h, n in zip(*ax.get_legend_handles_labels()):
+            seen.setdefault(n, h)
+    fig.legend(list(seen.values()), list(seen), loc="upper center", ncol=4, fontsize=8,
+               bbox_to_anchor=(0.5, 0.95))
     r = axes[-1]
     sel_c = q["controller"] == "pid_inverse"
+    freqs = []
+    shift = {T: 1.0 + 0.04 * (k - (len(temps) - 1) / 2) for k, T in enumerate(temps)}  # side by side
     for T in temps:
         sel = sel_c & np.isclose(q["temperature_C"], T) & np.isclose(q["amplitude_um"], A0)
         if sel.any():
-            f = q["frequency_Hz"][sel]
-            line, = r.loglog(f, q["ratio_median"][sel], "o-", label=f"{T:g} °C median")
-            r.fill_between(f, q["ratio_min"][sel], q["ratio_max"][sel], color=line.get_color(),
-                           alpha=0.15)
-    r.axhline(5.0, color="k", ls="--", lw=0.8, label="goal: median 5")
-    r.axhline(2.0, color="k", ls=":", lw=0.8, label="goal: min 2")
+            f, med = q["frequency_Hz"][sel], q["ratio_median"][sel]
+            freqs.extend(f)
+            r.errorbar(f * shift[T], med, yerr=[med - q["ratio_min"][sel], q["ratio_max"][sel] - med], fmt="o-",
+                       capsize=4, label=f"{T:g} °C: median, min..max")
+    r.set_xscale("log")
+    r.set_yscale("log")
+    if freqs:  # the frequencies run, not decades around one point
+        r.set_xlim(min(freqs) / 2.0, max(freqs) * 2.0)
+    r.axhline(1.0, color="k", lw=0.8, label="1: no gain from the feed-forward")
     r.set_xlabel("reference frequency (Hz)")
     r.set_ylabel("RMS(PID) / RMS(PID + inverse) (-)")
     if r.lines:
         plots.plain_log_axis(r, "x")
         plots.plain_log_axis(r, "y")
-    r.set_title(f"error ratio over the plants, {A0:g} µm (band: min..max)", fontsize=9)
+    r.set_title(f"error ratio over the plants, {A0:g} µm", fontsize=9)
     r.grid(alpha=0.3, which="both")
-    r.legend(fontsize=7)
+    r.legend(fontsize=7, loc="upper right")
     fig.suptitle("Inverse-model feed-forward against plants that differ from the model")
     fig.tight_layout(rect=(0, 0, 1, 0.9))
     return fig

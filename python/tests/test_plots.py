@@ -229,3 +229,27 @@ def test_the_loop_panels_say_what_they_show(gmasim_bin, tmp_path):
     assert loop_title("--waveform", str(wave), "--metrics-window", "0.02") == \
         "y against current (metrics window 0.08-0.1 s)"
     assert loop_title("--periods", "2") == "y against current (last period)"
+
+
+def test_the_feedforward_figure_marks_the_loops_that_do_not_track(gmasim_bin, tmp_path):
+    """Issue 41: track_feedforward.png had no mark for the plants whose loop does not track, and
+    one frequency's min..max band was invisible on a 10-1000 Hz axis."""
+    import subprocess
+
+    from gmasim import command_figures
+    out = tmp_path / "ff"
+    subprocess.run([gmasim_bin, "track", "--feedforward", "inverse", "--temperatures", "20",
+                    "--frequencies", "100", "--amplitudes", "20", "--out", str(out)],
+                   check=True, capture_output=True)
+    t = plots.read_csv(out / "track.csv")
+    fig = command_figures.track_feedforward(out)
+    rings = [l for l in fig.axes[0].get_lines() if l.get_label().startswith("no tracking")]
+    want = np.sort(t["rms_error_um"][(t["saturated"] == "true") | (t["rms_error_um"] > 20 / np.sqrt(2))])
+    got = np.sort(np.concatenate([l.get_ydata() for l in rings])) if rings else np.array([])
+    assert want.size > 0  # at 20 degC, 20 um, 100 Hz some mismatched plants ring (issue 40)
+    np.testing.assert_array_equal(got, want)
+    ratio = fig.axes[-1]
+    lo, hi = ratio.get_xlim()
+    assert 40 < lo < 100 < hi < 250  # around the one frequency run, not 10-1000 Hz
+    bars = [c for c in ratio.containers]  # the min..max error bars, one per temperature
+    assert bars and all(np.ptp(seg[:, 1]) > 0 for c in bars for seg in c.lines[2][0].get_segments())
