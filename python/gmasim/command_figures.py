@@ -361,7 +361,7 @@ def track_feedforward(out):
         plots.plain_log_axis(r, "y")
     r.set_title(f"error ratio over the plants, {A0:g} µm", fontsize=9)
     r.grid(alpha=0.3, which="both")
-    r.legend(fontsize=7, loc="upper right")
+    r.legend(fontsize=7, loc="best")
     fig.suptitle("Inverse-model feed-forward against plants that differ from the model")
     fig.tight_layout(rect=(0, 0, 1, 0.9))
     return fig

@@ -333,8 +333,8 @@ def _panel_data(ax):
         y = np.asarray(ln.get_ydata(), float)
         if len(y) > 1:
             series.append(unit(y))
-    for bars in ax.containers:  # each bar() call a series
-        heights = [p.get_height() for p in bars.patches if hasattr(p, "get_height")]
+    for bars in ax.containers:  # each bar() call a series (error bars hold no patches)
+        heights = [p.get_height() for p in getattr(bars, "patches", []) if hasattr(p, "get_height")]
         if len(heights) > 1:
             series.append(unit(heights))
     return series

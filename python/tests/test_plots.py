@@ -6,6 +6,14 @@ import gmasim
 from gmasim import plots
 
 
+@pytest.fixture(autouse=True)
+def _close_figures():
+    """Each test's figures closed after it (pyplot keeps them open otherwise)."""
+    yield
+    import matplotlib.pyplot as plt
+    plt.close("all")
+
+
 def _check_axes(fig):
     for ax in fig.axes:
         if ax.get_label() == "<colorbar>":
