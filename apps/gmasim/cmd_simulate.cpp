@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -174,15 +175,18 @@ void prepare_simulate_out(const SimulateArgs& a) {
 // recorded step all the same.
 constexpr std::size_t kCsvRows = 10000;
 
-// Every k-th row of ts, and its last row.
-TimeSeries thinned(const TimeSeries& ts, std::size_t k) {
+// Every k-th row of ts, its last row, and every row from full_from_s on (the last three metrics
+// windows: what simulate.png draws at full resolution; thinned too, a self-heating run's last
+// period had ~16 points, issue 41).
+TimeSeries thinned(const TimeSeries& ts, std::size_t k, double full_from_s) {
   TimeSeries out;
   out.names = ts.names;
   out.columns.resize(ts.columns.size());
   const std::size_t n = ts.rows();
-  for (std::size_t c = 0; c < ts.columns.size(); ++c) {
-    for (std::size_t i = 0; i < n; i += k) out.columns[c].push_back(ts.columns[c][i]);
-    if ((n - 1) % k != 0) out.columns[c].push_back(ts.columns[c][n - 1]);
+  const std::vector<double>& t = ts.column("t_s");
+  for (std::size_t i = 0; i < n; ++i) {
+    if (i % k != 0 && i != n - 1 && !(t[i] >= full_from_s)) continue;
+    for (std::size_t c = 0; c < ts.columns.size(); ++c) out.columns[c].push_back(ts.columns[c][i]);
   }
   return out;
 }
@@ -292,7 +296,11 @@ int run_one(const Model& model, const SimulateArgs& a) {
       a.record_every_given || rows <= kCsvRows ? 1 : (rows + kCsvRows - 1) / kCsvRows;
   // One set: both temporaries are complete before either is renamed, and metrics.json
   // (renamed last) names the hash of its timeseries.csv.
-  const std::string csv = timeseries_csv(k > 1 ? thinned(r.series, k) : r.series);
+  const double window_s = r.metrics.window_end_s - r.metrics.window_start_s;
+  const double full_from_s = r.has_metrics && window_s > 0.0
+                                 ? r.metrics.window_end_s - 3.0 * window_s
+                                 : std::numeric_limits<double>::infinity();
+  const std::string csv = timeseries_csv(k > 1 ? thinned(r.series, k, full_from_s) : r.series);
   std::vector<std::pair<std::string, std::string>> files = {
       {(dir / "timeseries.csv").string(), csv}};
   if (s.self_heating.enabled)

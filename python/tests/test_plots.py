@@ -207,6 +207,14 @@ def test_the_simulate_figure_names_the_set_overrides_and_the_heated_rods(gmasim_
     heat = tmp_path / "h"
     subprocess.run([gmasim_bin, "simulate", "--periods", "20", "--frequency", "50", "--self-heating",
                     "--out", str(heat)], check=True, capture_output=True)
+    # timeseries.csv is thinned (40,000 steps > 10,000 rows) but keeps every step of the last
+    # three metrics windows, which simulate.png draws (it had ~16 points a period there).
+    ts = plots.read_csv(heat / "timeseries.csv")
+    m = json.loads((heat / "metrics.json").read_text())
+    w0, w1 = m["metrics"]["window_start_s"], m["metrics"]["window_end_s"]
+    steps_per_window = round((w1 - w0) / m["dt_s"])
+    assert len(ts["t_s"]) < 20000
+    assert np.sum(ts["t_s"] >= w1 - 3 * (w1 - w0) - 1e-12) == 3 * steps_per_window + 1
     figs = dict(command_figures.simulate(heat))
     title = figs["simulate"]._suptitle.get_text()
     assert "from 20 °C (rods at" in title and "°C at the end), self-heating" in title
