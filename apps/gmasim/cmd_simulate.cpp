@@ -175,17 +175,18 @@ void prepare_simulate_out(const SimulateArgs& a) {
 // recorded step all the same.
 constexpr std::size_t kCsvRows = 10000;
 
-// Every k-th row of ts, its last row, and every row from full_from_s on (the last three metrics
-// windows: what simulate.png draws at full resolution; thinned too, a self-heating run's last
-// period had ~16 points, issue 41).
-TimeSeries thinned(const TimeSeries& ts, std::size_t k, double full_from_s) {
+// Every k-th row of ts, its last row, and every k_window-th row from full_from_s on (the last
+// three metrics windows, which simulate.png draws: about kWindowRows a window; thinned like the
+// rest, a self-heating run's last period had ~16 points, issue 41).
+constexpr double kWindowRows = 2000.0;
+TimeSeries thinned(const TimeSeries& ts, std::size_t k, double full_from_s, std::size_t k_window) {
   TimeSeries out;
   out.names = ts.names;
   out.columns.resize(ts.columns.size());
   const std::size_t n = ts.rows();
   const std::vector<double>& t = ts.column("t_s");
   for (std::size_t i = 0; i < n; ++i) {
-    if (i % k != 0 && i != n - 1 && !(t[i] >= full_from_s)) continue;
+    if (i % k != 0 && i != n - 1 && !(t[i] >= full_from_s && i % k_window == 0)) continue;
     for (std::size_t c = 0; c < ts.columns.size(); ++c) out.columns[c].push_back(ts.columns[c][i]);
   }
   return out;
@@ -296,11 +297,17 @@ int run_one(const Model& model, const SimulateArgs& a) {
       a.record_every_given || rows <= kCsvRows ? 1 : (rows + kCsvRows - 1) / kCsvRows;
   // One set: both temporaries are complete before either is renamed, and metrics.json
   // (renamed last) names the hash of its timeseries.csv.
+  // The last three metrics windows, where the window is not the whole run.
   const double window_s = r.metrics.window_end_s - r.metrics.window_start_s;
-  const double full_from_s = r.has_metrics && window_s > 0.0
-                                 ? r.metrics.window_end_s - 3.0 * window_s
-                                 : std::numeric_limits<double>::infinity();
-  const std::string csv = timeseries_csv(k > 1 ? thinned(r.series, k, full_from_s) : r.series);
+  const bool windowed = r.has_metrics && window_s > 0.0 && r.metrics.window_start_s > 0.0;
+  const double full_from_s =
+      windowed ? r.metrics.window_end_s - 3.0 * window_s : std::numeric_limits<double>::infinity();
+  const auto k_window = static_cast<std::size_t>(
+      windowed && r.dt_s > 0.0
+          ? std::max(1.0, std::ceil(std::round(window_s / r.dt_s) / kWindowRows))  // steps, whole
+          : 1.0);
+  const TimeSeries thin = k > 1 ? thinned(r.series, k, full_from_s, k_window) : TimeSeries{};
+  const std::string csv = timeseries_csv(k > 1 ? thin : r.series);
   std::vector<std::pair<std::string, std::string>> files = {
       {(dir / "timeseries.csv").string(), csv}};
   if (s.self_heating.enabled)
@@ -312,10 +319,12 @@ int run_one(const Model& model, const SimulateArgs& a) {
              s.self_heating.enabled ? fmt::format(", {}/self_heating.csv", a.out) : "", a.out);
   if (k > 1)
     fmt::print(
-        "  timeseries.csv holds one row in {} of the {} recorded ({} rows): a run over {} "
-        "rows is thinned by default (--record-every N sets the recording, 1 keeps every "
-        "step); the metrics use every step\n",
-        k, rows, (rows - 1) / k + 1 + ((rows - 1) % k != 0 ? 1 : 0), kCsvRows);
+        "  timeseries.csv holds one row in {} of the {} recorded ({} rows{}): a run over {} rows "
+        "is thinned by default (--record-every N sets the recording, 1 keeps every step); the "
+        "metrics use every step\n",
+        k, rows, thin.rows(),
+        windowed ? fmt::format("; one in {} over the last three metrics windows", k_window) : "",
+        kCsvRows);
   if (a.plot && r.steps > 0) fmt::print("  wrote {}\n", render_plot("simulate", a.out));
   if (r.diverged) {
     print_error(r.error +

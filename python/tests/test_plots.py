@@ -208,7 +208,8 @@ def test_the_simulate_figure_names_the_set_overrides_and_the_heated_rods(gmasim_
     subprocess.run([gmasim_bin, "simulate", "--periods", "20", "--frequency", "50", "--self-heating",
                     "--out", str(heat)], check=True, capture_output=True)
     # timeseries.csv is thinned (40,000 steps > 10,000 rows) but keeps every step of the last
-    # three metrics windows, which simulate.png draws (it had ~16 points a period there).
+    # three metrics windows (2000 a window here, at most kWindowRows), which simulate.png draws
+    # (it had ~16 points a period there).
     ts = plots.read_csv(heat / "timeseries.csv")
     m = json.loads((heat / "metrics.json").read_text())
     w0, w1 = m["metrics"]["window_start_s"], m["metrics"]["window_end_s"]
