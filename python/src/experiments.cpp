@@ -268,6 +268,17 @@ py::list complex_list(const std::vector<std::complex<double>>& z) {
   for (const auto& x : z) l.append(py::cast(x));
   return l;
 }
+// A state space's A, B, C, D and its states' and outputs' names and units into d.
+void put_matrices(py::dict& d, const StateSpace& ss) {
+  d["A"] = matrix(ss.A, ss.n_states, ss.n_states);
+  d["B"] = matrix(ss.B, ss.n_states, 1);
+  d["C"] = matrix(ss.C, ss.n_outputs, ss.n_states);
+  d["D"] = matrix(ss.D, ss.n_outputs, 1);
+  d["states"] = ss.states;
+  d["state_units"] = ss.state_units;
+  d["outputs"] = ss.outputs;
+  d["output_units"] = ss.output_units;
+}
 void bind_linearize(py::module_& mod) {
   mod.def(
       "_linearize",
@@ -284,27 +295,13 @@ void bind_linearize(py::module_& mod) {
           t["amplitude_A"] = amplitude_A;
           d["describing_function"] = t;
         }
-        d["A"] = matrix(ss.A, ss.n_states, ss.n_states);
-        d["B"] = matrix(ss.B, ss.n_states, 1);
-        d["C"] = matrix(ss.C, ss.n_outputs, ss.n_states);
-        d["D"] = matrix(ss.D, ss.n_outputs, 1);
-        d["states"] = ss.states;
-        d["state_units"] = ss.state_units;
-        d["outputs"] = ss.outputs;
-        d["output_units"] = ss.output_units;
+        put_matrices(d, ss);
         d["temperature_C"] = ss.temperature_C;
         d["bias_A"] = ss.bias_A;
         py::list blocks;  // the plant split at the sensor mount (StateSpace::blocks)
         for (const StateSpace& b : ss.blocks) {
           py::dict bd;
-          bd["A"] = matrix(b.A, b.n_states, b.n_states);
-          bd["B"] = matrix(b.B, b.n_states, 1);
-          bd["C"] = matrix(b.C, b.n_outputs, b.n_states);
-          bd["D"] = matrix(b.D, b.n_outputs, 1);
-          bd["states"] = b.states;
-          bd["state_units"] = b.state_units;
-          bd["outputs"] = b.outputs;
-          bd["output_units"] = b.output_units;
+          put_matrices(bd, b);
           bd["input"] = b.input;
           bd["input_unit"] = b.input_unit;
           blocks.append(bd);

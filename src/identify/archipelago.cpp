@@ -31,17 +31,6 @@
 namespace gmasim::identify_detail {
 namespace {
 
-unsigned mix_seed(unsigned seed, int rank, int island, int generation) {
-  std::uint64_t z =
-      (static_cast<std::uint64_t>(seed) << 32) ^ (static_cast<std::uint64_t>(rank) << 20) ^
-      (static_cast<std::uint64_t>(island) << 12) ^ static_cast<std::uint64_t>(generation);
-  z += 0x9E3779B97F4A7C15ULL;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-  z ^= z >> 31;
-  return static_cast<unsigned>(z & 0x7fffffffU);
-}
-
 pagmo::algorithm make_algorithm(const std::string& name, unsigned gen, std::size_t dim,
                                 unsigned seed) {
   if (name == "sga") {

@@ -19,6 +19,10 @@
 
 namespace gmasim::identify_detail {
 
+// A seed for (rank, island, generation) from the search's seed (splitmix64's finaliser): the
+// same on every machine, and distinct for every island and generation.
+unsigned mix_seed(unsigned seed, int rank, int island, int generation);
+
 // Runs f(0) .. f(n - 1) on min(threads, n) threads (the caller's among them); rethrows the
 // first exception after every task has ended.
 void parallel_for(std::size_t n, int threads, const std::function<void(std::size_t)>& f);

@@ -39,16 +39,10 @@ using identify_detail::numbers;
 constexpr const char* kMagic = "gmasim-design-checkpoint";
 constexpr double kInfeasible = 1e15;  // far above any objective a design reports
 
-// A seed per generation from the search's seed (splitmix64): generation g's NSGA-II is the same
-// whether the search started at 0 or resumed at g.
+// A seed per generation from the search's seed (identify's mix_seed, rank 0, island 0):
+// generation g's NSGA-II is the same whether the search started at 0 or resumed at g.
 unsigned generation_seed(unsigned seed, int generation) {
-  std::uint64_t z =
-      (static_cast<std::uint64_t>(seed) << 32) ^ static_cast<std::uint64_t>(generation);
-  z += 0x9E3779B97F4A7C15ULL;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-  z ^= z >> 31;
-  return static_cast<unsigned>(z & 0x7fffffffU);
+  return identify_detail::mix_seed(seed, 0, 0, generation);
 }
 
 // Shares a batch of candidates over the ranks (candidate i on rank i mod N) and each rank's over
