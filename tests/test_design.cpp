@@ -180,7 +180,8 @@ TEST(Design, ACandidateIsTheModelRecompiledWithItsValues) {
       gmasim::parse_design_quantity("retention_pct@20:70", "t"),
       gmasim::parse_design_quantity("rods_mass_kg", "t"),
       gmasim::parse_design_quantity("coil_copper_loss_W@20", "t"),
-      gmasim::parse_design_quantity("current_peak_A", "t")};
+      gmasim::parse_design_quantity("current_peak_A", "t"),
+      gmasim::parse_design_quantity("rods_volume_m3", "t")};
   const gmasim::DesignCandidate c = gmasim::evaluate_design(base, r, qs, {0.06, 5.0});
   ASSERT_FALSE(c.failed);
   gmasim::ModelSpec spec = base;
@@ -199,6 +200,8 @@ TEST(Design, ACandidateIsTheModelRecompiledWithItsValues) {
   EXPECT_NEAR(c.values[2], 9250.0 * M_PI * 0.005 * 0.005 * 0.06, 1e-12);
   EXPECT_EQ(c.values[3], gmasim::coil_copper_loss_W(m, 0.0, 5.0, 20.0));
   EXPECT_EQ(c.values[4], 5.0);
+  EXPECT_NEAR(c.values[5], M_PI * 0.005 * 0.005 * 0.06, 1e-18);  // the rod's volume [m^3]
+  EXPECT_NEAR(c.values[2] / c.values[5], 9250.0, 1e-9);          // mass = density x volume
   // The mass bound: 0.06 m gives 0.0436 kg, within 0.05 kg.
   EXPECT_EQ(c.violation, 0.0);
   const gmasim::DesignCandidate heavy = gmasim::evaluate_design(base, r, qs, {0.08, 5.0});

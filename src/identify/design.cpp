@@ -39,6 +39,7 @@ constexpr QuantityRow kQuantities[] = {
      "the band)"},
     {"first_resonance_Hz", 0, "small-signal first resonance at the reference temperature [Hz]"},
     {"rods_mass_kg", 0, "the rods' mass, derived from their geometry [kg]"},
+    {"rods_volume_m3", 0, "the rods' volume, pi (d_o^2 - d_i^2) l / 4 summed [m^3]"},
     {"coil_resistance_ohm", 0, "the coil's resistance at T_ref [ohm]"},
     {"current_peak_A", 0, "the drive's largest |current| [A]"},
 };
@@ -300,6 +301,14 @@ DesignCandidate evaluate_design(const ModelSpec& base, const DesignRequest& r,
       if (n == "rods_mass_kg") {
         v = 0.0;
         for (const auto& rod : m.rods) v += rod.mass_kg;
+      }
+      if (n == "rods_volume_m3") {
+        v = 0.0;
+        for (const auto& rod : m.rods)
+          v += 0.25 * M_PI *
+               (rod.outer_diameter_m * rod.outer_diameter_m -
+                rod.inner_diameter_m * rod.inner_diameter_m) *
+               rod.length_m;
       }
       if (n == "coil_resistance_ohm") v = m.thermal_network.coil_resistance_ohm;
       if (n == "current_peak_A")

@@ -36,21 +36,22 @@ struct DesignVariable {
 // A quantity of a candidate (design_quantity_list() names them with their units):
 //   stroke_um@T, hysteresis_um@T, B_pp_T@T   the drive's metrics at T degC (last period)
 //   retention_pct@T1:T2                      100 stroke(T2) / stroke(T1)
-//   copper_loss_W@T                          the drive's I_rms^2 R(T) (coil_copper_loss_W)
+//   coil_copper_loss_W@T                     the drive's I_rms^2 R(T) (coil_copper_loss_W)
 //   temperature_rise_K@T                     that loss over housing_to_ambient_W_per_K
 //   bandwidth_Hz, first_resonance_Hz         small-signal, at the reference temperature and
 //                                            the bias (linear_frf_markers)
-//   mass_kg                                  the rods' mass (derived from their geometry)
+//   rods_mass_kg, rods_volume_m3             the rods' mass (derived from their geometry) and
+//                                            volume
 //   coil_resistance_ohm                      at T_ref (derived from the winding when given)
 //   current_peak_A                           max |current| of the drive
 struct DesignQuantity {
   std::string name;  // "stroke_um", ...
   double T1_C = std::numeric_limits<double>::quiet_NaN();
   double T2_C = std::numeric_limits<double>::quiet_NaN();
-  std::string label() const;  // "stroke_um@20", "retention_pct@20:150", "mass_kg"
+  std::string label() const;  // "stroke_um@20", "retention_pct@20:150", "rods_mass_kg"
 };
-// Parses "stroke_um@20", "retention_pct@20:150", "mass_kg"; InputError naming `what` (the flag)
-// and the form otherwise.
+// Parses "stroke_um@20", "retention_pct@20:150", "rods_mass_kg"; InputError naming `what` (the
+// flag) and the form otherwise.
 DesignQuantity parse_design_quantity(const std::string& text, const std::string& what);
 std::string design_quantity_list();  // the names, their units and forms, for messages and help
 
@@ -64,7 +65,7 @@ struct DesignConstraint {
   bool at_most = true;  // quantity <= bound (false: >=)
   double bound = 0;
 };
-// "mass_kg<=0.1", "temperature_rise_K@70>=0"; InputError naming --constraint otherwise.
+// "rods_mass_kg<=0.1", "temperature_rise_K@70>=0"; InputError naming --constraint otherwise.
 DesignConstraint parse_design_constraint(const std::string& text);
 
 struct DesignRequest {
