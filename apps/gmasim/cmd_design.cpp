@@ -56,6 +56,7 @@ void build_request(DesignArgs& a, Communicator& comm) {
     a.req.objectives.push_back({parse_design_quantity(q, "--maximize"), true});
   for (const auto& c : a.constraints) a.req.constraints.push_back(parse_design_constraint(c));
   a.req.comm = &comm;
+  a.req.threads = threads_per_rank(a.req.threads, comm);  // 0: the cores over this node's ranks
   const ProgressFn p = stderr_progress("gmasim design: generations", a.progress);
   if (comm.rank() == 0 && p)
     a.req.progress = [p](int g, int n) {

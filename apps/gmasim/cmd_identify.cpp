@@ -209,13 +209,7 @@ int run_identify_body(IdentifyArgs& a, Communicator& comm) {
   o.profile = !a.no_profile;
   o.comm = &comm;
   o.stop = &g_stop;
-  if (o.threads < 0)  // before the default below hides it (issue 19, item 4)
-    throw InputError(fmt::format("--threads {}: must be 0 (all cores) or >= 1", o.threads));
-  if (o.threads == 0) {
-    const int local =
-        std::max(1, env_int("OMPI_COMM_WORLD_LOCAL_SIZE", comm.size() > 1 ? comm.size() : 1));
-    o.threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / local);
-  }
+  o.threads = threads_per_rank(o.threads, comm);  // before a default could hide a negative one
   if (root) {
     // Fail on an unwritable destination before hours of search, not after: a file's path that
     // is a directory too.

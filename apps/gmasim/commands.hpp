@@ -82,6 +82,9 @@ int env_int(const char* name, int fallback);  // an integer environment variable
 // directories.
 int run_on_ranks(const std::string& mpi, const std::string& command,
                  const std::function<int(Communicator&)>& body);
+// --threads on a rank: as given (>= 1), or 0: the cores over the ranks on this node
+// (OMPI_COMM_WORLD_LOCAL_SIZE). InputError for a negative count.
+int threads_per_rank(int requested, const Communicator& comm);
 std::string model_label(const std::string& path);  // "models/mdma.toml (built-in)" or path
 void print_error(const std::string& what);
 void print_warning(const std::string& what);  // "gmasim: warning: ..." on stderr

@@ -2,7 +2,9 @@
 // design, sweep --grid).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <memory>
+#include <thread>
 
 #include "commands.hpp"
 #include "gmasim/identify/identify.hpp"
@@ -18,6 +20,15 @@ void abort_ranks(Communicator& comm, int code) {
 }
 
 }  // namespace
+
+int threads_per_rank(int requested, const Communicator& comm) {
+  if (requested < 0)
+    throw InputError(fmt::format("--threads {}: must be 0 (all cores) or >= 1", requested));
+  if (requested > 0) return requested;
+  const int local =
+      std::max(1, env_int("OMPI_COMM_WORLD_LOCAL_SIZE", comm.size() > 1 ? comm.size() : 1));
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / local);
+}
 
 int run_on_ranks(const std::string& mpi, const std::string& command,
                  const std::function<int(Communicator&)>& body) {
