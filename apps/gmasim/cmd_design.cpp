@@ -83,7 +83,15 @@ int run_design_body(DesignArgs& a, Communicator& comm) {
   const bool root = comm.rank() == 0;
   const ModelSpec spec = load_model_spec_args(a.model);
   build_request(a, comm);
-  if (root) prepare_output_dir(a.out, {"design"}, model_inputs(a.model));
+  if (root) {
+    // No output may overwrite an input: the checkpoint is written too (beside the model file it
+    // must not replace, and the design's own files it must not be).
+    std::vector<FileArg> outputs =
+        files_in(a.out, {"design.csv", "design_population.csv", "design.json"}, "--out");
+    if (!a.req.checkpoint_path.empty()) outputs.push_back({a.req.checkpoint_path, "--checkpoint"});
+    require_outputs_distinct(model_inputs(a.model), outputs);
+    prepare_output_dir(a.out, {"design"}, model_inputs(a.model));
+  }
   const DesignResult res = run_design(spec, a.req);
   if (!root) return 0;
   auto files = write_report(a.out, "design", design_report(a.req, res));

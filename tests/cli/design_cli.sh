@@ -6,6 +6,7 @@ set -euo pipefail
 GMASIM="$1"
 WORK="$2"
 MPIEXEC="${3:-}"
+SRC="$(cd "$(dirname "$0")/../.." && pwd)"
 rm -rf "$WORK"
 mkdir -p "$WORK"
 cd "$WORK"
@@ -61,6 +62,10 @@ refused 2 "must be a multiple of 4" design --variable preload.force_N=950:3000 \
   --maximize stroke_um@20 --minimize rods_mass_kg --population 10
 refused 2 "expected QUANTITY<=BOUND" design --variable preload.force_N=950:3000 \
   --maximize stroke_um@20 --minimize rods_mass_kg --constraint 'rods_mass_kg<0.1'
+cp "$SRC/models/single_rod.toml" mine.toml
+refused 2 "checkpoint" design --model mine.toml --variable rod.length_m=0.03:0.08 \
+  --maximize stroke_um@20 --minimize rods_mass_kg --current-min 0 --checkpoint mine.toml
+cmp mine.toml "$SRC/models/single_rod.toml"  # the model file is untouched
 refused 1 "requires --checkpoint\|--resume requires" design --variable preload.force_N=950:3000 \
   --maximize stroke_um@20 --minimize rods_mass_kg --resume
 
